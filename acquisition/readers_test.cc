@@ -1,0 +1,125 @@
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <fstream>
+#include <nlohmann/json.hpp>
+
+#include "acquisition/scan_reader.h"
+#include "acquisition/simulate.h"
+#include "core/error.h"
+#include "core/hdf5.h"
+#include "core/testing/testing.h"
+
+namespace arcwheel::acquisition {
+namespace {
+
+using testing::TempDir;
+
+void WriteText(const std::filesystem::path& path, const std::string& text) { std::ofstream(path) << text; }
+
+const char* kSettings = "# spindle_rpm: 500\n# feed_mm_per_min: 100\n# sample_period_s: 0.001\n";
+
+// 3 turns at 500 rpm with 1 ms samples: 360 samples; the reader needs them to accept the file.
+std::string Rows(const std::string& first_rows, char separator = ',') {
+  std::string text = first_rows;
+  for (int i = 0; i < 400; ++i) text += "0.5" + std::string(1, separator) + std::to_string(0.01 + i * 0.001) + "\n";
+  return text;
+}
+
+TEST(CsvReader, FoldsAlarmWordsNanAndEmptyCellsIntoInvalidSamples) {
+  TempDir dir;
+  std::string text = std::string(kSettings) + "# wheel_id: W-17\n# note without a key\nz_mm\n0.25\n-FFFFFFF\n+FFFF\nalarm\nNaN\n\n0.125\n";
+  for (int i = 0; i < 400; ++i) text += "0.5\n";
+  WriteText(dir / "scan.csv", text);
+  const Scan scan = ReadCsvScan(dir / "scan.csv");
+  ASSERT_EQ(scan.size(), 407u);
+  EXPECT_EQ(scan.z_mm[0], 0.25);
+  for (int i = 1; i <= 5; ++i) EXPECT_TRUE(std::isnan(scan.z_mm[i])) << i;
+  EXPECT_EQ(scan.z_mm[6], 0.125);
+  EXPECT_EQ(scan.metadata.wheel_id, "W-17");
+  EXPECT_EQ(*scan.metadata.spindle_rpm, 500.0);
+  EXPECT_EQ(scan.CountValid(), 402u);
+}
+
+TEST(CsvReader, AcceptsSemicolonAndTabSeparators) {
+  TempDir dir;
+  for (const char separator : {';', '\t'}) {
+    WriteText(dir / "scan.csv", Rows(std::string(kSettings) + "z_mm" + separator + "y_mm\n", separator));
+    const Scan scan = ReadCsvScan(dir / "scan.csv");
+    EXPECT_EQ(scan.size(), 400u);
+    EXPECT_NEAR(scan.y_mm[399], 0.01 + 399 * 0.001, 1e-12);
+  }
+}
+
+TEST(CsvReader, NamesTheLineOfAValueThatDoesNotParse) {
+  TempDir dir;
+  WriteText(dir / "scan.csv", std::string(kSettings) + "z_mm,y_mm\n0.5,0.1\n0.5,0.1x\n");
+  try {
+    (void)ReadCsvScan(dir / "scan.csv");
+    FAIL();
+  } catch (const Error& e) {
+    EXPECT_EQ(e.code(), ErrorCode::kBadInput);
+    EXPECT_NE(std::string(e.what()).find("line 6"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("0.1x"), std::string::npos) << e.what();
+  }
+}
+
+TEST(Hdf5Reader, ComparesTheInvalidValueInTheFilesOwnType) {
+  TempDir dir;
+  {
+    auto file = hdf5::File::Create(dir / "scan.h5");
+    file.CreateGroup("/scan");
+    std::vector<float> z(400, 0.5f);
+    z[3] = 0.1f;  // not exactly representable: only a float comparison finds it
+    file.WriteFloats("/scan/z", z, {400});
+    file.WriteAttribute("/scan", "spindle_rpm", 500.0);
+    file.WriteAttribute("/scan", "feed_mm_per_min", 100.0);
+    file.WriteAttribute("/scan", "sample_period_s", 0.001);
+    file.WriteAttribute("/scan", "invalid_value", 0.1);
+    file.WriteAttribute("/scan", "range_max_mm", 3.0);
+  }
+  const Scan scan = ReadHdf5Scan(dir / "scan.h5");
+  EXPECT_TRUE(std::isnan(scan.z_mm[3]));
+  EXPECT_EQ(scan.CountValid(), 399u);
+}
+
+TEST(Hdf5Reader, RefusesColumnsOfDifferentLengths) {
+  TempDir dir;
+  {
+    auto file = hdf5::File::Create(dir / "scan.h5");
+    file.CreateGroup("/scan");
+    file.WriteDoubles("/scan/z", std::vector<double>(400, 0.5), {400});
+    file.WriteDoubles("/scan/t", std::vector<double>(399, 0.5), {399});
+    file.WriteAttribute("/scan", "spindle_rpm", 500.0);
+    file.WriteAttribute("/scan", "feed_mm_per_min", 100.0);
+  }
+  try {
+    (void)ReadHdf5Scan(dir / "scan.h5");
+    FAIL();
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("column 't' has 399 values but 'z' has 400"), std::string::npos) << e.what();
+  }
+}
+
+TEST(Hdf5Reader, RefusesAFileWithoutTheScanGroup) {
+  TempDir dir;
+  { auto file = hdf5::File::Create(dir / "scan.h5"); }
+  EXPECT_THROW((void)ReadHdf5Scan(dir / "scan.h5"), Error);
+}
+
+// Golden file: the shipped scan and its truth (testdata/README.md says how they were made).
+TEST(Readers, ShippedPaperScanMatchesItsTruthFile) {
+  const auto folder = testing::SourceDir() / "testdata";
+  const Scan scan = ReadScan(folder / "paper_wheel_scan.h5");
+  std::ifstream in(folder / "paper_wheel_scan.h5.truth.json");
+  const auto truth = nlohmann::json::parse(in);
+  EXPECT_EQ(scan.size(), truth["counts"]["samples"].get<std::size_t>());
+  EXPECT_EQ(scan.size() - scan.CountValid(),
+            truth["counts"]["off_rim"].get<std::size_t>() + truth["counts"]["dropouts"].get<std::size_t>());
+  EXPECT_EQ(*scan.metadata.spindle_rpm, truth["settings"]["spindle_rpm_nominal"].get<double>());
+  EXPECT_EQ(*scan.metadata.sample_period_s, truth["settings"]["sample_period_s"].get<double>());
+  EXPECT_EQ(*scan.metadata.feed_mm_per_min, truth["settings"]["feed_mm_per_min"].get<double>());
+}
+
+}  // namespace
+}  // namespace arcwheel::acquisition

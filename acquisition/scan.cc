@@ -1,0 +1,115 @@
+#include "acquisition/scan.h"
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+
+#include "core/error.h"
+
+namespace arcwheel::acquisition {
+namespace {
+
+constexpr const char* kStage = "acquisition.validate";
+
+[[noreturn]] void Refuse(const Scan& scan, const std::string& problem) {
+  throw Error(ErrorCode::kBadInput, kStage, "'" + scan.path + "': " + problem);
+}
+
+std::string Number(double value) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.9g", value);
+  return text;
+}
+
+void CheckColumn(const Scan& scan, const std::vector<double>& column, const char* name) {
+  if (column.empty()) return;
+  if (column.size() != scan.z_mm.size()) {
+    Refuse(scan, std::string("column '") + name + "' has " + std::to_string(column.size()) +
+                     " values but 'z' has " + std::to_string(scan.z_mm.size()));
+  }
+  for (size_t i = 0; i < column.size(); ++i) {
+    if (!std::isfinite(column[i])) {
+      Refuse(scan, std::string("column '") + name + "' is not finite at sample " + std::to_string(i));
+    }
+  }
+}
+
+void CheckIncreasing(const Scan& scan, const std::vector<double>& column, const char* name) {
+  for (size_t i = 1; i < column.size(); ++i) {
+    if (!(column[i] > column[i - 1])) {
+      Refuse(scan, std::string("column '") + name + "' does not increase at sample " + std::to_string(i) + " (" +
+                       Number(column[i - 1]) + " then " + Number(column[i]) + ")");
+    }
+  }
+}
+
+void CheckPositive(const Scan& scan, const std::optional<double>& value, const char* name) {
+  if (value && !(*value > 0.0 && std::isfinite(*value))) {
+    Refuse(scan, std::string(name) + " must be positive, got " + Number(*value));
+  }
+}
+
+}  // namespace
+
+size_t Scan::CountValid() const {
+  return static_cast<size_t>(std::count_if(z_mm.begin(), z_mm.end(), [](double z) { return std::isfinite(z); }));
+}
+
+void ValidateScan(const Scan& scan) {
+  const ScanMetadata& meta = scan.metadata;
+  if (scan.z_mm.empty()) Refuse(scan, "holds no samples");
+  CheckColumn(scan, scan.t_s, "t");
+  CheckColumn(scan, scan.angle_deg, "angle");
+  CheckColumn(scan, scan.y_mm, "y");
+  CheckPositive(scan, meta.spindle_rpm, "spindle_rpm");
+  CheckPositive(scan, meta.feed_mm_per_min, "feed_mm_per_min");
+  CheckPositive(scan, meta.sample_period_s, "sample_period_s");
+  if (!scan.has_encoder() && !meta.spindle_rpm) Refuse(scan, "lacks spindle_rpm (and has no angle column)");
+  if (!scan.has_time() && !meta.sample_period_s) Refuse(scan, "lacks sample_period_s (and has no t column)");
+  if (!scan.has_axial() && !meta.feed_mm_per_min) Refuse(scan, "lacks feed_mm_per_min (and has no y column)");
+  if (meta.radius_sign != 1.0 && meta.radius_sign != -1.0) {
+    Refuse(scan, "radius_sign must be +1 or -1, got " + Number(meta.radius_sign));
+  }
+  CheckIncreasing(scan, scan.t_s, "t");
+
+  const auto first = std::find_if(scan.z_mm.begin(), scan.z_mm.end(), [](double z) { return std::isfinite(z); });
+  if (first == scan.z_mm.end()) Refuse(scan, "has no valid samples");
+  const auto last = std::find_if(scan.z_mm.rbegin(), scan.z_mm.rend(), [](double z) { return std::isfinite(z); });
+  const size_t i0 = static_cast<size_t>(first - scan.z_mm.begin());
+  const size_t i1 = scan.z_mm.size() - 1 - static_cast<size_t>(last - scan.z_mm.rbegin());
+
+  const auto time_at = [&](size_t i) {
+    return scan.has_time() ? scan.t_s[i] : static_cast<double>(i) * *meta.sample_period_s;
+  };
+  const double duration_s = time_at(i1) - time_at(i0);
+  // An encoder may be wrapped; its coverage is judged after unwrapping in processing, so here
+  // only the nominal speed (when given) or the sample count can say "too short".
+  double turns = 0.0;
+  if (scan.has_encoder()) {
+    double unwrapped = 0.0;
+    for (size_t i = i0 + 1; i <= i1; ++i) {
+      double step = scan.angle_deg[i] - scan.angle_deg[i - 1];
+      if (step < -180.0) step += 360.0;
+      if (step <= 0.0) {
+        Refuse(scan, "column 'angle' does not increase at sample " + std::to_string(i) + " (" +
+                         Number(scan.angle_deg[i - 1]) + " then " + Number(scan.angle_deg[i]) + ")");
+      }
+      unwrapped += step;
+    }
+    turns = unwrapped / 360.0;
+  } else {
+    turns = *meta.spindle_rpm * duration_s / 60.0;
+  }
+  if (turns < 2.0) {
+    Refuse(scan, "its valid samples cover " + Number(turns) + " turns of the wheel; at least 2 are needed");
+  }
+  const double axial_span_mm = scan.has_axial() ? std::abs(scan.y_mm[i1] - scan.y_mm[i0])
+                                                : *meta.feed_mm_per_min * duration_s / 60.0;
+  const double pitch_mm = axial_span_mm / turns;
+  if (!(axial_span_mm >= 3.0 * pitch_mm) || !(pitch_mm > 0.0)) {
+    Refuse(scan, "its valid samples span " + Number(axial_span_mm) + " mm along the axis, under 3 helix pitches (" +
+                     Number(3.0 * pitch_mm) + " mm)");
+  }
+}
+
+}  // namespace arcwheel::acquisition

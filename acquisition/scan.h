@@ -1,0 +1,57 @@
+#pragma once
+// A raw helical wheel scan as read from disk (formats.md section 2), before any processing.
+
+#include <cstddef>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace arcwheel::acquisition {
+
+// The scan's settings and provenance: the HDF5 attributes on /scan, or the CSV's `# key: value`
+// lines. Optional fields are empty when the file does not give them.
+struct ScanMetadata {
+  std::optional<double> spindle_rpm;        // nominal spindle speed, > 0
+  std::optional<double> feed_mm_per_min;    // axial feed of the wheel past the sensor, > 0
+  std::optional<double> sample_period_s;    // time between samples, > 0
+  double radius_sign = 1.0;                 // rho = radius_sign * z; +1 or -1
+  double start_y_mm = 0.0;                  // axial position of the first sample
+  double start_phase_deg = 0.0;             // phase of the first sample (no encoder)
+  std::optional<double> invalid_value;      // z equal to this marks an invalid sample
+  std::optional<double> range_min_mm;       // z outside [range_min_mm, range_max_mm] is invalid
+  std::optional<double> range_max_mm;
+  std::optional<double> wheel_diameter_mm;
+  std::optional<double> wheel_width_mm;
+  std::string wheel_id;
+  std::string sensor;
+  std::string operator_name;
+  std::string timestamp;  // ISO 8601, as given
+};
+
+// Column-wise samples. `z_mm` always has one entry per row of the file; invalid samples are NaN
+// (the readers fold invalid_value, the range limits and alarm words into NaN). The optional
+// columns are empty when absent, else as long as z_mm.
+struct Scan {
+  std::string path;  // the file it came from, for messages and provenance
+  ScanMetadata metadata;
+  std::vector<double> z_mm;
+  std::vector<double> t_s;
+  std::vector<double> angle_deg;
+  std::vector<double> y_mm;
+
+  [[nodiscard]] std::size_t size() const { return z_mm.size(); }
+  [[nodiscard]] bool has_time() const { return !t_s.empty(); }
+  [[nodiscard]] bool has_encoder() const { return !angle_deg.empty(); }
+  [[nodiscard]] bool has_axial() const { return !y_mm.empty(); }
+  // Number of samples with a finite z.
+  [[nodiscard]] std::size_t CountValid() const;
+};
+
+// Checks everything formats.md 2.3 asks of a scan that does not need processing to see:
+// required settings present and positive, radius_sign +-1, columns of equal length, finite
+// optional columns, at least one valid sample, and phase/axial coverage of at least 2 turns
+// and 3 helix pitches (judged from the nominal settings and the valid samples' extent).
+// Throws Error{kBadInput} naming scan.path and the problem.
+void ValidateScan(const Scan& scan);
+
+}  // namespace arcwheel::acquisition

@@ -1,0 +1,138 @@
+// arcwheel process SCAN -o OUTDIR: raw helical scan -> summary.json + wheel_map.h5.
+
+#include <fmt/core.h>
+
+#include <filesystem>
+#include <string>
+
+#include "acquisition/scan_reader.h"
+#include "cli/commands.h"
+#include "core/error.h"
+#include "core/interrupt.h"
+#include "core/progress.h"
+#include "core/sha256.h"
+#include "fitting/outputs.h"
+#include "fitting/wheel_fit.h"
+#include "processing/process_scan.h"
+
+namespace arcwheel::cli {
+namespace {
+
+struct ProcessArgs {
+  std::string scan_path;
+  std::string outdir;
+  processing::ProcessOptions processing;
+  fitting::WheelFitOptions fit;
+  std::string despike_method = "median";
+  std::string rpm_source = "auto";
+  std::string fit_span = "band";
+  bool quiet = false;
+};
+
+fitting::RunRecord MakeRecord(const ProcessArgs& args, const acquisition::Scan& scan) {
+  fitting::RunRecord record;
+  record.input_path = args.scan_path;
+  record.input_sha256 = Sha256OfFile(args.scan_path);
+  const std::string extension = std::filesystem::path(args.scan_path).extension().string();
+  record.input_format = extension == ".h5" || extension == ".hdf5" ? "hdf5" : "csv";
+  record.metadata = scan.metadata;
+  record.has_encoder = scan.has_encoder();
+  const auto& p = args.processing;
+  record.numeric_parameters = {
+      {"phases", p.map.phases},
+      {"band_half_width_mm", args.fit.band_half_width_mm},
+      {"despike_window_half_width", p.despike.window_half_width},
+      {"despike_threshold_um", p.despike.threshold_um},
+      {"despike_threshold_sigmas", p.despike.threshold_sigmas},
+      {"despike_min_threshold_um", p.despike.min_threshold_um},
+      {"speed_max_harmonic", p.speed.max_harmonic},
+      {"speed_significance_sigmas", p.speed.significance_sigmas},
+      {"map_min_support", p.map.min_support},
+      {"fit_min_points", args.fit.min_points},
+      {"fit_min_band_coverage", args.fit.min_band_coverage},
+      {"runout_min_phase_coverage", args.fit.min_phase_coverage},
+      {"beam_offset_mm", p.beam_offset_mm},
+      {"wheel_radius_mm", p.wheel_radius_mm},
+  };
+  record.text_parameters = {{"despike_method", args.despike_method},
+                            {"rpm_source", args.rpm_source},
+                            {"fit_span", args.fit_span},
+                            {"filter", "none"}};
+  return record;
+}
+
+void PrintHeadline(const ProcessArgs& args, const processing::ProcessedScan& p, const fitting::WheelFit& f) {
+  const std::filesystem::path out(args.outdir);
+  fmt::print("summary: {}\nmap:     {}\n", (out / "summary.json").string(), (out / "wheel_map.h5").string());
+  fmt::print("samples {} (valid {}, despiked {}); noise {:.3f} um; spindle {:.4f} rpm ({})\n", p.samples,
+             p.valid_samples, p.despike.rejected, p.noise_sigma_mm * 1000.0, p.rpm_used,
+             p.phase_source == processing::PhaseSource::kEncoder     ? "encoder"
+             : p.phase_source == processing::PhaseSource::kEstimated ? "estimated from the data"
+                                                                     : "nominal");
+  fmt::print("mean arc radius      {:.5f} +- {:.5f} mm (1 sigma), {} of {} phases usable\n", f.mean_arc_radius_mm,
+             f.mean_arc_radius_sigma_mm, f.usable_phases, f.phases.size());
+  fmt::print("arc radius range     {:.5f} mm ({:.3f} %); real spread beyond noise {:.5f} mm\n", f.arc_radius_range_mm,
+             f.arc_radius_fluctuation_pct, f.arc_radius_excess_std_mm);
+  fmt::print("arc centre axial     {:.5f} mm, deviation {:.5f} mm\n", f.mean_center_axial_mm, f.center_axial_deviation_mm);
+  fmt::print("max arc error        {:.3f} um in the band [{:.3f}, {:.3f}] mm\n", f.max_arc_error_um, f.band_low_mm,
+             f.band_high_mm);
+  fmt::print("max runout           {:.3f} um (wheel + spindle error motion)\n", f.max_runout_um);
+  fmt::print("max roundness        {:.3f} um\n", f.max_roundness_um);
+}
+
+void Run(ProcessArgs& args) {
+  args.processing.despike.method = processing::ParseDespikeMethod(args.despike_method);
+  args.processing.rpm_source = processing::ParseRpmSource(args.rpm_source);
+  args.fit.fit_span = fitting::ParseFitSpan(args.fit_span);
+  Progress progress(!args.quiet);
+  progress.Update("reading", 0.0);
+  const acquisition::Scan scan = acquisition::ReadScan(args.scan_path);
+  ThrowIfInterrupted();
+  progress.Update("processing", 0.3);
+  const processing::ProcessedScan processed = processing::ProcessScan(scan, args.processing);
+  progress.Update("fitting", 0.7);
+  const fitting::WheelFit fit = fitting::FitWheel(processed.map, args.fit);
+  progress.Update("writing", 0.9);
+  const fitting::RunRecord record = MakeRecord(args, scan);
+  ThrowIfInterrupted();
+  fitting::WriteProcessOutputs(args.outdir, record, processed, fit);
+  progress.Done();
+  if (!args.quiet) PrintHeadline(args, processed, fit);
+}
+
+}  // namespace
+
+void AddProcessCommand(CLI::App& app) {
+  auto args = std::make_shared<ProcessArgs>();
+  CLI::App* cmd = app.add_subcommand("process", "turn a raw helical wheel scan into summary.json and wheel_map.h5");
+  cmd->footer(
+      "Steps: trim invalid ends; estimate the noise; despike; unwrap the helix (encoder, or the\n"
+      "spindle speed estimated from the data when it differs significantly from nominal); fit a\n"
+      "least-squares cubic spline along the helix; sample it at every phase on every turn; fit a\n"
+      "circle to each phase's section inside the band (Ceres, with 1-sigma uncertainties); map the\n"
+      "sections onto a regular (phase, axial) grid for runout and roundness.\n"
+      "Runout is the wheel's plus the spindle's error motion: one sensor cannot separate them.\n"
+      "Outputs are written under temporary names and renamed when complete.");
+  cmd->add_option("SCAN", args->scan_path, "raw scan, .h5/.hdf5 or .csv/.txt (formats.md section 2)")
+      ->required()
+      ->check(CLI::ExistingFile);
+  cmd->add_option("-o,--output", args->outdir, "output folder")->required();
+  auto& p = args->processing;
+  cmd->add_option("--phases", p.map.phases, "phase nodes per turn")->capture_default_str();
+  cmd->add_option("--band-half-width-mm", args->fit.band_half_width_mm, "half width of the grinding band")->capture_default_str();
+  cmd->add_option("--fit-span", args->fit_span, "band: fit inside the band; full: the whole rim")->capture_default_str();
+  cmd->add_option("--axial-step-mm", p.map.axial_step_mm, "map node spacing (default one helix pitch)");
+  cmd->add_option("--knot-step-deg", p.map.knot_step_deg, "helix spline knot spacing (default 360/phases)");
+  cmd->add_option("--despike", args->despike_method, "median (burst-safe), moving-mean (the paper's), none")->capture_default_str();
+  cmd->add_option("--despike-window", p.despike.window_half_width, "window half-width, samples")->capture_default_str();
+  cmd->add_option("--despike-threshold-um", p.despike.threshold_um, "rejection threshold (default: sigmas x noise)");
+  cmd->add_option("--despike-sigmas", p.despike.threshold_sigmas, "automatic threshold in noise sigmas")->capture_default_str();
+  cmd->add_option("--rpm-source", args->rpm_source, "auto, nominal, encoder or estimate")->capture_default_str();
+  cmd->add_option("--beam-offset-mm", p.beam_offset_mm, "correct a beam offset from the axis (method.md A.7)")->capture_default_str();
+  cmd->add_option("--wheel-radius-mm", p.wheel_radius_mm, "wheel radius for the beam-offset correction");
+  cmd->add_option("--min-points", args->fit.min_points, "fewest section points for a usable phase")->capture_default_str();
+  cmd->add_flag("-q,--quiet", args->quiet, "no progress and no headline");
+  cmd->callback([args] { Run(*args); });
+}
+
+}  // namespace arcwheel::cli

@@ -1,0 +1,13 @@
+#pragma once
+// One Add*Command per command, each in its own command_<name>.cc. A command's callback does
+// its work and throws arcwheel::Error on failure; main() maps the error to the exit status.
+
+#include <CLI/CLI.hpp>
+
+namespace arcwheel::cli {
+
+void AddSimulateCommand(CLI::App& app);
+void AddProcessCommand(CLI::App& app);
+void AddFitCommand(CLI::App& app);
+
+}  // namespace arcwheel::cli

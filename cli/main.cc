@@ -1,0 +1,81 @@
+// arcwheel: one binary, one subcommand per job. main() is the only catch-all.
+
+#include <CLI/CLI.hpp>
+#include <fmt/core.h>
+
+#include <cstdio>
+#include <exception>
+#include <string>
+#include <vector>
+
+#include "cli/commands.h"
+#include "core/error.h"
+#include "core/interrupt.h"
+#include "core/version.h"
+
+namespace {
+
+using arcwheel::ErrorCode;
+
+struct Command {
+  const char* name;
+  void (*add)(CLI::App&);
+};
+
+// The command table: add a row here and a command_<name>.cc beside this file.
+const std::vector<Command> kCommands = {
+    {"simulate", arcwheel::cli::AddSimulateCommand},
+    {"process", arcwheel::cli::AddProcessCommand},
+    {"fit", arcwheel::cli::AddFitCommand},
+};
+
+constexpr const char* kExitCodes =
+    "Exit status: 0 ok; 1 unknown command or usage; 2 invalid option; 3 bad input file;\n"
+    "4 I/O failure (cannot read, write or rename); 5 no usable fit; 70 internal error;\n"
+    "130 interrupted (SIGINT/SIGTERM). A failed run leaves no new or partial output file.";
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"arcwheel: metrology and toolpaths for arc-profile diamond wheels", "arcwheel"};
+  app.footer(kExitCodes);
+  app.require_subcommand(1);
+  bool no_catch = false;
+  app.add_flag("--no-catch", no_catch, "let errors escape main() so that a debugger stops at the throw");
+  app.set_version_flag("--version", std::string("arcwheel ") + arcwheel::kVersion);
+  for (const Command& command : kCommands) command.add(app);
+  app.add_subcommand("version", "print the arcwheel version")->callback([] {
+    fmt::print("arcwheel {}\n", arcwheel::kVersion);
+  });
+  app.add_subcommand("help", "list the commands; `arcwheel COMMAND --help` for one")->callback([&app] {
+    fmt::print("{}", app.help());
+  });
+  arcwheel::InstallInterruptHandlers();
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::CallForHelp&) {
+    fmt::print("{}", app.help());
+    return 0;
+  } catch (const CLI::CallForAllHelp&) {
+    fmt::print("{}", app.help("", CLI::AppFormatMode::All));
+    return 0;
+  } catch (const CLI::Success& success) {
+    return app.exit(success);
+  } catch (const CLI::ParseError& error) {
+    const bool unknown_command = app.get_subcommands().empty();
+    fmt::print(stderr, "arcwheel: {}\n", error.what());
+    fmt::print(stderr, "{}\n", unknown_command ? "run `arcwheel help` for the list of commands"
+                                              : "run `arcwheel COMMAND --help` for its options");
+    return unknown_command ? 1 : arcwheel::ExitStatus(ErrorCode::kInvalidOption);
+  } catch (const arcwheel::Error& error) {
+    if (no_catch) throw;
+    fmt::print(stderr, "arcwheel: {}: {}\n", arcwheel::ErrorCodeName(error.code()), error.what());
+    return arcwheel::ExitStatus(error.code());
+  } catch (const std::exception& error) {
+    if (no_catch) throw;
+    fmt::print(stderr, "arcwheel: internal error: {}\n", error.what());
+    return arcwheel::ExitStatus(ErrorCode::kInternal);
+  }
+  return 0;
+}

@@ -1,0 +1,48 @@
+# arcwheel_add_library(NAME n SRCS ... DEPS ...): target arcwheel_<n>, alias arcwheel::<n>.
+# arcwheel_add_test(NAME n SRCS ... DEPS ...): a GoogleTest binary registered with CTest as <folder>/<n>.
+# arcwheel_add_benchmark(NAME n SRCS ... DEPS ...): a Google Benchmark binary.
+
+set(ARCWHEEL_WARNINGS -Wall -Wextra -Wpedantic -Wshadow -Wconversion -Wno-sign-conversion)
+if(ARCWHEEL_WERROR)
+  list(APPEND ARCWHEEL_WARNINGS -Werror)
+endif()
+if(ARCWHEEL_SANITIZE)
+  string(REPLACE ";" "," _arcwheel_sanitizers "${ARCWHEEL_SANITIZE}")
+  add_compile_options(-fsanitize=${_arcwheel_sanitizers} -fno-omit-frame-pointer -fno-sanitize-recover=undefined)
+  add_link_options(-fsanitize=${_arcwheel_sanitizers})
+endif()
+
+function(arcwheel_add_library)
+  cmake_parse_arguments(ARG "" "NAME" "SRCS;DEPS" ${ARGN})
+  add_library(arcwheel_${ARG_NAME} STATIC ${ARG_SRCS})
+  add_library(arcwheel::${ARG_NAME} ALIAS arcwheel_${ARG_NAME})
+  target_include_directories(arcwheel_${ARG_NAME} PUBLIC ${PROJECT_SOURCE_DIR} ${PROJECT_BINARY_DIR}/generated)
+  target_link_libraries(arcwheel_${ARG_NAME} PUBLIC ${ARG_DEPS})
+  target_compile_options(arcwheel_${ARG_NAME} PRIVATE ${ARCWHEEL_WARNINGS})
+endfunction()
+
+function(arcwheel_add_test)
+  if(NOT ARCWHEEL_BUILD_TESTS)
+    return()
+  endif()
+  cmake_parse_arguments(ARG "" "NAME" "SRCS;DEPS" ${ARGN})
+  get_filename_component(_folder ${CMAKE_CURRENT_SOURCE_DIR} NAME)
+  set(_target ${_folder}_${ARG_NAME})
+  add_executable(${_target} ${ARG_SRCS})
+  target_link_libraries(${_target} PRIVATE ${ARG_DEPS} arcwheel::testing GTest::gtest GTest::gmock)
+  target_compile_options(${_target} PRIVATE ${ARCWHEEL_WARNINGS})
+  add_test(NAME ${_folder}/${ARG_NAME} COMMAND ${_target}
+           WORKING_DIRECTORY ${PROJECT_SOURCE_DIR})
+  set_tests_properties(${_folder}/${ARG_NAME} PROPERTIES
+                       ENVIRONMENT "ARCWHEEL_SOURCE_DIR=${PROJECT_SOURCE_DIR};ARCWHEEL_BINARY=$<TARGET_FILE:arcwheel>")
+endfunction()
+
+function(arcwheel_add_benchmark)
+  if(NOT ARCWHEEL_BUILD_BENCHMARKS)
+    return()
+  endif()
+  cmake_parse_arguments(ARG "" "NAME" "SRCS;DEPS" ${ARGN})
+  add_executable(${ARG_NAME} ${ARG_SRCS})
+  target_link_libraries(${ARG_NAME} PRIVATE ${ARG_DEPS} benchmark::benchmark)
+  target_compile_options(${ARG_NAME} PRIVATE ${ARCWHEEL_WARNINGS})
+endfunction()

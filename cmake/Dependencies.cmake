@@ -1,0 +1,28 @@
+# Every third-party package arcwheel uses, all from Debian (scripts/install_deps.sh installs them).
+find_package(Eigen3 3.3 REQUIRED NO_MODULE)
+find_package(Ceres REQUIRED)
+find_package(HDF5 REQUIRED COMPONENTS C)
+find_package(nlohmann_json 3.10 REQUIRED)
+find_package(CLI11 REQUIRED)
+find_package(fmt REQUIRED)
+find_package(OpenSSL REQUIRED COMPONENTS Crypto)
+find_package(Threads REQUIRED)
+if(ARCWHEEL_BUILD_TESTS)
+  find_package(GTest REQUIRED)
+endif()
+if(ARCWHEEL_BUILD_BENCHMARKS)
+  find_package(benchmark REQUIRED)
+endif()
+
+# HDF5's CMake module exposes variables, not a target: wrap them once here.
+if(NOT TARGET arcwheel_hdf5)
+  add_library(arcwheel_hdf5 INTERFACE)
+  target_include_directories(arcwheel_hdf5 SYSTEM INTERFACE ${HDF5_C_INCLUDE_DIRS} ${HDF5_INCLUDE_DIRS})
+  target_link_libraries(arcwheel_hdf5 INTERFACE ${HDF5_C_LIBRARIES})
+  target_compile_definitions(arcwheel_hdf5 INTERFACE ${HDF5_C_DEFINITIONS} ${HDF5_DEFINITIONS})
+  add_library(arcwheel::hdf5 ALIAS arcwheel_hdf5)
+endif()
+
+# cairo draws the report plots to SVG, PNG and PDF from one drawing code (reports/).
+find_package(PkgConfig REQUIRED)
+pkg_check_modules(CAIRO REQUIRED IMPORTED_TARGET cairo)

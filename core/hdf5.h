@@ -1,0 +1,80 @@
+#pragma once
+// A thin RAII layer over the HDF5 C API: just what arcwheel's readers and writers need.
+// Every failure throws Error naming the file and the object; HDF5's own error stack printing
+// is switched off so that the user sees one clear message.
+
+#include <hdf5.h>
+
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace arcwheel::hdf5 {
+
+// Owns one hid_t and closes it with the matching H5*close.
+class Handle {
+ public:
+  using Closer = herr_t (*)(hid_t);
+  Handle() = default;
+  Handle(hid_t id, Closer closer) : id_(id), closer_(closer) {}
+  Handle(Handle&& other) noexcept : id_(other.id_), closer_(other.closer_) { other.id_ = -1; }
+  Handle& operator=(Handle&& other) noexcept;
+  Handle(const Handle&) = delete;
+  Handle& operator=(const Handle&) = delete;
+  ~Handle();
+  [[nodiscard]] hid_t id() const { return id_; }
+  [[nodiscard]] bool valid() const { return id_ >= 0; }
+
+ private:
+  hid_t id_ = -1;
+  Closer closer_ = nullptr;
+};
+
+class File {
+ public:
+  // Opens read-only. Throws Error{kBadInput} if the file is not HDF5 or is damaged.
+  static File OpenReadOnly(const std::filesystem::path& path);
+  // Creates (truncating) for writing. Throws Error{kIo}.
+  static File Create(const std::filesystem::path& path);
+
+  [[nodiscard]] bool HasObject(const std::string& name) const;
+  void CreateGroup(const std::string& name);
+
+  // Dataset shape; empty for a scalar.
+  [[nodiscard]] std::vector<hsize_t> Shape(const std::string& dataset) const;
+  // Class and size in bytes of the stored element type.
+  [[nodiscard]] H5T_class_t ElementClass(const std::string& dataset) const;
+  [[nodiscard]] size_t ElementSize(const std::string& dataset) const;
+  // Reads any numeric dataset converted to double (HDF5 converts in place, no second copy).
+  [[nodiscard]] std::vector<double> ReadDoubles(const std::string& dataset) const;
+  // Reads a numeric dataset as float (for float32 data that need no widening).
+  [[nodiscard]] std::vector<float> ReadFloats(const std::string& dataset) const;
+  void WriteDoubles(const std::string& dataset, const std::vector<double>& values,
+                    const std::vector<hsize_t>& shape);
+  void WriteFloats(const std::string& dataset, const std::vector<float>& values,
+                   const std::vector<hsize_t>& shape);
+  void WriteInts(const std::string& dataset, const std::vector<int>& values,
+                 const std::vector<hsize_t>& shape);
+
+  // Attributes on an object ("/" or a group or dataset path).
+  [[nodiscard]] bool HasAttribute(const std::string& object, const std::string& name) const;
+  [[nodiscard]] std::optional<double> ReadAttributeDouble(const std::string& object,
+                                                          const std::string& name) const;
+  [[nodiscard]] std::optional<std::string> ReadAttributeString(const std::string& object,
+                                                               const std::string& name) const;
+  void WriteAttribute(const std::string& object, const std::string& name, double value);
+  void WriteAttribute(const std::string& object, const std::string& name, const std::string& value);
+
+  [[nodiscard]] const std::filesystem::path& path() const { return path_; }
+
+ private:
+  File(Handle handle, std::filesystem::path path) : handle_(std::move(handle)), path_(std::move(path)) {}
+  [[nodiscard]] Handle OpenDataset(const std::string& dataset) const;
+  [[nodiscard]] std::string Where(const std::string& object) const;
+
+  Handle handle_;
+  std::filesystem::path path_;
+};
+
+}  // namespace arcwheel::hdf5

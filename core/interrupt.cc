@@ -1,0 +1,27 @@
+#include "core/interrupt.h"
+
+#include <csignal>
+
+#include "core/error.h"
+
+namespace arcwheel {
+namespace {
+
+volatile std::sig_atomic_t g_interrupted = 0;
+
+extern "C" void OnSignal(int /*signal*/) { g_interrupted = 1; }
+
+}  // namespace
+
+void InstallInterruptHandlers() {
+  std::signal(SIGINT, OnSignal);
+  std::signal(SIGTERM, OnSignal);
+}
+
+bool InterruptRequested() noexcept { return g_interrupted != 0; }
+
+void ThrowIfInterrupted() {
+  if (g_interrupted != 0) throw Error(ErrorCode::kInterrupted, "arcwheel", "interrupted by a signal");
+}
+
+}  // namespace arcwheel

@@ -1,0 +1,58 @@
+#include "core/testing/testing.h"
+
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <array>
+#include <cstdio>
+#include <cstdlib>
+#include <random>
+#include <stdexcept>
+#include <vector>
+
+namespace arcwheel::testing {
+namespace fs = std::filesystem;
+
+TempDir::TempDir() {
+  std::random_device device;
+  path_ = fs::temp_directory_path() /
+          ("arcwheel-test-" + std::to_string(::getpid()) + "-" + std::to_string(device()));
+  fs::create_directories(path_);
+}
+
+TempDir::~TempDir() {
+  std::error_code ignored;
+  fs::remove_all(path_, ignored);
+}
+
+fs::path SourceDir() {
+  if (const char* dir = std::getenv("ARCWHEEL_SOURCE_DIR")) return dir;
+  return fs::current_path();
+}
+
+CommandResult RunArcwheel(const std::string& arguments) {
+  const char* binary = std::getenv("ARCWHEEL_BINARY");
+  if (binary == nullptr) throw std::runtime_error("ARCWHEEL_BINARY is not set (run the tests through ctest)");
+  const std::string command = std::string(binary) + " " + arguments + " 2>&1";
+  FILE* pipe = ::popen(command.c_str(), "r");
+  if (pipe == nullptr) throw std::runtime_error("cannot run " + command);
+  CommandResult result;
+  std::array<char, 4096> buffer{};
+  size_t read = 0;
+  while ((read = std::fread(buffer.data(), 1, buffer.size(), pipe)) > 0) result.output.append(buffer.data(), read);
+  const int status = ::pclose(pipe);
+  result.exit_status = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  return result;
+}
+
+std::string ListFolder(const fs::path& folder) {
+  std::vector<std::string> names;
+  for (const auto& entry : fs::directory_iterator(folder)) names.push_back(entry.path().filename().string());
+  std::sort(names.begin(), names.end());
+  std::string listing;
+  for (const auto& name : names) listing += name + "\n";
+  return listing;
+}
+
+}  // namespace arcwheel::testing

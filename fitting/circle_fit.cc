@@ -1,0 +1,228 @@
+#include "fitting/circle_fit.h"
+
+#include <ceres/ceres.h>
+
+#include <Eigen/Dense>
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
+namespace arcwheel::fitting {
+namespace {
+
+// All n residuals in one block: r_i = w_i (|p_i - c| - r), analytic Jacobian.
+class CircleResiduals final : public ceres::CostFunction {
+ public:
+  CircleResiduals(const std::vector<double>& x, const std::vector<double>& y, const std::vector<double>& w)
+      : x_(x), y_(y), w_(w) {
+    set_num_residuals(static_cast<int>(x.size()));
+    mutable_parameter_block_sizes()->push_back(3);
+  }
+
+  bool Evaluate(double const* const* parameters, double* residuals, double** jacobians) const override {
+    const double a = parameters[0][0];
+    const double b = parameters[0][1];
+    const double r = parameters[0][2];
+    for (std::size_t i = 0; i < x_.size(); ++i) {
+      const double dx = x_[i] - a;
+      const double dy = y_[i] - b;
+      const double d = std::hypot(dx, dy);
+      residuals[i] = w_[i] * (d - r);
+      if (jacobians != nullptr && jacobians[0] != nullptr) {
+        double* row = jacobians[0] + 3 * i;
+        const double inv = d > 0 ? 1.0 / d : 0.0;
+        row[0] = -w_[i] * dx * inv;
+        row[1] = -w_[i] * dy * inv;
+        row[2] = -w_[i];
+      }
+    }
+    return true;
+  }
+
+ private:
+  const std::vector<double>& x_;
+  const std::vector<double>& y_;
+  const std::vector<double>& w_;
+};
+
+// Kasa 1976 algebraic fit: only the initial guess for Ceres.
+bool AlgebraicCircle(const std::vector<double>& x, const std::vector<double>& y, const std::vector<double>& w,
+                     double guess[3]) {
+  const auto n = static_cast<Eigen::Index>(x.size());
+  Eigen::MatrixXd design(n, 3);
+  Eigen::VectorXd rhs(n);
+  for (Eigen::Index i = 0; i < n; ++i) {
+    const auto k = static_cast<std::size_t>(i);
+    design(i, 0) = w[k] * x[k];
+    design(i, 1) = w[k] * y[k];
+    design(i, 2) = w[k];
+    rhs(i) = -w[k] * (x[k] * x[k] + y[k] * y[k]);
+  }
+  const Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(design);
+  if (qr.rank() < 3) return false;
+  const Eigen::Vector3d p = qr.solve(rhs);
+  guess[0] = -p(0) / 2.0;
+  guess[1] = -p(1) / 2.0;
+  const double r2 = guess[0] * guess[0] + guess[1] * guess[1] - p(2);
+  if (!(r2 > 0)) return false;
+  guess[2] = std::sqrt(r2);
+  return true;
+}
+
+double WeightedCost(const std::vector<double>& x, const std::vector<double>& y, const std::vector<double>& w,
+                    const double p[3]) {
+  double cost = 0.0;
+  for (std::size_t i = 0; i < x.size(); ++i) {
+    const double r = w[i] * (std::hypot(x[i] - p[0], y[i] - p[1]) - p[2]);
+    cost += r * r;
+  }
+  return cost;
+}
+
+// Levenberg-Marquardt's damping makes its last steps short along the flat direction of a short
+// arc; a few undamped Gauss-Newton steps from its answer reach the minimum to rounding.
+void PolishByGaussNewton(const std::vector<double>& x, const std::vector<double>& y, const std::vector<double>& w,
+                         double p[3]) {
+  const auto n = static_cast<Eigen::Index>(x.size());
+  double cost = WeightedCost(x, y, w, p);
+  for (int iteration = 0; iteration < 5; ++iteration) {
+    Eigen::MatrixXd jacobian(n, 3);
+    Eigen::VectorXd residual(n);
+    for (Eigen::Index i = 0; i < n; ++i) {
+      const auto k = static_cast<std::size_t>(i);
+      const double dx = x[k] - p[0];
+      const double dy = y[k] - p[1];
+      const double d = std::hypot(dx, dy);
+      residual(i) = w[k] * (d - p[2]);
+      jacobian(i, 0) = -w[k] * dx / d;
+      jacobian(i, 1) = -w[k] * dy / d;
+      jacobian(i, 2) = -w[k];
+    }
+    const Eigen::Vector3d step = jacobian.colPivHouseholderQr().solve(-residual);
+    const double trial[3] = {p[0] + step(0), p[1] + step(1), p[2] + step(2)};
+    const double trial_cost = WeightedCost(x, y, w, trial);
+    if (!(trial_cost <= cost)) break;
+    std::copy(trial, trial + 3, p);
+    cost = trial_cost;
+    if (step.norm() < 1e-15) break;
+  }
+}
+
+}  // namespace
+
+CircleFit FitCircle(std::span<const double> x_in, std::span<const double> y_in, std::span<const double> weights,
+                    const CircleFitOptions& options) {
+  CircleFit fit;
+  const std::size_t n = x_in.size();
+  fit.n = static_cast<int>(n);
+  if (n < 3 || y_in.size() != n || (!weights.empty() && weights.size() != n)) {
+    fit.status = FitStatus::kDegenerate;
+    fit.message = "a circle needs at least 3 points (and as many weights)";
+    return fit;
+  }
+  // Centre on the centroid and scale to unit rms spread: the fit then works on O(1) numbers.
+  double cx = 0, cy = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    cx += x_in[i];
+    cy += y_in[i];
+  }
+  cx /= static_cast<double>(n);
+  cy /= static_cast<double>(n);
+  double spread = 0;
+  for (std::size_t i = 0; i < n; ++i) spread += (x_in[i] - cx) * (x_in[i] - cx) + (y_in[i] - cy) * (y_in[i] - cy);
+  const double scale = std::sqrt(spread / static_cast<double>(n));
+  if (!(scale > 0)) {
+    fit.status = FitStatus::kDegenerate;
+    fit.message = "all points coincide";
+    return fit;
+  }
+  std::vector<double> x(n), y(n), w(n, 1.0);
+  for (std::size_t i = 0; i < n; ++i) {
+    x[i] = (x_in[i] - cx) / scale;
+    y[i] = (y_in[i] - cy) / scale;
+    if (!weights.empty()) w[i] = weights[i];
+  }
+  double p[3];
+  if (!AlgebraicCircle(x, y, w, p)) {
+    fit.status = FitStatus::kDegenerate;
+    fit.message = "the points are collinear: no circle is determined";
+    return fit;
+  }
+
+  ceres::Problem::Options problem_options;
+  problem_options.cost_function_ownership = ceres::TAKE_OWNERSHIP;
+  ceres::Problem problem(problem_options);
+  problem.AddResidualBlock(new CircleResiduals(x, y, w), nullptr, p);
+  ceres::Solver::Options solver_options;
+  solver_options.linear_solver_type = ceres::DENSE_QR;
+  solver_options.max_num_iterations = options.max_iterations;
+  solver_options.function_tolerance = 1e-16;
+  solver_options.gradient_tolerance = 1e-16;
+  solver_options.parameter_tolerance = 1e-15;
+  solver_options.logging_type = ceres::SILENT;
+  ceres::Solver::Summary summary;
+  ceres::Solve(solver_options, &problem, &summary);
+  fit.iterations = static_cast<int>(summary.iterations.size());
+  PolishByGaussNewton(x, y, w, p);
+
+  // Jacobian at the solution (unscaled units follow from the chain rule: a, b, r scale with `scale`).
+  Eigen::MatrixXd jacobian(static_cast<Eigen::Index>(n), 3);
+  double rss_weighted = 0.0, rss = 0.0, low = 0.0, high = 0.0;
+  for (std::size_t i = 0; i < n; ++i) {
+    const double dx = x[i] - p[0];
+    const double dy = y[i] - p[1];
+    const double d = std::hypot(dx, dy);
+    const double residual_mm = (d - p[2]) * scale;
+    const auto row = static_cast<Eigen::Index>(i);
+    jacobian(row, 0) = -w[i] * dx / d;
+    jacobian(row, 1) = -w[i] * dy / d;
+    jacobian(row, 2) = -w[i];
+    rss_weighted += w[i] * w[i] * residual_mm * residual_mm;
+    rss += residual_mm * residual_mm;
+    low = i == 0 ? residual_mm : std::min(low, residual_mm);
+    high = i == 0 ? residual_mm : std::max(high, residual_mm);
+  }
+  // How the solution moves when the points move along y (the sensor's direction), to first order:
+  // dp = -(J^T J)^-1 J^T diag(w_i dy_i / d_i) dy.
+  Eigen::VectorXd along_y(static_cast<Eigen::Index>(n));
+  for (std::size_t i = 0; i < n; ++i) {
+    along_y(static_cast<Eigen::Index>(i)) = w[i] * (y[i] - p[1]) / std::hypot(x[i] - p[0], y[i] - p[1]);
+  }
+  const Eigen::Matrix3d normal = jacobian.transpose() * jacobian;
+  fit.sensitivity_to_y = -normal.ldlt().solve(jacobian.transpose() * along_y.asDiagonal());
+  fit.center_mm = {cx + p[0] * scale, cy + p[1] * scale};
+  fit.radius_mm = p[2] * scale;
+  fit.rms_residual_mm = std::sqrt(rss / static_cast<double>(n));
+  fit.pv_residual_mm = high - low;
+  fit.chi2 = rss_weighted;
+
+  ceres::Covariance::Options covariance_options;
+  covariance_options.algorithm_type = ceres::DENSE_SVD;
+  covariance_options.min_reciprocal_condition_number = 1e-14;
+  covariance_options.null_space_rank = 0;
+  ceres::Covariance covariance(covariance_options);
+  const std::vector<std::pair<const double*, const double*>> blocks = {{p, p}};
+  double scaled[9];
+  if (!covariance.Compute(blocks, &problem) || !covariance.GetCovarianceBlock(p, p, scaled)) {
+    fit.status = FitStatus::kDegenerate;
+    fit.message = "the points do not determine the circle (ill-conditioned)";
+    return fit;
+  }
+  // Scaling by `scale` leaves the Jacobian unchanged (d(r/scale)/d(p/scale) = dr/dp), so Ceres'
+  // (J^T J)^-1 is already the covariance in mm^2 for residuals of unit variance: exact when the
+  // weights are 1/sigma, else scaled by the residual variance.
+  fit.covariance = Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(scaled);
+  if (!options.weights_are_inverse_sigmas) {
+    fit.covariance *= n > 3 ? rss_weighted / static_cast<double>(n - 3) : 0.0;
+  }
+  if (summary.termination_type == ceres::CONVERGENCE || summary.termination_type == ceres::USER_SUCCESS) {
+    fit.status = FitStatus::kConverged;
+    fit.message = "converged";
+  } else {
+    fit.status = FitStatus::kNoConvergence;
+    fit.message = "did not converge: " + summary.message;
+  }
+  return fit;
+}
+
+}  // namespace arcwheel::fitting

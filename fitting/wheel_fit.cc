@@ -1,0 +1,282 @@
+#include "fitting/wheel_fit.h"
+
+#include <Eigen/Dense>
+#include <algorithm>
+#include <cmath>
+#include <fmt/core.h>
+#include <limits>
+#include <numbers>
+#include <numeric>
+#include <utility>
+
+#include "core/error.h"
+#include "core/interrupt.h"
+#include "fitting/circle_fit.h"
+
+namespace arcwheel::fitting {
+namespace {
+
+constexpr const char* kStage = "fitting";
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+struct PhaseSolution {
+  PhaseFit fit;
+  CircleFit circle;
+  std::vector<double> u_deg;  // helix points used, for propagation
+};
+
+// Fits the section's points with |y - center| <= half (all points for FitSpan::kFull).
+PhaseSolution FitSection(const processing::Section& section, double center_mm, double half_mm, bool full,
+                         const WheelFitOptions& options) {
+  PhaseSolution out;
+  std::vector<double> y, rho, sigma;
+  for (std::size_t k = 0; k < section.y_mm.size(); ++k) {
+    if (!full && std::abs(section.y_mm[k] - center_mm) > half_mm) continue;
+    y.push_back(section.y_mm[k]);
+    rho.push_back(section.rho_mm[k]);
+    sigma.push_back(section.sigma_mm[k]);
+    out.u_deg.push_back(section.u_deg[k]);
+  }
+  PhaseFit& fit = out.fit;
+  fit.points = static_cast<int>(y.size());
+  if (fit.points < options.min_points) {
+    fit.flag = fmt::format("too few points in the band ({})", fit.points);
+    return out;
+  }
+  const double extent = y.back() - y.front();
+  if (!full && extent < options.min_band_coverage * 2.0 * half_mm) {
+    fit.flag = fmt::format("the section covers {:.3g} mm of the {:.3g} mm band", extent, 2.0 * half_mm);
+    return out;
+  }
+  // The section's circle is the unweighted geometric least-squares circle (formats.md 3.1). Its
+  // covariance follows from the points' own sigmas (noise along rho, independent between turns)
+  // through the fit's first-order sensitivity: C = S diag(sigma^2) S^T.
+  out.circle = FitCircle(y, rho, {}, {});
+  if (out.circle.IsUsable() && std::all_of(sigma.begin(), sigma.end(), [](double s) { return s > 0; })) {
+    Eigen::VectorXd variance(static_cast<Eigen::Index>(sigma.size()));
+    for (std::size_t k = 0; k < sigma.size(); ++k) variance(static_cast<Eigen::Index>(k)) = sigma[k] * sigma[k];
+    out.circle.covariance = out.circle.sensitivity_to_y * variance.asDiagonal() * out.circle.sensitivity_to_y.transpose();
+    double chi2 = 0.0;
+    for (std::size_t k = 0; k < y.size(); ++k) {
+      const double e = std::hypot(y[k] - out.circle.center_mm.x(), rho[k] - out.circle.center_mm.y()) - out.circle.radius_mm;
+      chi2 += e * e / variance(static_cast<Eigen::Index>(k));
+    }
+    out.circle.chi2 = chi2;
+  }
+  const CircleFit& c = out.circle;
+  if (!c.IsUsable()) {
+    fit.flag = c.message;
+    return out;
+  }
+  fit.center_axial_mm = c.center_mm.x();
+  fit.center_radial_mm = c.center_mm.y();
+  fit.arc_radius_mm = c.radius_mm;
+  fit.center_axial_sigma_mm = std::sqrt(c.covariance(0, 0));
+  fit.center_radial_sigma_mm = std::sqrt(c.covariance(1, 1));
+  fit.arc_radius_sigma_mm = std::sqrt(c.covariance(2, 2));
+  fit.arc_error_um = c.pv_residual_mm * 1000.0;
+  fit.chi2_per_dof = fit.points > 3 ? c.chi2 / (fit.points - 3) : 0.0;
+  if (!std::isfinite(fit.arc_radius_sigma_mm) || fit.arc_radius_sigma_mm > 0.1 * fit.arc_radius_mm) {
+    fit.flag = "ill-conditioned: the radius is not determined";
+    return out;
+  }
+  fit.usable = true;
+  return out;
+}
+
+double Median(std::vector<double> values) {
+  if (values.empty()) return kNaN;
+  const auto middle = values.begin() + static_cast<long>(values.size() / 2);
+  std::nth_element(values.begin(), middle, values.end());
+  return *middle;
+}
+
+// Variance of the mean of parameter `row` over the usable phases, exactly through the helix
+// spline (neighbouring phases share spline coefficients, so their errors correlate).
+double SigmaOfMean(const std::vector<PhaseSolution>& solutions, int row, const processing::WheelMap& map) {
+  std::vector<std::pair<double, double>> terms;
+  int usable = 0;
+  for (const auto& s : solutions) usable += s.fit.usable ? 1 : 0;
+  for (const auto& s : solutions) {
+    if (!s.fit.usable) continue;
+    for (std::size_t k = 0; k < s.u_deg.size(); ++k) {
+      terms.emplace_back(s.u_deg[k], s.circle.sensitivity_to_y(row, static_cast<Eigen::Index>(k)) / usable);
+    }
+  }
+  const double factor = map.spline->CovarianceFactorOfSum(terms);
+  return map.noise_sigma_mm * std::sqrt(std::max(0.0, factor));
+}
+
+// Peak-to-valley after removing mean and first harmonic (least squares) over the phases given.
+double Roundness(const std::vector<double>& phase_deg, const std::vector<double>& rho) {
+  const auto n = static_cast<Eigen::Index>(rho.size());
+  Eigen::MatrixXd design(n, 3);
+  Eigen::VectorXd values(n);
+  for (Eigen::Index i = 0; i < n; ++i) {
+    const double c = phase_deg[static_cast<std::size_t>(i)] * std::numbers::pi / 180.0;
+    design(i, 0) = 1.0;
+    design(i, 1) = std::cos(c);
+    design(i, 2) = std::sin(c);
+    values(i) = rho[static_cast<std::size_t>(i)];
+  }
+  const Eigen::VectorXd residual = values - design * design.colPivHouseholderQr().solve(values);
+  return residual.maxCoeff() - residual.minCoeff();
+}
+
+}  // namespace
+
+std::vector<std::string> WheelFitOptions::Problems() const {
+  std::vector<std::string> problems;
+  if (!(band_half_width_mm > 0)) problems.push_back("band_half_width_mm must be > 0");
+  if (min_points < 4) problems.push_back("min_points must be >= 4");
+  if (!(min_band_coverage >= 0 && min_band_coverage <= 1)) problems.push_back("min_band_coverage must be in 0..1");
+  if (!(min_phase_coverage > 0 && min_phase_coverage <= 1)) problems.push_back("min_phase_coverage must be in (0, 1]");
+  return problems;
+}
+
+FitSpan ParseFitSpan(const std::string& name) {
+  if (name == "band") return FitSpan::kBand;
+  if (name == "full") return FitSpan::kFull;
+  throw Error(ErrorCode::kInvalidOption, kStage, "unknown fit span '" + name + "' (expected band or full)");
+}
+
+WheelFit FitWheel(const processing::WheelMap& map, const WheelFitOptions& options) {
+  if (const auto problems = options.Problems(); !problems.empty()) {
+    throw Error(ErrorCode::kInvalidOption, kStage, problems.front());
+  }
+  const std::size_t n_phase = map.n_phase();
+  const std::size_t n_y = map.n_y();
+  const double y_min = map.y_mm.front();
+  const double y_max = map.y_mm.back();
+  const double half = options.band_half_width_mm;
+  const bool full = options.fit_span == FitSpan::kFull;
+
+  // Pass 1 centres the band on the middle of the scanned span; pass 2 on the mean arc centre.
+  double band_center = 0.5 * (y_min + y_max);
+  double used_center = band_center;  // the centre of the band the final fits used
+  std::vector<PhaseSolution> solutions(n_phase);
+  for (int pass = 0; pass < 2; ++pass) {
+    used_center = band_center;
+    double sum_a = 0.0;
+    int usable = 0;
+    for (std::size_t j = 0; j < n_phase; ++j) {
+      if ((j & 31) == 0) ThrowIfInterrupted();
+      solutions[j] = FitSection(map.sections[j], band_center, half, full, options);
+      if (solutions[j].fit.usable) {
+        sum_a += solutions[j].fit.center_axial_mm;
+        ++usable;
+      }
+    }
+    if (usable == 0) {
+      const std::string why = n_phase > 0 ? solutions[0].fit.flag : "no phases";
+      throw Error(ErrorCode::kFitFailed, kStage, "no phase gave a usable arc fit (phase 0: " + why + ")");
+    }
+    band_center = sum_a / usable;
+  }
+
+  WheelFit out;
+  out.band_low_mm = std::max(used_center - half, y_min);
+  out.band_high_mm = std::min(used_center + half, y_max);
+  if (!(out.band_high_mm > out.band_low_mm)) {
+    throw Error(ErrorCode::kBadInput, kStage,
+                fmt::format("the band {:.4g} +- {:.4g} mm lies outside the scanned span [{:.4g}, {:.4g}] mm",
+                            band_center, half, y_min, y_max));
+  }
+  if (out.band_high_mm - out.band_low_mm < 2.0 * half - 1e-9 && !full) {
+    out.warnings.push_back(fmt::format("the band was clipped to [{:.4f}, {:.4f}] mm by the scanned span",
+                                       out.band_low_mm, out.band_high_mm));
+  }
+
+  std::vector<double> radii, axial, radial, sigmas, chi2;
+  for (const auto& s : solutions) {
+    out.phases.push_back(s.fit);
+    if (!s.fit.usable) continue;
+    radii.push_back(s.fit.arc_radius_mm);
+    axial.push_back(s.fit.center_axial_mm);
+    radial.push_back(s.fit.center_radial_mm);
+    sigmas.push_back(s.fit.arc_radius_sigma_mm);
+    chi2.push_back(s.fit.chi2_per_dof);
+    out.max_arc_error_um = std::max(out.max_arc_error_um, s.fit.arc_error_um);
+  }
+  const auto n = static_cast<double>(radii.size());
+  out.usable_phases = static_cast<int>(radii.size());
+  const auto mean = [](const std::vector<double>& v) { return std::accumulate(v.begin(), v.end(), 0.0) / v.size(); };
+  out.mean_arc_radius_mm = mean(radii);
+  out.mean_center_axial_mm = mean(axial);
+  out.mean_center_radial_mm = mean(radial);
+  const auto [r_min, r_max] = std::minmax_element(radii.begin(), radii.end());
+  out.arc_radius_range_mm = *r_max - *r_min;
+  out.arc_radius_fluctuation_pct = out.arc_radius_range_mm / out.mean_arc_radius_mm * 100.0;
+  const auto [a_min, a_max] = std::minmax_element(axial.begin(), axial.end());
+  out.center_axial_deviation_mm = *a_max - *a_min;
+  double var = 0.0, noise = 0.0;
+  for (std::size_t k = 0; k < radii.size(); ++k) {
+    var += (radii[k] - out.mean_arc_radius_mm) * (radii[k] - out.mean_arc_radius_mm);
+    noise += sigmas[k] * sigmas[k];
+  }
+  out.arc_radius_std_mm = std::sqrt(var / std::max(1.0, n - 1.0));
+  out.arc_radius_noise_std_mm = std::sqrt(noise / n);
+  out.arc_radius_excess_std_mm = std::sqrt(std::max(0.0, out.arc_radius_std_mm * out.arc_radius_std_mm -
+                                                             out.arc_radius_noise_std_mm * out.arc_radius_noise_std_mm));
+  out.median_chi2_per_dof = Median(chi2);
+  out.mean_arc_radius_sigma_mm = SigmaOfMean(solutions, 2, map);
+  out.mean_center_axial_sigma_mm = SigmaOfMean(solutions, 0, map);
+  if (out.usable_phases < static_cast<int>(n_phase)) {
+    out.warnings.push_back(fmt::format("{} of {} phases were not usable and are left out of the means",
+                                       n_phase - static_cast<std::size_t>(out.usable_phases), n_phase));
+  }
+
+  // Runout and roundness over the map's axial nodes in the band.
+  for (std::size_t m = 0; m < n_y; ++m) {
+    const double y = map.y_mm[m];
+    if (y < out.band_low_mm - 1e-9 || y > out.band_high_mm + 1e-9) continue;
+    std::vector<double> phase, rho;
+    for (std::size_t j = 0; j < n_phase; ++j) {
+      if (std::isfinite(map.rho(j, m))) {
+        phase.push_back(map.phase_deg[j]);
+        rho.push_back(map.rho(j, m));
+      }
+    }
+    out.axial_y_mm.push_back(y);
+    if (rho.size() < options.min_phase_coverage * static_cast<double>(n_phase) || rho.size() < 4) {
+      out.runout_um.push_back(kNaN);
+      out.roundness_um.push_back(kNaN);
+      continue;
+    }
+    const auto [lo, hi] = std::minmax_element(rho.begin(), rho.end());
+    out.runout_um.push_back((*hi - *lo) * 1000.0);
+    out.roundness_um.push_back(Roundness(phase, rho) * 1000.0);
+    out.max_runout_um = std::max(out.max_runout_um, out.runout_um.back());
+    out.max_roundness_um = std::max(out.max_roundness_um, out.roundness_um.back());
+  }
+
+  // Mean profile deviation and the form-error map.
+  for (std::size_t m = 0; m < n_y; ++m) {
+    const double y = map.y_mm[m];
+    if (y < out.band_low_mm - 1e-9 || y > out.band_high_mm + 1e-9) continue;
+    double sum = 0.0;
+    int count = 0;
+    for (std::size_t j = 0; j < n_phase; ++j) {
+      const PhaseFit& f = out.phases[j];
+      const double u = y - f.center_axial_mm;
+      if (!f.usable || !std::isfinite(map.rho(j, m)) || std::abs(u) >= f.arc_radius_mm) continue;
+      sum += map.rho(j, m) - (f.center_radial_mm + std::sqrt(f.arc_radius_mm * f.arc_radius_mm - u * u));
+      ++count;
+    }
+    out.profile_u_mm.push_back(y - out.mean_center_axial_mm);
+    out.profile_error_um.push_back(count > 0 ? sum / count * 1000.0 : kNaN);
+  }
+  out.form_error_um.assign(n_phase * n_y, kNaN);
+  const double R = out.mean_arc_radius_mm;
+  for (std::size_t m = 0; m < n_y; ++m) {
+    const double u = map.y_mm[m] - out.mean_center_axial_mm;
+    if (std::abs(u) >= R) continue;
+    const double mean_wheel = out.mean_center_radial_mm + std::sqrt(R * R - u * u);
+    for (std::size_t j = 0; j < n_phase; ++j) {
+      out.form_error_um[j * n_y + m] = (map.rho(j, m) - mean_wheel) * 1000.0;
+    }
+  }
+  return out;
+}
+
+}  // namespace arcwheel::fitting

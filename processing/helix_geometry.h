@@ -1,0 +1,51 @@
+#pragma once
+// Where each sample lies on the helix (formats.md section 1, method.md A.1-A.3): its unwrapped
+// phase u (deg, continuous across turns: u = c + 360 k on turn k) and its axial position y (mm).
+
+#include <cstddef>
+#include <vector>
+
+#include "acquisition/scan.h"
+
+namespace arcwheel::processing {
+
+enum class PhaseSource { kNominal, kEstimated, kEncoder };
+
+class HelixGeometry {
+ public:
+  // From the scan's own columns where present, else from its settings with `spindle_rpm`
+  // (the speed the processing decided on; ignored when the scan has an encoder column).
+  // Throws Error{kBadInput} if an encoder column does not increase.
+  HelixGeometry(const acquisition::Scan& scan, double spindle_rpm);
+
+  [[nodiscard]] double TimeAt(std::size_t i) const {
+    return t_s_ != nullptr ? (*t_s_)[i] - (*t_s_)[0] : static_cast<double>(i) * sample_period_s_;
+  }
+  [[nodiscard]] double PhaseAt(std::size_t i) const {
+    return unwrapped_deg_.empty() ? start_phase_deg_ + 6.0 * rpm_ * TimeAt(i) : unwrapped_deg_[i];
+  }
+  [[nodiscard]] double AxialAt(std::size_t i) const {
+    return y_mm_ != nullptr ? (*y_mm_)[i] : start_y_mm_ + feed_mm_per_min_ * TimeAt(i) / 60.0;
+  }
+  // Axial position where the helix passes unwrapped phase u (linear between samples).
+  [[nodiscard]] double AxialAtPhase(double u_deg) const;
+  // Mean advance per turn (mm); negative if the wheel moves towards -y.
+  [[nodiscard]] double PitchMm() const { return pitch_mm_; }
+  [[nodiscard]] double rpm() const { return rpm_; }
+  [[nodiscard]] bool has_encoder() const { return !unwrapped_deg_.empty(); }
+  [[nodiscard]] std::size_t size() const { return size_; }
+
+ private:
+  std::size_t size_ = 0;
+  const std::vector<double>* t_s_ = nullptr;
+  const std::vector<double>* y_mm_ = nullptr;
+  std::vector<double> unwrapped_deg_;
+  double sample_period_s_ = 0.0;
+  double start_phase_deg_ = 0.0;
+  double start_y_mm_ = 0.0;
+  double feed_mm_per_min_ = 0.0;
+  double rpm_ = 0.0;
+  double pitch_mm_ = 0.0;
+};
+
+}  // namespace arcwheel::processing

@@ -1,0 +1,132 @@
+#include "processing/helix_spline.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "core/check.h"
+#include "core/error.h"
+#include "core/interrupt.h"
+
+namespace arcwheel::processing {
+namespace {
+
+// Relative weight of the second-difference penalty: small enough to leave a well-sampled
+// spline untouched (bias far below the noise), large enough to bridge a dropout.
+constexpr double kPenaltyRelative = 1e-7;
+
+std::pair<std::size_t, std::size_t> ValidSpan(std::span<const double> z) {
+  std::size_t first = 0;
+  while (first < z.size() && !std::isfinite(z[first])) ++first;
+  std::size_t last = z.size();
+  while (last > first && !std::isfinite(z[last - 1])) --last;
+  return {first, last};
+}
+
+std::size_t CountCells(double u_first, double u_last, double u0, double h) {
+  (void)u_first;
+  return static_cast<std::size_t>(std::floor((u_last - u0) / h)) + 1;
+}
+
+}  // namespace
+
+HelixSpline::Basis HelixSpline::BasisAt(double u) const {
+  const double s = (u - u0_) / h_;
+  double cell = std::floor(s);
+  const double max_cell = static_cast<double>(cell_counts_.size() - 1);
+  cell = std::clamp(cell, 0.0, max_cell);
+  const double f = s - cell;
+  Basis b;
+  b.first = static_cast<std::size_t>(cell);
+  const double g = 1.0 - f;
+  b.w[0] = g * g * g / 6.0;
+  b.w[1] = (3.0 * f * f * f - 6.0 * f * f + 4.0) / 6.0;
+  b.w[2] = (-3.0 * f * f * f + 3.0 * f * f + 3.0 * f + 1.0) / 6.0;
+  b.w[3] = f * f * f / 6.0;
+  return b;
+}
+
+HelixSpline::HelixSpline(std::span<const double> z, const HelixGeometry& geometry, double knot_step_deg)
+    : h_(knot_step_deg), normal_(0) {
+  const auto [first, last] = ValidSpan(z);
+  ARCWHEEL_CHECK(first < last) << "no valid samples reached the helix spline";
+  u_first_ = geometry.PhaseAt(first);
+  u_last_ = geometry.PhaseAt(last - 1);
+  u0_ = std::floor(u_first_ / h_) * h_;
+  const std::size_t cells = CountCells(u_first_, u_last_, u0_, h_);
+  cell_counts_.assign(cells, 0);
+  const std::size_t n = cells + 3;
+  normal_ = BandedSpd(n);
+  std::vector<double> rhs(n, 0.0);
+
+  for (std::size_t i = first; i < last; ++i) {
+    if (!std::isfinite(z[i])) continue;
+    if ((i & 0xFFFFF) == 0) ThrowIfInterrupted();
+    const Basis b = BasisAt(geometry.PhaseAt(i));
+    ++cell_counts_[b.first];
+    for (int a = 0; a < 4; ++a) {
+      rhs[b.first + a] += b.w[a] * z[i];
+      for (int c = a; c < 4; ++c) normal_.Add(b.first + a, b.first + c, b.w[a] * b.w[c]);
+    }
+  }
+  // Penalty lambda * |D2 c|^2 with lambda relative to the mean diagonal.
+  double mean_diagonal = 0.0;
+  for (std::size_t i = 0; i < n; ++i) mean_diagonal += normal_.Get(i, i);
+  mean_diagonal /= static_cast<double>(n);
+  const double lambda = kPenaltyRelative * std::max(mean_diagonal, 1e-12);
+  for (std::size_t r = 0; r + 2 < n; ++r) {
+    const double d[3] = {1.0, -2.0, 1.0};
+    for (int a = 0; a < 3; ++a) {
+      for (int c = a; c < 3; ++c) normal_.Add(r + a, r + c, lambda * d[a] * d[c]);
+    }
+  }
+  if (!normal_.Factorize()) {
+    throw Error(ErrorCode::kFitFailed, "processing.spline", "the helix spline's normal matrix is not definite");
+  }
+  normal_.Solve(rhs);
+  coefficients_ = std::move(rhs);
+  normal_.ComputeSelectedInverse();
+}
+
+double HelixSpline::Value(double u) const {
+  const Basis b = BasisAt(u);
+  double value = 0.0;
+  for (int a = 0; a < 4; ++a) value += b.w[a] * coefficients_[b.first + a];
+  return value;
+}
+
+double HelixSpline::VarianceFactor(double u) const {
+  const Basis b = BasisAt(u);
+  double v = 0.0;
+  for (int a = 0; a < 4; ++a) {
+    for (int c = 0; c < 4; ++c) v += b.w[a] * b.w[c] * normal_.Inverse(b.first + a, b.first + c);
+  }
+  return v;
+}
+
+int HelixSpline::Support(double u) const {
+  const double s = (u - u0_) / h_;
+  const auto cell = static_cast<long>(std::floor(s));
+  const double f = s - static_cast<double>(cell);
+  // The two cells nearest u: its own and the neighbour on the nearer side.
+  const long other = f < 0.5 ? cell - 1 : cell + 1;
+  int count = 0;
+  for (const long c : {cell, other}) {
+    if (c >= 0 && c < static_cast<long>(cell_counts_.size())) count += cell_counts_[static_cast<std::size_t>(c)];
+  }
+  return count;
+}
+
+double HelixSpline::CovarianceFactorOfSum(const std::vector<std::pair<double, double>>& terms) const {
+  std::vector<double> v(coefficients_.size(), 0.0);
+  for (const auto& [u, weight] : terms) {
+    const Basis b = BasisAt(u);
+    for (int a = 0; a < 4; ++a) v[b.first + a] += weight * b.w[a];
+  }
+  std::vector<double> x = v;
+  normal_.Solve(x);
+  double sum = 0.0;
+  for (std::size_t i = 0; i < v.size(); ++i) sum += v[i] * x[i];
+  return sum;
+}
+
+}  // namespace arcwheel::processing

@@ -1,0 +1,58 @@
+#pragma once
+// A least-squares cubic B-spline g(u) of the readings along the helix, in the unwrapped phase u.
+//
+// The wheel map is built from this spline rather than from one interpolated point per turn: at
+// the paper's settings every knot interval (1 deg) holds about three samples, and all of them
+// inform the value at each phase (method.md A, "things learned": ~1.8x less noise per phase).
+// A tiny second-difference penalty keeps the normal matrix definite across dropouts; values
+// there rest on few samples, and support() says how many.
+//
+// Uncertainty: with white noise of sigma per sample, Var g(u) = sigma^2 b(u)^T (A^T A)^-1 b(u),
+// b(u) the four basis values; VarianceFactor() returns the factor after sigma^2. Values at the
+// same phase on different turns are 360 knots apart and uncorrelated for all practical purposes;
+// CovarianceFactorOfSum() gives the exact variance factor of any weighted sum of spline values.
+
+#include <cstddef>
+#include <span>
+#include <utility>
+#include <vector>
+
+#include "processing/banded_spd.h"
+#include "processing/helix_geometry.h"
+
+namespace arcwheel::processing {
+
+class HelixSpline {
+ public:
+  // Fits z (NaN = invalid) over the span of valid samples with knots every knot_step_deg.
+  // Throws Error{kFitFailed} if the system cannot be factorised.
+  HelixSpline(std::span<const double> rho_mm, const HelixGeometry& geometry, double knot_step_deg);
+
+  [[nodiscard]] double Value(double u_deg) const;
+  [[nodiscard]] double VarianceFactor(double u_deg) const;
+  // Valid samples in the two knot intervals around u.
+  [[nodiscard]] int Support(double u_deg) const;
+  // sum_a sum_b w_a w_b Cov(g(u_a), g(u_b)) / sigma^2 for the given (u, w) pairs: one banded solve.
+  [[nodiscard]] double CovarianceFactorOfSum(const std::vector<std::pair<double, double>>& terms) const;
+
+  [[nodiscard]] double first_phase_deg() const { return u_first_; }
+  [[nodiscard]] double last_phase_deg() const { return u_last_; }
+  [[nodiscard]] double knot_step_deg() const { return h_; }
+
+ private:
+  struct Basis {
+    std::size_t first = 0;
+    double w[4] = {0, 0, 0, 0};
+  };
+  [[nodiscard]] Basis BasisAt(double u_deg) const;
+
+  double u0_ = 0.0;     // first knot
+  double h_ = 1.0;      // knot spacing
+  double u_first_ = 0.0;
+  double u_last_ = 0.0;
+  std::vector<double> coefficients_;
+  std::vector<int> cell_counts_;
+  BandedSpd normal_;
+};
+
+}  // namespace arcwheel::processing

@@ -1,0 +1,138 @@
+#include "processing/process_scan.h"
+
+#include <algorithm>
+#include <cmath>
+#include <fmt/core.h>
+
+#include "core/error.h"
+#include "core/interrupt.h"
+#include "processing/noise.h"
+
+namespace arcwheel::processing {
+namespace {
+
+constexpr const char* kStage = "processing";
+
+// rho = radius_sign * z, invalid samples NaN.
+std::vector<double> RadialCoordinate(const acquisition::Scan& scan) {
+  std::vector<double> rho(scan.z_mm);
+  if (scan.metadata.radius_sign < 0) {
+    for (double& v : rho) v = -v;
+  }
+  return rho;
+}
+
+// method.md A.7: a beam at lateral offset e reads h = sqrt(R^2 - e^2) of a rim at radius R.
+// With the sensor's zero at radius R0 (rho = h - R0): R = sqrt((R0 + rho)^2 + e^2).
+void CorrectBeamOffset(std::vector<double>& rho, double offset_mm, double apex_radius_mm) {
+  std::vector<double> finite;
+  for (std::size_t i = 0; i < rho.size(); i += std::max<std::size_t>(1, rho.size() / 100000)) {
+    if (std::isfinite(rho[i])) finite.push_back(rho[i]);
+  }
+  // The apex of the rim is where rho peaks; its radius is the wheel's.
+  const auto top = finite.begin() + static_cast<long>(0.995 * static_cast<double>(finite.size()));
+  std::nth_element(finite.begin(), top, finite.end());
+  const double zero_radius_mm = apex_radius_mm - *top;
+  const double e2 = offset_mm * offset_mm;
+  for (double& v : rho) {
+    if (std::isfinite(v)) v = std::sqrt((zero_radius_mm + v) * (zero_radius_mm + v) + e2) - zero_radius_mm;
+  }
+}
+
+}  // namespace
+
+std::vector<std::string> ProcessOptions::Problems() const {
+  std::vector<std::string> problems = despike.Problems();
+  for (auto& p : map.Problems()) problems.push_back(std::move(p));
+  if (!std::isfinite(beam_offset_mm)) problems.push_back("beam_offset_mm must be finite");
+  if (speed.max_harmonic < 1 || speed.max_harmonic > 60) problems.push_back("speed max_harmonic violates 1..60");
+  return problems;
+}
+
+RpmSource ParseRpmSource(const std::string& name) {
+  if (name == "auto") return RpmSource::kAuto;
+  if (name == "nominal") return RpmSource::kNominal;
+  if (name == "encoder") return RpmSource::kEncoder;
+  if (name == "estimate") return RpmSource::kEstimate;
+  throw Error(ErrorCode::kInvalidOption, kStage,
+              "unknown rpm source '" + name + "' (expected auto, nominal, encoder or estimate)");
+}
+
+std::string RpmSourceName(RpmSource source) {
+  switch (source) {
+    case RpmSource::kAuto: return "auto";
+    case RpmSource::kNominal: return "nominal";
+    case RpmSource::kEncoder: return "encoder";
+    case RpmSource::kEstimate: return "estimate";
+  }
+  return "auto";
+}
+
+ProcessedScan ProcessScan(const acquisition::Scan& scan, const ProcessOptions& options) {
+  if (const auto problems = options.Problems(); !problems.empty()) {
+    throw Error(ErrorCode::kInvalidOption, kStage, problems.front());
+  }
+  if (options.rpm_source == RpmSource::kEncoder && !scan.has_encoder()) {
+    throw Error(ErrorCode::kInvalidOption, kStage, "'" + scan.path + "' has no angle column for --rpm-source encoder");
+  }
+  ProcessedScan out;
+  out.samples = scan.size();
+  std::vector<double> rho = RadialCoordinate(scan);
+  out.valid_samples = static_cast<std::size_t>(std::count_if(rho.begin(), rho.end(), [](double v) { return std::isfinite(v); }));
+  const auto first = std::find_if(rho.begin(), rho.end(), [](double v) { return std::isfinite(v); });
+  const auto last = std::find_if(rho.rbegin(), rho.rend(), [](double v) { return std::isfinite(v); });
+  out.first_valid = static_cast<std::size_t>(first - rho.begin());
+  out.last_valid = rho.size() - 1 - static_cast<std::size_t>(last - rho.rbegin());
+  ThrowIfInterrupted();
+
+  out.noise_sigma_mm = EstimateNoiseSigmaMm(rho);
+  out.despike = Despike(rho, out.noise_sigma_mm, options.despike);
+  // The noise that matters for the sigmas is that of the samples the map is built from.
+  out.noise_sigma_mm = EstimateNoiseSigmaMm(rho);
+  if (out.despike.rejected > out.valid_samples / 10) {
+    out.warnings.push_back(fmt::format("despiking rejected {} of {} valid samples: check the threshold ({:.3g} um)",
+                                       out.despike.rejected, out.valid_samples, out.despike.threshold_um));
+  }
+  ThrowIfInterrupted();
+
+  if (options.beam_offset_mm != 0.0) {
+    double radius = options.wheel_radius_mm;
+    if (radius <= 0 && scan.metadata.wheel_diameter_mm) radius = *scan.metadata.wheel_diameter_mm / 2.0;
+    if (radius <= 0) {
+      throw Error(ErrorCode::kInvalidOption, kStage,
+                  "the beam-offset correction needs the wheel radius: give --wheel-radius-mm or a wheel_diameter_mm attribute");
+    }
+    CorrectBeamOffset(rho, options.beam_offset_mm, radius);
+  }
+
+  const bool use_encoder =
+      scan.has_encoder() && (options.rpm_source == RpmSource::kAuto || options.rpm_source == RpmSource::kEncoder);
+  if (use_encoder) {
+    out.phase_source = PhaseSource::kEncoder;
+    out.rpm_used = HelixGeometry(scan, 0.0).rpm();
+  } else {
+    if (!scan.metadata.spindle_rpm) {
+      throw Error(ErrorCode::kBadInput, kStage, "'" + scan.path + "' lacks spindle_rpm");
+    }
+    out.rpm_used = *scan.metadata.spindle_rpm;
+    out.phase_source = PhaseSource::kNominal;
+    if (options.rpm_source != RpmSource::kNominal && !scan.has_encoder()) {
+      out.speed = EstimateSpindleSpeed(scan, rho, options.speed);
+      const bool forced = options.rpm_source == RpmSource::kEstimate;
+      if (out.speed.available && (out.speed.significant || forced)) {
+        out.rpm_used = out.speed.fitted_rpm;
+        out.phase_source = PhaseSource::kEstimated;
+        out.warnings.push_back(fmt::format("spindle speed estimated from the data: {:.6f} rpm (nominal {:.6f}, sigma {:.2g})",
+                                           out.speed.fitted_rpm, out.speed.nominal_rpm, out.speed.sigma_rpm));
+      }
+      if (!out.speed.note.empty()) out.warnings.push_back(out.speed.note);
+    }
+  }
+  ThrowIfInterrupted();
+
+  const HelixGeometry geometry(scan, out.rpm_used);
+  out.map = BuildWheelMap(rho, geometry, out.noise_sigma_mm, out.despike.indices, options.map);
+  return out;
+}
+
+}  // namespace arcwheel::processing

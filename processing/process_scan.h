@@ -1,0 +1,56 @@
+#pragma once
+// The processing stage end to end: raw Scan -> WheelMap (method.md A.2-A.4, A.7).
+//   1. the valid span (invalid ends trimmed),
+//   2. noise from second differences, 3. despiking,
+//   4. beam-offset correction (optional), 5. spindle speed (encoder, estimate, or nominal),
+//   6. helix spline and wheel map.
+
+#include <cstddef>
+#include <string>
+#include <vector>
+
+#include "acquisition/scan.h"
+#include "processing/despike.h"
+#include "processing/helix_geometry.h"
+#include "processing/spindle_speed.h"
+#include "processing/wheel_map.h"
+
+namespace arcwheel::processing {
+
+enum class RpmSource { kAuto, kNominal, kEncoder, kEstimate };
+
+struct ProcessOptions {
+  DespikeOptions despike;
+  SpindleSpeedOptions speed;
+  // kAuto: the encoder when there is one, else the estimate when significant, else nominal.
+  RpmSource rpm_source = RpmSource::kAuto;
+  MapOptions map;
+  // Lateral offset of the sensor's beam from the wheel axis (method.md A.7); 0 = none.
+  double beam_offset_mm = 0.0;
+  // Wheel radius at the arc apex, for the beam-offset correction; <= 0: from the scan's
+  // wheel_diameter_mm.
+  double wheel_radius_mm = 0.0;
+  [[nodiscard]] std::vector<std::string> Problems() const;
+};
+
+[[nodiscard]] RpmSource ParseRpmSource(const std::string& name);
+[[nodiscard]] std::string RpmSourceName(RpmSource source);
+
+struct ProcessedScan {
+  std::size_t samples = 0;
+  std::size_t valid_samples = 0;       // before despiking
+  std::size_t first_valid = 0;         // the trimmed span [first_valid, last_valid]
+  std::size_t last_valid = 0;
+  DespikeResult despike;
+  double noise_sigma_mm = 0.0;
+  SpindleSpeedEstimate speed;          // filled when estimated
+  PhaseSource phase_source = PhaseSource::kNominal;
+  double rpm_used = 0.0;
+  WheelMap map;
+  std::vector<std::string> warnings;
+};
+
+// Throws Error{kInvalidOption} for bad options, kBadInput for scans that cannot be mapped.
+[[nodiscard]] ProcessedScan ProcessScan(const acquisition::Scan& scan, const ProcessOptions& options);
+
+}  // namespace arcwheel::processing

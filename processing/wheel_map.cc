@@ -1,0 +1,140 @@
+#include "processing/wheel_map.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <numeric>
+
+#include "core/error.h"
+#include "core/interrupt.h"
+#include "processing/cubic_interpolation.h"
+
+namespace arcwheel::processing {
+namespace {
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+double ChooseKnotStep(const MapOptions& options, const HelixGeometry& geometry, std::size_t valid_samples) {
+  if (options.knot_step_deg > 0) return options.knot_step_deg;
+  const double phase_step = 360.0 / options.phases;
+  const double span_deg = geometry.PhaseAt(geometry.size() - 1) - geometry.PhaseAt(0);
+  const double degrees_per_sample = span_deg / std::max<double>(1.0, static_cast<double>(valid_samples));
+  // At least 2.5 samples per knot interval keeps every coefficient determined by data.
+  double step = phase_step;
+  while (step < 2.5 * degrees_per_sample) step += phase_step;
+  return step;
+}
+
+Section SampleSection(const HelixSpline& spline, const HelixGeometry& geometry, double phase_deg,
+                      double noise_sigma_mm, int min_support) {
+  Section section;
+  const double first = spline.first_phase_deg();
+  const double last = spline.last_phase_deg();
+  double u = phase_deg + 360.0 * std::ceil((first - phase_deg) / 360.0);
+  for (; u <= last; u += 360.0) {
+    if (spline.Support(u) < min_support) continue;
+    section.u_deg.push_back(u);
+    section.y_mm.push_back(geometry.AxialAtPhase(u));
+    section.rho_mm.push_back(spline.Value(u));
+    section.sigma_mm.push_back(noise_sigma_mm * std::sqrt(std::max(0.0, spline.VarianceFactor(u))));
+  }
+  // Order by axial position (the feed may run towards -y).
+  if (section.y_mm.size() > 1 && section.y_mm.front() > section.y_mm.back()) {
+    std::reverse(section.u_deg.begin(), section.u_deg.end());
+    std::reverse(section.y_mm.begin(), section.y_mm.end());
+    std::reverse(section.rho_mm.begin(), section.rho_mm.end());
+    std::reverse(section.sigma_mm.begin(), section.sigma_mm.end());
+  }
+  return section;
+}
+
+// Interpolates one section onto the axial nodes; nodes inside a gap wider than 1.5 pitches
+// (a dropout removed a point) or outside the section stay NaN.
+void InterpolateSection(const Section& section, std::span<const double> nodes, double pitch_mm,
+                        std::span<double> out) {
+  std::fill(out.begin(), out.end(), kNaN);
+  if (section.y_mm.size() < 2) return;
+  const NaturalCubicSpline spline(section.y_mm, section.rho_mm);
+  const double max_gap = 1.5 * std::abs(pitch_mm);
+  for (std::size_t m = 0; m < nodes.size(); ++m) {
+    const double y = nodes[m];
+    if (y < section.y_mm.front() - 1e-9 || y > section.y_mm.back() + 1e-9) continue;
+    const std::size_t i = spline.Interval(y);
+    if (section.y_mm[i + 1] - section.y_mm[i] > max_gap) continue;
+    out[m] = spline(y);
+  }
+}
+
+}  // namespace
+
+std::vector<std::string> MapOptions::Problems() const {
+  std::vector<std::string> problems;
+  if (phases < 4 || phases > 36000) problems.push_back("phases = " + std::to_string(phases) + " violates 4..36000");
+  if (!std::isfinite(knot_step_deg) || knot_step_deg > 90) problems.push_back("knot_step_deg must be <= 90");
+  if (!std::isfinite(axial_step_mm)) problems.push_back("axial_step_mm must be finite");
+  if (min_support < 1) problems.push_back("min_support must be >= 1");
+  return problems;
+}
+
+WheelMap BuildWheelMap(std::span<const double> rho, const HelixGeometry& geometry, double noise_sigma_mm,
+                       std::span<const std::size_t> despiked, const MapOptions& options) {
+  if (const auto problems = options.Problems(); !problems.empty()) {
+    throw Error(ErrorCode::kInvalidOption, "processing.map", problems.front());
+  }
+  const auto valid = static_cast<std::size_t>(std::count_if(rho.begin(), rho.end(), [](double v) { return std::isfinite(v); }));
+  WheelMap map;
+  map.noise_sigma_mm = noise_sigma_mm;
+  map.knot_step_deg = ChooseKnotStep(options, geometry, valid);
+  map.pitch_mm = geometry.PitchMm();
+  auto spline = std::make_shared<HelixSpline>(rho, geometry, map.knot_step_deg);
+
+  const auto n_phase = static_cast<std::size_t>(options.phases);
+  map.phase_deg.resize(n_phase);
+  map.sections.resize(n_phase);
+  double y_low = -std::numeric_limits<double>::infinity();
+  double y_high = std::numeric_limits<double>::infinity();
+  for (std::size_t j = 0; j < n_phase; ++j) {
+    map.phase_deg[j] = 360.0 * static_cast<double>(j) / options.phases;
+    map.sections[j] = SampleSection(*spline, geometry, map.phase_deg[j], noise_sigma_mm, options.min_support);
+    const Section& s = map.sections[j];
+    if (s.y_mm.size() < 2) continue;
+    y_low = std::max(y_low, s.y_mm.front());
+    y_high = std::min(y_high, s.y_mm.back());
+  }
+  if (!(y_high > y_low)) {
+    throw Error(ErrorCode::kBadInput, "processing.map", "the valid samples do not cover a common axial span at all phases");
+  }
+  ThrowIfInterrupted();
+
+  map.axial_step_mm = options.axial_step_mm > 0 ? options.axial_step_mm : std::abs(map.pitch_mm);
+  const auto n_y = static_cast<std::size_t>(std::floor((y_high - y_low) / map.axial_step_mm + 1e-9)) + 1;
+  map.y_mm.resize(n_y);
+  for (std::size_t m = 0; m < n_y; ++m) map.y_mm[m] = y_low + static_cast<double>(m) * map.axial_step_mm;
+  map.rho_mm.assign(n_phase * n_y, kNaN);
+  for (std::size_t j = 0; j < n_phase; ++j) {
+    InterpolateSection(map.sections[j], map.y_mm, map.pitch_mm, std::span(map.rho_mm).subspan(j * n_y, n_y));
+  }
+
+  // Coverage diagnostics: raw samples per cell around each node.
+  map.sample_count.assign(n_phase * n_y, 0);
+  map.despiked_count.assign(n_phase * n_y, 0);
+  const double phase_step = 360.0 / options.phases;
+  const auto cell_of = [&](std::size_t i) -> long {
+    const double c = std::fmod(geometry.PhaseAt(i), 360.0);
+    const auto j = static_cast<std::size_t>(std::lround((c < 0 ? c + 360.0 : c) / phase_step)) % n_phase;
+    const double m = std::round((geometry.AxialAt(i) - y_low) / map.axial_step_mm);
+    if (m < 0 || m >= static_cast<double>(n_y)) return -1;
+    return static_cast<long>(j * n_y + static_cast<std::size_t>(m));
+  };
+  for (std::size_t i = 0; i < rho.size(); ++i) {
+    if (!std::isfinite(rho[i])) continue;
+    if (const long cell = cell_of(i); cell >= 0) ++map.sample_count[static_cast<std::size_t>(cell)];
+  }
+  for (const std::size_t i : despiked) {
+    if (const long cell = cell_of(i); cell >= 0) ++map.despiked_count[static_cast<std::size_t>(cell)];
+  }
+  map.spline = std::move(spline);
+  return map;
+}
+
+}  // namespace arcwheel::processing

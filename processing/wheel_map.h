@@ -1,0 +1,56 @@
+#pragma once
+// The wheel map (method.md A.3-A.4): the helix spline sampled at every phase node on every
+// turn (the "sections", which the arc fits use), and those sections interpolated along the axis
+// onto a regular (phase, axial) grid (the map, which runout, roundness and the report use).
+
+#include <cstddef>
+#include <memory>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "processing/helix_geometry.h"
+#include "processing/helix_spline.h"
+
+namespace arcwheel::processing {
+
+struct MapOptions {
+  int phases = 360;             // phase nodes 0, 360/phases, ...; 4..36000
+  double knot_step_deg = 0.0;   // helix spline knot spacing; <= 0: 360/phases, widened to >= 2.5 samples
+  double axial_step_mm = 0.0;   // map node spacing; <= 0: one helix pitch
+  int min_support = 2;          // a section point needs this many valid samples within its two knot intervals
+  [[nodiscard]] std::vector<std::string> Problems() const;
+};
+
+// The helix points at one phase node, ordered by axial position.
+struct Section {
+  std::vector<double> y_mm;
+  std::vector<double> rho_mm;
+  std::vector<double> sigma_mm;  // 1-sigma of rho from the measurement noise
+  std::vector<double> u_deg;     // unwrapped phase of each point on the helix
+};
+
+struct WheelMap {
+  std::vector<double> phase_deg;   // [n_phase]
+  std::vector<double> y_mm;        // [n_y]
+  std::vector<double> rho_mm;      // [n_phase * n_y], row-major by phase; NaN where not covered
+  std::vector<int> sample_count;   // valid samples per cell
+  std::vector<int> despiked_count; // despiked samples per cell
+  std::vector<Section> sections;   // [n_phase]
+  double noise_sigma_mm = 0.0;     // per-sample noise used for the sigmas
+  double knot_step_deg = 0.0;
+  double axial_step_mm = 0.0;
+  double pitch_mm = 0.0;
+  std::shared_ptr<const HelixSpline> spline;  // kept for exact propagation of the noise
+
+  [[nodiscard]] std::size_t n_phase() const { return phase_deg.size(); }
+  [[nodiscard]] std::size_t n_y() const { return y_mm.size(); }
+  [[nodiscard]] double rho(std::size_t phase, std::size_t axial) const { return rho_mm[phase * n_y() + axial]; }
+};
+
+// `rho_mm` per sample (NaN = invalid), already despiked. `despiked` lists rejected samples.
+[[nodiscard]] WheelMap BuildWheelMap(std::span<const double> rho_mm, const HelixGeometry& geometry,
+                                     double noise_sigma_mm, std::span<const std::size_t> despiked,
+                                     const MapOptions& options);
+
+}  // namespace arcwheel::processing

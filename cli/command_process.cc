@@ -3,6 +3,7 @@
 #include <fmt/core.h>
 
 #include <filesystem>
+#include <future>
 #include <string>
 
 #include "acquisition/scan_reader.h"
@@ -32,7 +33,6 @@ struct ProcessArgs {
 fitting::RunRecord MakeRecord(const ProcessArgs& args, const acquisition::Scan& scan) {
   fitting::RunRecord record;
   record.input_path = args.scan_path;
-  record.input_sha256 = Sha256OfFile(args.scan_path);
   const std::string extension = std::filesystem::path(args.scan_path).extension().string();
   record.input_format = extension == ".h5" || extension == ".hdf5" ? "hdf5" : "csv";
   record.metadata = scan.metadata;
@@ -86,14 +86,17 @@ void Run(ProcessArgs& args) {
   args.fit.fit_span = fitting::ParseFitSpan(args.fit_span);
   Progress progress(!args.quiet);
   progress.Update("reading", 0.0);
-  const acquisition::Scan scan = acquisition::ReadScan(args.scan_path);
+  // The input's SHA-256 is computed on the second core while the first one works.
+  auto sha256 = std::async(std::launch::async, [path = args.scan_path] { return Sha256OfFile(path); });
+  acquisition::Scan scan = acquisition::ReadScan(args.scan_path);
+  fitting::RunRecord record = MakeRecord(args, scan);
   ThrowIfInterrupted();
   progress.Update("processing", 0.3);
-  const processing::ProcessedScan processed = processing::ProcessScan(scan, args.processing);
+  const processing::ProcessedScan processed = processing::ProcessScan(std::move(scan), args.processing);
   progress.Update("fitting", 0.7);
   const fitting::WheelFit fit = fitting::FitWheel(processed.map, args.fit);
   progress.Update("writing", 0.9);
-  const fitting::RunRecord record = MakeRecord(args, scan);
+  record.input_sha256 = sha256.get();
   ThrowIfInterrupted();
   fitting::WriteProcessOutputs(args.outdir, record, processed, fit);
   progress.Done();

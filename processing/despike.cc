@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <deque>
+#include <thread>
 #include <limits>
 
 #include "core/error.h"
@@ -10,15 +12,6 @@ namespace arcwheel::processing {
 namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
-
-std::vector<std::size_t> ValidIndices(std::span<const double> z) {
-  std::vector<std::size_t> valid;
-  valid.reserve(z.size());
-  for (std::size_t i = 0; i < z.size(); ++i) {
-    if (std::isfinite(z[i])) valid.push_back(i);
-  }
-  return valid;
-}
 
 // A sorted window of the last 2w+1 values: O(w) insert and erase, which for w <= 50 beats a
 // heap-based running median in practice.
@@ -35,53 +28,122 @@ class SortedWindow {
   std::vector<double> values_;
 };
 
-void DespikeByMedian(std::span<double> z, const std::vector<std::size_t>& valid, int w, double threshold_mm,
-                     DespikeResult& result) {
-  const std::size_t n = valid.size();
+struct Sample {
+  std::size_t index;
+  double value;
+};
+
+// Both filters stream the valid samples through a deque holding up to w samples on each side of
+// the one being judged: no per-sample index array, so a 1e7-sample scan needs no more memory
+// than its own readings. Decisions use the original values; the rejected samples are changed
+// only after the pass.
+template <typename Statistic>
+std::vector<Sample> Reject(std::span<const double> z, int w, double threshold_mm, Statistic& statistic) {
   const auto half = static_cast<std::size_t>(w);
-  // Decisions use the original values: rejected samples become NaN only after the pass.
-  SortedWindow window;
-  std::size_t in_end = 0;  // window covers valid[in_begin, in_end)
-  std::size_t in_begin = 0;
-  std::vector<std::size_t> rejected;
-  for (std::size_t k = 0; k < n; ++k) {
-    const std::size_t want_begin = k >= half ? k - half : 0;
-    const std::size_t want_end = std::min(n, k + half + 1);
-    while (in_end < want_end) window.Insert(z[valid[in_end++]]);
-    while (in_begin < want_begin) {
-      window.Erase(z[valid[in_begin]]);
-      ++in_begin;
+  std::deque<Sample> window;
+  std::size_t centre = 0;
+  std::vector<Sample> rejected;  // index and the statistic it was judged against
+  const auto judge_next = [&] {
+    const Sample& sample = window[centre];
+    const double reference = statistic.Reference(sample.value);
+    if (std::isfinite(reference) && std::abs(sample.value - reference) > threshold_mm) {
+      rejected.push_back({sample.index, reference});
     }
-    if (std::abs(z[valid[k]] - window.Median()) > threshold_mm) rejected.push_back(valid[k]);
+    ++centre;
+    if (centre > half) {
+      statistic.Remove(window.front().value);
+      window.pop_front();
+      --centre;
+    }
+  };
+  for (std::size_t i = 0; i < z.size(); ++i) {
+    if (!std::isfinite(z[i])) continue;
+    window.push_back({i, z[i]});
+    statistic.Add(z[i]);
+    if (window.size() - centre > half) judge_next();
   }
-  for (const std::size_t i : rejected) z[i] = kNaN;
-  result.indices = std::move(rejected);
+  while (centre < window.size()) judge_next();
+  return rejected;
 }
 
-void DespikeByMovingMean(std::span<double> z, const std::vector<std::size_t>& valid, int w, double threshold_mm,
-                         DespikeResult& result) {
-  const std::size_t n = valid.size();
-  const auto half = static_cast<std::size_t>(w);
-  std::vector<double> replaced;
-  std::vector<std::size_t> rejected;
+// Median of the whole window (Hampel-type, burst-safe).
+struct WindowMedian {
+  SortedWindow sorted;
+  void Add(double v) { sorted.Insert(v); }
+  void Remove(double v) { sorted.Erase(v); }
+  [[nodiscard]] double Reference(double /*centre*/) const { return sorted.Median(); }
+};
+
+// Mean of the other samples in the window (the paper's improved moving average).
+struct WindowMeanOfOthers {
   double sum = 0.0;
-  std::size_t begin = 0;
-  std::size_t end = 0;
-  for (std::size_t k = 0; k < n; ++k) {
-    const std::size_t want_begin = k >= half ? k - half : 0;
-    const std::size_t want_end = std::min(n, k + half + 1);
-    while (end < want_end) sum += z[valid[end++]];
-    while (begin < want_begin) sum -= z[valid[begin++]];
-    const double others = static_cast<double>(end - begin - 1);
-    if (others < 1) continue;
-    const double mean_of_others = (sum - z[valid[k]]) / others;
-    if (std::abs(z[valid[k]] - mean_of_others) > threshold_mm) {
-      rejected.push_back(valid[k]);
-      replaced.push_back(mean_of_others);
-    }
+  std::size_t count = 0;
+  void Add(double v) {
+    sum += v;
+    ++count;
   }
-  for (std::size_t r = 0; r < rejected.size(); ++r) z[rejected[r]] = replaced[r];
-  result.indices = std::move(rejected);
+  void Remove(double v) {
+    sum -= v;
+    --count;
+  }
+  [[nodiscard]] double Reference(double centre) const {
+    return count > 1 ? (sum - centre) / static_cast<double>(count - 1) : std::numeric_limits<double>::quiet_NaN();
+  }
+};
+
+// Index where the w-th valid sample before (direction -1) or after (+1) `from` lies, clamped.
+std::size_t ContextEdge(std::span<const double> z, std::size_t from, int w, int direction) {
+  std::size_t i = from;
+  for (int found = 0; found <= w;) {
+    if (direction < 0 ? i == 0 : i + 1 >= z.size()) return direction < 0 ? 0 : z.size();
+    i = direction < 0 ? i - 1 : i + 1;
+    if (std::isfinite(z[i])) ++found;
+  }
+  return direction < 0 ? i : i + 1;
+}
+
+// Runs Reject on the two halves of the scan on two threads. Each half streams w valid samples of
+// the other half as context and keeps only its own decisions, so the result is exactly that of
+// one pass over the whole scan.
+template <typename Statistic>
+std::vector<Sample> RejectInParallel(std::span<const double> z, int w, double threshold_mm) {
+  const std::size_t middle = z.size() / 2;
+  if (z.size() < 100000) {
+    Statistic statistic;
+    return Reject(z, w, threshold_mm, statistic);
+  }
+  std::vector<Sample> second;
+  std::thread worker([&] {
+    const std::size_t begin = ContextEdge(z, middle, w, -1);
+    Statistic statistic;
+    for (Sample s : Reject(z.subspan(begin), w, threshold_mm, statistic)) {
+      s.index += begin;
+      if (s.index >= middle) second.push_back(s);
+    }
+  });
+  const std::size_t end = ContextEdge(z, middle - 1, w, +1);
+  Statistic statistic;
+  std::vector<Sample> first;
+  for (const Sample& s : Reject(z.subspan(0, end), w, threshold_mm, statistic)) {
+    if (s.index < middle) first.push_back(s);
+  }
+  worker.join();
+  first.insert(first.end(), second.begin(), second.end());
+  return first;
+}
+
+void DespikeByMedian(std::span<double> z, int w, double threshold_mm, DespikeResult& result) {
+  for (const Sample& s : RejectInParallel<WindowMedian>(z, w, threshold_mm)) {
+    z[s.index] = kNaN;
+    result.indices.push_back(s.index);
+  }
+}
+
+void DespikeByMovingMean(std::span<double> z, int w, double threshold_mm, DespikeResult& result) {
+  for (const Sample& s : RejectInParallel<WindowMeanOfOthers>(z, w, threshold_mm)) {
+    z[s.index] = s.value;  // replaced by the mean of the others, as in the paper
+    result.indices.push_back(s.index);
+  }
 }
 
 }  // namespace
@@ -123,12 +185,11 @@ DespikeResult Despike(std::span<double> z_mm, double noise_sigma_mm, const Despi
                             ? options.threshold_um
                             : std::max(options.min_threshold_um, options.threshold_sigmas * noise_sigma_mm * 1000.0);
   if (options.method == DespikeMethod::kNone) return result;
-  const std::vector<std::size_t> valid = ValidIndices(z_mm);
   const double threshold_mm = result.threshold_um / 1000.0;
   if (options.method == DespikeMethod::kMedian) {
-    DespikeByMedian(z_mm, valid, options.window_half_width, threshold_mm, result);
+    DespikeByMedian(z_mm, options.window_half_width, threshold_mm, result);
   } else {
-    DespikeByMovingMean(z_mm, valid, options.window_half_width, threshold_mm, result);
+    DespikeByMovingMean(z_mm, options.window_half_width, threshold_mm, result);
   }
   result.rejected = result.indices.size();
   return result;

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <thread>
 
 #include "core/check.h"
 #include "core/error.h"
@@ -22,8 +23,7 @@ std::pair<std::size_t, std::size_t> ValidSpan(std::span<const double> z) {
   return {first, last};
 }
 
-std::size_t CountCells(double u_first, double u_last, double u0, double h) {
-  (void)u_first;
+std::size_t CountCells(double u_last, double u0, double h) {
   return static_cast<std::size_t>(std::floor((u_last - u0) / h)) + 1;
 }
 
@@ -52,22 +52,26 @@ HelixSpline::HelixSpline(std::span<const double> z, const HelixGeometry& geometr
   u_first_ = geometry.PhaseAt(first);
   u_last_ = geometry.PhaseAt(last - 1);
   u0_ = std::floor(u_first_ / h_) * h_;
-  const std::size_t cells = CountCells(u_first_, u_last_, u0_, h_);
+  const std::size_t cells = CountCells(u_last_, u0_, h_);
   cell_counts_.assign(cells, 0);
   const std::size_t n = cells + 3;
   normal_ = BandedSpd(n);
   std::vector<double> rhs(n, 0.0);
 
-  for (std::size_t i = first; i < last; ++i) {
-    if (!std::isfinite(z[i])) continue;
-    if ((i & 0xFFFFF) == 0) ThrowIfInterrupted();
-    const Basis b = BasisAt(geometry.PhaseAt(i));
-    ++cell_counts_[b.first];
-    for (int a = 0; a < 4; ++a) {
-      rhs[b.first + a] += b.w[a] * z[i];
-      for (int c = a; c < 4; ++c) normal_.Add(b.first + a, b.first + c, b.w[a] * b.w[c]);
-    }
+  // Two threads accumulate the normal equations of the two halves; the sums are added.
+  const std::size_t middle = first + (last - first) / 2;
+  BandedSpd upper_normal(n);
+  std::vector<double> upper_rhs(n, 0.0);
+  std::vector<int> upper_counts(cells, 0);
+  std::thread upper([&] { Accumulate(z, geometry, middle, last, upper_normal, upper_rhs, upper_counts); });
+  Accumulate(z, geometry, first, middle, normal_, rhs, cell_counts_);
+  upper.join();
+  for (std::size_t i = 0; i < n; ++i) {
+    rhs[i] += upper_rhs[i];
+    for (std::size_t j = i; j <= std::min(n - 1, i + BandedSpd::kBand); ++j) normal_.Add(i, j, upper_normal.Get(i, j));
   }
+  for (std::size_t c = 0; c < cells; ++c) cell_counts_[c] += upper_counts[c];
+  ThrowIfInterrupted();
   // Penalty lambda * |D2 c|^2 with lambda relative to the mean diagonal.
   double mean_diagonal = 0.0;
   for (std::size_t i = 0; i < n; ++i) mean_diagonal += normal_.Get(i, i);
@@ -85,6 +89,20 @@ HelixSpline::HelixSpline(std::span<const double> z, const HelixGeometry& geometr
   normal_.Solve(rhs);
   coefficients_ = std::move(rhs);
   normal_.ComputeSelectedInverse();
+}
+
+void HelixSpline::Accumulate(std::span<const double> z, const HelixGeometry& geometry, std::size_t begin,
+                             std::size_t end, BandedSpd& normal, std::vector<double>& rhs,
+                             std::vector<int>& counts) const {
+  for (std::size_t i = begin; i < end; ++i) {
+    if (!std::isfinite(z[i])) continue;
+    const Basis b = BasisAt(geometry.PhaseAt(i));
+    ++counts[b.first];
+    for (int a = 0; a < 4; ++a) {
+      rhs[b.first + a] += b.w[a] * z[i];
+      for (int c = a; c < 4; ++c) normal.Add(b.first + a, b.first + c, b.w[a] * b.w[c]);
+    }
+  }
 }
 
 double HelixSpline::Value(double u) const {

@@ -13,13 +13,11 @@ namespace {
 
 constexpr const char* kStage = "processing";
 
-// rho = radius_sign * z, invalid samples NaN.
-std::vector<double> RadialCoordinate(const acquisition::Scan& scan) {
-  std::vector<double> rho(scan.z_mm);
+// rho = radius_sign * z, in place; invalid samples stay NaN.
+void ToRadialCoordinate(acquisition::Scan& scan) {
   if (scan.metadata.radius_sign < 0) {
-    for (double& v : rho) v = -v;
+    for (double& v : scan.z_mm) v = -v;
   }
-  return rho;
 }
 
 // method.md A.7: a beam at lateral offset e reads h = sqrt(R^2 - e^2) of a rim at radius R.
@@ -68,7 +66,7 @@ std::string RpmSourceName(RpmSource source) {
   return "auto";
 }
 
-ProcessedScan ProcessScan(const acquisition::Scan& scan, const ProcessOptions& options) {
+ProcessedScan ProcessScan(acquisition::Scan scan, const ProcessOptions& options) {
   if (const auto problems = options.Problems(); !problems.empty()) {
     throw Error(ErrorCode::kInvalidOption, kStage, problems.front());
   }
@@ -77,7 +75,8 @@ ProcessedScan ProcessScan(const acquisition::Scan& scan, const ProcessOptions& o
   }
   ProcessedScan out;
   out.samples = scan.size();
-  std::vector<double> rho = RadialCoordinate(scan);
+  ToRadialCoordinate(scan);
+  std::vector<double>& rho = scan.z_mm;
   out.valid_samples = static_cast<std::size_t>(std::count_if(rho.begin(), rho.end(), [](double v) { return std::isfinite(v); }));
   const auto first = std::find_if(rho.begin(), rho.end(), [](double v) { return std::isfinite(v); });
   const auto last = std::find_if(rho.rbegin(), rho.rend(), [](double v) { return std::isfinite(v); });

@@ -72,10 +72,11 @@ TEST(Noise, SecondDifferencesRecoverTheSensorNoiseDespiteSpikes) {
 }
 
 TEST(Despike, MedianFilterRemovesFiveSampleBurstsThatTheMovingMeanLeaves) {
-  std::vector<double> clean = NoisySine(20000, 0.2e-3, 2);
+  // Long enough for the two-thread path (each half streams the other's edge as context).
+  std::vector<double> clean = NoisySine(240000, 0.2e-3, 2);
   std::vector<double> spiked = clean;
   std::vector<std::size_t> injected;
-  for (std::size_t start = 500; start + 5 < spiked.size(); start += 1500) {
+  for (std::size_t start = 500; start + 5 < spiked.size(); start += 1499) {
     for (std::size_t k = 0; k < 5; ++k) {
       spiked[start + k] += 0.04;  // a 40 um burst of 5 samples
       injected.push_back(start + k);

@@ -15,13 +15,21 @@ namespace {
 using Complex = std::complex<double>;
 
 struct TurnHarmonics {
-  double turn = 0.0;               // turn index
+  double turn = 0.0;               // turn index of the window's middle
   std::vector<Complex> amplitude;  // Q_h = A_h - i B_h, h = 1..H
+  std::vector<double> amplitude_sigma;  // 1 sigma of |Q_h| from the turn's residuals
   double residual_sigma = 0.0;     // rms of the per-bin fit residual
 };
 
-// Bins every turn by phase at `rpm`, and fits each well-filled turn with
-// p0 + p1 s + p2 s^2 + sum_h (A_h cos(h theta) + B_h sin(h theta)).
+// Over one turn a smooth trend and the lowest harmonics are nearly the same functions (a ramp's
+// Fourier series), so each fit spans a window of several turns: the trend (the arc profile passing
+// under the sensor) is a cubic in time across the window, the wheel's signature repeats in it.
+constexpr int kTurnsPerWindow = 4;
+constexpr int kTrendTerms = 4;
+constexpr std::size_t kMaxWindows = 64;
+
+// Bins the scan by phase at `rpm` and fits each window whose turns are 90 % covered with
+// sum_j p_j tau^j + sum_h (A_h cos(h theta) + B_h sin(h theta)); `turn` is the window's middle.
 std::vector<TurnHarmonics> FitTurns(const acquisition::Scan& scan, std::span<const double> z, double rpm,
                                     int bins, int harmonics) {
   const HelixGeometry geometry(scan, rpm);
@@ -29,60 +37,73 @@ std::vector<TurnHarmonics> FitTurns(const acquisition::Scan& scan, std::span<con
   const auto turns = static_cast<std::size_t>(std::floor((geometry.PhaseAt(scan.size() - 1) - u0) / 360.0)) + 1;
   const auto nb = static_cast<std::size_t>(bins);
   std::vector<double> sum(turns * nb, 0.0);
+  std::vector<double> position(turns * nb, 0.0);  // sum of the samples' fractional turn positions
   std::vector<int> count(turns * nb, 0);
-  for (std::size_t i = 0; i < z.size(); ++i) {
+  // Bins need a few samples each, not thirty: long scans are read with a stride.
+  const std::size_t sample_stride = std::max<std::size_t>(1, z.size() / (turns * nb * 4));
+  for (std::size_t i = 0; i < z.size(); i += sample_stride) {
     if (!std::isfinite(z[i])) continue;
     const double turn_position = (geometry.PhaseAt(i) - u0) / 360.0;
     const auto k = static_cast<std::size_t>(turn_position);
-    const auto b = std::min(nb - 1, static_cast<std::size_t>((turn_position - static_cast<double>(k)) * bins));
+    const double fraction = turn_position - static_cast<double>(k);
+    const auto b = std::min(nb - 1, static_cast<std::size_t>(fraction * bins));
     sum[k * nb + b] += z[i];
+    position[k * nb + b] += fraction;
     ++count[k * nb + b];
   }
-  const int parameters = 3 + 2 * harmonics;
-  const auto design_row = [&](std::size_t b, auto&& row) {
-    const double s = (static_cast<double>(b) + 0.5) / bins;
-    const double theta = 2.0 * std::numbers::pi * s;
-    row(0) = 1.0;
-    row(1) = s - 0.5;
-    row(2) = (s - 0.5) * (s - 0.5);
-    for (int h = 1; h <= harmonics; ++h) {
-      row(1 + 2 * h) = std::cos(h * theta);
-      row(2 + 2 * h) = std::sin(h * theta);
-    }
-  };
-  // Most turns have every bin filled: their least-squares solution is one precomputed matrix.
-  Eigen::MatrixXd full_design(static_cast<Eigen::Index>(nb), parameters);
-  for (std::size_t b = 0; b < nb; ++b) design_row(b, full_design.row(static_cast<Eigen::Index>(b)));
-  const Eigen::MatrixXd full_solver = full_design.completeOrthogonalDecomposition().pseudoInverse();
-
+  // Each bin enters at the mean position of its own samples, not at its centre: with a
+  // non-integer number of samples per bin the two differ, and the arc's slope through a turn
+  // would turn that difference into a phase that drifts along the axis.
+  const int parameters = kTrendTerms + 2 * harmonics;
+  const auto window = static_cast<std::size_t>(kTurnsPerWindow);
+  // A long scan pins the speed far better than needed: spread at most kMaxWindows windows over it.
+  const std::size_t available = turns / window;
+  const std::size_t stride = window * std::max<std::size_t>(1, (available + kMaxWindows - 1) / kMaxWindows);
   std::vector<TurnHarmonics> result;
-  for (std::size_t k = 0; k < turns; ++k) {
-    std::vector<std::size_t> filled;
-    for (std::size_t b = 0; b < nb; ++b) {
-      if (count[k * nb + b] > 0) filled.push_back(b);
+  for (std::size_t first = 0; first + window <= turns; first += stride) {
+    std::vector<std::size_t> cells;
+    bool covered = true;
+    for (std::size_t k = first; k < first + window && covered; ++k) {
+      std::size_t filled = 0;
+      for (std::size_t b = 0; b < nb; ++b) {
+        if (count[k * nb + b] > 0) {
+          cells.push_back(k * nb + b);
+          ++filled;
+        }
+      }
+      covered = filled >= 0.9 * static_cast<double>(nb);
     }
-    if (filled.size() < 0.9 * static_cast<double>(nb)) continue;
-    const auto rows = static_cast<Eigen::Index>(filled.size());
+    if (!covered) continue;
+    const auto rows = static_cast<Eigen::Index>(cells.size());
+    Eigen::MatrixXd design(rows, parameters);
     Eigen::VectorXd values(rows);
     for (Eigen::Index r = 0; r < rows; ++r) {
-      const std::size_t b = filled[static_cast<std::size_t>(r)];
-      values(r) = sum[k * nb + b] / count[k * nb + b];
+      const std::size_t cell = cells[static_cast<std::size_t>(r)];
+      const double fraction = position[cell] / count[cell];
+      const double in_window = static_cast<double>(cell / nb - first) + fraction;
+      const double tau = (in_window - 0.5 * kTurnsPerWindow) / kTurnsPerWindow;
+      const double theta = 2.0 * std::numbers::pi * fraction;
+      double power = 1.0;
+      for (int j = 0; j < kTrendTerms; ++j, power *= tau) design(r, j) = power;
+      for (int h = 1; h <= harmonics; ++h) {
+        design(r, kTrendTerms - 2 + 2 * h) = std::cos(h * theta);
+        design(r, kTrendTerms - 1 + 2 * h) = std::sin(h * theta);
+      }
+      values(r) = sum[cell] / count[cell];
     }
-    Eigen::VectorXd p;
-    double rss = 0.0;
-    if (filled.size() == nb) {
-      p = full_solver * values;
-      rss = (full_design * p - values).squaredNorm();
-    } else {
-      Eigen::MatrixXd design(rows, parameters);
-      for (Eigen::Index r = 0; r < rows; ++r) design_row(filled[static_cast<std::size_t>(r)], design.row(r));
-      p = design.colPivHouseholderQr().solve(values);
-      rss = (design * p - values).squaredNorm();
-    }
+    const Eigen::MatrixXd normal = design.transpose() * design;
+    const Eigen::LDLT<Eigen::MatrixXd> solver(normal);
+    const Eigen::VectorXd p = solver.solve(design.transpose() * values);
+    const Eigen::MatrixXd inverse = solver.solve(Eigen::MatrixXd::Identity(parameters, parameters));
+    const double rss = (design * p - values).squaredNorm();
     TurnHarmonics turn;
-    turn.turn = static_cast<double>(k);
+    turn.turn = static_cast<double>(first) + 0.5 * kTurnsPerWindow;
     turn.residual_sigma = std::sqrt(rss / std::max<double>(1.0, static_cast<double>(rows - parameters)));
-    for (int h = 1; h <= harmonics; ++h) turn.amplitude.emplace_back(p(1 + 2 * h), -p(2 + 2 * h));
+    for (int h = 1; h <= harmonics; ++h) {
+      const int c = kTrendTerms - 2 + 2 * h;
+      turn.amplitude.emplace_back(p(c), -p(c + 1));
+      turn.amplitude_sigma.push_back(turn.residual_sigma * std::sqrt(0.5 * (inverse(c, c) + inverse(c + 1, c + 1))));
+    }
     result.push_back(std::move(turn));
   }
   return result;
@@ -153,16 +174,19 @@ SpindleSpeedEstimate EstimateSpindleSpeed(const acquisition::Scan& scan, std::sp
       return estimate;
     }
     estimate.turns_used = static_cast<int>(turns.size());
-    // Noise of one harmonic amplitude: per-bin residual sigma * sqrt(2 / bins).
-    double residual = 0.0;
-    for (const auto& t : turns) residual += t.residual_sigma * t.residual_sigma;
-    const double amplitude_sigma = std::sqrt(residual / static_cast<double>(turns.size()) * 2.0 / bins);
     std::vector<int> usable;
     for (int h = 1; h <= harmonics; ++h) {
+      const auto index = static_cast<std::size_t>(h - 1);
       double mean_amplitude = 0.0;
-      for (const auto& t : turns) mean_amplitude += std::abs(t.amplitude[static_cast<std::size_t>(h - 1)]);
+      double mean_sigma = 0.0;
+      for (const auto& t : turns) {
+        mean_amplitude += std::abs(t.amplitude[index]);
+        mean_sigma += t.amplitude_sigma[index];
+      }
       mean_amplitude /= static_cast<double>(turns.size());
-      if (mean_amplitude > options.min_harmonic_snr * amplitude_sigma) usable.push_back(h);
+      mean_sigma /= static_cast<double>(turns.size());
+      const double floor_mm = options.min_harmonic_amplitude_um / 1000.0;
+      if (mean_amplitude > std::max(options.min_harmonic_snr * mean_sigma, floor_mm)) usable.push_back(h);
     }
     const bool only_first = usable.size() == 1 && usable.front() == 1;
     if (!only_first) std::erase(usable, 1);
@@ -170,16 +194,24 @@ SpindleSpeedEstimate EstimateSpindleSpeed(const acquisition::Scan& scan, std::sp
       estimate.note = "the wheel shows no harmonic clear of the noise; the nominal speed is used";
       return estimate;
     }
+    std::vector<Drift> drifts;
     double weight_sum = 0.0;
     double weighted = 0.0;
     for (const int h : usable) {
-      const Drift d = PhaseDrift(turns, h);
-      const double w = 1.0 / std::max(d.sigma * d.sigma, 1e-30);
+      drifts.push_back(PhaseDrift(turns, h));
+      const double w = 1.0 / std::max(drifts.back().sigma * drifts.back().sigma, 1e-30);
       weight_sum += w;
-      weighted += w * d.delta;
+      weighted += w * drifts.back().delta;
     }
     const double delta = weighted / weight_sum;
     sigma_relative = std::sqrt(1.0 / weight_sum);
+    // Harmonics that disagree beyond their sigmas reveal model error (what the wheel does that the
+    // per-turn model does not describe): widen the sigma by the Birge ratio.
+    if (drifts.size() > 1) {
+      double chi2 = 0.0;
+      for (const Drift& d : drifts) chi2 += (d.delta - delta) * (d.delta - delta) / std::max(d.sigma * d.sigma, 1e-30);
+      sigma_relative *= std::max(1.0, std::sqrt(chi2 / static_cast<double>(drifts.size() - 1)));
+    }
     rpm *= 1.0 + delta;
     estimate.harmonics_used = static_cast<int>(usable.size());
     estimate.used_first_harmonic = only_first;

@@ -23,6 +23,7 @@ namespace arcwheel::processing {
 struct SpindleSpeedOptions {
   int max_harmonic = 12;            // H, 1..60
   double min_harmonic_snr = 8.0;    // a harmonic is used when its mean amplitude is this many sigmas
+  double min_harmonic_amplitude_um = 0.05;  // ... and at least this large (a phase needs an amplitude)
   double significance_sigmas = 3.0; // the estimate replaces the nominal only beyond this many sigmas
   int iterations = 3;               // re-binning at the improved speed
 };

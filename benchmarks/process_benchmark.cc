@@ -1,0 +1,64 @@
+// End-to-end `process` throughput: read a float32 HDF5 scan, despike, estimate the speed, build the
+// map, fit every phase, write summary.json and wheel_map.h5 (as `arcwheel process` does, less the
+// SHA-256, which runs on the second core there). Peak memory: benchmarks/process_bench.sh.
+
+#include <benchmark/benchmark.h>
+
+#include <filesystem>
+#include <map>
+
+#include "acquisition/scan_reader.h"
+#include "acquisition/simulate.h"
+#include "fitting/outputs.h"
+#include "fitting/wheel_fit.h"
+#include "processing/process_scan.h"
+
+namespace {
+
+namespace fs = std::filesystem;
+using namespace arcwheel;
+
+// A 500 rpm scan of the paper's wheel with 10 us samples; the feed sets the sample count.
+const fs::path& ScanWithSamples(double samples) {
+  static std::map<double, fs::path> cache;
+  auto& path = cache[samples];
+  if (path.empty()) {
+    path = fs::temp_directory_path() / ("arcwheel-bench-" + std::to_string(static_cast<long>(samples)) + ".h5");
+    acquisition::WheelModel wheel;
+    wheel.radial_harmonics_um = {{1, 3.0, 40.0}, {3, 0.8, 15.0}};
+    acquisition::ScanSettings settings;
+    settings.sample_period_s = 10e-6;
+    settings.noise_um = 0.3;
+    settings.spike_rate = 1e-5;
+    const double duration_s = samples * settings.sample_period_s;
+    settings.feed_mm_per_min = (settings.end_y_mm - settings.start_y_mm) / duration_s * 60.0;
+    const auto simulated = acquisition::SimulateScan(wheel, settings);
+    acquisition::WriteHdf5Scan(simulated.scan, true, path.string());
+  }
+  return path;
+}
+
+void BM_ProcessEndToEnd(benchmark::State& state) {
+  const fs::path& scan_path = ScanWithSamples(static_cast<double>(state.range(0)));
+  const fs::path outdir = fs::temp_directory_path() / "arcwheel-bench-out";
+  std::size_t samples = 0;
+  for (auto _ : state) {
+    acquisition::Scan scan = acquisition::ReadScan(scan_path);
+    samples = scan.size();
+    fitting::RunRecord record;
+    record.input_path = scan_path.string();
+    record.metadata = scan.metadata;
+    const auto processed = processing::ProcessScan(std::move(scan), {});
+    const auto fit = fitting::FitWheel(processed.map, {});
+    fitting::WriteProcessOutputs(outdir, record, processed, fit);
+  }
+  state.counters["samples_per_s"] = benchmark::Counter(static_cast<double>(samples) * static_cast<double>(state.iterations()),
+                                                       benchmark::Counter::kIsRate);
+  state.counters["samples"] = static_cast<double>(samples);
+}
+
+BENCHMARK(BM_ProcessEndToEnd)->Arg(1'000'000)->Arg(10'000'000)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+}  // namespace
+
+BENCHMARK_MAIN();

@@ -27,6 +27,9 @@ const std::vector<Command> kCommands = {
     {"simulate", arcwheel::cli::AddSimulateCommand},
     {"process", arcwheel::cli::AddProcessCommand},
     {"fit", arcwheel::cli::AddFitCommand},
+    {"frame", arcwheel::cli::AddFrameCommand},
+    {"transform", arcwheel::cli::AddTransformCommand},
+    {"headcenter", arcwheel::cli::AddHeadcenterCommand},
 };
 
 constexpr const char* kExitCodes =

@@ -9,6 +9,7 @@ namespace arcwheel::cli {
 void AddSimulateCommand(CLI::App& app);
 void AddProcessCommand(CLI::App& app);
 void AddFitCommand(CLI::App& app);
+void AddToolpathCommand(CLI::App& app);
 void AddFrameCommand(CLI::App& app);
 void AddTransformCommand(CLI::App& app);
 void AddHeadcenterCommand(CLI::App& app);

@@ -27,6 +27,7 @@ const std::vector<Command> kCommands = {
     {"simulate", arcwheel::cli::AddSimulateCommand},
     {"process", arcwheel::cli::AddProcessCommand},
     {"fit", arcwheel::cli::AddFitCommand},
+    {"toolpath", arcwheel::cli::AddToolpathCommand},
     {"frame", arcwheel::cli::AddFrameCommand},
     {"transform", arcwheel::cli::AddTransformCommand},
     {"headcenter", arcwheel::cli::AddHeadcenterCommand},

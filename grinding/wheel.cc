@@ -1,0 +1,150 @@
+#include "grinding/wheel.h"
+
+#include <fmt/core.h>
+
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <nlohmann/json.hpp>
+
+#include "core/error.h"
+
+namespace arcwheel::grinding {
+namespace {
+
+constexpr const char* kStage = "grinding.wheel";
+using nlohmann::json;
+
+[[noreturn]] void Bad(const std::filesystem::path& path, const std::string& key,
+                      const std::string& what) {
+  throw Error(ErrorCode::kBadInput, kStage, fmt::format("'{}': key '{}' {}", path.string(), key, what));
+}
+
+double RequiredNumber(const json& object, const std::filesystem::path& path, const std::string& key) {
+  if (!object.contains(key)) Bad(path, key, "is missing");
+  if (!object.at(key).is_number()) Bad(path, key, "must be a number");
+  return object.at(key).get<double>();
+}
+
+std::vector<double> NumberArray(const json& object, const std::filesystem::path& path,
+                                const std::string& key, const std::string& full_key) {
+  if (!object.contains(key) || !object.at(key).is_array()) Bad(path, full_key, "must be an array");
+  std::vector<double> values;
+  for (const json& v : object.at(key)) {
+    values.push_back(v.is_number() ? v.get<double>() : std::nan(""));  // null -> NaN
+  }
+  return values;
+}
+
+void ReadPhases(const json& root, const std::filesystem::path& path, WheelSummary& s) {
+  if (!root.contains("phases") || !root.at("phases").is_object()) return;
+  const json& phases = root.at("phases");
+  const std::vector<double> phase = NumberArray(phases, path, "phase_deg", "phases.phase_deg");
+  const std::vector<double> ra = NumberArray(phases, path, "arc_radius_mm", "phases.arc_radius_mm");
+  const std::vector<double> rb =
+      NumberArray(phases, path, "center_radial_mm", "phases.center_radial_mm");
+  if (ra.size() != phase.size() || rb.size() != phase.size()) {
+    Bad(path, "phases", "arrays differ in length");
+  }
+  std::vector<bool> usable(phase.size(), true);
+  if (phases.contains("usable") && phases.at("usable").is_array() &&
+      phases.at("usable").size() == phase.size()) {
+    for (size_t i = 0; i < phase.size(); ++i) usable[i] = phases.at("usable")[i] == true;
+  }
+  for (size_t i = 0; i < phase.size(); ++i) {
+    if (!usable[i] || !std::isfinite(phase[i]) || !std::isfinite(ra[i]) || !std::isfinite(rb[i])) {
+      continue;
+    }
+    s.phase_deg.push_back(phase[i]);
+    s.arc_radius_mm.push_back(ra[i]);
+    s.center_radial_mm.push_back(rb[i]);
+  }
+}
+
+}  // namespace
+
+double Wheel::ArcRadiusAt(double u_mm) const {
+  if (!HasProfile()) return arc_radius_mm;
+  const auto upper = std::upper_bound(profile_u_mm.begin(), profile_u_mm.end(), u_mm);
+  const size_t k = std::clamp<size_t>(static_cast<size_t>(upper - profile_u_mm.begin()), 1,
+                                      profile_u_mm.size() - 1);
+  const double t = (u_mm - profile_u_mm[k - 1]) / (profile_u_mm[k] - profile_u_mm[k - 1]);
+  const double error_um = profile_error_um[k - 1] + t * (profile_error_um[k] - profile_error_um[k - 1]);
+  return arc_radius_mm + 1e-3 * error_um;
+}
+
+bool Wheel::Reaches(double u_mm) const {
+  if (HasProfile() && (u_mm < profile_u_mm.front() || u_mm > profile_u_mm.back())) return false;
+  return std::abs(u_mm) <= half_width_mm;
+}
+
+std::vector<std::string> Wheel::Problems() const {
+  std::vector<std::string> problems;
+  if (!(arc_radius_mm > 0.0)) {
+    problems.push_back(fmt::format("wheel.arc_radius_mm = {} violates > 0", arc_radius_mm));
+  }
+  if (!(base_radius_mm >= 0.0)) {
+    problems.push_back(fmt::format(
+        "wheel base radius = total radius - arc radius = {} mm violates >= 0", base_radius_mm));
+  }
+  if (!(half_width_mm > 0.0) || half_width_mm > arc_radius_mm) {
+    problems.push_back(fmt::format("wheel.width_mm / 2 = {} violates 0 < width / 2 <= arc radius {}",
+                                   half_width_mm, arc_radius_mm));
+  }
+  if (profile_u_mm.size() != profile_error_um.size() || profile_u_mm.size() == 1) {
+    problems.push_back("wheel mean profile needs matching u_mm and error_um arrays of >= 2 values");
+  }
+  for (size_t i = 0; i < profile_u_mm.size(); ++i) {
+    if (!std::isfinite(profile_u_mm[i]) || (i < profile_error_um.size() && !std::isfinite(profile_error_um[i])) ||
+        (i > 0 && !(profile_u_mm[i] > profile_u_mm[i - 1]))) {
+      problems.push_back(fmt::format(
+          "wheel mean profile node {} is not finite or u_mm is not strictly increasing", i));
+      break;
+    }
+  }
+  return problems;
+}
+
+WheelSummary ReadWheelSummary(const std::filesystem::path& path) {
+  std::ifstream in(path);
+  if (!in) throw Error(ErrorCode::kIo, kStage, fmt::format("cannot open '{}'", path.string()));
+  json root;
+  try {
+    root = json::parse(in);
+  } catch (const json::parse_error& e) {
+    throw Error(ErrorCode::kBadInput, kStage,
+                fmt::format("'{}' is not valid JSON: {}", path.string(), e.what()));
+  }
+  if (!root.is_object()) Bad(path, "(root)", "must be a JSON object");
+  WheelSummary s;
+  s.mean_arc_radius_mm = RequiredNumber(root, path, "mean_arc_radius_mm");
+  if (!(s.mean_arc_radius_mm > 0.0)) Bad(path, "mean_arc_radius_mm", "must be > 0");
+  s.mean_arc_radius_sigma_mm = RequiredNumber(root, path, "mean_arc_radius_sigma_mm");
+  if (root.contains("max_runout_um") && root.at("max_runout_um").is_number()) {
+    s.max_runout_um = root.at("max_runout_um").get<double>();
+  }
+  if (root.contains("scan") && root.at("scan").is_object()) {
+    const json& scan = root.at("scan");
+    if (scan.contains("wheel_diameter_mm") && scan.at("wheel_diameter_mm").is_number()) {
+      s.wheel_diameter_mm = scan.at("wheel_diameter_mm").get<double>();
+    }
+    if (scan.contains("wheel_id") && scan.at("wheel_id").is_string()) {
+      s.wheel_id = scan.at("wheel_id").get<std::string>();
+    }
+  }
+  if (root.contains("arcwheel_version") && root.at("arcwheel_version").is_string()) {
+    s.arcwheel_version = root.at("arcwheel_version").get<std::string>();
+  }
+  if (root.contains("mean_profile") && root.at("mean_profile").is_object()) {
+    const json& profile = root.at("mean_profile");
+    s.profile_u_mm = NumberArray(profile, path, "u_mm", "mean_profile.u_mm");
+    s.profile_error_um = NumberArray(profile, path, "error_um", "mean_profile.error_um");
+    if (s.profile_u_mm.size() != s.profile_error_um.size()) {
+      Bad(path, "mean_profile", "u_mm and error_um differ in length");
+    }
+  }
+  ReadPhases(root, path, s);
+  return s;
+}
+
+}  // namespace arcwheel::grinding

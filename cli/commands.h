@@ -10,6 +10,7 @@ void AddSimulateCommand(CLI::App& app);
 void AddProcessCommand(CLI::App& app);
 void AddFitCommand(CLI::App& app);
 void AddToolpathCommand(CLI::App& app);
+void AddReportCommand(CLI::App& app);
 void AddFrameCommand(CLI::App& app);
 void AddTransformCommand(CLI::App& app);
 void AddHeadcenterCommand(CLI::App& app);

@@ -28,6 +28,7 @@ const std::vector<Command> kCommands = {
     {"process", arcwheel::cli::AddProcessCommand},
     {"fit", arcwheel::cli::AddFitCommand},
     {"toolpath", arcwheel::cli::AddToolpathCommand},
+    {"report", arcwheel::cli::AddReportCommand},
     {"frame", arcwheel::cli::AddFrameCommand},
     {"transform", arcwheel::cli::AddTransformCommand},
     {"headcenter", arcwheel::cli::AddHeadcenterCommand},

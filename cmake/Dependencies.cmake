@@ -23,3 +23,6 @@ if(NOT TARGET arcwheel_hdf5)
   add_library(arcwheel::hdf5 ALIAS arcwheel_hdf5)
 endif()
 
+# cairo draws the report plots to SVG, PNG and PDF from one drawing code (reports/).
+find_package(PkgConfig REQUIRED)
+pkg_check_modules(CAIRO REQUIRED IMPORTED_TARGET cairo)

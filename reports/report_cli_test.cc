@@ -1,0 +1,118 @@
+// `arcwheel report` as a user runs it: on a fixture folder, on broken folders, and end to end
+// after `arcwheel simulate` and `arcwheel process`.
+
+#include <fmt/format.h>
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include <fstream>
+#include <sstream>
+
+#include "core/testing/testing.h"
+#include "reports/report_fixture.h"
+
+namespace arcwheel::reports {
+namespace {
+
+namespace fs = std::filesystem;
+using ::testing::HasSubstr;
+using arcwheel::testing::ListFolder;
+using arcwheel::testing::RunArcwheel;
+using arcwheel::testing::TempDir;
+
+std::string ReadText(const fs::path& path) {
+  std::ifstream stream(path, std::ios::binary);
+  std::ostringstream text;
+  text << stream.rdbuf();
+  return text.str();
+}
+
+std::string PdfText(const fs::path& pdf) {
+  const fs::path text = fs::path(pdf).replace_extension(".txt");
+  const std::string command = "pdftotext -enc UTF-8 '" + pdf.string() + "' '" + text.string() + "'";
+  EXPECT_EQ(std::system(command.c_str()), 0) << command;
+  std::string contents = ReadText(text);
+  fs::remove(text);
+  return contents;
+}
+
+TEST(ReportCommand, WritesBothReportsAndJudgesAToleranceFile) {
+  TempDir dir;
+  testing::WriteFixture(dir / "out", {.n_phase = 36, .n_y = 81});
+  std::ofstream(dir / "tol.json") << R"({"max_runout_um": 7.5, "max_roundness_um": {"max": 3.0}})";
+  const auto result = RunArcwheel("report '" + (dir / "out").string() + "' --tolerances '" + (dir / "tol.json").string() + "'");
+  ASSERT_EQ(result.exit_status, 0) << result.output;
+  EXPECT_THAT(result.output, HasSubstr("overall: FAIL")) << "roundness 3.47 um > 3.0 um";
+  EXPECT_EQ(ListFolder(dir / "out"), "report.html\nreport.pdf\nsummary.json\nwheel_map.h5\n");
+  const std::string text = PdfText(dir / "out" / "report.pdf");
+  EXPECT_THAT(text, HasSubstr("7.13 µm"));
+  EXPECT_THAT(text, HasSubstr("≤ 7.5 µm"));
+}
+
+TEST(ReportCommand, FlagsOverrideTheToleranceFile) {
+  TempDir dir;
+  testing::WriteFixture(dir / "out", {.n_phase = 36, .n_y = 81});
+  std::ofstream(dir / "tol.json") << R"({"max_roundness_um": 3.0})";
+  const auto result = RunArcwheel("report '" + (dir / "out").string() + "' --tolerances '" + (dir / "tol.json").string() +
+                                  "' --tolerance max_roundness_um=3.5");
+  ASSERT_EQ(result.exit_status, 0) << result.output;
+  EXPECT_THAT(result.output, HasSubstr("overall: PASS"));
+}
+
+TEST(ReportCommand, RefusesAFolderWithoutSummaryAndWritesNothing) {
+  TempDir dir;
+  const auto result = RunArcwheel("report '" + dir.path().string() + "'");
+  EXPECT_EQ(result.exit_status, 4) << result.output;
+  EXPECT_THAT(result.output, HasSubstr((dir / "summary.json").string() + "' does not exist"));
+  EXPECT_EQ(ListFolder(dir.path()), "");
+}
+
+TEST(ReportCommand, RefusesASummaryMissingAKeyAndWritesNothing) {
+  TempDir dir;
+  nlohmann::json summary = testing::FixtureSummary({.n_phase = 12, .n_y = 21});
+  summary.erase("mean_arc_radius_sigma_mm");
+  testing::WriteFixture(dir.path(), {.n_phase = 12, .n_y = 21}, summary);
+  const auto result = RunArcwheel("report '" + dir.path().string() + "'");
+  EXPECT_EQ(result.exit_status, 3) << result.output;
+  EXPECT_THAT(result.output, HasSubstr("summary.json' key 'mean_arc_radius_sigma_mm' is missing"));
+  EXPECT_EQ(ListFolder(dir.path()), "summary.json\nwheel_map.h5\n");
+}
+
+TEST(ReportCommand, RefusesAMalformedToleranceFlag) {
+  TempDir dir;
+  testing::WriteFixture(dir.path(), {.n_phase = 12, .n_y = 21});
+  const auto result = RunArcwheel("report '" + dir.path().string() + "' --tolerance runout=3");
+  EXPECT_EQ(result.exit_status, 2) << result.output;
+  EXPECT_THAT(result.output, HasSubstr("tolerance 'runout=3'"));
+  EXPECT_EQ(ListFolder(dir.path()), "summary.json\nwheel_map.h5\n");
+}
+
+TEST(ReportCommand, ReportsASimulatedAndProcessedScanWithTheSummaryNumbers) {
+  TempDir dir;
+  const auto simulated = RunArcwheel("simulate '" + (dir / "scan.h5").string() + "' --noise-um 0.5 --spike-rate 0.0005");
+  ASSERT_EQ(simulated.exit_status, 0) << simulated.output;
+  const auto processed = RunArcwheel("process '" + (dir / "scan.h5").string() + "' -o '" + (dir / "out").string() + "' -q");
+  ASSERT_EQ(processed.exit_status, 0) << processed.output;
+  const auto reported = RunArcwheel("report '" + (dir / "out").string() + "' --tolerance max_runout_um=1000");
+  ASSERT_EQ(reported.exit_status, 0) << reported.output;
+
+  // The headline numbers as summary.json has them, printed at the report's documented precision.
+  const nlohmann::json summary = nlohmann::json::parse(ReadText(dir / "out" / "summary.json"));
+  const std::string text = PdfText(dir / "out" / "report.pdf");
+  EXPECT_THAT(text, HasSubstr(fmt::format("{:.5f} ± {:.5f} mm", summary["mean_arc_radius_mm"].get<double>(),
+                                          summary["mean_arc_radius_sigma_mm"].get<double>())));
+  EXPECT_THAT(text, HasSubstr(fmt::format("{:.4f} mm", summary["arc_radius_range_mm"].get<double>())));
+  EXPECT_THAT(text, HasSubstr(fmt::format("{:.3f} %", summary["arc_radius_fluctuation_pct"].get<double>())));
+  EXPECT_THAT(text, HasSubstr(fmt::format("{:.4f} mm", summary["center_axial_deviation_mm"].get<double>())));
+  for (const char* key : {"max_arc_error_um", "max_runout_um", "max_roundness_um"}) {
+    EXPECT_THAT(text, HasSubstr(fmt::format("{:.2f} µm", summary[key].get<double>()))) << key;
+  }
+  EXPECT_THAT(text, HasSubstr(summary["input"]["sha256"].get<std::string>()));
+  EXPECT_THAT(text, HasSubstr("Overall: PASS"));
+  const std::string html = ReadText(dir / "out" / "report.html");
+  EXPECT_THAT(html, HasSubstr(fmt::format("{:.2f} µm", summary["max_runout_um"].get<double>())));
+}
+
+}  // namespace
+}  // namespace arcwheel::reports

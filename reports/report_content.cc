@@ -1,0 +1,381 @@
+#include "reports/report_content.h"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "core/version.h"
+
+namespace arcwheel::reports {
+namespace {
+
+using nlohmann::json;
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+struct HeadlineSpec {
+  const char* key;
+  const char* label;
+  const char* unit;
+  int decimals;
+};
+
+// Same order as kHeadlineKeys.
+constexpr std::array<HeadlineSpec, 7> kHeadline = {{
+    {"mean_arc_radius_mm", "Mean arc radius (± 1σ)", "mm", 5},
+    {"arc_radius_range_mm", "Arc radius range (max − min)", "mm", 4},
+    {"arc_radius_fluctuation_pct", "Arc radius fluctuation (range / mean)", "%", 3},
+    {"center_axial_deviation_mm", "Arc centre axial deviation (max − min)", "mm", 4},
+    {"max_arc_error_um", "Max arc error in the band", "µm", 2},
+    {"max_runout_um", "Max runout in the band", "µm", 2},
+    {"max_roundness_um", "Max roundness in the band", "µm", 2},
+}};
+
+double HeadlineValue(const Summary& s, const std::string& key) {
+  if (key == "mean_arc_radius_mm") return s.mean_arc_radius_mm;
+  if (key == "arc_radius_range_mm") return s.arc_radius_range_mm;
+  if (key == "arc_radius_fluctuation_pct") return s.arc_radius_fluctuation_pct;
+  if (key == "center_axial_deviation_mm") return s.center_axial_deviation_mm;
+  if (key == "max_arc_error_um") return s.max_arc_error_um;
+  if (key == "max_runout_um") return s.max_runout_um;
+  return s.max_roundness_um;
+}
+
+std::string WithUnit(const std::string& number, const char* unit) {
+  return number == "n/a" ? number : number + " " + unit;
+}
+
+// Limits are shown as given (shortest form that reads back exactly), not rounded.
+std::string LimitText(const Limit& limit, const HeadlineSpec& spec) {
+  const std::string unit = spec.unit;
+  if (limit.min && limit.max) return fmt::format("{} … {} {}", *limit.min, *limit.max, unit);
+  if (limit.max) return fmt::format("≤ {} {}", *limit.max, unit);
+  return fmt::format("≥ {} {}", *limit.min, unit);
+}
+
+std::vector<HeadlineRow> HeadlineRows(const Summary& summary, const Tolerances& tolerances) {
+  std::vector<HeadlineRow> rows;
+  for (const HeadlineSpec& spec : kHeadline) {
+    HeadlineRow row;
+    row.key = spec.key;
+    row.label = spec.label;
+    const double value = HeadlineValue(summary, spec.key);
+    row.value = WithUnit(FormatNumber(value, spec.decimals), spec.unit);
+    if (row.key == "mean_arc_radius_mm" && std::isfinite(value)) {
+      row.value = FormatNumber(value, spec.decimals) + " ± " + FormatNumber(summary.mean_arc_radius_sigma_mm, spec.decimals) + " mm";
+    }
+    std::optional<Limit> limit;
+    if (const auto it = tolerances.limits.find(row.key); it != tolerances.limits.end()) limit = it->second;
+    row.tolerance = limit ? LimitText(*limit, spec) : "-";
+    row.verdict = Judge(value, limit);
+    rows.push_back(row);
+  }
+  return rows;
+}
+
+Verdict Overall(const std::vector<HeadlineRow>& rows) {
+  Verdict overall = Verdict::kNoTolerance;
+  for (const HeadlineRow& row : rows) {
+    if (row.verdict == Verdict::kFail) return Verdict::kFail;
+    if (row.verdict == Verdict::kPass) overall = Verdict::kPass;
+  }
+  return overall;
+}
+
+std::string ScanText(const json& scan, const char* key) {
+  const auto it = scan.find(key);
+  if (it == scan.end() || it->is_null()) return "not recorded";
+  if (it->is_string()) return it->get<std::string>().empty() ? "not recorded" : it->get<std::string>();
+  return it->dump();
+}
+
+std::string ScanNumber(const json& scan, const char* key, int decimals, const char* unit) {
+  const auto it = scan.find(key);
+  if (it == scan.end() || !it->is_number()) return "not recorded";
+  return FormatNumber(it->get<double>(), decimals) + " " + unit;
+}
+
+std::vector<KeyValue> Provenance(const ReportInputs& inputs) {
+  const Summary& s = inputs.summary;
+  const InputProvenance& in = s.input;
+  const double valid_pct = in.samples > 0 ? 100.0 * static_cast<double>(in.valid_samples) / static_cast<double>(in.samples) : kNaN;
+  std::string estimated = FormatNumber(s.spindle_rpm_estimated, 2) + " rpm";
+  if (!s.spindle_rpm_source.empty()) estimated += " (used: " + s.spindle_rpm_source + ")";
+  std::vector<KeyValue> rows = {
+      {"Wheel id", ScanText(s.scan, "wheel_id")},
+      {"Scan date/time", ScanText(s.scan, "timestamp")},
+      {"Sensor", ScanText(s.scan, "sensor")},
+      {"Operator", ScanText(s.scan, "operator")},
+      {"Spindle speed, nominal", FormatNumber(s.spindle_rpm_nominal, 2) + " rpm"},
+      {"Spindle speed, estimated", estimated},
+      {"Feed", ScanNumber(s.scan, "feed_mm_per_min", 3, "mm/min")},
+      {"Sample period", ScanNumber(s.scan, "sample_period_s", 7, "s")},
+      {"Samples", fmt::format("{}", in.samples)},
+      {"Valid samples", fmt::format("{} ({}%)", in.valid_samples, FormatNumber(valid_pct, 2))},
+      {"Despiked samples", fmt::format("{}", in.despiked_samples)},
+      {"Band used (axial)", FormatNumber(s.band_low_mm, 3) + " … " + FormatNumber(s.band_high_mm, 3) +
+                                " mm (half width " + FormatNumber(s.band_half_width_mm, 3) + " mm)"},
+      {"Map", fmt::format("{} phases × {} axial nodes", inputs.map.n_phase(), inputs.map.n_y())},
+  };
+  if (std::isfinite(s.noise_sigma_um)) rows.push_back({"Measurement noise (1σ)", FormatNumber(s.noise_sigma_um, 3) + " µm"});
+  if (std::isfinite(s.map_sigma_um)) rows.push_back({"Map value noise (median 1σ)", FormatNumber(s.map_sigma_um, 3) + " µm"});
+  rows.push_back({"Input file", in.path + (in.format.empty() ? "" : " (" + in.format + ")")});
+  rows.push_back({"Input SHA-256", in.sha256});
+  rows.push_back({"Processed by", "arcwheel " + s.arcwheel_version});
+  rows.push_back({"Report by", std::string("arcwheel ") + kVersion});
+  return rows;
+}
+
+void Flatten(const json& value, const std::string& prefix, std::vector<KeyValue>& out) {
+  if (value.is_object() && !value.empty()) {
+    for (const auto& [key, child] : value.items()) Flatten(child, prefix.empty() ? key : prefix + "." + key, out);
+    return;
+  }
+  out.push_back({prefix, value.is_string() ? value.get<std::string>() : value.dump()});
+}
+
+// Per-phase values with unusable phases blanked, so that plots show gaps instead of outliers.
+std::vector<double> UsableOnly(const std::vector<double>& values, const std::vector<bool>& usable) {
+  std::vector<double> out(values);
+  for (std::size_t i = 0; i < out.size(); ++i) {
+    if (!usable[i]) out[i] = kNaN;
+  }
+  return out;
+}
+
+double FiniteMean(const std::vector<double>& values) {
+  double sum = 0.0;
+  int count = 0;
+  for (double v : values) {
+    if (std::isfinite(v)) {
+      sum += v;
+      ++count;
+    }
+  }
+  return count == 0 ? kNaN : sum / count;
+}
+
+plot::Axis FreeAxis(const std::string& label) {
+  plot::Axis axis;
+  axis.label = label;
+  return axis;
+}
+
+const plot::Axis kPhaseAxis{"phase c (deg)", 0.0, 360.0};
+const plot::Axis kAxialAxis = FreeAxis("axial position y (mm)");
+
+ReportFigure FormErrorMap(const ReportInputs& inputs) {
+  plot::HeatMap map;
+  map.title = "Form error map (measured minus mean wheel)";
+  map.x = FreeAxis("phase c (deg)");
+  map.y = kAxialAxis;
+  map.n_x = inputs.map.n_phase();
+  map.n_y = inputs.map.n_y();
+  map.values = inputs.map.form_error_um;
+  map.x_nodes = inputs.map.phase_deg;
+  map.y_nodes = inputs.map.y_mm;
+  map.colour_bar_label = "form error (µm)";
+  return {"Unwrapped form-error map: radial deviation of the wheel from the circle of mean radius and mean "
+          "centre, by phase and axial position (colour range: 0.5 to 99.5 percentile; grey: no value).",
+          map, 0.5};
+}
+
+ReportFigure RadiusPlot(const PhaseSeries& p) {
+  plot::Series series{"arc radius Ra", p.phase_deg, UsableOnly(p.arc_radius_mm, p.usable), {}, {}, plot::SeriesColour(0)};
+  for (std::size_t i = 0; i < p.phase_deg.size(); ++i) {
+    series.band_low.push_back(series.y[i] - p.arc_radius_sigma_mm[i]);
+    series.band_high.push_back(series.y[i] + p.arc_radius_sigma_mm[i]);
+  }
+  plot::LinePlot plot{"Arc radius vs phase (shaded: ± 1σ)", kPhaseAxis, FreeAxis("arc radius Ra (mm)"), {series}, {}};
+  return {"Arc radius of each axial section, with its 1-sigma band.", plot, 0.42};
+}
+
+ReportFigure CentrePlot(const PhaseSeries& p) {
+  auto deviation_um = [&p](const std::vector<double>& values) {
+    std::vector<double> usable = UsableOnly(values, p.usable);
+    const double mean = FiniteMean(usable);
+    for (double& v : usable) v = (v - mean) * 1000.0;
+    return std::pair{usable, mean};
+  };
+  const auto [axial, mean_axial] = deviation_um(p.center_axial_mm);
+  const auto [radial, mean_radial] = deviation_um(p.center_radial_mm);
+  plot::LinePlot plot{"Arc centre vs phase (deviation from its mean)",
+                      kPhaseAxis,
+                      FreeAxis("centre deviation (µm)"),
+                      {{"axial a − mean", p.phase_deg, axial, {}, {}, plot::SeriesColour(0)},
+                       {"radial b − mean", p.phase_deg, radial, {}, {}, plot::SeriesColour(1), false, true}},
+                      {}};
+  return {fmt::format("Arc centre position by phase: axial a (mean {} mm) and radial b (mean {} mm).",
+                      FormatNumber(mean_axial, 4), FormatNumber(mean_radial, 4)),
+          plot, 0.42};
+}
+
+ReportFigure ArcErrorPlot(const PhaseSeries& p) {
+  plot::LinePlot plot{"Arc error vs phase",
+                      kPhaseAxis,
+                      FreeAxis("arc error, peak-to-valley (µm)"),
+                      {{"arc error", p.phase_deg, UsableOnly(p.arc_error_um, p.usable), {}, {}, plot::SeriesColour(2)}},
+                      {}};
+  return {"Peak-to-valley of each section's residuals against its own fitted circle, inside the band.", plot, 0.42};
+}
+
+ReportFigure RunoutPlot(const Summary& s) {
+  plot::LinePlot plot{"Runout and roundness vs axial position",
+                      kAxialAxis,
+                      FreeAxis("runout, roundness (µm)"),
+                      {{"runout", s.axial.y_mm, s.axial.runout_um, {}, {}, plot::SeriesColour(0)},
+                       {"roundness", s.axial.y_mm, s.axial.roundness_um, {}, {}, plot::SeriesColour(1), false, true}},
+                      {{s.band_low_mm, s.band_high_mm, "band"}}};
+  return {"Total indicated runout (max − min over a turn) and roundness (after removing the least-squares "
+          "circle) at each axial node of the band.",
+          plot, 0.42};
+}
+
+// Usable phases of largest and smallest arc radius; npos if none is usable.
+std::pair<std::size_t, std::size_t> ExtremePhases(const PhaseSeries& p) {
+  std::size_t largest = std::string::npos;
+  std::size_t smallest = std::string::npos;
+  for (std::size_t i = 0; i < p.arc_radius_mm.size(); ++i) {
+    if (!p.usable[i] || !std::isfinite(p.arc_radius_mm[i])) continue;
+    if (largest == std::string::npos || p.arc_radius_mm[i] > p.arc_radius_mm[largest]) largest = i;
+    if (smallest == std::string::npos || p.arc_radius_mm[i] < p.arc_radius_mm[smallest]) smallest = i;
+  }
+  return {largest, smallest};
+}
+
+// The fitted arc of phase `k` over the band, on the branch (above or below the centre) on which
+// the measured section lies.
+plot::Series FittedArc(const ReportInputs& inputs, std::size_t k, const std::string& label, plot::Rgb colour) {
+  const PhaseSeries& p = inputs.summary.phases;
+  const double a = p.center_axial_mm[k], b = p.center_radial_mm[k], radius = p.arc_radius_mm[k];
+  double side = 0.0;
+  for (std::size_t j = 0; j < inputs.map.n_y(); ++j) {
+    const double rho = inputs.map.rho_mm[k * inputs.map.n_y() + j];
+    if (std::isfinite(rho)) side += rho - b;
+  }
+  plot::Series arc{label, {}, {}, {}, {}, colour, false, true};
+  constexpr int kPoints = 200;
+  const double low = inputs.summary.band_low_mm, high = inputs.summary.band_high_mm;
+  for (int i = 0; i <= kPoints; ++i) {
+    const double y = low + (high - low) * i / kPoints;
+    const double under_root = radius * radius - (y - a) * (y - a);
+    arc.x.push_back(y);
+    arc.y.push_back(under_root < 0.0 ? kNaN : b + std::copysign(std::sqrt(under_root), side));
+  }
+  return arc;
+}
+
+plot::Series MeasuredSection(const ReportInputs& inputs, std::size_t k, const std::string& label, plot::Rgb colour) {
+  plot::Series section{label, inputs.map.y_mm, {}, {}, {}, colour, true};
+  section.y.assign(inputs.map.rho_mm.begin() + static_cast<std::ptrdiff_t>(k * inputs.map.n_y()),
+                   inputs.map.rho_mm.begin() + static_cast<std::ptrdiff_t>((k + 1) * inputs.map.n_y()));
+  return section;
+}
+
+std::vector<ReportFigure> SectionFigures(const ReportInputs& inputs) {
+  const PhaseSeries& p = inputs.summary.phases;
+  const auto [largest, smallest] = ExtremePhases(p);
+  if (largest == std::string::npos) return {};
+  auto name = [&p](std::size_t k, const char* which) {
+    return fmt::format("c = {} deg ({})", FormatNumber(p.phase_deg[k], 1), which);
+  };
+  const std::string large = name(largest, "largest Ra"), small = name(smallest, "smallest Ra");
+  const plot::XSpan band{inputs.summary.band_low_mm, inputs.summary.band_high_mm, "band"};
+  plot::LinePlot sections{"Measured sections and fitted arcs",
+                          kAxialAxis,
+                          FreeAxis("radial coordinate rho (mm)"),
+                          {MeasuredSection(inputs, largest, large, plot::SeriesColour(0)),
+                           FittedArc(inputs, largest, "fit", plot::SeriesColour(0)),
+                           MeasuredSection(inputs, smallest, small, plot::SeriesColour(1)),
+                           FittedArc(inputs, smallest, "fit", plot::SeriesColour(1))},
+                          {band}};
+  const SectionResidual r_large = SectionResiduals(inputs, largest);
+  const SectionResidual r_small = SectionResiduals(inputs, smallest);
+  plot::LinePlot residuals{"Section residuals against the fitted arc (magnified)",
+                           kAxialAxis,
+                           FreeAxis("residual |p − centre| − Ra (µm)"),
+                           {{large, r_large.y_mm, r_large.residual_um, {}, {}, plot::SeriesColour(0)},
+                            {small, r_small.y_mm, r_small.residual_um, {}, {}, plot::SeriesColour(1), false, true}},
+                           {}};
+  return {{"Axial sections (map nodes, dots) at the phases of largest and smallest arc radius, with their fitted "
+           "arcs over the band.",
+           sections, 0.5},
+          {"Geometric residuals of the same two sections inside the band, in micrometres.", residuals, 0.42}};
+}
+
+ReportFigure CoverageMap(const WheelMapData& map) {
+  plot::CategoryMap coverage;
+  coverage.title = "Coverage and despiking";
+  coverage.x = FreeAxis("phase c (deg)");
+  coverage.y = kAxialAxis;
+  coverage.n_x = map.n_phase();
+  coverage.n_y = map.n_y();
+  coverage.x_nodes = map.phase_deg;
+  coverage.y_nodes = map.y_mm;
+  coverage.categories = {{"samples ok", {0.86, 0.90, 0.94}},
+                         {"some samples despiked", {0.90, 0.62, 0.00}},
+                         {"no valid sample", {0.80, 0.10, 0.10}}};
+  coverage.codes.resize(map.sample_count.size());
+  for (std::size_t i = 0; i < coverage.codes.size(); ++i) {
+    const bool missing = !(map.sample_count[i] > 0.0) || !std::isfinite(map.rho_mm[i]);
+    coverage.codes[i] = missing ? 2 : (map.despiked_count[i] > 0.0 ? 1 : 0);
+  }
+  return {"Map cells by their raw samples: where samples were missing or replaced by despiking (a merged "
+          "display pixel shows its worst cell).",
+          coverage, 0.5};
+}
+
+}  // namespace
+
+std::string FormatNumber(double value, int decimals) {
+  if (!std::isfinite(value)) return "n/a";
+  std::string text = fmt::format("{:.{}f}", value, decimals);
+  if (text.find_first_not_of("-0.") == std::string::npos) text = fmt::format("{:.{}f}", 0.0, decimals);
+  return text;
+}
+
+std::string VerdictText(Verdict verdict) {
+  switch (verdict) {
+    case Verdict::kPass:
+      return "PASS";
+    case Verdict::kFail:
+      return "FAIL";
+    default:
+      return "NO TOLERANCE";
+  }
+}
+
+SectionResidual SectionResiduals(const ReportInputs& inputs, std::size_t phase_index) {
+  const PhaseSeries& p = inputs.summary.phases;
+  const double a = p.center_axial_mm[phase_index], b = p.center_radial_mm[phase_index];
+  const double radius = p.arc_radius_mm[phase_index];
+  SectionResidual residual;
+  for (std::size_t j = 0; j < inputs.map.n_y(); ++j) {
+    const double y = inputs.map.y_mm[j];
+    if (y < inputs.summary.band_low_mm || y > inputs.summary.band_high_mm) continue;
+    const double rho = inputs.map.rho_mm[phase_index * inputs.map.n_y() + j];
+    residual.y_mm.push_back(y);
+    residual.residual_um.push_back((std::hypot(y - a, rho - b) - radius) * 1000.0);
+  }
+  return residual;
+}
+
+ReportContent ComposeReport(const ReportInputs& inputs, const Tolerances& tolerances) {
+  const Summary& s = inputs.summary;
+  ReportContent content;
+  const std::string wheel = ScanText(s.scan, "wheel_id");
+  content.title = "Wheel inspection report: " + (wheel == "not recorded" ? std::string("wheel id not recorded") : wheel);
+  content.provenance = Provenance(inputs);
+  content.headline = HeadlineRows(s, tolerances);
+  content.overall = Overall(content.headline);
+  content.figures = {FormErrorMap(inputs), RadiusPlot(s.phases), CentrePlot(s.phases), ArcErrorPlot(s.phases),
+                     RunoutPlot(s)};
+  for (ReportFigure& figure : SectionFigures(inputs)) content.figures.push_back(std::move(figure));
+  content.figures.push_back(CoverageMap(inputs.map));
+  if (!s.processing.empty()) Flatten(s.processing, "", content.processing);
+  content.warnings = s.warnings;
+  return content;
+}
+
+}  // namespace arcwheel::reports

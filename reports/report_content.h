@@ -1,0 +1,64 @@
+#pragma once
+// What a wheel report says, independent of its format: the HTML and PDF renderers
+// (reports/report.h) lay out the same ReportContent.
+
+#include <string>
+#include <vector>
+
+#include "reports/plot.h"
+#include "reports/report_inputs.h"
+#include "reports/tolerances.h"
+
+namespace arcwheel::reports {
+
+struct KeyValue {
+  std::string key;
+  std::string value;
+};
+
+// One row of the headline table. Numbers are shown at fixed precision: lengths in mm with 4
+// decimals (0.1 um; the mean arc radius and its 1-sigma with 5), um values with 2, percentages
+// with 3. A number that could not be computed shows as "n/a".
+struct HeadlineRow {
+  std::string key;        // summary.json key, e.g. "max_runout_um"
+  std::string label;      // e.g. "Max runout in the band"
+  std::string value;      // e.g. "7.25 µm"
+  std::string tolerance;  // e.g. "≤ 10.00 µm", or "-" without one
+  Verdict verdict = Verdict::kNoTolerance;
+};
+
+struct ReportFigure {
+  std::string caption;
+  plot::Figure figure;
+  double height_over_width = 0.45;  // aspect ratio the renderers keep
+};
+
+struct ReportContent {
+  std::string title;                  // "Wheel inspection report: WHEEL-ID"
+  std::vector<KeyValue> provenance;   // wheel, scan settings, input file and SHA-256, versions
+  std::vector<HeadlineRow> headline;  // in kHeadlineKeys order
+  Verdict overall = Verdict::kNoTolerance;  // kFail if any row fails, kPass if some pass and none fail
+  std::vector<ReportFigure> figures;
+  std::vector<KeyValue> processing;  // summary.json "processing", flattened to dotted keys
+  std::vector<std::string> warnings;
+};
+
+// Builds the report from the two inputs and the tolerances. Pure: no I/O.
+[[nodiscard]] ReportContent ComposeReport(const ReportInputs& inputs, const Tolerances& tolerances);
+
+// "PASS", "FAIL" or "NO TOLERANCE".
+[[nodiscard]] std::string VerdictText(Verdict verdict);
+
+// `value` with `decimals` decimals, or "n/a" when not finite.
+[[nodiscard]] std::string FormatNumber(double value, int decimals);
+
+// Geometric residuals |p - centre| - Ra, in um, of the section at map phase row `phase_index`
+// against the circle (center_axial_mm, center_radial_mm, arc_radius_mm) of that phase, for the
+// map's axial nodes inside [band_low_mm, band_high_mm]. NaN where the map has no value.
+struct SectionResidual {
+  std::vector<double> y_mm;
+  std::vector<double> residual_um;
+};
+[[nodiscard]] SectionResidual SectionResiduals(const ReportInputs& inputs, std::size_t phase_index);
+
+}  // namespace arcwheel::reports

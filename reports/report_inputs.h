@@ -1,0 +1,120 @@
+#pragma once
+// The report stage's reader of what `arcwheel process` writes: OUTDIR/summary.json and
+// OUTDIR/wheel_map.h5, as docs/outputs.md and spec/formats.md section 3 describe them.
+//
+// The report is drawn from these two files alone. Every key and dataset the report uses is
+// checked: a missing file, key or dataset, a value of the wrong type, or arrays of different
+// lengths throw Error{kBadInput} (Error{kIo} for a file that cannot be opened) whose message
+// names the file and the key or dataset. Numbers that `process` could not compute are `null` in
+// JSON and NaN in HDF5; both are read as NaN.
+
+#include <nlohmann/json.hpp>
+
+#include <cstdint>
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace arcwheel::reports {
+
+// summary.json "input": provenance of the scan.
+struct InputProvenance {
+  std::string path;
+  std::string sha256;
+  std::string format;  // "hdf5", "csv", or "" when not recorded
+  std::int64_t samples = 0;
+  std::int64_t valid_samples = 0;
+  std::int64_t despiked_samples = 0;
+};
+
+// summary.json "phases": one entry per phase node, all arrays of equal length.
+struct PhaseSeries {
+  std::vector<double> phase_deg;
+  std::vector<double> arc_radius_mm;
+  std::vector<double> arc_radius_sigma_mm;
+  std::vector<double> center_axial_mm;
+  std::vector<double> center_radial_mm;
+  std::vector<double> arc_error_um;
+  // Optional in the file; all true when absent.
+  std::vector<bool> usable;
+};
+
+// summary.json "axial": one entry per axial node in the band.
+struct AxialSeries {
+  std::vector<double> y_mm;
+  std::vector<double> runout_um;
+  std::vector<double> roundness_um;
+};
+
+struct Summary {
+  std::string arcwheel_version;
+  InputProvenance input;
+  double spindle_rpm_nominal = 0.0;
+  double spindle_rpm_estimated = 0.0;
+  double mean_arc_radius_mm = 0.0;
+  double mean_arc_radius_sigma_mm = 0.0;
+  double arc_radius_range_mm = 0.0;
+  double arc_radius_fluctuation_pct = 0.0;
+  double mean_center_axial_mm = 0.0;
+  double center_axial_deviation_mm = 0.0;
+  double band_half_width_mm = 0.0;
+  double max_arc_error_um = 0.0;
+  double max_runout_um = 0.0;
+  double max_roundness_um = 0.0;
+  // "band_mm" [low, high] when recorded; else mean_center_axial_mm -/+ band_half_width_mm.
+  double band_low_mm = 0.0;
+  double band_high_mm = 0.0;
+  PhaseSeries phases;
+  AxialSeries axial;
+  // "scan" (wheel id, sensor, feed, sample period, ...): an object, empty when not recorded.
+  nlohmann::json scan = nlohmann::json::object();
+  // "processing": every processing parameter as used. Required: the report states how its
+  // numbers were made.
+  nlohmann::json processing = nlohmann::json::object();
+  std::vector<std::string> warnings;
+  // Optional extensions shown in the report when present (NaN when absent).
+  double noise_sigma_um = 0.0;
+  double map_sigma_um = 0.0;
+  std::string spindle_rpm_source;
+};
+
+// wheel_map.h5: the regular map rho(c, y) and its diagnostics. Grids are row-major
+// [n_phase, n_y]: value (i_phase, i_y) is at index i_phase * n_y + i_y.
+struct WheelMapData {
+  std::vector<double> phase_deg;       // /map/phase_deg
+  std::vector<double> y_mm;            // /map/y_mm
+  std::vector<double> rho_mm;          // /map/rho
+  std::vector<double> form_error_um;   // /map/form_error_um
+  std::vector<double> sample_count;    // /map/sample_count
+  std::vector<double> despiked_count;  // /map/despiked_count
+  // Root attributes, empty when absent.
+  std::string arcwheel_version;
+  std::string input_sha256;
+  [[nodiscard]] std::size_t n_phase() const { return phase_deg.size(); }
+  [[nodiscard]] std::size_t n_y() const { return y_mm.size(); }
+};
+
+// Parses summary.json. Throws Error{kIo} if it cannot be read, Error{kBadInput} naming the file
+// and the key for invalid JSON, a missing contract key, a wrong type or unequal array lengths.
+[[nodiscard]] Summary ReadSummary(const std::filesystem::path& path);
+// Same from a string; `name` stands for the file in messages.
+[[nodiscard]] Summary ParseSummary(const std::string& text, const std::string& name);
+
+// Reads wheel_map.h5. Throws Error{kIo} for a missing file, Error{kBadInput} naming the file and
+// dataset for a missing dataset or one whose shape does not match the phase and axial nodes.
+[[nodiscard]] WheelMapData ReadWheelMap(const std::filesystem::path& path);
+
+// Both inputs of a report, checked against each other.
+struct ReportInputs {
+  Summary summary;
+  WheelMapData map;
+  std::filesystem::path summary_path;
+  std::filesystem::path map_path;
+};
+
+// Reads OUTDIR/summary.json and OUTDIR/wheel_map.h5 and checks that they describe the same scan
+// (same input SHA-256 when the map records one, same number of phases). Throws as above.
+[[nodiscard]] ReportInputs ReadReportInputs(const std::filesystem::path& outdir);
+
+}  // namespace arcwheel::reports

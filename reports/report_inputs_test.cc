@@ -1,0 +1,197 @@
+#include "reports/report_inputs.h"
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <fstream>
+
+#include "core/error.h"
+#include "core/hdf5.h"
+#include "core/testing/testing.h"
+#include "reports/report_fixture.h"
+
+namespace arcwheel::reports {
+namespace {
+
+using ::testing::HasSubstr;
+using testing::FixtureOptions;
+using testing::FixtureSummary;
+using testing::WriteFixture;
+using arcwheel::testing::TempDir;
+
+// Runs `read` and returns the Error it throws; fails the test if it throws nothing.
+template <typename Read>
+Error ErrorOf(const Read& read) {
+  try {
+    read();
+  } catch (const Error& error) {
+    return error;
+  }
+  ADD_FAILURE() << "no Error thrown";
+  return Error(ErrorCode::kInternal, "test", "no error");
+}
+
+TEST(ReadReportInputs, ReadsBackTheFixtureValues) {
+  TempDir dir;
+  const FixtureOptions options{.n_phase = 36, .n_y = 41};
+  WriteFixture(dir.path(), options);
+  const ReportInputs inputs = ReadReportInputs(dir.path());
+  const Summary& s = inputs.summary;
+  EXPECT_EQ(s.arcwheel_version, "0.1.0");
+  EXPECT_EQ(s.input.path, "/data/scans/wheel_W17.h5");
+  EXPECT_EQ(s.input.samples, 2400000);
+  EXPECT_EQ(s.input.despiked_samples, 37);
+  EXPECT_DOUBLE_EQ(s.mean_arc_radius_mm, 75.01234);
+  EXPECT_DOUBLE_EQ(s.max_runout_um, 7.13);
+  EXPECT_DOUBLE_EQ(s.band_low_mm, 2.0);
+  EXPECT_DOUBLE_EQ(s.band_high_mm, 18.0);
+  ASSERT_EQ(s.phases.phase_deg.size(), 36u);
+  EXPECT_DOUBLE_EQ(s.phases.phase_deg[9], 90.0);
+  EXPECT_DOUBLE_EQ(s.phases.arc_radius_mm[9], testing::FixtureArcRadius_mm(90.0));
+  EXPECT_EQ(s.scan.at("wheel_id"), "W17-arc75");
+  EXPECT_EQ(s.processing.at("despike").at("threshold_um"), 5.0);
+  ASSERT_EQ(s.warnings.size(), 1u);
+
+  const WheelMapData& map = inputs.map;
+  ASSERT_EQ(map.n_phase(), 36u);
+  ASSERT_EQ(map.n_y(), 41u);
+  EXPECT_DOUBLE_EQ(map.y_mm[40], 20.0);
+  // rho at (c = 0, y = 10) from the fixture's closed form.
+  const double a = testing::FixtureCenterAxial_mm(0.0);
+  const double ra = testing::FixtureArcRadius_mm(0.0);
+  EXPECT_NEAR(map.rho_mm[20], testing::FixtureCenterRadial_mm(0.0) + std::sqrt(ra * ra - (10.0 - a) * (10.0 - a)), 1e-12);
+  EXPECT_TRUE(std::isnan(map.rho_mm[9 * 41 + 0])) << "missing cell at c = 90, y = 0";
+  EXPECT_EQ(map.sample_count[9 * 41 + 0], 0.0);
+  EXPECT_EQ(map.despiked_count[18 * 41 + 11], 1.0) << "despiked cell at c = 180, y = 5.5";
+  EXPECT_EQ(map.input_sha256, s.input.sha256);
+}
+
+TEST(ReadSummary, ReadsNullAsNaN) {
+  nlohmann::json summary = FixtureSummary({});
+  summary["max_roundness_um"] = nullptr;
+  summary["phases"]["arc_radius_mm"][3] = nullptr;
+  const Summary s = ParseSummary(summary.dump(), "s.json");
+  EXPECT_TRUE(std::isnan(s.max_roundness_um));
+  EXPECT_TRUE(std::isnan(s.phases.arc_radius_mm[3]));
+}
+
+TEST(ReadSummary, RefusesAMissingFileNamingIt) {
+  TempDir dir;
+  const Error error = ErrorOf([&] { (void)ReadSummary(dir / "summary.json"); });
+  EXPECT_EQ(error.code(), ErrorCode::kIo);
+  EXPECT_THAT(error.what(), HasSubstr((dir / "summary.json").string()));
+  EXPECT_THAT(error.what(), HasSubstr("does not exist"));
+}
+
+TEST(ReadSummary, RefusesInvalidJsonNamingTheFile) {
+  const Error error = ErrorOf([] { (void)ParseSummary("{\"arcwheel_version\": ", "out/summary.json"); });
+  EXPECT_EQ(error.code(), ErrorCode::kBadInput);
+  EXPECT_THAT(error.what(), HasSubstr("'out/summary.json' is not valid JSON"));
+}
+
+struct BrokenSummaryCase {
+  const char* name;
+  void (*damage)(nlohmann::json&);
+  const char* expected_message;
+};
+
+class ReadSummaryRefuses : public ::testing::TestWithParam<BrokenSummaryCase> {};
+
+TEST_P(ReadSummaryRefuses, NamingTheKey) {
+  nlohmann::json summary = FixtureSummary({.n_phase = 12, .n_y = 21});
+  GetParam().damage(summary);
+  const Error error = ErrorOf([&] { (void)ParseSummary(summary.dump(), "out/summary.json"); });
+  EXPECT_EQ(error.code(), ErrorCode::kBadInput);
+  EXPECT_THAT(error.what(), HasSubstr(GetParam().expected_message));
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    BadSummaries, ReadSummaryRefuses,
+    ::testing::Values(
+        BrokenSummaryCase{"MissingHeadline", [](nlohmann::json& s) { s.erase("max_runout_um"); },
+                          "'out/summary.json' key 'max_runout_um' is missing"},
+        BrokenSummaryCase{"MissingInputHash", [](nlohmann::json& s) { s["input"].erase("sha256"); },
+                          "key 'input.sha256' is missing"},
+        BrokenSummaryCase{"TextForNumber", [](nlohmann::json& s) { s["mean_arc_radius_mm"] = "75.0"; },
+                          "key 'mean_arc_radius_mm' is not a number (found \"75.0\")"},
+        BrokenSummaryCase{"ShortArray", [](nlohmann::json& s) { s["phases"]["arc_error_um"].erase(0); },
+                          "key 'phases.arc_error_um' has 11 entries, expected 12"},
+        BrokenSummaryCase{"TextInArray", [](nlohmann::json& s) { s["axial"]["runout_um"][2] = "x"; },
+                          "key 'axial.runout_um.2' is not a number"},
+        BrokenSummaryCase{"MissingPhases", [](nlohmann::json& s) { s.erase("phases"); }, "key 'phases' is missing"},
+        BrokenSummaryCase{"MissingProcessing", [](nlohmann::json& s) { s.erase("processing"); },
+                          "key 'processing' is missing"},
+        BrokenSummaryCase{"NegativeCount", [](nlohmann::json& s) { s["input"]["samples"] = -4; },
+                          "key 'input.samples' is not a non-negative integer"},
+        BrokenSummaryCase{"BadUsable", [](nlohmann::json& s) { s["phases"]["usable"][1] = 1; },
+                          "key 'phases.usable.1' is not a boolean"},
+        BrokenSummaryCase{"NotAnObject", [](nlohmann::json& s) { s = nlohmann::json::array(); },
+                          "'out/summary.json' is not a JSON object"}),
+    [](const ::testing::TestParamInfo<BrokenSummaryCase>& param_info) { return std::string(param_info.param.name); });
+
+TEST(ReadWheelMap, RefusesAMissingFileNamingIt) {
+  TempDir dir;
+  const Error error = ErrorOf([&] { (void)ReadWheelMap(dir / "wheel_map.h5"); });
+  EXPECT_EQ(error.code(), ErrorCode::kIo);
+  EXPECT_THAT(error.what(), HasSubstr((dir / "wheel_map.h5").string()));
+}
+
+TEST(ReadWheelMap, RefusesAFileThatIsNotHdf5) {
+  TempDir dir;
+  std::ofstream(dir / "wheel_map.h5") << "not hdf5";
+  const Error error = ErrorOf([&] { (void)ReadWheelMap(dir / "wheel_map.h5"); });
+  EXPECT_EQ(error.code(), ErrorCode::kBadInput);
+  EXPECT_THAT(error.what(), HasSubstr("not an HDF5 file"));
+}
+
+// Writes a 3 x 2 map; `rho_shape` may differ from it, and form_error_um may be left out.
+void WriteMapWith(const std::filesystem::path& path, bool with_form_error, std::vector<hsize_t> rho_shape) {
+  hdf5::File file = hdf5::File::Create(path);
+  file.CreateGroup("/map");
+  file.WriteDoubles("/map/phase_deg", {0.0, 120.0, 240.0}, {3});
+  file.WriteDoubles("/map/y_mm", {0.0, 1.0}, {2});
+  const std::vector<double> grid(rho_shape[0] * rho_shape[1], 1.0);
+  file.WriteDoubles("/map/rho", grid, rho_shape);
+  if (with_form_error) file.WriteDoubles("/map/form_error_um", std::vector<double>(6, 0.0), {3, 2});
+  file.WriteInts("/map/sample_count", std::vector<int>(6, 1), {3, 2});
+  file.WriteInts("/map/despiked_count", std::vector<int>(6, 0), {3, 2});
+}
+
+TEST(ReadWheelMap, RefusesAMissingDatasetNamingIt) {
+  TempDir dir;
+  WriteMapWith(dir / "wheel_map.h5", false, {3, 2});
+  const Error error = ErrorOf([&] { (void)ReadWheelMap(dir / "wheel_map.h5"); });
+  EXPECT_EQ(error.code(), ErrorCode::kBadInput);
+  EXPECT_THAT(error.what(), HasSubstr("wheel_map.h5' dataset '/map/form_error_um' is missing"));
+}
+
+TEST(ReadWheelMap, RefusesAGridOfTheWrongShape) {
+  TempDir dir;
+  WriteMapWith(dir / "wheel_map.h5", true, {2, 3});
+  const Error error = ErrorOf([&] { (void)ReadWheelMap(dir / "wheel_map.h5"); });
+  EXPECT_EQ(error.code(), ErrorCode::kBadInput);
+  EXPECT_THAT(error.what(), HasSubstr("dataset '/map/rho' has shape [2, 3], expected [3, 2]"));
+}
+
+TEST(ReadReportInputs, RefusesASummaryAndMapOfDifferentScans) {
+  TempDir dir;
+  const FixtureOptions options{.n_phase = 12, .n_y = 21};
+  nlohmann::json summary = FixtureSummary(options);
+  summary["input"]["sha256"] = std::string(64, 'a');
+  WriteFixture(dir.path(), options, summary);
+  const Error error = ErrorOf([&] { (void)ReadReportInputs(dir.path()); });
+  EXPECT_EQ(error.code(), ErrorCode::kBadInput);
+  EXPECT_THAT(error.what(), HasSubstr("describe different scans"));
+}
+
+TEST(ReadReportInputs, RefusesAMapWithADifferentPhaseCount) {
+  TempDir dir;
+  WriteFixture(dir.path(), {.n_phase = 12, .n_y = 21}, FixtureSummary({.n_phase = 24, .n_y = 21}));
+  const Error error = ErrorOf([&] { (void)ReadReportInputs(dir.path()); });
+  EXPECT_EQ(error.code(), ErrorCode::kBadInput);
+  EXPECT_THAT(error.what(), HasSubstr("has 12 phases but"));
+}
+
+}  // namespace
+}  // namespace arcwheel::reports

@@ -1,0 +1,138 @@
+#include "reports/tolerances.h"
+
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <sstream>
+
+#include "core/error.h"
+
+namespace arcwheel::reports {
+namespace {
+
+constexpr const char* kStage = "reports.tolerances";
+
+bool IsHeadlineKey(const std::string& key) {
+  return std::find(kHeadlineKeys.begin(), kHeadlineKeys.end(), key) != kHeadlineKeys.end();
+}
+
+std::string KnownKeys() {
+  std::string keys;
+  for (const char* key : kHeadlineKeys) keys += (keys.empty() ? "" : ", ") + std::string(key);
+  return keys;
+}
+
+[[noreturn]] void BadTolerance(ErrorCode code, const std::string& where, const std::string& problem) {
+  throw Error(code, kStage, where + " " + problem);
+}
+
+void CheckOrder(const Limit& limit, ErrorCode code, const std::string& where) {
+  if (limit.min && limit.max && *limit.min > *limit.max) {
+    BadTolerance(code, where, "has min " + std::to_string(*limit.min) + " > max " + std::to_string(*limit.max));
+  }
+}
+
+double FiniteNumber(const nlohmann::json& value, const std::string& where) {
+  if (!value.is_number() || !std::isfinite(value.get<double>())) {
+    BadTolerance(ErrorCode::kBadInput, where, "is not a finite number (found " + value.dump() + ")");
+  }
+  return value.get<double>();
+}
+
+Limit ParseLimit(const nlohmann::json& value, const std::string& where) {
+  Limit limit;
+  if (value.is_number()) {
+    limit.max = FiniteNumber(value, where);
+    return limit;
+  }
+  if (!value.is_object()) BadTolerance(ErrorCode::kBadInput, where, "is neither a number nor {\"min\":..,\"max\":..}");
+  for (const auto& [name, bound] : value.items()) {
+    if (name == "min") {
+      limit.min = FiniteNumber(bound, where + ".min");
+    } else if (name == "max") {
+      limit.max = FiniteNumber(bound, where + ".max");
+    } else {
+      BadTolerance(ErrorCode::kBadInput, where + "." + name, "is not 'min' or 'max'");
+    }
+  }
+  if (!limit.min && !limit.max) BadTolerance(ErrorCode::kBadInput, where, "has neither 'min' nor 'max'");
+  CheckOrder(limit, ErrorCode::kBadInput, where);
+  return limit;
+}
+
+std::optional<double> ParseBound(const std::string& text, const std::string& flag) {
+  if (text.empty()) return std::nullopt;
+  std::size_t used = 0;
+  double value = 0.0;
+  try {
+    value = std::stod(text, &used);
+  } catch (const std::exception&) {
+    used = 0;
+  }
+  if (used != text.size() || !std::isfinite(value)) {
+    BadTolerance(ErrorCode::kInvalidOption, "tolerance '" + flag + "'", "has '" + text + "', which is not a number");
+  }
+  return value;
+}
+
+}  // namespace
+
+Verdict Judge(double value, const std::optional<Limit>& limit) {
+  if (!limit) return Verdict::kNoTolerance;
+  if (!std::isfinite(value)) return Verdict::kFail;
+  if (limit->min && value < *limit->min) return Verdict::kFail;
+  if (limit->max && value > *limit->max) return Verdict::kFail;
+  return Verdict::kPass;
+}
+
+Tolerances ParseTolerances(const std::string& text, const std::string& name) {
+  nlohmann::json root;
+  try {
+    root = nlohmann::json::parse(text);
+  } catch (const nlohmann::json::parse_error& error) {
+    throw Error(ErrorCode::kBadInput, kStage, "'" + name + "' is not valid JSON: " + error.what());
+  }
+  if (!root.is_object()) throw Error(ErrorCode::kBadInput, kStage, "'" + name + "' is not a JSON object");
+  Tolerances tolerances;
+  for (const auto& [key, value] : root.items()) {
+    const std::string where = "'" + name + "' key '" + key + "'";
+    if (!IsHeadlineKey(key)) BadTolerance(ErrorCode::kBadInput, where, "is not a headline quantity (" + KnownKeys() + ")");
+    tolerances.limits[key] = ParseLimit(value, where);
+  }
+  return tolerances;
+}
+
+Tolerances ReadTolerances(const std::filesystem::path& path) {
+  std::ifstream stream(path, std::ios::binary);
+  if (!stream) throw Error(ErrorCode::kIo, kStage, "cannot open '" + path.string() + "'");
+  std::ostringstream contents;
+  contents << stream.rdbuf();
+  return ParseTolerances(contents.str(), path.string());
+}
+
+void AddToleranceFlag(Tolerances& tolerances, const std::string& flag) {
+  const std::size_t equals = flag.find('=');
+  if (equals == std::string::npos) {
+    BadTolerance(ErrorCode::kInvalidOption, "tolerance '" + flag + "'", "is not KEY=MAX or KEY=MIN:MAX");
+  }
+  const std::string key = flag.substr(0, equals);
+  if (!IsHeadlineKey(key)) {
+    BadTolerance(ErrorCode::kInvalidOption, "tolerance '" + flag + "'", "names no headline quantity (" + KnownKeys() + ")");
+  }
+  const std::string bounds = flag.substr(equals + 1);
+  const std::size_t colon = bounds.find(':');
+  Limit limit;
+  if (colon == std::string::npos) {
+    limit.max = ParseBound(bounds, flag);
+  } else {
+    limit.min = ParseBound(bounds.substr(0, colon), flag);
+    limit.max = ParseBound(bounds.substr(colon + 1), flag);
+  }
+  if (!limit.min && !limit.max) BadTolerance(ErrorCode::kInvalidOption, "tolerance '" + flag + "'", "gives no limit");
+  CheckOrder(limit, ErrorCode::kInvalidOption, "tolerance '" + flag + "'");
+  tolerances.limits[key] = limit;
+}
+
+}  // namespace arcwheel::reports

@@ -1,0 +1,52 @@
+#pragma once
+// Tolerances for the headline numbers of a wheel report, and the pass/fail verdict against them.
+//
+// Tolerance file (JSON object), keyed by the summary.json name of the headline quantity:
+//   {"max_arc_error_um": 3.0,                                 // a number: the upper limit
+//    "mean_arc_radius_mm": {"min": 74.95, "max": 75.05},      // or an object with min and/or max
+//    "max_runout_um": {"max": 10}}
+// Keys: mean_arc_radius_mm, arc_radius_range_mm, arc_radius_fluctuation_pct,
+// center_axial_deviation_mm, max_arc_error_um, max_runout_um, max_roundness_um.
+// Command-line form of one limit: "KEY=MAX" or "KEY=MIN:MAX" (either side of ':' may be empty).
+// A value passes when min <= value <= max (limits inclusive, value as recorded in summary.json,
+// its uncertainty not added); a value that could not be computed (null) fails any limit.
+
+#include <array>
+#include <filesystem>
+#include <map>
+#include <optional>
+#include <string>
+
+namespace arcwheel::reports {
+
+struct Limit {
+  std::optional<double> min = std::nullopt;
+  std::optional<double> max = std::nullopt;
+};
+
+// The headline quantities, in report order.
+inline constexpr std::array<const char*, 7> kHeadlineKeys = {
+    "mean_arc_radius_mm",        "arc_radius_range_mm", "arc_radius_fluctuation_pct",
+    "center_axial_deviation_mm", "max_arc_error_um",    "max_runout_um",
+    "max_roundness_um"};
+
+struct Tolerances {
+  std::map<std::string, Limit> limits;  // by headline key; absent = no tolerance
+};
+
+enum class Verdict { kPass, kFail, kNoTolerance };
+
+// Verdict of one value against an optional limit (see the file comment for the rule).
+[[nodiscard]] Verdict Judge(double value, const std::optional<Limit>& limit);
+
+// Parses a tolerance file's text; `name` stands for the file in messages. Throws
+// Error{kBadInput} naming the file and key for invalid JSON, an unknown key, a non-numeric limit
+// or min > max.
+[[nodiscard]] Tolerances ParseTolerances(const std::string& text, const std::string& name);
+// Reads a tolerance file. Throws Error{kIo} if it cannot be read, else as ParseTolerances.
+[[nodiscard]] Tolerances ReadTolerances(const std::filesystem::path& path);
+// Adds (or replaces) one limit given as "KEY=MAX" or "KEY=MIN:MAX". Throws
+// Error{kInvalidOption} quoting the text when it does not parse or names an unknown key.
+void AddToleranceFlag(Tolerances& tolerances, const std::string& flag);
+
+}  // namespace arcwheel::reports

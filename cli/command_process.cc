@@ -15,6 +15,8 @@
 #include "fitting/outputs.h"
 #include "fitting/wheel_fit.h"
 #include "processing/process_scan.h"
+#include "reports/report.h"
+#include "reports/tolerances.h"
 
 namespace arcwheel::cli {
 namespace {
@@ -27,6 +29,8 @@ struct ProcessArgs {
   std::string despike_method = "median";
   std::string rpm_source = "auto";
   std::string fit_span = "band";
+  std::vector<std::string> report_formats;
+  std::string tolerance_file;
   bool quiet = false;
 };
 
@@ -101,6 +105,13 @@ void Run(ProcessArgs& args) {
   fitting::WriteProcessOutputs(args.outdir, record, processed, fit);
   progress.Done();
   if (!args.quiet) PrintHeadline(args, processed, fit);
+  if (!args.report_formats.empty()) {
+    // The report is drawn from the files just written, exactly as `arcwheel report` would.
+    reports::Tolerances tolerances;
+    if (!args.tolerance_file.empty()) tolerances = reports::ReadTolerances(args.tolerance_file);
+    const reports::WrittenReports written = reports::WriteReports(args.outdir, tolerances);
+    if (!args.quiet) fmt::print("report:  {}\n         {}\n", written.html.string(), written.pdf.string());
+  }
 }
 
 }  // namespace
@@ -134,6 +145,11 @@ void AddProcessCommand(CLI::App& app) {
   cmd->add_option("--beam-offset-mm", p.beam_offset_mm, "correct a beam offset from the axis (method.md A.7)")->capture_default_str();
   cmd->add_option("--wheel-radius-mm", p.wheel_radius_mm, "wheel radius for the beam-offset correction");
   cmd->add_option("--min-points", args->fit.min_points, "fewest section points for a usable phase")->capture_default_str();
+  cmd->add_option("--report", args->report_formats, "also render the inspection report: html,pdf (both are written)")
+      ->delimiter(',')
+      ->check(CLI::IsMember({"html", "pdf"}));
+  cmd->add_option("--tolerances", args->tolerance_file, "tolerance file for the report's pass/fail (docs/reports.md)")
+      ->check(CLI::ExistingFile);
   cmd->add_flag("-q,--quiet", args->quiet, "no progress and no headline");
   cmd->callback([args] { Run(*args); });
 }

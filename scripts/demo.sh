@@ -4,4 +4,4 @@ set -euo pipefail
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 "$root/scripts/build.sh"
 out=${1:-"$root/out/demo"}
-"$root/build/cli/arcwheel" process "$root/testdata/paper_wheel_scan.h5" -o "$out"
+"$root/build/cli/arcwheel" process "$root/testdata/paper_wheel_scan.h5" -o "$out" --report html,pdf

@@ -45,6 +45,17 @@ TEST(Cli, SimulateThenProcessWritesTheContractKeys) {
   EXPECT_NEAR(s["max_runout_um"].get<double>(), 8.0, 1.5);
 }
 
+TEST(Cli, ProcessWithReportWritesBothReportsBesideTheOutputs) {
+  TempDir dir;
+  ASSERT_EQ(RunArcwheel("simulate " + (dir / "scan.h5").string() + " --radial-harmonic 1:4").exit_status, 0);
+  const auto run = RunArcwheel("process -q " + (dir / "scan.h5").string() + " -o " + (dir / "out").string() +
+                               " --report html,pdf");
+  ASSERT_EQ(run.exit_status, 0) << run.output;
+  EXPECT_EQ(testing::ListFolder(dir / "out"), "report.html\nreport.pdf\nsummary.json\nwheel_map.h5\n");
+  EXPECT_NE(RunArcwheel("process -q " + (dir / "scan.h5").string() + " -o " + (dir / "x").string() +
+                        " --report docx").exit_status, 0);
+}
+
 TEST(Cli, CsvAndHdf5OfTheSameScanGiveTheSameNumbers) {
   TempDir dir;
   ASSERT_EQ(RunArcwheel("simulate " + (dir / "a.h5").string() + " --float64 --seed 3 --noise-um 0.2").exit_status, 0);

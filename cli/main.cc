@@ -4,6 +4,7 @@
 #include <fmt/core.h>
 
 #include <cstdio>
+#include <cstdlib>
 #include <exception>
 #include <string>
 #include <vector>
@@ -38,6 +39,14 @@ constexpr const char* kExitCodes =
     "Exit status: 0 ok; 1 unknown command or usage; 2 invalid option; 3 bad input file;\n"
     "4 I/O failure (cannot read, write or rename); 5 no usable fit; 70 internal error;\n"
     "130 interrupted (SIGINT/SIGTERM). A failed run leaves no new or partial output file.";
+
+// After a failed write (a full disk) HDF5 keeps the broken file open and its exit handler
+// crashes closing it again. Our own cleanup (temporary files) has run during unwinding, so a failed
+// run ends without the libraries' exit handlers.
+[[noreturn]] void ExitWithoutLibraryCleanup(int status) {
+  std::fflush(nullptr);
+  std::_Exit(status);
+}
 
 }  // namespace
 
@@ -76,11 +85,11 @@ int main(int argc, char** argv) {
   } catch (const arcwheel::Error& error) {
     if (no_catch) throw;
     fmt::print(stderr, "arcwheel: {}: {}\n", arcwheel::ErrorCodeName(error.code()), error.what());
-    return arcwheel::ExitStatus(error.code());
+    ExitWithoutLibraryCleanup(arcwheel::ExitStatus(error.code()));
   } catch (const std::exception& error) {
     if (no_catch) throw;
     fmt::print(stderr, "arcwheel: internal error: {}\n", error.what());
-    return arcwheel::ExitStatus(ErrorCode::kInternal);
+    ExitWithoutLibraryCleanup(arcwheel::ExitStatus(ErrorCode::kInternal));
   }
   return 0;
 }

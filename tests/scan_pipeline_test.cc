@@ -224,6 +224,39 @@ TEST(ScanPipeline, BeamOffsetCorrectionRestoresTheArcRadius) {
   EXPECT_NEAR(corrected.fit.mean_arc_radius_mm, wheel.arc_radius_mm, 2e-4);
 }
 
+TEST(ScanPipeline, SectionsTooShortOrTooSparseAreFlaggedAndLeftOutOfTheMeans) {
+  WheelModel wheel = PaperWheel();
+  wheel.profile_legendre_um.clear();
+  const auto simulated = acquisition::SimulateScan(wheel, PaperScan());
+  processing::ProcessedScan processed = processing::ProcessScan(simulated.scan, {});
+  auto& sections = processed.map.sections;
+  const auto keep_below = [](processing::Section& section, double y_limit) {
+    processing::Section kept;
+    for (std::size_t k = 0; k < section.y_mm.size(); ++k) {
+      if (section.y_mm[k] >= y_limit) continue;
+      kept.y_mm.push_back(section.y_mm[k]);
+      kept.rho_mm.push_back(section.rho_mm[k]);
+      kept.sigma_mm.push_back(section.sigma_mm[k]);
+      kept.u_deg.push_back(section.u_deg[k]);
+    }
+    section = kept;
+  };
+  for (std::size_t j = 10; j < 20; ++j) keep_below(sections[j], -3.0);   // covers 5 of the 16 mm band
+  for (std::size_t j = 30; j < 35; ++j) keep_below(sections[j], -7.5);   // three points or so
+  const fitting::WheelFit fit = fitting::FitWheel(processed.map, {});
+  EXPECT_EQ(fit.usable_phases, 345);
+  double truth_mean = 0.0;
+  for (std::size_t j = 0; j < fit.phases.size(); ++j) {
+    const bool damaged = (j >= 10 && j < 20) || (j >= 30 && j < 35);
+    EXPECT_EQ(fit.phases[j].usable, !damaged) << j;
+    EXPECT_EQ(fit.phases[j].flag.empty(), !damaged) << j << ": " << fit.phases[j].flag;
+    if (!damaged) truth_mean += wheel.ArcRadiusMm(processed.map.phase_deg[j]) / 345.0;
+  }
+  EXPECT_NE(fit.phases[12].flag.find("covers"), std::string::npos) << fit.phases[12].flag;
+  EXPECT_NE(fit.phases[31].flag.find("too few points"), std::string::npos) << fit.phases[31].flag;
+  EXPECT_NEAR(fit.mean_arc_radius_mm, truth_mean, 50e-6);
+}
+
 TEST(ScanPipeline, BurstsOfSpikesAreRemovedBeforeTheFit) {
   WheelModel wheel = PaperWheel();
   wheel.profile_legendre_um.clear();

@@ -1,0 +1,91 @@
+// Faults that must lose nothing: a signal in the middle of processing, and a write that fails part
+// way (the file-size limit stands in for a full disk). Earlier outputs stay intact and no partial
+// or temporary file is left.
+
+#include <gtest/gtest.h>
+#include <signal.h>
+#include <spawn.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cstdlib>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <thread>
+
+#include "core/testing/testing.h"
+
+extern char** environ;
+
+namespace arcwheel {
+namespace {
+
+using testing::RunArcwheel;
+using testing::TempDir;
+
+std::string Slurp(const std::filesystem::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::stringstream contents;
+  contents << in.rdbuf();
+  return contents.str();
+}
+
+// A scan of the paper's settings and a finished run of it in `out`.
+void PrepareEarlierOutputs(const TempDir& dir) {
+  ASSERT_EQ(RunArcwheel("simulate " + (dir / "short.h5").string() + " --noise-um 0.3").exit_status, 0);
+  ASSERT_EQ(RunArcwheel("process -q " + (dir / "short.h5").string() + " -o " + (dir / "out").string()).exit_status, 0);
+}
+
+TEST(Faults, InterruptDuringProcessingLeavesEarlierOutputsIntact) {
+  TempDir dir;
+  PrepareEarlierOutputs(dir);
+  // 4e6 samples: about half a second of processing, interrupted after a quarter.
+  ASSERT_EQ(RunArcwheel("simulate " + (dir / "long.h5").string() +
+                        " --sample-period-s 1e-5 --feed-mm-per-min 33 --noise-um 0.3 --radial-harmonic 1:3")
+                .exit_status,
+            0);
+  const std::string summary_before = Slurp(dir / "out" / "summary.json");
+  const std::string map_before = Slurp(dir / "out" / "wheel_map.h5");
+
+  const std::string binary = std::getenv("ARCWHEEL_BINARY");
+  const std::string scan = (dir / "long.h5").string();
+  const std::string out = (dir / "out").string();
+  const char* argv[] = {binary.c_str(), "process", "-q", scan.c_str(), "-o", out.c_str(), nullptr};
+  pid_t pid = 0;
+  ASSERT_EQ(posix_spawn(&pid, binary.c_str(), nullptr, nullptr, const_cast<char* const*>(argv), environ), 0);
+  std::this_thread::sleep_for(std::chrono::milliseconds(250));
+  ::kill(pid, SIGINT);
+  int status = 0;
+  ASSERT_EQ(::waitpid(pid, &status, 0), pid);
+  ASSERT_TRUE(WIFEXITED(status));
+  EXPECT_EQ(WEXITSTATUS(status), 130) << "the run should have been interrupted, not finished";
+  EXPECT_EQ(testing::ListFolder(dir / "out"), "summary.json\nwheel_map.h5\n");
+  EXPECT_EQ(Slurp(dir / "out" / "summary.json"), summary_before);
+  EXPECT_EQ(Slurp(dir / "out" / "wheel_map.h5"), map_before);
+}
+
+TEST(Faults, WriteFailingPartWayLeavesEarlierOutputsIntact) {
+  TempDir dir;
+  PrepareEarlierOutputs(dir);
+  const std::string summary_before = Slurp(dir / "out" / "summary.json");
+  // A 512 KiB file-size limit: the summary fits, the new map (~0.9 MB) does not (SIGXFSZ ignored, so the
+  // write fails with EFBIG as on a full disk).
+  const std::string command = "bash -c 'trap \"\" XFSZ; ulimit -f 512; exec \"" + std::string(std::getenv("ARCWHEEL_BINARY")) +
+                              "\" process -q " + (dir / "short.h5").string() + " -o " + (dir / "out").string() + "' 2>&1";
+  FILE* pipe = ::popen(command.c_str(), "r");
+  ASSERT_NE(pipe, nullptr);
+  std::string output;
+  char buffer[512];
+  while (std::fgets(buffer, sizeof buffer, pipe) != nullptr) output += buffer;
+  const int status = ::pclose(pipe);
+  ASSERT_TRUE(WIFEXITED(status));
+  EXPECT_EQ(WEXITSTATUS(status), 4) << output;
+  EXPECT_NE(output.find("wheel_map.h5"), std::string::npos) << output;
+  EXPECT_EQ(testing::ListFolder(dir / "out"), "summary.json\nwheel_map.h5\n");
+  EXPECT_EQ(Slurp(dir / "out" / "summary.json"), summary_before);
+}
+
+}  // namespace
+}  // namespace arcwheel

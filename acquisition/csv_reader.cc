@@ -213,8 +213,10 @@ std::string ReadWholeFile(const std::filesystem::path& path) {
 
 }  // namespace
 
-Scan ReadCsvScan(const std::filesystem::path& path) {
-  CsvParser parser(path.string(), ReadWholeFile(path));
+Scan ReadCsvScan(const std::filesystem::path& path) { return ParseCsvScan(ReadWholeFile(path), path.string()); }
+
+Scan ParseCsvScan(std::string text, const std::string& name) {
+  CsvParser parser(name, std::move(text));
   Scan scan = parser.Parse();
   ApplyInvalidMarkers(scan, /*compare_as_float=*/false);
   ValidateScan(scan);

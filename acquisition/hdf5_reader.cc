@@ -33,8 +33,10 @@ void ReadAttributes(const hdf5::File& file, ScanMetadata& metadata) {
 
 }  // namespace
 
-Scan ReadHdf5Scan(const std::filesystem::path& path) {
-  const hdf5::File file = hdf5::File::OpenReadOnly(path);
+Scan ReadHdf5Scan(const std::filesystem::path& path) { return ReadHdf5Scan(hdf5::File::OpenReadOnly(path)); }
+
+Scan ReadHdf5Scan(const hdf5::File& file) {
+  const std::filesystem::path& path = file.path();
   if (!file.HasObject("/scan")) {
     throw Error(ErrorCode::kBadInput, kStage, "'" + path.string() + "' has no group /scan");
   }

@@ -11,6 +11,7 @@
 #include <filesystem>
 
 #include "acquisition/scan.h"
+#include "core/hdf5.h"
 
 namespace arcwheel::acquisition {
 
@@ -22,5 +23,10 @@ namespace arcwheel::acquisition {
 
 // formats.md 2.2: `# key: value` lines, a header row, separators , ; or tab, decimal point.
 [[nodiscard]] Scan ReadCsvScan(const std::filesystem::path& path);
+// The same from text already in memory; `name` stands for the file in messages.
+[[nodiscard]] Scan ParseCsvScan(std::string text, const std::string& name);
+
+// formats.md 2.1 from an open file (e.g. an in-memory image, hdf5::File::OpenImage).
+[[nodiscard]] Scan ReadHdf5Scan(const hdf5::File& file);
 
 }  // namespace arcwheel::acquisition

@@ -48,6 +48,19 @@ File File::OpenReadOnly(const std::filesystem::path& path) {
   return File(Handle(id, H5Fclose), path);
 }
 
+File File::OpenImage(const void* data, size_t size, const std::string& name) {
+  SilenceHdf5ErrorStack();
+  const Handle access(H5Pcreate(H5P_FILE_ACCESS), H5Pclose);
+  // The core driver without a backing store reads the image from memory only.
+  if (size == 0 || H5Pset_fapl_core(access.id(), 1 << 16, 0) < 0 ||
+      H5Pset_file_image(access.id(), const_cast<void*>(data), size) < 0) {
+    throw Error(ErrorCode::kBadInput, kStage, "'" + name + "' is not an HDF5 file image");
+  }
+  const hid_t id = H5Fopen(name.c_str(), H5F_ACC_RDONLY, access.id());
+  if (id < 0) throw Error(ErrorCode::kBadInput, kStage, "'" + name + "' is not an HDF5 file (or is truncated)");
+  return File(Handle(id, H5Fclose), name);
+}
+
 File File::Create(const std::filesystem::path& path) {
   SilenceHdf5ErrorStack();
   const hid_t id = H5Fcreate(path.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT);

@@ -35,6 +35,8 @@ class File {
  public:
   // Opens read-only. Throws Error{kBadInput} if the file is not HDF5 or is damaged.
   static File OpenReadOnly(const std::filesystem::path& path);
+  // Opens a file image held in memory (the bytes are copied); `name` stands for it in messages.
+  static File OpenImage(const void* data, size_t size, const std::string& name);
   // Creates (truncating) for writing. Throws Error{kIo}.
   static File Create(const std::filesystem::path& path);
 

@@ -1,5 +1,7 @@
 #include "core/interrupt.h"
 
+#include <pthread.h>
+
 #include <csignal>
 
 #include "core/error.h"
@@ -16,6 +18,12 @@ extern "C" void OnSignal(int /*signal*/) { g_interrupted = 1; }
 void InstallInterruptHandlers() {
   std::signal(SIGINT, OnSignal);
   std::signal(SIGTERM, OnSignal);
+  // A parent may have started us with the signals blocked; from here on they are handled.
+  sigset_t handled;
+  sigemptyset(&handled);
+  sigaddset(&handled, SIGINT);
+  sigaddset(&handled, SIGTERM);
+  pthread_sigmask(SIG_UNBLOCK, &handled, nullptr);
 }
 
 bool InterruptRequested() noexcept { return g_interrupted != 0; }

@@ -53,8 +53,18 @@ TEST(Faults, InterruptDuringProcessingLeavesEarlierOutputsIntact) {
   const std::string scan = (dir / "long.h5").string();
   const std::string out = (dir / "out").string();
   const char* argv[] = {binary.c_str(), "process", "-q", scan.c_str(), "-o", out.c_str(), nullptr};
+  // The child starts with SIGINT blocked, so a signal sent before it has installed its handler
+  // (a loaded machine) waits for it instead of killing it: the outcome does not depend on timing.
+  posix_spawnattr_t attributes;
+  posix_spawnattr_init(&attributes);
+  sigset_t blocked;
+  sigemptyset(&blocked);
+  sigaddset(&blocked, SIGINT);
+  posix_spawnattr_setsigmask(&attributes, &blocked);
+  posix_spawnattr_setflags(&attributes, POSIX_SPAWN_SETSIGMASK);
   pid_t pid = 0;
-  ASSERT_EQ(posix_spawn(&pid, binary.c_str(), nullptr, nullptr, const_cast<char* const*>(argv), environ), 0);
+  ASSERT_EQ(posix_spawn(&pid, binary.c_str(), nullptr, &attributes, const_cast<char* const*>(argv), environ), 0);
+  posix_spawnattr_destroy(&attributes);
   std::this_thread::sleep_for(std::chrono::milliseconds(250));
   ::kill(pid, SIGINT);
   int status = 0;

@@ -14,5 +14,6 @@ void AddReportCommand(CLI::App& app);
 void AddFrameCommand(CLI::App& app);
 void AddTransformCommand(CLI::App& app);
 void AddHeadcenterCommand(CLI::App& app);
+void AddPolishCommand(CLI::App& app);
 
 }  // namespace arcwheel::cli

@@ -33,6 +33,7 @@ const std::vector<Command> kCommands = {
     {"frame", arcwheel::cli::AddFrameCommand},
     {"transform", arcwheel::cli::AddTransformCommand},
     {"headcenter", arcwheel::cli::AddHeadcenterCommand},
+    {"polish", arcwheel::cli::AddPolishCommand},
 };
 
 constexpr const char* kExitCodes =

@@ -1,0 +1,89 @@
+#pragma once
+// Dwell time for computer-controlled polishing (issue 5 point 3, method.md B).
+//
+// The removal is the convolution of the dwell with the tool's removal function: the depth removed
+// at map node m is  sum_k R(x_m - x_k, y_m - y_k) t_k,  with t_k the dwell (s) at path point k and
+// R a Gaussian removal rate (um/s) in the part's (x, y) projection. Dwell points lie anywhere along
+// the path (not on the map's grid). The dwell solves the bounded linear least-squares problem
+//     minimise || A t - target ||^2  over the clear-aperture nodes,   t_min_k <= t_k <= t_max_k,
+// where the bounds come from the speed limits (a point stands for the path segment that ends at
+// it: t_k = length_k / speed_k). The path runs beyond the aperture by an extension so that the
+// edge can be reached by the whole removal function (surface extension); residuals are counted
+// inside the aperture only.
+//
+// A is sparse (the Gaussian is truncated at 3.5 sigma, 0.2 % of the peak); the problem is solved
+// by accelerated projected gradient (FISTA with adaptive restart) on sparse matrix products.
+
+#include <Eigen/Core>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "grinding/surface.h"
+#include "polishing/removal_target.h"
+
+namespace arcwheel::polishing {
+
+struct GaussianRemovalFunction {
+  double peak_rate_um_per_s = 1.0;  // removal rate at the centre, > 0
+  double fwhm_mm = 10.0;            // full width at half maximum, > 0
+  [[nodiscard]] double SigmaMm() const;
+  [[nodiscard]] double SupportRadiusMm() const;  // 3.5 sigma: the truncation radius
+  // Rate at an offset from the centre; zero beyond the support radius.
+  [[nodiscard]] double RateUmPerS(double dx_mm, double dy_mm) const;
+};
+
+struct RasterOptions {
+  double line_spacing_mm = 2.0;   // distance between raster lines (along y), > 0
+  double point_spacing_mm = 2.0;  // largest distance between dwell points along a line, > 0
+  double extension_mm = 0.0;      // the path runs this far beyond the aperture, >= 0
+};
+
+// A zigzag raster: lines along x, stepping in y, over the aperture grown by the extension; each
+// line is cut into equal steps of at most point_spacing_mm. Throws Error{kInvalidOption}.
+[[nodiscard]] std::vector<Eigen::Vector2d> RasterPath(const grinding::Aperture& aperture,
+                                                      const RasterOptions& options);
+
+struct DwellOptions {
+  double max_speed_mm_s = 100.0;  // fastest TCP speed, > 0: sets the least dwell of each point
+  double min_speed_mm_s = 0.0;    // slowest TCP speed, [0, max]; 0 = no bound on dwell
+  double min_dwell_s = 0.0;       // least dwell of every point after the first (controller), >= 0
+  // Largest TCP acceleration, mm/s^2; 0 = not checked. The speed changes from v_(k-1) to v_k
+  // over the segment into point k, which takes |v_k^2 - v_(k-1)^2| / (2 length_k).
+  double max_acceleration_mm_s2 = 0.0;
+  int max_iterations = 5000;      // projected-gradient iterations, >= 1
+  double relative_tolerance = 1e-7;  // stop when the dwell changes by less than this, relative
+  // Also stop when the residual norm has improved over the last stall_iterations iterations by
+  // less than stall_improvement times the first residual norm: further iterations only polish
+  // the prediction at the sub-nanometre level. stall_iterations = 0 disables this test.
+  int stall_iterations = 100;        // >= 0
+  double stall_improvement = 1e-3;   // > 0
+};
+
+struct DwellSolution {
+  std::vector<double> dwell_s;        // one per path point
+  std::vector<double> speed_mm_s;     // TCP speed into each point (the first: max speed, no dwell)
+  std::vector<double> segment_mm;     // length of the segment ending at each point (first: 0)
+  ErrorMap predicted_removal_um;      // over the aperture nodes; NaN elsewhere
+  ErrorMap residual_um;               // target - removal over the aperture; NaN elsewhere
+  MapStatistics before;               // of the target (= the error) in the aperture
+  MapStatistics after;                // of the residual in the aperture
+  double total_time_s = 0.0;
+  double max_acceleration_mm_s2 = 0.0;  // largest acceleration the speeds imply (see DwellOptions)
+  int iterations = 0;
+  bool converged = false;
+  int nonzeros = 0;                   // entries of the sparse removal matrix
+};
+
+// Solves the dwell for a removal target (RemovalTarget) along `path_xy_mm`.
+// Throws Error{kInvalidOption, "polishing.dwell"} for options out of range or speeds that cannot
+// be met (min > max); Error{kBadInput, "polishing.dwell"} for an empty aperture, when running
+// the path at the maximum speed (or the least dwell) already removes more than the target
+// somewhere (naming the point and the uniform layer that would make it reachable), or when the
+// speeds need more than the maximum acceleration (naming the point).
+[[nodiscard]] DwellSolution SolveDwell(const ErrorMap& target, const grinding::Aperture& aperture,
+                                       std::span<const Eigen::Vector2d> path_xy_mm,
+                                       const GaussianRemovalFunction& removal,
+                                       const DwellOptions& options);
+
+}  // namespace arcwheel::polishing

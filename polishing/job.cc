@@ -1,0 +1,461 @@
+#include "polishing/job.h"
+
+#include <fmt/core.h>
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <iterator>
+#include <limits>
+#include <map>
+#include <set>
+#include <sstream>
+
+#include "core/atomic_file.h"
+#include "core/error.h"
+#include "core/version.h"
+
+namespace arcwheel::polishing {
+namespace {
+
+using nlohmann::json;
+constexpr const char* kStage = "polishing.job";
+
+// One JSON object of the job: typed reads by key, remembered for the unknown-key check.
+class Section {
+ public:
+  Section(const json* object, std::string prefix, const std::filesystem::path& source)
+      : object_(object), prefix_(std::move(prefix)), source_(source) {
+    if (object_ != nullptr && !object_->is_object()) Fail("", "must be an object");
+  }
+  [[noreturn]] void Fail(const std::string& key, const std::string& what) const {
+    throw Error(ErrorCode::kBadInput, kStage, fmt::format("'{}': '{}' {}", source_.string(), Dotted(key), what));
+  }
+  [[nodiscard]] bool Has(const std::string& key) const { return object_ != nullptr && object_->contains(key); }
+  double Number(const std::string& key, double fallback) {
+    used_.insert(key);
+    double v = fallback;
+    if (Has(key)) {
+      if (!object_->at(key).is_number() || !std::isfinite(object_->at(key).get<double>())) Fail(key, "must be a finite number");
+      v = object_->at(key).get<double>();
+    }
+    resolved_[key] = v;
+    return v;
+  }
+  double RequiredNumber(const std::string& key) {
+    if (!Has(key)) Fail(key, "is required");
+    return Number(key, 0.0);
+  }
+  std::vector<double> Numbers(const std::string& key, std::vector<double> fallback) {
+    used_.insert(key);
+    if (Has(key)) {
+      const json& v = object_->at(key);
+      if (!v.is_array() || (!fallback.empty() && v.size() != fallback.size())) {
+        Fail(key, fmt::format("must be an array of {} numbers", fallback.size()));
+      }
+      fallback.clear();
+      for (const json& e : v) {
+        if (!e.is_number() || !std::isfinite(e.get<double>())) Fail(key, "must hold finite numbers only");
+        fallback.push_back(e.get<double>());
+      }
+    }
+    resolved_[key] = fallback;
+    return fallback;
+  }
+  std::string String(const std::string& key, const std::string& fallback) {
+    used_.insert(key);
+    std::string v = fallback;
+    if (Has(key)) {
+      if (!object_->at(key).is_string()) Fail(key, "must be a string");
+      v = object_->at(key).get<std::string>();
+    }
+    resolved_[key] = v;
+    return v;
+  }
+  std::string Choice(const std::string& key, const std::vector<std::string>& allowed) {
+    const std::string v = String(key, allowed.front());
+    if (std::find(allowed.begin(), allowed.end(), v) == allowed.end()) {
+      Fail(key, fmt::format("= \"{}\" is not one of \"{}\"", v, fmt::join(allowed, "\", \"")));
+    }
+    return v;
+  }
+  Section Child(const std::string& key) {
+    used_.insert(key);
+    return Section(Has(key) ? &object_->at(key) : nullptr, Dotted(key), source_);
+  }
+  void Adopt(const std::string& key, const Section& child) { resolved_[key] = child.resolved_; }
+  void SetResolved(const std::string& key, const json& value) { resolved_[key] = value; }
+  [[nodiscard]] const json& Raw(const std::string& key) {
+    used_.insert(key);
+    return object_->at(key);
+  }
+  [[nodiscard]] const std::filesystem::path& source() const { return source_; }
+  void Finish() const {
+    if (object_ == nullptr) return;
+    for (const auto& [key, value] : object_->items()) {
+      if (!used_.count(key)) Fail(key, "is an unknown key (see docs/polishing.md for the job keys)");
+    }
+  }
+  [[nodiscard]] const json& resolved() const { return resolved_; }
+  [[nodiscard]] std::string Dotted(const std::string& key) const {
+    return prefix_.empty() ? key : (key.empty() ? prefix_ : prefix_ + "." + key);
+  }
+
+ private:
+  const json* object_;
+  std::string prefix_;
+  const std::filesystem::path& source_;
+  std::set<std::string> used_;
+  json resolved_ = json::object();
+};
+
+std::shared_ptr<const grinding::Surface> ReadSurface(Section& s) {
+  const std::string type = s.Choice("type", {"even_asphere", "xy_polynomial"});
+  if (type == "xy_polynomial") {
+    // The same form as the grinding job: [{"x_power": i, "y_power": j, "coefficient": c}, ...].
+    if (!s.Has("terms") || !s.Raw("terms").is_array()) {
+      s.Fail("terms", "must be an array of {\"x_power\", \"y_power\", \"coefficient\"} objects");
+    }
+    std::vector<grinding::XyPolynomialTerm> terms;
+    json resolved = json::array();
+    for (std::size_t k = 0; k < s.Raw("terms").size(); ++k) {
+      Section t(&s.Raw("terms")[k], s.Dotted(fmt::format("terms[{}]", k)), s.source());
+      grinding::XyPolynomialTerm term;
+      term.x_power = static_cast<int>(t.Number("x_power", 0.0));
+      term.y_power = static_cast<int>(t.Number("y_power", 0.0));
+      term.coefficient = t.RequiredNumber("coefficient");
+      if (term.x_power < 0 || term.y_power < 0 || term.x_power > 20 || term.y_power > 20) {
+        t.Fail("x_power", "and y_power must be whole numbers within 0 .. 20");
+      }
+      t.Finish();
+      terms.push_back(term);
+      resolved.push_back(t.resolved());
+    }
+    s.SetResolved("terms", resolved);
+    return std::make_shared<grinding::XyPolynomial>(std::move(terms));
+  }
+  grinding::EvenAsphereParameters p;
+  p.vertex_radius_mm = s.RequiredNumber("vertex_radius_mm");
+  if (!(p.vertex_radius_mm > 0.0)) s.Fail("vertex_radius_mm", "must be > 0 (use \"form\" for the side)");
+  p.conic = s.Number("conic", 0.0);
+  if (s.Has("coefficients")) {
+    // The same form as the grinding job: {"A4": ..., "A6": ..., ..., "A20": ...}.
+    Section c = s.Child("coefficients");
+    for (int order = 4; order <= 20; order += 2) p.even_coefficients.push_back(c.Number(fmt::format("A{}", order), 0.0));
+    while (!p.even_coefficients.empty() && p.even_coefficients.back() == 0.0) p.even_coefficients.pop_back();
+    c.Finish();
+    s.Adopt("coefficients", c);
+  }
+  const std::vector<double> off = s.Numbers("off_axis_mm", {0.0, 0.0});
+  p.off_axis_x_mm = off[0];
+  p.off_axis_y_mm = off[1];
+  p.concave = s.Choice("form", {"concave", "convex"}) == "concave";
+  try {
+    return std::make_shared<grinding::EvenAsphere>(p);
+  } catch (const Error& e) {
+    s.Fail("", fmt::format("is not usable: {}", e.what()));
+  }
+}
+
+grinding::Aperture ReadAperture(Section& s) {
+  grinding::Aperture a;
+  if (s.Choice("shape", {"circle", "rectangle"}) == "circle") {
+    a.shape = grinding::Aperture::Shape::kCircle;
+    a.diameter_mm = s.RequiredNumber("diameter_mm");
+    if (!(a.diameter_mm > 0.0)) s.Fail("diameter_mm", "must be > 0");
+  } else {
+    const std::vector<double> size = s.Numbers("size_mm", {0.0, 0.0});
+    if (!(size[0] > 0.0) || !(size[1] > 0.0)) s.Fail("size_mm", "must be two sizes > 0");
+    a.width_x_mm = size[0];
+    a.width_y_mm = size[1];
+  }
+  return a;
+}
+
+AbbQuaternion ReadQuaternion(Section& s, const std::string& key) {
+  const std::vector<double> q = s.Numbers(key, {1.0, 0.0, 0.0, 0.0});
+  const double norm = std::sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
+  if (std::abs(norm - 1.0) > 1e-6) s.Fail(key, fmt::format("must be a unit quaternion (q1 scalar first), has norm {}", norm));
+  return {q[0] / norm, q[1] / norm, q[2] / norm, q[3] / norm};
+}
+
+void ReadMachine(Section& s, PolishJob& job) {
+  job.dwell.max_speed_mm_s = s.RequiredNumber("max_speed_mm_s");
+  if (!(job.dwell.max_speed_mm_s > 0.0)) s.Fail("max_speed_mm_s", "must be > 0");
+  job.dwell.min_speed_mm_s = s.Number("min_speed_mm_s", 0.0);
+  if (!(job.dwell.min_speed_mm_s >= 0.0 && job.dwell.min_speed_mm_s <= job.dwell.max_speed_mm_s)) {
+    s.Fail("min_speed_mm_s", fmt::format("= {} is unreachable: it must lie in [0, max_speed_mm_s = {}]",
+                                         job.dwell.min_speed_mm_s, job.dwell.max_speed_mm_s));
+  }
+  job.dwell.min_dwell_s = s.Number("min_dwell_s", 0.0);
+  if (!(job.dwell.min_dwell_s >= 0.0)) s.Fail("min_dwell_s", "must be >= 0");
+  if (job.dwell.min_dwell_s > 0.0 && job.dwell.min_speed_mm_s > 0.0) {
+    s.Fail("min_dwell_s", "is unreachable together with min_speed_mm_s: give one of them");
+  }
+  job.dwell.max_acceleration_mm_s2 = s.Number("max_acceleration_mm_s2", 0.0);
+  if (!(job.dwell.max_acceleration_mm_s2 >= 0.0)) s.Fail("max_acceleration_mm_s2", "must be >= 0 (0 = not checked)");
+  job.robot_side = s.Choice("robot_side", {"+x", "-x"}) == "+x" ? RobotSide::kPlusX : RobotSide::kMinusX;
+}
+
+void ReadTool(Section& s, PolishJob& job) {
+  const std::vector<double> tcp = s.Numbers("tcp_mm", {0.0, 0.0, 150.0});
+  job.tool.tcp_mm = {tcp[0], tcp[1], tcp[2]};
+  job.tool.orientation = ReadQuaternion(s, "quaternion");
+  const std::vector<double> offset = s.Numbers("removal_centre_offset_mm", {0.0, 0.0});
+  job.tool.removal_centre_offset_mm = {offset[0], offset[1]};
+  job.tool.mass_kg = s.Number("mass_kg", 5.0);
+  if (!(job.tool.mass_kg > 0.0)) s.Fail("mass_kg", "must be > 0");
+  const std::vector<double> cog = s.Numbers("centre_of_gravity_mm", {0.0, 0.0, 75.0});
+  job.tool.centre_of_gravity_mm = {cog[0], cog[1], cog[2]};
+}
+
+[[noreturn]] void MapFail(const std::filesystem::path& path, std::size_t line, const std::string& what) {
+  throw Error(ErrorCode::kBadInput, "polishing.map", fmt::format("'{}' line {}: {}", path.string(), line, what));
+}
+
+// Index of `v` on a grid of spacing d from v0, or -1 if it is not within 1e-6 d of a node.
+int GridIndex(double v, double v0, double d) {
+  const double u = (v - v0) / d;
+  const double r = std::round(u);
+  return std::abs(u - r) <= 1e-6 ? static_cast<int>(r) : -1;
+}
+
+// The grid spacing along one axis: the median gap between the distinct coordinates, so that a
+// stray off-grid value is reported as such rather than taken for the spacing.
+double MedianGap(const std::set<double>& values) {
+  std::vector<double> gaps;
+  for (auto it = std::next(values.begin()); it != values.end(); ++it) gaps.push_back(*it - *std::prev(it));
+  std::nth_element(gaps.begin(), gaps.begin() + static_cast<std::ptrdiff_t>(gaps.size() / 2), gaps.end());
+  return gaps[gaps.size() / 2];
+}
+
+}  // namespace
+
+ErrorMap ReadErrorMapCsv(const std::filesystem::path& path) {
+  std::ifstream in(path);
+  if (!in) throw Error(ErrorCode::kIo, "polishing.map", fmt::format("cannot open '{}'", path.string()));
+  struct Node {
+    double x, y, e;
+    std::size_t line;
+  };
+  std::vector<Node> nodes;
+  std::string text;
+  std::size_t line = 0;
+  bool header = false;
+  while (std::getline(in, text)) {
+    ++line;
+    if (!text.empty() && text.back() == '\r') text.pop_back();
+    if (text.empty() || text[0] == '#') continue;
+    if (!header) {
+      if (text != "x_mm,y_mm,error_um") MapFail(path, line, fmt::format("header '{}' is not 'x_mm,y_mm,error_um'", text));
+      header = true;
+      continue;
+    }
+    std::stringstream cells(text);
+    std::string cell;
+    double v[3];
+    int count = 0;
+    while (std::getline(cells, cell, ',')) {
+      if (count == 3) MapFail(path, line, "has more than 3 values");
+      char* end = nullptr;
+      v[count] = std::strtod(cell.c_str(), &end);
+      if (cell.empty() || *end != '\0') MapFail(path, line, fmt::format("'{}' is not a number", cell));
+      ++count;
+    }
+    if (count != 3) MapFail(path, line, fmt::format("has {} values, needs x_mm,y_mm,error_um", count));
+    if (!std::isfinite(v[0]) || !std::isfinite(v[1])) MapFail(path, line, "x_mm and y_mm must be finite");
+    nodes.push_back({v[0], v[1], v[2], line});
+  }
+  if (nodes.size() < 2) MapFail(path, line, "the map needs at least two nodes");
+  std::set<double> xs, ys;
+  for (const Node& n : nodes) xs.insert(n.x), ys.insert(n.y);
+  ErrorMap map;
+  map.x0_mm = *xs.begin();
+  map.y0_mm = *ys.begin();
+  map.dx_mm = xs.size() > 1 ? MedianGap(xs) : 1.0;
+  map.dy_mm = ys.size() > 1 ? MedianGap(ys) : 1.0;
+  map.nx = static_cast<int>(std::lround((*xs.rbegin() - map.x0_mm) / map.dx_mm)) + 1;
+  map.ny = static_cast<int>(std::lround((*ys.rbegin() - map.y0_mm) / map.dy_mm)) + 1;
+  if (static_cast<double>(map.nx) * map.ny > 1e8) MapFail(path, line, "the grid would exceed 1e8 nodes");
+  map.error_um.assign(static_cast<std::size_t>(map.nx) * map.ny, std::numeric_limits<double>::quiet_NaN());
+  std::vector<bool> seen(map.error_um.size(), false);
+  for (const Node& n : nodes) {
+    const int i = GridIndex(n.x, map.x0_mm, map.dx_mm), j = GridIndex(n.y, map.y0_mm, map.dy_mm);
+    if (i < 0 || j < 0) {
+      MapFail(path, n.line, fmt::format("({}, {}) mm is not on the regular grid of spacing {} x {} mm", n.x, n.y, map.dx_mm, map.dy_mm));
+    }
+    const std::size_t index = static_cast<std::size_t>(j) * map.nx + i;
+    if (seen[index]) MapFail(path, n.line, fmt::format("({}, {}) mm appears twice", n.x, n.y));
+    seen[index] = true;
+    map.error_um[index] = n.e;
+  }
+  return map;
+}
+
+PolishJob ReadPolishJob(const std::filesystem::path& path) {
+  std::ifstream in(path);
+  if (!in) throw Error(ErrorCode::kIo, kStage, fmt::format("cannot open '{}'", path.string()));
+  std::stringstream buffer;
+  buffer << in.rdbuf();
+  json root;
+  try {
+    root = json::parse(buffer.str());
+  } catch (const json::parse_error& e) {
+    throw Error(ErrorCode::kBadInput, kStage, fmt::format("'{}' is not valid JSON: {}", path.string(), e.what()));
+  }
+  PolishJob job;
+  job.source = path;
+  Section s(&root, "", path);
+  job.name = s.String("name", path.stem().string());
+  auto section = [&](const std::string& key, auto&& read) {
+    if (!s.Has(key) && key != "removal_target" && key != "path" && key != "solver" && key != "tool" &&
+        key != "workobject" && key != "precession") {
+      s.Fail(key, "is required");
+    }
+    Section child = s.Child(key);
+    read(child);
+    child.Finish();
+    s.Adopt(key, child);
+  };
+  section("surface", [&](Section& c) { job.surface = ReadSurface(c); });
+  section("aperture", [&](Section& c) { job.aperture = ReadAperture(c); });
+  section("error_map", [&](Section& c) {
+    const std::string file = c.String("file", "");
+    if (file.empty()) c.Fail("file", "is required: a CSV of x_mm,y_mm,error_um");
+    job.error_map_file = std::filesystem::path(file).is_absolute() ? std::filesystem::path(file) : path.parent_path() / file;
+    job.error_map = ReadErrorMapCsv(job.error_map_file);
+  });
+  section("removal_target", [&](Section& c) {
+    job.target.uniform_layer_um = c.Number("uniform_layer_um", 0.0);
+    if (!(job.target.uniform_layer_um >= 0.0)) c.Fail("uniform_layer_um", "must be >= 0");
+  });
+  section("removal_function", [&](Section& c) {
+    job.removal.peak_rate_um_per_s = c.RequiredNumber("peak_rate_um_per_s");
+    if (!(job.removal.peak_rate_um_per_s > 0.0)) c.Fail("peak_rate_um_per_s", "must be > 0");
+    job.removal.fwhm_mm = c.RequiredNumber("fwhm_mm");
+    if (!(job.removal.fwhm_mm > 0.0)) c.Fail("fwhm_mm", "must be > 0");
+  });
+  section("path", [&](Section& c) {
+    job.path.line_spacing_mm = c.Number("line_spacing_mm", job.removal.fwhm_mm / 5.0);
+    if (!(job.path.line_spacing_mm > 0.0)) c.Fail("line_spacing_mm", "must be > 0");
+    job.path.point_spacing_mm = c.Number("point_spacing_mm", job.path.line_spacing_mm);
+    if (!(job.path.point_spacing_mm > 0.0)) c.Fail("point_spacing_mm", "must be > 0");
+    job.path.extension_mm = c.Number("extension_mm", job.removal.SupportRadiusMm() / 2.0);
+    if (!(job.path.extension_mm >= 0.0)) c.Fail("extension_mm", "must be >= 0");
+  });
+  section("machine", [&](Section& c) { ReadMachine(c, job); });
+  section("solver", [&](Section& c) {
+    job.dwell.max_iterations = static_cast<int>(c.Number("max_iterations", 2000));
+    if (job.dwell.max_iterations < 1) c.Fail("max_iterations", "must be >= 1");
+    job.dwell.relative_tolerance = c.Number("relative_tolerance", 1e-7);
+    if (!(job.dwell.relative_tolerance > 0.0)) c.Fail("relative_tolerance", "must be > 0");
+  });
+  section("tool", [&](Section& c) { ReadTool(c, job); });
+  if (s.Has("precession")) {
+    section("precession", [&](Section& c) {
+      job.precession.enabled = true;
+      job.precession.tilt_deg = c.RequiredNumber("tilt_deg");
+      if (!(job.precession.tilt_deg >= 0.0 && job.precession.tilt_deg < 90.0)) c.Fail("tilt_deg", "must lie in [0, 90)");
+      job.precession.precession_rate_rpm = c.RequiredNumber("precession_rate_rpm");
+      job.precession.bonnet_radius_mm = c.Number("bonnet_radius_mm", 0.0);
+      if (!(job.precession.bonnet_radius_mm >= 0.0)) c.Fail("bonnet_radius_mm", "must be >= 0");
+    });
+  }
+  section("workobject", [&](Section& c) {
+    const std::vector<double> origin = c.Numbers("origin_mm", {0.0, 0.0, 0.0});
+    job.work_object.origin_mm = {origin[0], origin[1], origin[2]};
+    job.work_object.orientation = ReadQuaternion(c, "quaternion");
+  });
+  s.Finish();
+  job.resolved = s.resolved();
+  return job;
+}
+
+namespace {
+
+void CheckOnSurface(const PolishJob& job, std::span<const Eigen::Vector2d> path) {
+  const ErrorMap& m = job.error_map;
+  for (int j = 0; j < m.ny; ++j) {
+    for (int i = 0; i < m.nx; ++i) {
+      if (!std::isfinite(m.At(i, j)) || !job.aperture.Contains(m.X(i), m.Y(j))) continue;
+      if (!job.surface->InDomain(m.X(i), m.Y(j))) {
+        throw Error(ErrorCode::kBadInput, kStage,
+                    fmt::format("map off the surface: '{}' node ({}, {}) mm lies outside {}",
+                                job.error_map_file.string(), m.X(i), m.Y(j), job.surface->Describe()));
+      }
+    }
+  }
+  for (std::size_t k = 0; k < path.size(); ++k) {
+    if (!job.surface->InDomain(path[k].x(), path[k].y())) {
+      throw Error(ErrorCode::kBadInput, kStage,
+                  fmt::format("'{}': path point {} ({}, {}) mm (aperture grown by path.extension_mm = {}) "
+                              "is off the surface {}", job.source.string(), k, path[k].x(), path[k].y(),
+                              job.path.extension_mm, job.surface->Describe()));
+    }
+  }
+}
+
+std::string ResidualCsv(const ErrorMap& target, const DwellSolution& d) {
+  fmt::memory_buffer out;
+  fmt::format_to(std::back_inserter(out), "x_mm,y_mm,target_um,removal_um,residual_um\n");
+  for (int j = 0; j < target.ny; ++j) {
+    for (int i = 0; i < target.nx; ++i) {
+      const std::size_t k = static_cast<std::size_t>(j) * target.nx + i;
+      if (!std::isfinite(d.residual_um.error_um[k])) continue;
+      fmt::format_to(std::back_inserter(out), "{},{},{},{},{}\n", target.X(i), target.Y(j), target.error_um[k],
+                     d.predicted_removal_um.error_um[k], d.residual_um.error_um[k]);
+    }
+  }
+  return fmt::to_string(out);
+}
+
+}  // namespace
+
+PolishRunReport RunPolishJob(const PolishJob& job, const std::filesystem::path& output_folder) {
+  const std::vector<Eigen::Vector2d> path = RasterPath(job.aperture, job.path);
+  CheckOnSurface(job, path);
+  const ErrorMap target = RemovalTarget(job.error_map, job.aperture, job.target);
+  PolishRunReport report;
+  report.dwell = SolveDwell(target, job.aperture, path, job.removal, job.dwell);
+  const std::vector<PolishingPoint> points = BuildPolishingPath(*job.surface, path, report.dwell, job.robot_side, job.precession);
+  report.points = points.size();
+  report.max_speed_mm_s = *std::max_element(report.dwell.speed_mm_s.begin() + 1, report.dwell.speed_mm_s.end());
+  report.min_speed_mm_s = *std::min_element(report.dwell.speed_mm_s.begin() + 1, report.dwell.speed_mm_s.end());
+
+  const std::vector<std::string> comments = {
+      fmt::format("arcwheel {} polish, job '{}'", kVersion, job.name),
+      fmt::format("surface: {}", job.surface->Describe()),
+      fmt::format("aperture: {}", job.aperture.Describe()),
+      fmt::format("removal function: Gaussian, peak {} um/s, FWHM {} mm", job.removal.peak_rate_um_per_s, job.removal.fwhm_mm)};
+  json summary = {
+      {"arcwheel_version", kVersion},
+      {"job", job.resolved},
+      {"points", report.points},
+      {"total_time_s", report.dwell.total_time_s},
+      {"before", {{"pv_um", report.dwell.before.pv_um}, {"rms_um", report.dwell.before.rms_um}}},
+      {"after", {{"pv_um", report.dwell.after.pv_um}, {"rms_um", report.dwell.after.rms_um}}},
+      {"aperture_nodes", report.dwell.before.nodes},
+      {"speed_mm_s", {{"min", report.min_speed_mm_s}, {"max", report.max_speed_mm_s}}},
+      {"max_acceleration_mm_s2", report.dwell.max_acceleration_mm_s2},
+      {"solver", {{"iterations", report.dwell.iterations}, {"converged", report.dwell.converged},
+                  {"nonzeros", report.dwell.nonzeros}}}};
+
+  EnsureDirectory(output_folder);
+  OutputSet outputs;
+  auto write = [&](const std::string& name, const std::string& text) {
+    const std::filesystem::path temporary = outputs.Stage(output_folder / name);
+    std::ofstream out(temporary, std::ios::binary);
+    out << text;
+    out.close();
+    if (!out) throw Error(ErrorCode::kIo, kStage, fmt::format("cannot write '{}'", temporary.string()));
+  };
+  write("polishing_path.csv", PolishingPathCsv(points, comments));
+  write("polish.mod", RapidModule(points, job.tool, job.work_object, "ArcwheelPolish", comments));
+  write("residual_map.csv", ResidualCsv(target, report.dwell));
+  write("polish_summary.json", summary.dump(2) + "\n");
+  outputs.Commit();
+  return report;
+}
+
+}  // namespace arcwheel::polishing

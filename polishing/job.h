@@ -1,0 +1,57 @@
+#pragma once
+// The polishing job file (JSON, documented in docs/polishing.md) and the run that turns it into a
+// robot program. Unknown keys are refused by their dotted name.
+
+#include <filesystem>
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <string>
+
+#include "grinding/surface.h"
+#include "polishing/dwell.h"
+#include "polishing/removal_target.h"
+#include "polishing/robot_program.h"
+#include "polishing/tool_frame.h"
+
+namespace arcwheel::polishing {
+
+struct PolishJob {
+  std::string name;
+  std::filesystem::path source;
+  std::shared_ptr<const grinding::Surface> surface;
+  grinding::Aperture aperture;
+  std::filesystem::path error_map_file;
+  ErrorMap error_map;
+  RemovalTargetOptions target;
+  GaussianRemovalFunction removal;
+  RasterOptions path;
+  DwellOptions dwell;
+  RobotSide robot_side = RobotSide::kPlusX;
+  PathPrecession precession;  // enabled when the job has a "precession" section
+  ToolData tool;
+  WorkObject work_object;
+  nlohmann::json resolved;  // the job with every default filled in
+};
+
+// Reads an error map CSV: a header `x_mm,y_mm,error_um`, then one node of a regular grid per row
+// (any order; missing nodes and `nan` have no data). Throws Error{kIo} if unreadable and
+// Error{kBadInput, "polishing.map"} naming the file and line of anything malformed.
+[[nodiscard]] ErrorMap ReadErrorMapCsv(const std::filesystem::path& path);
+
+// Reads and validates a job; the error map's "file" is relative to the job's folder.
+// Throws Error{kIo} or Error{kBadInput, "polishing.job"} naming the file and the dotted key.
+[[nodiscard]] PolishJob ReadPolishJob(const std::filesystem::path& path);
+
+struct PolishRunReport {
+  DwellSolution dwell;
+  std::size_t points = 0;
+  double max_speed_mm_s = 0.0;
+  double min_speed_mm_s = 0.0;
+};
+
+// Solves the dwell and writes OUTDIR/polishing_path.csv, polish.mod (RAPID), residual_map.csv and
+// polish_summary.json, all or none. Throws Error{kBadInput, "polishing.job"} for a map node or a
+// path point off the surface, and whatever SolveDwell throws.
+PolishRunReport RunPolishJob(const PolishJob& job, const std::filesystem::path& output_folder);
+
+}  // namespace arcwheel::polishing

@@ -1,0 +1,184 @@
+// End-to-end tests of `arcwheel polish JOB -o OUTDIR`.
+#include <fmt/core.h>
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <string>
+
+#include "core/testing/testing.h"
+
+namespace arcwheel::polishing {
+namespace {
+
+using arcwheel::testing::RunArcwheel;
+using arcwheel::testing::TempDir;
+
+// Astigmatism plus a bump on a 1 mm grid over 64 x 64 mm, in micrometres.
+void WriteMap(const std::filesystem::path& path, double x_offset_mm = 0.0) {
+  std::ofstream out(path);
+  out << "# simulated error map\nx_mm,y_mm,error_um\n";
+  for (int j = -32; j <= 32; ++j) {
+    for (int i = -32; i <= 32; ++i) {
+      const double x = i + x_offset_mm, y = j;
+      out << fmt::format("{},{},{}\n", x, y,
+                         0.3 * (x * x - y * y) / 900.0 + 0.4 * std::exp(-((x - 8) * (x - 8) + y * y) / 150.0));
+    }
+  }
+}
+
+std::string Job(const std::string& extra_machine = "", const std::string& extra_root = "",
+                double vertex_radius_mm = 400.0) {
+  return fmt::format(R"({{
+  "name": "cli test",
+  "surface": {{"type": "even_asphere", "vertex_radius_mm": {}, "conic": -0.5, "form": "convex"}},
+  "aperture": {{"shape": "circle", "diameter_mm": 60.0}},
+  "error_map": {{"file": "map.csv"}},
+  "removal_target": {{"uniform_layer_um": 1.0}},
+  "removal_function": {{"peak_rate_um_per_s": 1.5, "fwhm_mm": 10.0}},
+  "path": {{"line_spacing_mm": 2.0, "point_spacing_mm": 2.0, "extension_mm": 6.0}},
+  "machine": {{"max_speed_mm_s": 150.0, "min_speed_mm_s": 0.5{}}},
+  "solver": {{"max_iterations": 800}},
+  "tool": {{"tcp_mm": [0, 0, 180], "removal_centre_offset_mm": [0.25, -0.1]}}{}
+}})", vertex_radius_mm, extra_machine, extra_root);
+}
+
+void WriteText(const std::filesystem::path& path, const std::string& text) {
+  std::ofstream(path) << text;
+}
+
+TEST(PolishCommand, WritesPathRapidResidualAndSummaryWithATenfoldRmsDrop) {
+  TempDir dir;
+  WriteMap(dir / "map.csv");
+  WriteText(dir / "job.json", Job());
+  const auto result = RunArcwheel(fmt::format("polish {} -o {}", (dir / "job.json").string(), (dir / "out").string()));
+  ASSERT_EQ(result.exit_status, 0) << result.output;
+  std::ifstream summary_file(dir / "out" / "polish_summary.json");
+  const nlohmann::json summary = nlohmann::json::parse(summary_file);
+  EXPECT_LT(summary["after"]["rms_um"].get<double>(), summary["before"]["rms_um"].get<double>() / 10.0) << summary.dump(2);
+  EXPECT_LE(summary["speed_mm_s"]["max"].get<double>(), 150.0 * (1 + 1e-12));
+  EXPECT_GE(summary["speed_mm_s"]["min"].get<double>(), 0.5 * (1 - 1e-12));
+  std::ifstream csv(dir / "out" / "polishing_path.csv");
+  std::string line;
+  while (std::getline(csv, line) && line.rfind("# ", 0) == 0) {}
+  EXPECT_EQ(line, "x,y,z,q1,q2,q3,q4,speed_mm_s,dwell_s");
+  std::stringstream rapid;
+  rapid << std::ifstream(dir / "out" / "polish.mod").rdbuf();
+  EXPECT_NE(rapid.str().find("PERS tooldata tPolish := [TRUE,[[0.2500,-0.1000,180.0000]"), std::string::npos);
+  EXPECT_TRUE(std::filesystem::exists(dir / "out" / "residual_map.csv"));
+}
+
+TEST(PolishCommand, RunsTheShippedExampleJob) {
+  TempDir dir;
+  const auto job = arcwheel::testing::SourceDir() / "polishing" / "examples" / "disc_job.json";
+  const auto result = RunArcwheel(fmt::format("polish {} -o {}", job.string(), (dir / "out").string()));
+  ASSERT_EQ(result.exit_status, 0) << result.output;
+  std::ifstream summary_file(dir / "out" / "polish_summary.json");
+  const nlohmann::json summary = nlohmann::json::parse(summary_file);
+  EXPECT_LT(summary["after"]["rms_um"].get<double>(), summary["before"]["rms_um"].get<double>() / 10.0);
+}
+
+
+void ExpectRefused(const std::string& job, const std::string& message, bool shifted_map = false) {
+  TempDir dir;
+  WriteMap(dir / "map.csv", shifted_map ? 1000.0 : 0.0);
+  WriteText(dir / "job.json", job);
+  const auto result = RunArcwheel(fmt::format("polish {} -o {}", (dir / "job.json").string(), (dir / "out").string()));
+  EXPECT_EQ(result.exit_status, 3) << result.output;
+  EXPECT_NE(result.output.find(message), std::string::npos) << result.output;
+  EXPECT_FALSE(std::filesystem::exists(dir / "out" / "polishing_path.csv"));
+  EXPECT_FALSE(std::filesystem::exists(dir / "out" / "polish.mod"));
+}
+
+std::string WithSurface(const std::string& surface) {
+  std::string job = Job();
+  const std::size_t begin = job.find("\"surface\"");
+  const std::size_t end = job.find('\n', begin);
+  return job.replace(begin, end - begin, "\"surface\": " + surface + ",");
+}
+
+TEST(PolishCommand, ReadsFreeformAndAsphereSurfacesInTheGrindingJobsForm) {
+  TempDir dir;
+  WriteMap(dir / "map.csv");
+  WriteText(dir / "job.json", WithSurface(R"({"type": "xy_polynomial", "terms": [
+      {"x_power": 2, "coefficient": -0.001}, {"y_power": 2, "coefficient": -0.0012}]})"));
+  const auto result = RunArcwheel(fmt::format("polish {} -o {}", (dir / "job.json").string(), (dir / "out").string()));
+  ASSERT_EQ(result.exit_status, 0) << result.output;
+  // z = -0.001 x^2 - 0.0012 y^2: the CSV's z follows the freeform.
+  std::ifstream csv(dir / "out" / "polishing_path.csv");
+  std::string line;
+  while (std::getline(csv, line) && line.rfind("# ", 0) == 0) {}
+  int rows = 0;
+  while (std::getline(csv, line)) {
+    double x, y, z;
+    ASSERT_EQ(std::sscanf(line.c_str(), "%lf,%lf,%lf", &x, &y, &z), 3) << line;
+    EXPECT_NEAR(z, -0.001 * x * x - 0.0012 * y * y, 1e-12);
+    ++rows;
+  }
+  EXPECT_GT(rows, 500);
+}
+
+TEST(PolishCommand, TiltsThePrecessingBonnetByTheJobsAngle) {
+  TempDir dir;
+  WriteMap(dir / "map.csv");
+  WriteText(dir / "job.json", Job("", R"(,
+  "precession": {"tilt_deg": 20.0, "precession_rate_rpm": 5.0, "bonnet_radius_mm": 40.0})"));
+  const auto result = RunArcwheel(fmt::format("polish {} -o {}", (dir / "job.json").string(), (dir / "out").string()));
+  ASSERT_EQ(result.exit_status, 0) << result.output;
+  std::ifstream csv(dir / "out" / "polishing_path.csv");
+  std::string line;
+  while (std::getline(csv, line) && line.rfind("# ", 0) == 0) {}
+  int rows = 0;
+  while (std::getline(csv, line)) {
+    double x, y, z, q1, q2, q3, q4;
+    ASSERT_EQ(std::sscanf(line.c_str(), "%lf,%lf,%lf,%lf,%lf,%lf,%lf", &x, &y, &z, &q1, &q2, &q3, &q4), 7) << line;
+    // Tool z of the quaternion (third column of its rotation matrix) against the inward normal
+    // of the convex conic (R0 = 400, k = -0.5) at the contact under the bonnet centre.
+    const double zx = 2 * (q2 * q4 + q1 * q3), zy = 2 * (q3 * q4 - q1 * q2), zz = 1 - 2 * (q2 * q2 + q3 * q3);
+    EXPECT_NEAR(std::sqrt(zx * zx + zy * zy + zz * zz), 1.0, 1e-12);
+    // Contact under the bonnet centre by fixed-point iteration (a contraction: 40 mm << R0), with
+    // the conic's slope dz/dr = -c r / sqrt(1 - (1 + k) c^2 r^2) written out here.
+    const double c = 1.0 / 400.0, k = -0.5;
+    double cx = x, cy = y, ux = 0, uy = 0, uz = 1;
+    for (int it = 0; it < 100; ++it) {
+      const double r = std::hypot(cx, cy);
+      const double slope = -c * r / std::sqrt(1.0 - (1.0 + k) * c * c * r * r);
+      const double fx = r > 0 ? slope * cx / r : 0.0, fy = r > 0 ? slope * cy / r : 0.0;
+      const double n = std::sqrt(fx * fx + fy * fy + 1.0);
+      ux = -fx / n, uy = -fy / n, uz = 1.0 / n;
+      cx = x - 40.0 * ux, cy = y - 40.0 * uy;
+    }
+    EXPECT_NEAR(std::acos(-(zx * ux + zy * uy + zz * uz)), 20.0 * std::acos(-1.0) / 180.0, 1e-9) << line;
+    ++rows;
+  }
+  EXPECT_GT(rows, 500);
+}
+
+TEST(PolishCommand, RefusesAnUnknownAsphereCoefficientByItsDottedName) {
+  ExpectRefused(WithSurface(R"({"type": "even_asphere", "vertex_radius_mm": 400, "coefficients": {"A4": 1e-10, "A5": 1}})"),
+                "'surface.coefficients.A5' is an unknown key");
+}
+
+TEST(PolishCommand, RefusesAnUnknownKeyByItsDottedName) {
+  ExpectRefused(Job(", \"max_sped_mm_s\": 3"), "'machine.max_sped_mm_s' is an unknown key");
+}
+
+TEST(PolishCommand, RefusesUnreachableSpeeds) {
+  ExpectRefused(Job().replace(Job().find("\"min_speed_mm_s\": 0.5"), 21, "\"min_speed_mm_s\": 500"),
+                "'machine.min_speed_mm_s' = 500 is unreachable");
+}
+
+TEST(PolishCommand, RefusesAMapOffTheSurface) {
+  // A convex sphere of radius 25 mm cannot carry the 60 mm aperture.
+  ExpectRefused(Job("", "", 25.0), "off the surface");
+}
+
+TEST(PolishCommand, RefusesAnEmptyAperture) {
+  ExpectRefused(Job(), "empty aperture", /*shifted_map=*/true);
+}
+
+}  // namespace
+}  // namespace arcwheel::polishing

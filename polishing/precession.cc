@@ -1,0 +1,92 @@
+#include "polishing/precession.h"
+
+#include <fmt/core.h>
+
+#include <cmath>
+#include <numbers>
+
+#include "core/error.h"
+
+namespace arcwheel::polishing {
+namespace {
+
+constexpr const char* kStage = "polishing.precession";
+
+void CheckOptions(const PrecessionOptions& o) {
+  auto bad = [](const char* name, double value, const char* rule) {
+    throw Error(ErrorCode::kInvalidOption, kStage,
+                fmt::format("PrecessionOptions::{} = {} violates {}", name, value, rule));
+  };
+  if (!(o.tilt_deg >= 0.0 && o.tilt_deg < 90.0)) bad("tilt_deg", o.tilt_deg, "[0, 90)");
+  if (!std::isfinite(o.precession_rate_rpm)) bad("precession_rate_rpm", o.precession_rate_rpm, "finite");
+  if (!(o.feed_mm_per_s > 0.0)) bad("feed_mm_per_s", o.feed_mm_per_s, "> 0");
+  if (!(o.bonnet_radius_mm >= 0.0)) bad("bonnet_radius_mm", o.bonnet_radius_mm, ">= 0");
+  if (!(o.arm_length_mm >= 0.0)) bad("arm_length_mm", o.arm_length_mm, ">= 0");
+  if (!(o.time_step_s > 0.0)) bad("time_step_s", o.time_step_s, "> 0");
+}
+
+Eigen::Vector3d UpwardNormal(const grinding::SurfacePoint& p) {
+  return Eigen::Vector3d(-p.fx, -p.fy, 1.0).normalized();
+}
+
+}  // namespace
+
+std::vector<PrecessionSample> PrecessionTrajectory(const grinding::Surface& surface,
+                                                   std::span<const Eigen::Vector2d> path_xy_mm,
+                                                   const PrecessionOptions& options) {
+  CheckOptions(options);
+  // Cumulative length of the polyline in the part's (x, y) plane lifted onto the surface.
+  std::vector<double> length_mm{0.0};
+  for (std::size_t i = 0; i < path_xy_mm.size(); ++i) {
+    const Eigen::Vector2d& p = path_xy_mm[i];
+    if (!surface.InDomain(p.x(), p.y())) {
+      throw Error(ErrorCode::kBadInput, kStage,
+                  fmt::format("path point {} ({}, {}) mm is off the surface", i, p.x(), p.y()));
+    }
+    if (i == 0) continue;
+    const Eigen::Vector3d a(path_xy_mm[i - 1].x(), path_xy_mm[i - 1].y(),
+                            surface.Evaluate(path_xy_mm[i - 1].x(), path_xy_mm[i - 1].y()).z_mm);
+    const Eigen::Vector3d b(p.x(), p.y(), surface.Evaluate(p.x(), p.y()).z_mm);
+    length_mm.push_back(length_mm.back() + (b - a).norm());
+  }
+  if (path_xy_mm.size() < 2 || !(length_mm.back() > 0.0)) {
+    throw Error(ErrorCode::kInvalidOption, kStage, "the path needs two or more distinct points");
+  }
+  const double theta_rad = options.tilt_deg * std::numbers::pi / 180.0;
+  const double w2_rad_per_s = options.precession_rate_rpm * 2.0 * std::numbers::pi / 60.0;
+
+  std::vector<PrecessionSample> samples;
+  std::size_t segment = 1;
+  const double total_s = length_mm.back() / options.feed_mm_per_s;
+  for (long k = 0;; ++k) {
+    const double t = std::min(static_cast<double>(k) * options.time_step_s, total_s);
+    const double s = t * options.feed_mm_per_s;
+    while (segment + 1 < length_mm.size() && length_mm[segment] < s) ++segment;
+    const double span_mm = length_mm[segment] - length_mm[segment - 1];
+    const double u = span_mm > 0.0 ? (s - length_mm[segment - 1]) / span_mm : 0.0;
+    const Eigen::Vector2d xy = (1.0 - u) * path_xy_mm[segment - 1] + u * path_xy_mm[segment];
+    const grinding::SurfacePoint sp = surface.Evaluate(xy.x(), xy.y());
+    const Eigen::Vector3d c = UpwardNormal(sp);
+    const Eigen::Vector2d d = path_xy_mm[segment] - path_xy_mm[segment - 1];
+    // Feed direction on the surface (the chord's tangent), then projected on the tangent plane.
+    const Eigen::Vector3d feed(d.x(), d.y(), sp.fx * d.x() + sp.fy * d.y());
+    const Eigen::Vector3d a = (feed - feed.dot(c) * c).normalized();
+    PrecessionSample sample;
+    sample.time_s = t;
+    sample.contact_mm = Eigen::Vector3d(xy.x(), xy.y(), sp.z_mm);
+    sample.centre_mm = sample.contact_mm + options.bonnet_radius_mm * c;
+    sample.local_frame.col(0) = a;
+    sample.local_frame.col(1) = c.cross(a);
+    sample.local_frame.col(2) = c;
+    const double alpha = w2_rad_per_s * t;
+    const Eigen::Vector3d p_a(std::sin(theta_rad) * std::cos(alpha),
+                              std::sin(theta_rad) * std::sin(alpha), std::cos(theta_rad));
+    sample.axis = sample.local_frame * p_a;
+    sample.traced_mm = sample.centre_mm + options.arm_length_mm * sample.axis;
+    samples.push_back(sample);
+    if (t >= total_s) break;
+  }
+  return samples;
+}
+
+}  // namespace arcwheel::polishing

@@ -1,0 +1,135 @@
+#include "polishing/robot_program.h"
+
+#include <fmt/core.h>
+#include <fmt/format.h>
+
+#include <Eigen/Geometry>
+#include <cmath>
+#include <iterator>
+#include <numbers>
+
+#include "core/error.h"
+#include "core/version.h"
+
+namespace arcwheel::polishing {
+namespace {
+
+std::string Quaternion9(const AbbQuaternion& q) {
+  return fmt::format("[{:.9f},{:.9f},{:.9f},{:.9f}]", q.q1, q.q2, q.q3, q.q4);
+}
+
+}  // namespace
+
+std::vector<PolishingPoint> BuildPolishingPath(const grinding::Surface& surface,
+                                               std::span<const Eigen::Vector2d> path_xy_mm,
+                                               const DwellSolution& dwell, RobotSide side,
+                                               const PathPrecession& precession) {
+  if (precession.enabled &&
+      (!(precession.tilt_deg >= 0.0 && precession.tilt_deg < 90.0) || !std::isfinite(precession.precession_rate_rpm) ||
+       !(precession.bonnet_radius_mm >= 0.0))) {
+    throw Error(ErrorCode::kInvalidOption, "polishing.path",
+                fmt::format("precession tilt_deg = {} (needs [0, 90)), precession_rate_rpm = {} (finite), "
+                            "bonnet_radius_mm = {} (>= 0)", precession.tilt_deg,
+                            precession.precession_rate_rpm, precession.bonnet_radius_mm));
+  }
+  double elapsed_s = 0.0;
+  if (dwell.dwell_s.size() != path_xy_mm.size() || dwell.speed_mm_s.size() != path_xy_mm.size()) {
+    throw Error(ErrorCode::kInvalidOption, "polishing.path",
+                fmt::format("{} path points but a dwell solution for {}", path_xy_mm.size(),
+                            dwell.dwell_s.size()));
+  }
+  std::vector<PolishingPoint> points;
+  points.reserve(path_xy_mm.size());
+  for (std::size_t k = 0; k < path_xy_mm.size(); ++k) {
+    const Eigen::Vector2d& p = path_xy_mm[k];
+    if (!surface.InDomain(p.x(), p.y())) {
+      throw Error(ErrorCode::kBadInput, "polishing.path",
+                  fmt::format("path point {} ({}, {}) mm is off the surface {}", k, p.x(), p.y(),
+                              surface.Describe()));
+    }
+    PolishingPoint point;
+    point.position_mm = Eigen::Vector3d(p.x(), p.y(), surface.Evaluate(p.x(), p.y()).z_mm);
+    Eigen::Matrix3d frame = ToolFrameAt(surface, p.x(), p.y(), side);
+    elapsed_s += dwell.dwell_s[k];
+    if (precession.enabled && path_xy_mm.size() > 1) {
+      const Eigen::Vector3d c = -frame.col(2);
+      const Eigen::Vector2d d = k > 0 ? Eigen::Vector2d(p - path_xy_mm[k - 1]) : Eigen::Vector2d(path_xy_mm[1] - p);
+      const grinding::SurfacePoint sp = surface.Evaluate(p.x(), p.y());
+      const Eigen::Vector3d feed(d.x(), d.y(), sp.fx * d.x() + sp.fy * d.y());
+      const Eigen::Vector3d a = (feed - feed.dot(c) * c).normalized();
+      const double theta = precession.tilt_deg * std::numbers::pi / 180.0;
+      const double alpha = precession.precession_rate_rpm * 2.0 * std::numbers::pi / 60.0 * elapsed_s;
+      const Eigen::Vector3d axis = std::sin(theta) * std::cos(alpha) * a +
+                                   std::sin(theta) * std::sin(alpha) * c.cross(a) + std::cos(theta) * c;
+      frame = Eigen::Quaterniond::FromTwoVectors(-c, -axis).toRotationMatrix() * frame;
+      point.position_mm += precession.bonnet_radius_mm * c;
+    }
+    point.orientation = AbbQuaternionFromRotation(frame);
+    point.speed_mm_s = dwell.speed_mm_s[k];
+    point.dwell_s = dwell.dwell_s[k];
+    points.push_back(point);
+  }
+  return points;
+}
+
+Eigen::Vector3d ToolData::CorrectedTcpMm() const {
+  const Eigen::Matrix3d flange_R_tool = RotationFromAbbQuaternion(orientation);
+  return tcp_mm + flange_R_tool * Eigen::Vector3d(removal_centre_offset_mm.x(), removal_centre_offset_mm.y(), 0.0);
+}
+
+std::string PolishingPathCsv(std::span<const PolishingPoint> points, std::span<const std::string> comments) {
+  fmt::memory_buffer out;
+  for (const std::string& c : comments) fmt::format_to(std::back_inserter(out), "# {}\n", c);
+  fmt::format_to(std::back_inserter(out), "x,y,z,q1,q2,q3,q4,speed_mm_s,dwell_s\n");
+  for (const PolishingPoint& p : points) {
+    // "{}" is the shortest representation that reads back to the same double.
+    fmt::format_to(std::back_inserter(out), "{},{},{},{},{},{},{},{},{}\n", p.position_mm.x(),
+                   p.position_mm.y(), p.position_mm.z(), p.orientation.q1, p.orientation.q2,
+                   p.orientation.q3, p.orientation.q4, p.speed_mm_s, p.dwell_s);
+  }
+  return fmt::to_string(out);
+}
+
+std::string RapidModule(std::span<const PolishingPoint> points, const ToolData& tool,
+                        const WorkObject& work_object, const std::string& module_name,
+                        std::span<const std::string> comments) {
+  fmt::memory_buffer out;
+  auto line = [&out](const std::string& text) { fmt::format_to(std::back_inserter(out), "{}\n", text); };
+  line(fmt::format("MODULE {}", module_name));
+  line(fmt::format("  ! arcwheel {} polishing program: {} points", kVersion, points.size()));
+  for (const std::string& c : comments) line(fmt::format("  ! {}", c));
+  line("  ! Positions rounded to 0.1 um, quaternions to 9 decimals (RAPID num precision).");
+  const Eigen::Vector3d tcp = tool.CorrectedTcpMm();
+  line(fmt::format("  ! TCP {:.4f},{:.4f},{:.4f} mm includes the removal-centre offset {:.4f},{:.4f} mm.",
+                   tcp.x(), tcp.y(), tcp.z(), tool.removal_centre_offset_mm.x(), tool.removal_centre_offset_mm.y()));
+  line(fmt::format("  PERS tooldata tPolish := [TRUE,[[{:.4f},{:.4f},{:.4f}],{}],[{:.4f},[{:.4f},{:.4f},{:.4f}],[1,0,0,0],0,0,0]];",
+                   tcp.x(), tcp.y(), tcp.z(), Quaternion9(tool.orientation), tool.mass_kg,
+                   tool.centre_of_gravity_mm.x(), tool.centre_of_gravity_mm.y(), tool.centre_of_gravity_mm.z()));
+  line(fmt::format("  PERS wobjdata wPart := [FALSE,TRUE,\"\",[[{:.4f},{:.4f},{:.4f}],{}],[[0,0,0],[1,0,0,0]]];",
+                   work_object.origin_mm.x(), work_object.origin_mm.y(), work_object.origin_mm.z(),
+                   Quaternion9(work_object.orientation)));
+  line(fmt::format("  CONST num nPoints := {};", points.size()));
+  line(fmt::format("  CONST robtarget pPath{{{}}} := [", points.size()));
+  for (std::size_t k = 0; k < points.size(); ++k) {
+    const PolishingPoint& p = points[k];
+    line(fmt::format("    [[{:.4f},{:.4f},{:.4f}],{},[0,0,0,0],[9E9,9E9,9E9,9E9,9E9,9E9]]{}",
+                     p.position_mm.x(), p.position_mm.y(), p.position_mm.z(), Quaternion9(p.orientation),
+                     k + 1 < points.size() ? "," : "];"));
+  }
+  // speeddata: TCP speed (mm/s), reorientation (deg/s), linear and rotational external axes.
+  line(fmt::format("  CONST speeddata vPath{{{}}} := [", points.size()));
+  for (std::size_t k = 0; k < points.size(); ++k) {
+    line(fmt::format("    [{:.4f},500,5000,1000]{}", points[k].speed_mm_s, k + 1 < points.size() ? "," : "];"));
+  }
+  line("  PROC main()");
+  line("    ConfL \\Off;");
+  line("    FOR i FROM 1 TO nPoints DO");
+  line("      MoveL pPath{i}, vPath{i}, z1, tPolish \\WObj:=wPart;");
+  line("    ENDFOR");
+  line("    MoveL pPath{nPoints}, vPath{nPoints}, fine, tPolish \\WObj:=wPart;");
+  line("  ENDPROC");
+  line("ENDMODULE");
+  return fmt::to_string(out);
+}
+
+}  // namespace arcwheel::polishing

@@ -1,0 +1,76 @@
+#pragma once
+// The polishing path as the robot runs it, and its two outputs (issue 5 points 5-6):
+//  - the path CSV of formats.md section 7: x,y,z,q1,q2,q3,q4,speed_mm_s,dwell_s at full precision;
+//  - an ABB RAPID module: tooldata of the head, wobjdata of the part frame, one robtarget per
+//    point (position and ABB quaternion) and MoveL with per-segment speeddata.
+
+#include <Eigen/Core>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "grinding/surface.h"
+#include "polishing/dwell.h"
+#include "polishing/tool_frame.h"
+
+namespace arcwheel::polishing {
+
+struct PolishingPoint {
+  Eigen::Vector3d position_mm = Eigen::Vector3d::Zero();  // TCP = contact point, part frame
+  AbbQuaternion orientation;                              // tool frame in the part frame
+  double speed_mm_s = 0.0;                                // TCP speed into this point
+  double dwell_s = 0.0;                                   // dwell this point stands for
+};
+
+// Bonnet continuous precession along the robot path (method.md C). At path point k the bonnet
+// axis is P_O = [a b c] (sin theta cos alpha, sin theta sin alpha, cos theta) with c the outward
+// normal, a the feed direction (from the previous point; for the first, towards the next) on the
+// tangent plane, b = c x a and alpha = w2 t_k, t_k the dwell accumulated up to point k. The tool
+// frame of ToolFrameAt is turned by the smallest rotation taking its z (-c) to -P_O, and the
+// target is the bonnet centre, contact + bonnet_radius c (the TCP of the tooldata is then the
+// bonnet centre): a spherical bonnet touches the surface at the same point at any tilt.
+struct PathPrecession {
+  bool enabled = false;
+  double tilt_deg = 20.0;            // theta, [0, 90)
+  double precession_rate_rpm = 5.0;  // w2, finite
+  double bonnet_radius_mm = 0.0;     // >= 0
+};
+
+// Places the tool on the surface at each path point (ToolFrameAt, or precessed) with the dwell
+// solution's speed and dwell. Throws Error{kBadInput, "polishing.path"} naming the first point
+// off the surface, Error{kInvalidOption} for precession options out of range.
+[[nodiscard]] std::vector<PolishingPoint> BuildPolishingPath(const grinding::Surface& surface,
+                                                             std::span<const Eigen::Vector2d> path_xy_mm,
+                                                             const DwellSolution& dwell, RobotSide side,
+                                                             const PathPrecession& precession = {});
+
+struct ToolData {
+  // Nominal TCP (the removal centre) in the flange frame, mm, and the tool frame's orientation.
+  Eigen::Vector3d tcp_mm = Eigen::Vector3d(0.0, 0.0, 150.0);
+  AbbQuaternion orientation;
+  // Measured offset of the true removal centre from the nominal TCP, in the tool's x-y plane (mm),
+  // from the force-sensor calibration (method.md D, `arcwheel headcenter`). Added to the TCP so
+  // that the robot brings the true removal centre onto the path.
+  Eigen::Vector2d removal_centre_offset_mm = Eigen::Vector2d::Zero();
+  double mass_kg = 5.0;                                     // > 0
+  Eigen::Vector3d centre_of_gravity_mm = Eigen::Vector3d(0.0, 0.0, 75.0);
+  [[nodiscard]] Eigen::Vector3d CorrectedTcpMm() const;
+};
+
+// The part frame in the robot's user frame (the frames issue's workobject): origin and rotation.
+struct WorkObject {
+  Eigen::Vector3d origin_mm = Eigen::Vector3d::Zero();
+  AbbQuaternion orientation;
+};
+
+// CSV text per formats.md section 7; `comments` become leading "# " lines.
+[[nodiscard]] std::string PolishingPathCsv(std::span<const PolishingPoint> points,
+                                           std::span<const std::string> comments);
+
+// RAPID module text. Positions are written to 0.1 um (4 decimals) and quaternions to 9 decimals,
+// as RAPID's num holds about 7 significant digits; the module header says so.
+[[nodiscard]] std::string RapidModule(std::span<const PolishingPoint> points, const ToolData& tool,
+                                      const WorkObject& work_object, const std::string& module_name,
+                                      std::span<const std::string> comments);
+
+}  // namespace arcwheel::polishing

@@ -107,6 +107,21 @@ TEST(Hdf5Reader, RefusesAFileWithoutTheScanGroup) {
   EXPECT_THROW((void)ReadHdf5Scan(dir / "scan.h5"), Error);
 }
 
+// Found by fuzzing (scripts/fuzz.sh): a header declaring ~2e14 values made the reader try to
+// allocate them.
+TEST(Hdf5Reader, RefusesADatasetLargerThanTheFileCanHold) {
+  const auto path = testing::SourceDir() / "testdata" / "fuzz_regressions" / "scan_hdf5_huge_dataset.h5";
+  std::ifstream in(path, std::ios::binary);
+  const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  ASSERT_FALSE(bytes.empty());
+  try {
+    (void)ReadHdf5Scan(hdf5::File::OpenImage(bytes.data(), bytes.size(), "regression.h5"));
+    FAIL() << "expected an Error";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.code(), ErrorCode::kBadInput) << e.what();
+  }
+}
+
 // Golden file: the shipped scan and its truth (testdata/README.md says how they were made).
 TEST(Readers, ShippedPaperScanMatchesItsTruthFile) {
   const auto folder = testing::SourceDir() / "testdata";

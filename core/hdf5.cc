@@ -1,5 +1,6 @@
 #include "core/hdf5.h"
 
+#include <algorithm>
 #include <utility>
 
 #include "core/error.h"
@@ -123,7 +124,7 @@ size_t File::ElementSize(const std::string& dataset) const {
 namespace {
 
 template <typename T>
-std::vector<T> ReadNumeric(const File& file, const Handle& data, hid_t memory_type, const std::string& where) {
+std::vector<T> ReadNumeric(hid_t file_id, const Handle& data, hid_t memory_type, const std::string& where) {
   const Handle type(H5Dget_type(data.id()), H5Tclose);
   const H5T_class_t type_class = H5Tget_class(type.id());
   if (type_class != H5T_FLOAT && type_class != H5T_INTEGER) {
@@ -132,24 +133,33 @@ std::vector<T> ReadNumeric(const File& file, const Handle& data, hid_t memory_ty
   const Handle space(H5Dget_space(data.id()), H5Sclose);
   const hssize_t count = H5Sget_simple_extent_npoints(space.id());
   if (count < 0) throw Error(ErrorCode::kBadInput, kStage, "cannot read the size of " + where);
+  // A damaged header can declare any size: refuse more values than the file could hold even
+  // compressed 64 to 1, rather than trying to allocate them.
+  hsize_t file_bytes = 0;
+  H5Fget_filesize(file_id, &file_bytes);
+  const double declared_bytes = static_cast<double>(count) * static_cast<double>(sizeof(T));
+  if (declared_bytes > 64.0 * std::max<double>(static_cast<double>(file_bytes), 1 << 20)) {
+    throw Error(ErrorCode::kBadInput, kStage,
+                where + " declares " + std::to_string(count) + " values, more than the " + std::to_string(file_bytes) +
+                    "-byte file can hold (damaged?)");
+  }
   std::vector<T> values(static_cast<size_t>(count));
   if (count > 0 &&
       H5Dread(data.id(), memory_type, H5S_ALL, H5S_ALL, H5P_DEFAULT, values.data()) < 0) {
     throw Error(ErrorCode::kBadInput, kStage,
                 "cannot read " + where + " (file truncated or damaged?)");
   }
-  (void)file;
   return values;
 }
 
 }  // namespace
 
 std::vector<double> File::ReadDoubles(const std::string& dataset) const {
-  return ReadNumeric<double>(*this, OpenDataset(dataset), H5T_NATIVE_DOUBLE, Where(dataset));
+  return ReadNumeric<double>(handle_.id(), OpenDataset(dataset), H5T_NATIVE_DOUBLE, Where(dataset));
 }
 
 std::vector<float> File::ReadFloats(const std::string& dataset) const {
-  return ReadNumeric<float>(*this, OpenDataset(dataset), H5T_NATIVE_FLOAT, Where(dataset));
+  return ReadNumeric<float>(handle_.id(), OpenDataset(dataset), H5T_NATIVE_FLOAT, Where(dataset));
 }
 
 namespace {

@@ -88,7 +88,9 @@ bool File::HasObject(const std::string& name) const {
 }
 
 void File::CreateGroup(const std::string& name) {
-  Handle group(H5Gcreate2(handle_.id(), name.c_str(), H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), H5Gclose);
+  const Handle creation(H5Pcreate(H5P_GROUP_CREATE), H5Pclose);
+  H5Pset_obj_track_times(creation.id(), 0);
+  Handle group(H5Gcreate2(handle_.id(), name.c_str(), H5P_DEFAULT, creation.id(), H5P_DEFAULT), H5Gclose);
   if (!group.valid()) throw Error(ErrorCode::kIo, kStage, "cannot create group " + Where(name));
 }
 
@@ -167,8 +169,11 @@ namespace {
 void WriteDataset(hid_t file, const std::string& name, hid_t file_type, hid_t memory_type,
                   const void* data, const std::vector<hsize_t>& shape, const std::string& where) {
   const Handle space(H5Screate_simple(static_cast<int>(shape.size()), shape.data(), nullptr), H5Sclose);
+  // No modification times: the same data give byte-identical files (and SHA-256s).
+  const Handle creation(H5Pcreate(H5P_DATASET_CREATE), H5Pclose);
+  H5Pset_obj_track_times(creation.id(), 0);
   const Handle dataset(H5Dcreate2(file, name.c_str(), file_type, space.id(), H5P_DEFAULT,
-                                  H5P_DEFAULT, H5P_DEFAULT),
+                                  creation.id(), H5P_DEFAULT),
                        H5Dclose);
   if (!dataset.valid() ||
       H5Dwrite(dataset.id(), memory_type, H5S_ALL, H5S_ALL, H5P_DEFAULT, data) < 0) {

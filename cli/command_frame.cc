@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "cli/commands.h"
+#include "cli/output.h"
 #include "core/atomic_file.h"
 #include "core/error.h"
 #include "frames/three_point_frame.h"
@@ -57,14 +58,6 @@ std::vector<std::string> PmacLines(const frames::Transform& workpiece_to_machine
 }
 
 Eigen::Vector3d Point(const std::vector<double>& values) { return {values[0], values[1], values[2]}; }
-
-void Emit(const std::string& text, const std::string& output) {
-  if (output.empty()) {
-    fmt::print("{}", text);
-  } else {
-    WriteFileAtomically(output, text);
-  }
-}
 
 nlohmann::json FrameJson(const frames::WorkpieceFrame& frame, const std::array<Eigen::Vector3d, 3>& probes) {
   const frames::Transform forward = frame.WorkpieceToMachine();
@@ -114,7 +107,7 @@ void AddPmac(CLI::App& frame) {
         fmt::format("; workpiece frame from {} (counts per mm {}, {}, {})\n", args->frame_json,
                     args->pmac.counts_per_mm[0], args->pmac.counts_per_mm[1], args->pmac.counts_per_mm[2]);
     for (const std::string& line : PmacLines(transform, args->pmac)) text += line + "\n";
-    Emit(text, args->output);
+    EmitText(text, args->output);
   });
 }
 
@@ -172,7 +165,7 @@ void AddFrameCommand(CLI::App& app) {
       out["pmac_axis_definitions"] = lines;
       for (const std::string& line : lines) summary += "  " + line + "\n";
     }
-    Emit(out.dump(2) + "\n", args->output);
+    EmitText(out.dump(2) + "\n", args->output);
     if (::isatty(STDERR_FILENO)) fmt::print(stderr, "{}", summary);
   });
 }

@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "cli/commands.h"
+#include "cli/output.h"
 #include "core/atomic_file.h"
 #include "core/error.h"
 #include "frames/csv_table.h"
@@ -139,19 +140,6 @@ std::vector<RecordRow> ReadRecordList(const std::string& list, const char* x_nam
   return rows;
 }
 
-void Emit(const nlohmann::json& json, const std::string& output) {
-  const std::string text = json.dump(2) + "\n";
-  if (output.empty()) {
-    fmt::print("{}", text);
-  } else {
-    WriteFileAtomically(output, text);
-  }
-}
-
-void Summarise(const std::string& text) {
-  if (::isatty(STDERR_FILENO)) fmt::print(stderr, "{}", text);
-}
-
 void AddSolve(CLI::App& headcenter) {
   CLI::App* solve = headcenter.add_subcommand("solve", "contact (removal) centre of one force/torque record");
   struct Args {
@@ -201,8 +189,8 @@ void AddSolve(CLI::App& headcenter) {
                                (machine - commanded).y());
       }
     }
-    Emit(out, args->output);
-    Summarise(summary);
+    EmitText(out.dump(2) + "\n", args->output);
+    SummariseOnTerminal(summary);
   });
 }
 
@@ -247,8 +235,8 @@ void AddCalibrate(CLI::App& headcenter) {
     out["target_frame"] = "machine";
     out["presses"] = presses;
     out["tare"] = TareJson(args->solve, tare);
-    Emit(out, args->output);
-    Summarise(
+    EmitText(out.dump(2) + "\n", args->output);
+    SummariseOnTerminal(
         fmt::format("sensor -> machine: rotation {:.4f} deg, translation ({:.4f}, {:.4f}) mm, rms residual "
                     "{:.4f} mm over {} presses\n",
                     fit.parameters(2) * 180.0 / M_PI, fit.parameters(0), fit.parameters(1),
@@ -329,8 +317,8 @@ void AddMoves(CLI::App& headcenter) {
                           {"worst_accuracy_mm", tables.worst_accuracy_mm},
                           {"records", records},
                           {"tare", TareJson(args->solve, tare)}};
-    Emit(out, args->output);
-    Summarise(TablesSummary(tables));
+    EmitText(out.dump(2) + "\n", args->output);
+    SummariseOnTerminal(TablesSummary(tables));
   });
 }
 

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "cli/commands.h"
+#include "cli/output.h"
 #include "core/atomic_file.h"
 #include "core/error.h"
 #include "frames/csv_table.h"
@@ -71,19 +72,6 @@ nlohmann::json ReadJson(const std::string& path, const char* stage) {
   }
 }
 
-// JSON to -o FILE (atomically) or stdout.
-void Emit(const std::string& text, const std::string& output) {
-  if (output.empty()) {
-    fmt::print("{}", text);
-  } else {
-    WriteFileAtomically(output, text);
-  }
-}
-
-void Summarise(const std::string& text) {
-  if (::isatty(STDERR_FILENO)) fmt::print(stderr, "{}", text);
-}
-
 std::string FitSummary(const frames::TransformFit& fit) {
   std::string text = fmt::format("{}: {} of {} pairs used, rms residual {:.6f} mm, max {:.6f} mm\n",
                                  frames::ModelName(fit.transform.model), fit.pairs_used,
@@ -131,8 +119,8 @@ void AddFit(CLI::App& transform) {
     const frames::TransformFit result = FitNamingFile(pairs, model, args->options, args->pairs);
     nlohmann::json out = frames::TransformFitToJson(result);
     out["input"] = args->pairs;
-    Emit(out.dump(2) + "\n", args->output);
-    Summarise(FitSummary(result));
+    EmitText(out.dump(2) + "\n", args->output);
+    SummariseOnTerminal(FitSummary(result));
   });
 }
 
@@ -166,8 +154,8 @@ void AddApply(CLI::App& transform) {
                                                             : frames::ParseProgramKind(args->format);
     const frames::ProgramTransformResult result =
         frames::TransformProgram(text, kind, chosen, args->input, args->options);
-    Emit(result.text, args->output);
-    Summarise(fmt::format("{}: {} points in {} lines rewritten ({})\n", args->input,
+    EmitText(result.text, args->output);
+    SummariseOnTerminal(fmt::format("{}: {} points in {} lines rewritten ({})\n", args->input,
                           result.points_transformed, result.lines_changed,
                           args->inverse ? "inverse" : "forward"));
   });

@@ -132,6 +132,17 @@ class CsvParser {
            std::tolower(static_cast<unsigned char>(cell[2])) == 'n';
   }
 
+  // inf, infinity (any case, signed): a float sensor's over-range reading.
+  static bool IsInfinityWord(std::string_view cell) {
+    if (!cell.empty() && (cell.front() == '+' || cell.front() == '-')) cell.remove_prefix(1);
+    auto equals = [cell](std::string_view word) {
+      return cell.size() == word.size() && std::equal(cell.begin(), cell.end(), word.begin(), [](char a, char b) {
+               return std::tolower(static_cast<unsigned char>(a)) == b;
+             });
+    };
+    return equals("inf") || equals("infinity");
+  }
+
   double ParseNumber(std::string_view cell, const char* column) const {
     if (!cell.empty() && cell.front() == '+') cell.remove_prefix(1);
     double value = 0.0;
@@ -145,7 +156,7 @@ class CsvParser {
   }
 
   double ParseZ(std::string_view cell) const {
-    if (cell.empty() || IsNanWord(cell) || IsAlarmWord(cell)) return kNaN;
+    if (cell.empty() || IsNanWord(cell) || IsInfinityWord(cell) || IsAlarmWord(cell)) return kNaN;
     return ParseNumber(cell, "z_mm");
   }
 

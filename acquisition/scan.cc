@@ -45,7 +45,7 @@ void CheckIncreasing(const Scan& scan, const std::vector<double>& column, const 
 
 void CheckPositive(const Scan& scan, const std::optional<double>& value, const char* name) {
   if (value && !(*value > 0.0 && std::isfinite(*value))) {
-    Refuse(scan, std::string(name) + " must be positive, got " + Number(*value));
+    Refuse(scan, std::string(name) + " must be positive and finite, got " + Number(*value));
   }
 }
 

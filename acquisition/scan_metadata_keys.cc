@@ -60,7 +60,8 @@ void ApplyInvalidMarkers(Scan& scan, bool compare_as_float) {
   const float sentinel_float = static_cast<float>(sentinel);
   for (double& z : scan.z_mm) {
     const bool is_sentinel = has_sentinel && (compare_as_float ? static_cast<float>(z) == sentinel_float : z == sentinel);
-    if (is_sentinel || !(z >= low && z <= high)) z = std::numeric_limits<double>::quiet_NaN();
+    // +-Inf is a float sensor's over-range reading: an invalid sample, like NaN.
+    if (is_sentinel || !std::isfinite(z) || !(z >= low && z <= high)) z = std::numeric_limits<double>::quiet_NaN();
   }
 }
 

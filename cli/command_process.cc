@@ -57,6 +57,7 @@ fitting::RunRecord MakeRecord(const ProcessArgs& args, const acquisition::Scan& 
       {"runout_min_phase_coverage", args.fit.min_phase_coverage},
       {"beam_offset_mm", p.beam_offset_mm},
       {"wheel_radius_mm", p.wheel_radius_mm},
+      {"stuck_run_deg", p.stuck_run_deg},
   };
   record.text_parameters = {{"despike_method", args.despike_method},
                             {"rpm_source", args.rpm_source},
@@ -120,7 +121,7 @@ void AddProcessCommand(CLI::App& app) {
   auto args = std::make_shared<ProcessArgs>();
   CLI::App* cmd = app.add_subcommand("process", "turn a raw helical wheel scan into summary.json and wheel_map.h5");
   cmd->footer(
-      "Steps: trim invalid ends; estimate the noise; despike; unwrap the helix (encoder, or the\n"
+      "Steps: trim invalid ends; drop stuck-sensor runs; estimate the noise; despike; unwrap the helix (encoder, or the\n"
       "spindle speed estimated from the data when it differs significantly from nominal); fit a\n"
       "least-squares cubic spline along the helix; sample it at every phase on every turn; fit a\n"
       "circle to each phase's section inside the band (Ceres, with 1-sigma uncertainties); map the\n"
@@ -142,6 +143,9 @@ void AddProcessCommand(CLI::App& app) {
   cmd->add_option("--despike-threshold-um", p.despike.threshold_um, "rejection threshold (default: sigmas x noise)");
   cmd->add_option("--despike-sigmas", p.despike.threshold_sigmas, "automatic threshold in noise sigmas")->capture_default_str();
   cmd->add_option("--rpm-source", args->rpm_source, "auto, nominal, encoder or estimate")->capture_default_str();
+  cmd->add_option("--stuck-run-deg", p.stuck_run_deg,
+                  "drop runs of equal readings lasting this much of a turn (stuck sensor); 0 keeps them")
+      ->capture_default_str();
   cmd->add_option("--beam-offset-mm", p.beam_offset_mm, "correct a beam offset from the axis (method.md A.7)")->capture_default_str();
   cmd->add_option("--wheel-radius-mm", p.wheel_radius_mm, "wheel radius for the beam-offset correction");
   cmd->add_option("--min-points", args->fit.min_points, "fewest section points for a usable phase")->capture_default_str();

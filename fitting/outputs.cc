@@ -121,7 +121,8 @@ std::string SummaryJson(const RunRecord& record, const processing::ProcessedScan
                 {"format", record.input_format},
                 {"samples", processed.samples},
                 {"valid_samples", processed.valid_samples},
-                {"despiked_samples", processed.despike.rejected}};
+                {"despiked_samples", processed.despike.rejected},
+                {"stuck_samples", processed.stuck.dropped}};
   s["scan"] = {{"wheel_id", m.wheel_id},
                {"sensor", m.sensor},
                {"operator", m.operator_name},
@@ -178,6 +179,7 @@ std::string SummaryJson(const RunRecord& record, const processing::ProcessedScan
   parameters["knot_step_deg"] = map.knot_step_deg;
   parameters["axial_step_mm"] = map.axial_step_mm;
   parameters["despike_threshold_used_um"] = processed.despike.threshold_um;
+  parameters["stuck_run_samples_used"] = processed.stuck.min_run;
   s["processing"] = parameters;
   json warnings = json::array();
   for (const auto& w : processed.warnings) warnings.push_back(w);

@@ -52,7 +52,7 @@ PhaseSolution FitSection(const processing::Section& section, double center_mm, d
   // The section's circle is the unweighted geometric least-squares circle (formats.md 3.1). Its
   // covariance follows from the points' own sigmas (noise along rho, independent between turns)
   // through the fit's first-order sensitivity: C = S diag(sigma^2) S^T.
-  out.circle = FitCircle(y, rho, {}, {});
+  out.circle = FitCircle(y, rho, {}, options.circle);
   if (out.circle.IsUsable() && std::all_of(sigma.begin(), sigma.end(), [](double s) { return s > 0; })) {
     Eigen::VectorXd variance(static_cast<Eigen::Index>(sigma.size()));
     for (std::size_t k = 0; k < sigma.size(); ++k) variance(static_cast<Eigen::Index>(k)) = sigma[k] * sigma[k];
@@ -132,6 +132,7 @@ std::vector<std::string> WheelFitOptions::Problems() const {
   if (min_points < 4) problems.push_back("min_points must be >= 4");
   if (!(min_band_coverage >= 0 && min_band_coverage <= 1)) problems.push_back("min_band_coverage must be in 0..1");
   if (!(min_phase_coverage > 0 && min_phase_coverage <= 1)) problems.push_back("min_phase_coverage must be in (0, 1]");
+  if (circle.max_iterations < 1) problems.push_back("circle.max_iterations must be >= 1");
   return problems;
 }
 

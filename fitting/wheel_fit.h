@@ -4,6 +4,7 @@
 #include <string>
 #include <vector>
 
+#include "fitting/circle_fit.h"
 #include "processing/wheel_map.h"
 
 namespace arcwheel::fitting {
@@ -16,6 +17,7 @@ struct WheelFitOptions {
   int min_points = 8;               // a phase with fewer points in the band is flagged
   double min_band_coverage = 0.6;   // fraction of the band's width the points must span
   double min_phase_coverage = 0.9;  // fraction of phases a runout/roundness node needs
+  CircleFitOptions circle;          // each section's circle fit; a fit that does not converge is flagged
   [[nodiscard]] std::vector<std::string> Problems() const;
 };
 

@@ -63,7 +63,7 @@ HelixSpline::HelixSpline(std::span<const double> z, const HelixGeometry& geometr
   BandedSpd upper_normal(n);
   std::vector<double> upper_rhs(n, 0.0);
   std::vector<int> upper_counts(cells, 0);
-  std::thread upper([&] { Accumulate(z, geometry, middle, last, upper_normal, upper_rhs, upper_counts); });
+  std::thread upper([&, end = last] { Accumulate(z, geometry, middle, end, upper_normal, upper_rhs, upper_counts); });
   Accumulate(z, geometry, first, middle, normal_, rhs, cell_counts_);
   upper.join();
   for (std::size_t i = 0; i < n; ++i) {

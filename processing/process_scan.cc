@@ -7,6 +7,7 @@
 #include "core/error.h"
 #include "core/interrupt.h"
 #include "processing/noise.h"
+#include "processing/stuck_readings.h"
 
 namespace arcwheel::processing {
 namespace {
@@ -37,11 +38,24 @@ void CorrectBeamOffset(std::vector<double>& rho, double offset_mm, double apex_r
   }
 }
 
+// Samples in `stuck_run_deg` of a turn (at least 16), from the scan's own timing; 0 when the run
+// is disabled or the scan gives no way to tell a turn (it is refused further on).
+std::size_t StuckRunSamples(const acquisition::Scan& scan, double stuck_run_deg) {
+  if (stuck_run_deg <= 0.0 || scan.size() < 2) return 0;
+  if (!scan.has_encoder() && !scan.metadata.spindle_rpm) return 0;
+  const HelixGeometry geometry(scan, scan.metadata.spindle_rpm.value_or(0.0));
+  const double turns = (geometry.PhaseAt(scan.size() - 1) - geometry.PhaseAt(0)) / 360.0;
+  if (!(turns > 0.0)) return 0;
+  const double samples_per_turn = static_cast<double>(scan.size()) / turns;
+  return std::max<std::size_t>(16, static_cast<std::size_t>(std::ceil(samples_per_turn * stuck_run_deg / 360.0)));
+}
+
 }  // namespace
 
 std::vector<std::string> ProcessOptions::Problems() const {
   std::vector<std::string> problems = despike.Problems();
   for (auto& p : map.Problems()) problems.push_back(std::move(p));
+  if (!(stuck_run_deg >= 0.0 && stuck_run_deg <= 360.0)) problems.push_back("stuck_run_deg violates 0..360");
   if (!std::isfinite(beam_offset_mm)) problems.push_back("beam_offset_mm must be finite");
   if (speed.max_harmonic < 1 || speed.max_harmonic > 60) problems.push_back("speed max_harmonic violates 1..60");
   return problems;
@@ -84,6 +98,18 @@ ProcessedScan ProcessScan(acquisition::Scan scan, const ProcessOptions& options)
   out.last_valid = rho.size() - 1 - static_cast<std::size_t>(last - rho.rbegin());
   ThrowIfInterrupted();
 
+  out.stuck = DropStuckReadings(rho, StuckRunSamples(scan, options.stuck_run_deg));
+  if (out.stuck.dropped > 0 && out.stuck.dropped == out.valid_samples) {
+    throw Error(ErrorCode::kBadInput, kStage,
+                fmt::format("'{}': every reading lies in a run of equal values (longest {} samples): the sensor is "
+                            "stuck or saturated",
+                            scan.path, out.stuck.longest_run));
+  }
+  if (out.stuck.dropped > 0) {
+    out.warnings.push_back(fmt::format("dropped {} samples in {} run(s) of equal readings (longest {} samples; a run of "
+                                       "{} or more is a stuck or saturated sensor): check the sensor",
+                                       out.stuck.dropped, out.stuck.runs, out.stuck.longest_run, out.stuck.min_run));
+  }
   out.noise_sigma_mm = EstimateNoiseSigmaMm(rho);
   out.despike = Despike(rho, out.noise_sigma_mm, options.despike);
   // The noise that matters for the sigmas is that of the samples the map is built from.

@@ -11,6 +11,7 @@
 
 #include "acquisition/scan.h"
 #include "processing/despike.h"
+#include "processing/stuck_readings.h"
 #include "processing/helix_geometry.h"
 #include "processing/spindle_speed.h"
 #include "processing/wheel_map.h"
@@ -30,6 +31,9 @@ struct ProcessOptions {
   // Wheel radius at the arc apex, for the beam-offset correction; <= 0: from the scan's
   // wheel_diameter_mm.
   double wheel_radius_mm = 0.0;
+  // Runs of exactly equal readings lasting this much of a turn (and at least 16 samples) are a
+  // stuck sensor and are dropped (processing/stuck_readings.h); 0 keeps them.
+  double stuck_run_deg = 20.0;
   [[nodiscard]] std::vector<std::string> Problems() const;
 };
 
@@ -41,6 +45,7 @@ struct ProcessedScan {
   std::size_t valid_samples = 0;       // before despiking
   std::size_t first_valid = 0;         // the trimmed span [first_valid, last_valid]
   std::size_t last_valid = 0;
+  StuckReadingsResult stuck;
   DespikeResult despike;
   double noise_sigma_mm = 0.0;
   SpindleSpeedEstimate speed;          // filled when estimated

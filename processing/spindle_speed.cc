@@ -71,7 +71,7 @@ std::vector<TurnHarmonics> FitTurns(const acquisition::Scan& scan, std::span<con
           ++filled;
         }
       }
-      covered = filled >= 0.9 * static_cast<double>(nb);
+      covered = static_cast<double>(filled) >= 0.9 * static_cast<double>(nb);
     }
     if (!covered) continue;
     const auto rows = static_cast<Eigen::Index>(cells.size());
@@ -161,7 +161,7 @@ SpindleSpeedEstimate EstimateSpindleSpeed(const acquisition::Scan& scan, std::sp
   estimate.fitted_rpm = estimate.used_rpm = estimate.nominal_rpm;
 
   const HelixGeometry nominal(scan, estimate.nominal_rpm);
-  const double samples_per_turn = scan.size() / std::max(1.0, (nominal.PhaseAt(scan.size() - 1) - nominal.PhaseAt(0)) / 360.0);
+  const double samples_per_turn = static_cast<double>(scan.size()) / std::max(1.0, (nominal.PhaseAt(scan.size() - 1) - nominal.PhaseAt(0)) / 360.0);
   const int bins = static_cast<int>(std::clamp(samples_per_turn / 2.0, 16.0, 360.0));
   const int harmonics = std::clamp(options.max_harmonic, 1, std::max(1, bins / 2 - 3));
 

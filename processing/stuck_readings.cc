@@ -1,0 +1,32 @@
+#include "processing/stuck_readings.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace arcwheel::processing {
+
+StuckReadingsResult DropStuckReadings(std::span<double> z_mm, std::size_t min_run) {
+  StuckReadingsResult result;
+  result.min_run = min_run;
+  if (min_run < 2) return result;
+  std::size_t begin = 0;
+  while (begin < z_mm.size()) {
+    std::size_t end = begin + 1;
+    if (std::isfinite(z_mm[begin])) {
+      while (end < z_mm.size() && z_mm[end] == z_mm[begin]) ++end;
+    }
+    const std::size_t length = end - begin;
+    if (std::isfinite(z_mm[begin]) && length >= min_run) {
+      std::fill(z_mm.begin() + static_cast<std::ptrdiff_t>(begin), z_mm.begin() + static_cast<std::ptrdiff_t>(end),
+                std::numeric_limits<double>::quiet_NaN());
+      result.dropped += length;
+      ++result.runs;
+      result.longest_run = std::max(result.longest_run, length);
+    }
+    begin = end;
+  }
+  return result;
+}
+
+}  // namespace arcwheel::processing

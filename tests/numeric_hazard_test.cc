@@ -1,0 +1,221 @@
+// Numeric hazards in scans (issue: hardening): NaN and Inf in every column, duplicated or
+// backward time and encoder values, a sensor stuck on one reading, sections without variance and
+// fits that do not converge. Each must give a clear refusal or an honest, flagged result, never a
+// plausible wrong number. Truth comes from the simulator's known wheel.
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <functional>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include "acquisition/scan_reader.h"
+#include "acquisition/simulate.h"
+#include "core/error.h"
+#include "core/testing/testing.h"
+#include "fitting/wheel_fit.h"
+#include "processing/process_scan.h"
+
+namespace arcwheel {
+namespace {
+
+using acquisition::ScanSettings;
+using acquisition::WheelModel;
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+constexpr double kTrueRadiusMm = 55.4423;  // WheelModel's default arc radius
+
+// A plain arc wheel with eccentricity, scanned with 0.5 um sensor noise over 14 mm: about 8.4e4
+// samples, 1200 a turn.
+ScanSettings NoisyScan() {
+  ScanSettings s;
+  s.noise_um = 0.5;
+  s.start_y_mm = -7.0;
+  s.end_y_mm = 7.0;
+  s.seed = 11;
+  return s;
+}
+
+WheelModel EccentricWheel() {
+  WheelModel w;
+  w.radial_harmonics_um = {{1, 3.0, 20.0}};
+  return w;
+}
+
+fitting::WheelFitOptions NarrowBand() {
+  fitting::WheelFitOptions options;
+  options.band_half_width_mm = 5.0;
+  return options;
+}
+
+// A message check that shows the message when it fails.
+void ExpectRefused(const std::function<void()>& run, ErrorCode code, const std::string& fragment) {
+  try {
+    run();
+    ADD_FAILURE() << "not refused; expected: " << fragment;
+  } catch (const Error& e) {
+    EXPECT_EQ(e.code(), code) << e.what();
+    EXPECT_NE(std::string(e.what()).find(fragment), std::string::npos) << e.what();
+  }
+}
+
+// Samples 0.1 s apart at 500 rpm: a few samples cover the two turns a scan needs.
+const std::string kCsvHeader = "# spindle_rpm: 500\n# feed_mm_per_min: 100\n# sample_period_s: 0.1\n";
+
+// --- NaN and Inf -----------------------------------------------------------------------------------
+
+TEST(NumericHazards, InfinityInTheReadingsIsAnInvalidSampleInCsvAndHdf5Alike) {
+  const std::string csv = kCsvHeader + "z_mm\n0.1\ninf\n0.2\n-Inf\nINFINITY\n0.3\nnan\n0.4\n";
+  const acquisition::Scan from_csv = acquisition::ParseCsvScan(csv, "inf.csv");
+  EXPECT_EQ(from_csv.size(), 8U);
+  EXPECT_EQ(from_csv.CountValid(), 4U);
+
+  testing::TempDir dir;
+  acquisition::Scan scan = from_csv;
+  scan.z_mm = {0.1, kInf, 0.2, -kInf, kInf, 0.3, std::nan(""), 0.4};
+  acquisition::WriteHdf5Scan(scan, /*float32=*/true, (dir / "inf.h5").string());
+  const acquisition::Scan from_hdf5 = acquisition::ReadHdf5Scan(dir / "inf.h5");
+  EXPECT_EQ(from_hdf5.CountValid(), 4U);
+  for (double z : from_hdf5.z_mm) EXPECT_TRUE(std::isnan(z) || std::isfinite(z)) << z;
+}
+
+TEST(NumericHazards, NonFiniteTimeAngleOrAxialValuesAreRefusedNamingTheLine) {
+  ExpectRefused([] { (void)acquisition::ParseCsvScan(kCsvHeader + "z_mm,t_s\n0.1,0\n0.2,inf\n", "t.csv"); },
+                ErrorCode::kBadInput, "line 6");
+  ExpectRefused([] { (void)acquisition::ParseCsvScan(kCsvHeader + "z_mm,angle_deg\n0.1,0\n0.2,nan\n", "a.csv"); },
+                ErrorCode::kBadInput, "line 6");
+  ExpectRefused([] { (void)acquisition::ParseCsvScan(kCsvHeader + "z_mm,y_mm\n0.1,-inf\n0.2,0\n", "y.csv"); },
+                ErrorCode::kBadInput, "line 5");
+
+  testing::TempDir dir;
+  acquisition::Scan scan = acquisition::ParseCsvScan(kCsvHeader + "z_mm,t_s\n0.1,0\n0.2,0.1\n0.3,0.2\n0.4,0.3\n0.5,0.4\n", "t.csv");
+  scan.t_s[1] = std::nan("");
+  acquisition::WriteHdf5Scan(scan, /*float32=*/false, (dir / "t.h5").string());
+  ExpectRefused([&] { (void)acquisition::ReadHdf5Scan(dir / "t.h5"); }, ErrorCode::kBadInput,
+                "column 't' is not finite at sample 1");
+}
+
+TEST(NumericHazards, NonFiniteOrNonPositiveSettingsAreRefused) {
+  for (const char* line : {"# spindle_rpm: inf\n", "# spindle_rpm: nan\n", "# spindle_rpm: 0\n"}) {
+    const std::string csv = std::string(line) + "# feed_mm_per_min: 100\n# sample_period_s: 0.0001\nz_mm\n0.1\n0.2\n0.3\n";
+    ExpectRefused([&] { (void)acquisition::ParseCsvScan(csv, "rpm.csv"); }, ErrorCode::kBadInput,
+                  "spindle_rpm must be positive and finite");
+  }
+  const std::string csv = "# spindle_rpm: 500\n# feed_mm_per_min: 100\n# sample_period_s: -inf\nz_mm\n0.1\n0.2\n";
+  ExpectRefused([&] { (void)acquisition::ParseCsvScan(csv, "period.csv"); }, ErrorCode::kBadInput,
+                "sample_period_s must be positive and finite");
+}
+
+// --- time and encoder order ------------------------------------------------------------------------
+
+TEST(NumericHazards, DuplicatedOrBackwardTimeIsRefusedNamingTheSample) {
+  ExpectRefused([] { (void)acquisition::ParseCsvScan(kCsvHeader + "z_mm,t_s\n0.1,0\n0.2,0.1\n0.3,0.1\n", "d.csv"); },
+                ErrorCode::kBadInput, "column 't' does not increase at sample 2");
+  ExpectRefused([] { (void)acquisition::ParseCsvScan(kCsvHeader + "z_mm,t_s\n0.1,0\n0.2,0.2\n0.3,0.1\n", "b.csv"); },
+                ErrorCode::kBadInput, "column 't' does not increase at sample 2");
+}
+
+TEST(NumericHazards, DuplicatedOrBackwardEncoderIsRefusedButAWrappedEncoderIsNot) {
+  ScanSettings settings = NoisyScan();
+  settings.write_encoder = true;
+  const acquisition::Scan wrapped = acquisition::SimulateScan(EccentricWheel(), settings).scan;
+  // The simulator writes the angle wrapped to [0, 360); unwrapped by hand it must give the same.
+  acquisition::Scan unwrapped = wrapped;
+  double turns = 0.0;
+  for (std::size_t i = 1; i < unwrapped.angle_deg.size(); ++i) {
+    if (wrapped.angle_deg[i] < wrapped.angle_deg[i - 1]) turns += 360.0;
+    unwrapped.angle_deg[i] = wrapped.angle_deg[i] + turns;
+  }
+  ASSERT_GT(turns, 3600.0);
+  const auto a = fitting::FitWheel(processing::ProcessScan(wrapped, {}).map, NarrowBand());
+  const auto b = fitting::FitWheel(processing::ProcessScan(unwrapped, {}).map, NarrowBand());
+  EXPECT_NEAR(a.mean_arc_radius_mm, b.mean_arc_radius_mm, 1e-9);
+  EXPECT_NEAR(a.mean_arc_radius_mm, kTrueRadiusMm, 3.0 * a.mean_arc_radius_sigma_mm);
+
+  acquisition::Scan duplicated = unwrapped;
+  duplicated.angle_deg[5000] = duplicated.angle_deg[4999];
+  ExpectRefused([&] { (void)processing::ProcessScan(duplicated, {}); }, ErrorCode::kBadInput, "does not increase");
+  acquisition::Scan backward = unwrapped;
+  backward.angle_deg[5000] -= 30.0;  // a jump back that is not a wrap
+  ExpectRefused([&] { (void)processing::ProcessScan(backward, {}); }, ErrorCode::kBadInput, "does not increase");
+}
+
+// --- a stuck sensor and sections without variance ------------------------------------------------
+
+TEST(NumericHazards, AStuckSensorIsDroppedAndTheRadiusStaysTrue) {
+  acquisition::Scan scan = acquisition::SimulateScan(EccentricWheel(), NoisyScan()).scan;
+  // The sensor hangs on one reading for two turns in the middle of the band.
+  const std::size_t begin = 40000, length = 2400;
+  for (std::size_t i = begin; i < begin + length; ++i) scan.z_mm[i] = scan.z_mm[begin];
+
+  processing::ProcessOptions keep;
+  keep.stuck_run_deg = 0.0;
+  const auto kept = fitting::FitWheel(processing::ProcessScan(scan, keep).map, NarrowBand());
+  // The hazard is real: left in, the run moves the radius far beyond its sigma.
+  EXPECT_GT(std::abs(kept.mean_arc_radius_mm - kTrueRadiusMm), 50.0 * kept.mean_arc_radius_sigma_mm);
+
+  const processing::ProcessedScan processed = processing::ProcessScan(scan, {});
+  EXPECT_EQ(processed.stuck.dropped, length);
+  EXPECT_EQ(processed.stuck.runs, 1U);
+  EXPECT_EQ(processed.stuck.min_run, 67U);  // 20 deg of a 1200-sample turn
+  ASSERT_FALSE(processed.warnings.empty());
+  EXPECT_NE(processed.warnings.front().find("stuck"), std::string::npos);
+  const auto fit = fitting::FitWheel(processed.map, NarrowBand());
+  EXPECT_NEAR(fit.mean_arc_radius_mm, kTrueRadiusMm, 3.0 * fit.mean_arc_radius_sigma_mm);
+}
+
+TEST(NumericHazards, QuantisedOrNoiseFreeReadingsAreNotTakenForAStuckSensor) {
+  // A 0.1 um sensor resolution with 0.5 um noise repeats values, but never for 20 deg.
+  acquisition::Scan quantised = acquisition::SimulateScan(EccentricWheel(), NoisyScan()).scan;
+  for (double& z : quantised.z_mm) z = std::round(z * 1e4) / 1e4;
+  EXPECT_EQ(processing::ProcessScan(quantised, {}).stuck.dropped, 0U);
+
+  // Noise-free float32 readings of a perfectly round wheel: the apex of the arc is flat to second
+  // order, the hardest case for equal consecutive readings.
+  ScanSettings clean = NoisyScan();
+  clean.noise_um = 0.0;
+  acquisition::Scan round = acquisition::SimulateScan(WheelModel{}, clean).scan;
+  for (double& z : round.z_mm) z = static_cast<double>(static_cast<float>(z));
+  EXPECT_EQ(processing::ProcessScan(round, {}).stuck.dropped, 0U);
+}
+
+TEST(NumericHazards, AScanWithoutVarianceIsRefusedClearly) {
+  acquisition::Scan flat = acquisition::SimulateScan(EccentricWheel(), NoisyScan()).scan;
+  for (double& z : flat.z_mm) z = 0.25;
+  ExpectRefused([&] { (void)processing::ProcessScan(flat, {}); }, ErrorCode::kBadInput, "stuck");
+  // With the stuck-sensor check off, every section is a straight line: no circle, and the fit says so.
+  processing::ProcessOptions keep;
+  keep.stuck_run_deg = 0.0;
+  const processing::ProcessedScan processed = processing::ProcessScan(flat, keep);
+  ExpectRefused([&] { (void)fitting::FitWheel(processed.map, NarrowBand()); }, ErrorCode::kFitFailed, "collinear");
+}
+
+// --- fits that do not converge ----------------------------------------------------------------
+
+TEST(NumericHazards, FitsThatDoNotConvergeAreFlaggedAndLeftOut) {
+  const processing::ProcessedScan processed =
+      processing::ProcessScan(acquisition::SimulateScan(EccentricWheel(), NoisyScan()).scan, {});
+  fitting::WheelFitOptions starved = NarrowBand();
+  starved.circle.max_iterations = 1;
+  try {
+    const fitting::WheelFit fit = fitting::FitWheel(processed.map, starved);
+    // Whatever converged in one step is usable; everything else is flagged and out of the means.
+    int flagged = 0;
+    for (const auto& phase : fit.phases) {
+      if (phase.usable) continue;
+      ++flagged;
+      EXPECT_NE(phase.flag.find("did not converge"), std::string::npos) << phase.flag;
+    }
+    ASSERT_GT(flagged, 0) << "one iteration should not converge every phase";
+    EXPECT_EQ(fit.usable_phases + flagged, static_cast<int>(fit.phases.size()));
+    EXPECT_FALSE(fit.warnings.empty());
+  } catch (const Error& e) {
+    EXPECT_EQ(e.code(), ErrorCode::kFitFailed);
+    EXPECT_NE(std::string(e.what()).find("did not converge"), std::string::npos) << e.what();
+  }
+}
+
+}  // namespace
+}  // namespace arcwheel

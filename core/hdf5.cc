@@ -1,6 +1,8 @@
 #include "core/hdf5.h"
 
 #include <algorithm>
+#include <cstddef>
+#include <cstring>
 #include <utility>
 
 #include "core/error.h"
@@ -286,6 +288,134 @@ std::optional<std::string> File::ReadAttributeString(const std::string& object, 
   }
   buffer.resize(buffer.find('\0') == std::string::npos ? buffer.size() : buffer.find('\0'));
   return buffer;
+}
+
+namespace {
+
+// One member of a compound type read on its own: HDF5 converts a compound by member name, so a
+// memory compound holding just that member picks it out of the stored one.
+struct MemberReader {
+  Handle memory_type;  // the one-member compound
+  size_t element_size = 0;
+  enum class Kind { kString, kVariableString, kNumber, kVariableNumbers } kind = Kind::kNumber;
+  size_t count = 1;  // numbers per element for kNumber (an array member)
+};
+
+bool IsNumeric(hid_t type) {
+  const H5T_class_t c = H5Tget_class(type);
+  return c == H5T_INTEGER || c == H5T_FLOAT;
+}
+
+std::optional<MemberReader> MakeMemberReader(hid_t member_type, const char* member_name) {
+  MemberReader reader;
+  Handle value_type;
+  const H5T_class_t member_class = H5Tget_class(member_type);
+  if (member_class == H5T_STRING) {
+    value_type = Handle(H5Tcopy(H5T_C_S1), H5Tclose);
+    if (H5Tis_variable_str(member_type) > 0) {
+      H5Tset_size(value_type.id(), H5T_VARIABLE);
+      reader.kind = MemberReader::Kind::kVariableString;
+      reader.element_size = sizeof(char*);
+    } else {
+      const size_t size = H5Tget_size(member_type);
+      if (size == 0 || size > (1u << 16)) return std::nullopt;
+      H5Tset_size(value_type.id(), size);
+      reader.kind = MemberReader::Kind::kString;
+      reader.element_size = size;
+    }
+  } else if (IsNumeric(member_type)) {
+    value_type = Handle(H5Tcopy(H5T_NATIVE_DOUBLE), H5Tclose);
+    reader.element_size = sizeof(double);
+  } else if (member_class == H5T_ARRAY) {
+    const Handle base(H5Tget_super(member_type), H5Tclose);
+    const int rank = H5Tget_array_ndims(member_type);
+    if (!base.valid() || !IsNumeric(base.id()) || rank < 1 || rank > 4) return std::nullopt;
+    hsize_t dims[4] = {0, 0, 0, 0};
+    H5Tget_array_dims2(member_type, dims);
+    hsize_t count = 1;
+    for (int k = 0; k < rank; ++k) count *= dims[k];
+    if (count == 0 || count > (1u << 16)) return std::nullopt;
+    value_type = Handle(H5Tarray_create2(H5T_NATIVE_DOUBLE, static_cast<unsigned>(rank), dims), H5Tclose);
+    reader.count = static_cast<size_t>(count);
+    reader.element_size = reader.count * sizeof(double);
+  } else if (member_class == H5T_VLEN) {
+    const Handle base(H5Tget_super(member_type), H5Tclose);
+    if (!base.valid() || !IsNumeric(base.id())) return std::nullopt;
+    value_type = Handle(H5Tvlen_create(H5T_NATIVE_DOUBLE), H5Tclose);
+    reader.kind = MemberReader::Kind::kVariableNumbers;
+    reader.element_size = sizeof(hvl_t);
+  } else {
+    return std::nullopt;
+  }
+  if (!value_type.valid()) return std::nullopt;
+  reader.memory_type = Handle(H5Tcreate(H5T_COMPOUND, reader.element_size), H5Tclose);
+  if (!reader.memory_type.valid() || H5Tinsert(reader.memory_type.id(), member_name, 0, value_type.id()) < 0) {
+    return std::nullopt;
+  }
+  return reader;
+}
+
+}  // namespace
+
+std::optional<File::Compound> File::ReadAttributeCompound(const std::string& object, const std::string& name) const {
+  if (!HasAttribute(object, name)) return std::nullopt;
+  const std::string where = "attribute '" + name + "' on " + Where(object);
+  const Handle attribute(H5Aopen_by_name(handle_.id(), object.c_str(), name.c_str(), H5P_DEFAULT, H5P_DEFAULT),
+                         H5Aclose);
+  const Handle type(H5Aget_type(attribute.id()), H5Tclose);
+  if (!attribute.valid() || !type.valid() || H5Tget_class(type.id()) != H5T_COMPOUND) {
+    throw Error(ErrorCode::kBadInput, kStage, where + " is not a compound");
+  }
+  const Handle space(H5Aget_space(attribute.id()), H5Sclose);
+  const hssize_t elements = H5Sget_simple_extent_npoints(space.id());
+  if (elements < 1 || elements > (1 << 16)) {
+    throw Error(ErrorCode::kBadInput, kStage, where + " holds " + std::to_string(elements) + " elements");
+  }
+  Compound result;
+  const int members = H5Tget_nmembers(type.id());
+  for (int m = 0; m < members; ++m) {
+    char* raw_name = H5Tget_member_name(type.id(), static_cast<unsigned>(m));
+    if (raw_name == nullptr) continue;
+    const std::string member(raw_name);
+    H5free_memory(raw_name);
+    const Handle member_type(H5Tget_member_type(type.id(), static_cast<unsigned>(m)), H5Tclose);
+    const std::optional<MemberReader> reader = MakeMemberReader(member_type.id(), member.c_str());
+    if (!reader) continue;
+    // max_align_t storage: the buffer holds pointers (variable-length members) and doubles.
+    std::vector<std::max_align_t> buffer(
+        (static_cast<size_t>(elements) * reader->element_size + sizeof(std::max_align_t) - 1) / sizeof(std::max_align_t));
+    if (H5Aread(attribute.id(), reader->memory_type.id(), buffer.data()) < 0) {
+      throw Error(ErrorCode::kBadInput, kStage, "cannot read member '" + member + "' of " + where);
+    }
+    const auto* first = reinterpret_cast<const unsigned char*>(buffer.data());
+    switch (reader->kind) {
+      case MemberReader::Kind::kString: {
+        const auto* text = reinterpret_cast<const char*>(first);
+        result.strings[member] = std::string(text, strnlen(text, reader->element_size));
+        break;
+      }
+      case MemberReader::Kind::kVariableString: {
+        const char* text = *reinterpret_cast<char* const*>(first);
+        result.strings[member] = text == nullptr ? std::string() : std::string(text);
+        break;
+      }
+      case MemberReader::Kind::kNumber: {
+        const auto* values = reinterpret_cast<const double*>(first);
+        result.numbers[member] = std::vector<double>(values, values + reader->count);
+        break;
+      }
+      case MemberReader::Kind::kVariableNumbers: {
+        const auto* sequence = reinterpret_cast<const hvl_t*>(first);
+        const auto* values = static_cast<const double*>(sequence->p);
+        result.numbers[member] = values == nullptr ? std::vector<double>() : std::vector<double>(values, values + sequence->len);
+        break;
+      }
+    }
+    if (reader->kind == MemberReader::Kind::kVariableString || reader->kind == MemberReader::Kind::kVariableNumbers) {
+      H5Dvlen_reclaim(reader->memory_type.id(), space.id(), H5P_DEFAULT, buffer.data());
+    }
+  }
+  return result;
 }
 
 void File::WriteAttribute(const std::string& object, const std::string& name, double value) {

@@ -6,6 +6,7 @@
 #include <hdf5.h>
 
 #include <filesystem>
+#include <map>
 #include <optional>
 #include <string>
 #include <vector>
@@ -65,6 +66,15 @@ class File {
                                                           const std::string& name) const;
   [[nodiscard]] std::optional<std::string> ReadAttributeString(const std::string& object,
                                                                const std::string& name) const;
+  // The first element of a compound attribute (e.g. Zygo's `Z Converter`): its string members
+  // (fixed or variable length) and numeric members (a number, a fixed array or a variable-length
+  // sequence, converted to double) by member name; other member kinds are left out.
+  struct Compound {
+    std::map<std::string, std::string> strings;
+    std::map<std::string, std::vector<double>> numbers;
+  };
+  [[nodiscard]] std::optional<Compound> ReadAttributeCompound(const std::string& object,
+                                                              const std::string& name) const;
   void WriteAttribute(const std::string& object, const std::string& name, double value);
   void WriteAttribute(const std::string& object, const std::string& name, const std::string& value);
 

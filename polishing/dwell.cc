@@ -22,13 +22,8 @@ constexpr double kOvershootToleranceUm = 1e-3;
   throw Error(ErrorCode::kInvalidOption, kStage, what);
 }
 
-void CheckOptions(const GaussianRemovalFunction& removal, const DwellOptions& o) {
-  if (!(removal.peak_rate_um_per_s > 0.0) || !std::isfinite(removal.peak_rate_um_per_s)) {
-    Invalid(fmt::format("peak_rate_um_per_s = {} violates > 0", removal.peak_rate_um_per_s));
-  }
-  if (!(removal.fwhm_mm > 0.0) || !std::isfinite(removal.fwhm_mm)) {
-    Invalid(fmt::format("fwhm_mm = {} violates > 0", removal.fwhm_mm));
-  }
+void CheckOptions(const RemovalFunction& removal, const DwellOptions& o, std::size_t points) {
+  removal.Check();
   if (!(o.max_speed_mm_s > 0.0) || !std::isfinite(o.max_speed_mm_s)) {
     Invalid(fmt::format("max_speed_mm_s = {} violates > 0", o.max_speed_mm_s));
   }
@@ -53,6 +48,19 @@ void CheckOptions(const GaussianRemovalFunction& removal, const DwellOptions& o)
   }
   if (!(o.relative_tolerance > 0.0)) {
     Invalid(fmt::format("relative_tolerance = {} violates > 0", o.relative_tolerance));
+  }
+  if (o.max_shaping_rounds < 1) Invalid(fmt::format("max_shaping_rounds = {} violates >= 1", o.max_shaping_rounds));
+  if (!(o.shaping_tolerance_um > 0.0)) {
+    Invalid(fmt::format("shaping_tolerance_um = {} violates > 0", o.shaping_tolerance_um));
+  }
+  if (!o.least_dwell_s.empty() && o.least_dwell_s.size() != points) {
+    Invalid(fmt::format("least_dwell_s has {} values for {} path points", o.least_dwell_s.size(), points));
+  }
+  for (std::size_t k = 0; k < o.least_dwell_s.size(); ++k) {
+    if (!(o.least_dwell_s[k] >= 0.0) || !std::isfinite(o.least_dwell_s[k]) || (k == 0 && o.least_dwell_s[k] > 0.0)) {
+      Invalid(fmt::format("least_dwell_s[{}] = {} violates {}", k, o.least_dwell_s[k],
+                          k == 0 ? "== 0 (the first point is the approach)" : ">= 0"));
+    }
   }
 }
 
@@ -86,18 +94,20 @@ Rows ApertureRows(const ErrorMap& target, const grinding::Aperture& aperture) {
 
 using SparseMatrix = Eigen::SparseMatrix<double, Eigen::ColMajor, int>;
 
-SparseMatrix RemovalMatrix(const ErrorMap& map, const Rows& rows,
-                           std::span<const Eigen::Vector2d> path, const GaussianRemovalFunction& removal) {
-  const double radius = removal.SupportRadiusMm();
+// Templated on the concrete removal model so that the rate is an inlined call in the inner loop.
+template <class Model>
+SparseMatrix RemovalMatrix(const ErrorMap& map, const Rows& rows, std::span<const Eigen::Vector2d> path,
+                           const Model& removal, const FootprintBox& box) {
   SparseMatrix a(static_cast<Eigen::Index>(rows.node.size()), static_cast<Eigen::Index>(path.size()));
-  const int per_column = static_cast<int>(std::ceil(2 * radius / map.dx_mm + 1) * std::ceil(2 * radius / map.dy_mm + 1));
+  const int per_column = static_cast<int>(std::ceil((box.max_x_mm - box.min_x_mm) / map.dx_mm + 1) *
+                                          std::ceil((box.max_y_mm - box.min_y_mm) / map.dy_mm + 1));
   a.reserve(Eigen::VectorXi::Constant(static_cast<Eigen::Index>(path.size()), per_column));
   for (std::size_t k = 0; k < path.size(); ++k) {
     const Eigen::Vector2d& p = path[k];
-    const int i0 = std::max(0, static_cast<int>(std::ceil((p.x() - radius - map.x0_mm) / map.dx_mm)));
-    const int i1 = std::min(map.nx - 1, static_cast<int>(std::floor((p.x() + radius - map.x0_mm) / map.dx_mm)));
-    const int j0 = std::max(0, static_cast<int>(std::ceil((p.y() - radius - map.y0_mm) / map.dy_mm)));
-    const int j1 = std::min(map.ny - 1, static_cast<int>(std::floor((p.y() + radius - map.y0_mm) / map.dy_mm)));
+    const int i0 = std::max(0, static_cast<int>(std::ceil((p.x() + box.min_x_mm - map.x0_mm) / map.dx_mm)));
+    const int i1 = std::min(map.nx - 1, static_cast<int>(std::floor((p.x() + box.max_x_mm - map.x0_mm) / map.dx_mm)));
+    const int j0 = std::max(0, static_cast<int>(std::ceil((p.y() + box.min_y_mm - map.y0_mm) / map.dy_mm)));
+    const int j1 = std::min(map.ny - 1, static_cast<int>(std::floor((p.y() + box.max_y_mm - map.y0_mm) / map.dy_mm)));
     for (int j = j0; j <= j1; ++j) {
       for (int i = i0; i <= i1; ++i) {
         const int row = rows.row_of_node[j * map.nx + i];
@@ -109,6 +119,12 @@ SparseMatrix RemovalMatrix(const ErrorMap& map, const Rows& rows,
   }
   a.makeCompressed();
   return a;
+}
+
+SparseMatrix RemovalMatrix(const ErrorMap& map, const Rows& rows, std::span<const Eigen::Vector2d> path,
+                           const RemovalFunction& removal) {
+  const FootprintBox box = removal.Footprint();
+  return std::visit([&](const auto& model) { return RemovalMatrix(map, rows, path, model, box); }, removal.model());
 }
 
 // Largest eigenvalue of A^T A by power iteration: the Lipschitz constant of the gradient.
@@ -156,6 +172,31 @@ void CheckReachable(const SparseMatrix& a, const Rows& rows, const ErrorMap& map
                           map.Y(node / map.nx), rows.target[worst], most));
 }
 
+// The caller's per-point least dwell, kept even where it removes more than the target.
+void AddLeastDwell(Bounds& b, std::span<const Eigen::Vector2d> path, const DwellOptions& o) {
+  for (std::size_t k = 1; k < o.least_dwell_s.size(); ++k) {
+    const auto i = static_cast<Eigen::Index>(k);
+    if (o.least_dwell_s[k] > b.upper[i]) {
+      Invalid(fmt::format("unreachable speeds: least_dwell_s[{}] = {} s at ({:.3f}, {:.3f}) mm is above the longest "
+                          "dwell {} s that min_speed_mm_s = {} allows", k, o.least_dwell_s[k], path[k].x(),
+                          path[k].y(), b.upper[i], o.min_speed_mm_s));
+    }
+    b.lower[i] = std::max(b.lower[i], o.least_dwell_s[k]);
+  }
+}
+
+[[noreturn]] void NotSettled(std::span<const Eigen::Vector2d> path, Eigen::Index worst, double added_um,
+                             const DwellOptions& o) {
+  const auto k = static_cast<std::size_t>(worst);
+  throw Error(ErrorCode::kBadInput, kStage,
+              fmt::format("unreachable speeds: after {} shaping rounds the speeds still exceed max_acceleration_mm_s2 "
+                          "= {}: slowing down into path point {} ({:.3f}, {:.3f}) mm adds {:.3g} um of removal "
+                          "(more than shaping_tolerance_um = {}); raise the acceleration limit, use a wider "
+                          "removal function or a larger uniform layer",
+                          o.max_shaping_rounds, o.max_acceleration_mm_s2, k, path[k].x(), path[k].y(), added_um,
+                          o.shaping_tolerance_um));
+}
+
 // True when the best residual norm so far has improved on the best one stall_iterations ago by
 // less than stall_improvement times the first residual norm. `history` keeps the running best of every iteration.
 bool Stalled(double residual_norm, int iteration, const DwellOptions& o, std::vector<double>& history) {
@@ -165,23 +206,95 @@ bool Stalled(double residual_norm, int iteration, const DwellOptions& o, std::ve
   return earlier - history.back() <= o.stall_improvement * history.front();
 }
 
-void CheckAcceleration(DwellSolution& s, std::span<const Eigen::Vector2d> path, const DwellOptions& o) {
-  std::size_t worst = 0;
-  for (std::size_t k = 2; k < path.size(); ++k) {
-    if (!(s.segment_mm[k] > 0.0)) continue;
-    const double a = std::abs(s.speed_mm_s[k] * s.speed_mm_s[k] - s.speed_mm_s[k - 1] * s.speed_mm_s[k - 1]) /
-                     (2.0 * s.segment_mm[k]);
-    if (a > s.max_acceleration_mm_s2) s.max_acceleration_mm_s2 = a, worst = k;
+// Largest acceleration the speeds need: |v_k^2 - v_(k-1)^2| / (2 length_k) over k >= 2 (the
+// first point is the approach, reached at whatever speed the robot brings).
+double MaxAcceleration(const std::vector<double>& speed, const Eigen::VectorXd& segment_mm) {
+  double most = 0.0;
+  for (std::size_t k = 2; k < speed.size(); ++k) {
+    const double length = segment_mm[static_cast<Eigen::Index>(k)];
+    if (!(length > 0.0)) continue;
+    most = std::max(most, std::abs(speed[k] * speed[k] - speed[k - 1] * speed[k - 1]) / (2.0 * length));
   }
-  if (o.max_acceleration_mm_s2 > 0.0 && s.max_acceleration_mm_s2 > o.max_acceleration_mm_s2) {
-    throw Error(ErrorCode::kBadInput, kStage,
-                fmt::format("unreachable speeds: from {:.4f} to {:.4f} mm/s over the {:.4f} mm segment into "
-                            "path point {} ({:.3f}, {:.3f}) mm needs {:.1f} mm/s^2, above "
-                            "max_acceleration_mm_s2 = {}; use a wider removal function or a larger "
-                            "uniform layer",
-                            s.speed_mm_s[worst - 1], s.speed_mm_s[worst], s.segment_mm[worst], worst,
-                            path[worst].x(), path[worst].y(), s.max_acceleration_mm_s2, o.max_acceleration_mm_s2));
+  return most;
+}
+
+std::vector<double> Speeds(const Eigen::VectorXd& t, const Eigen::VectorXd& segment_mm, const DwellOptions& o) {
+  std::vector<double> speed(static_cast<std::size_t>(t.size()));
+  for (Eigen::Index k = 0; k < t.size(); ++k) {
+    speed[static_cast<std::size_t>(k)] =
+        k == 0 || !(t[k] > 0.0) ? o.max_speed_mm_s : std::min(o.max_speed_mm_s, segment_mm[k] / t[k]);
   }
+  return speed;
+}
+
+// The forward and backward passes of a motion planner: each speed capped by what its neighbour
+// allows over the segment between them. Only lowers speeds; afterwards every pair satisfies the limit.
+std::vector<double> ShapedSpeeds(std::vector<double> v, const Eigen::VectorXd& segment_mm, double a_mm_s2) {
+  const std::size_t n = v.size();
+  for (std::size_t k = 2; k < n; ++k) {
+    const double length = segment_mm[static_cast<Eigen::Index>(k)];
+    if (length > 0.0) v[k] = std::min(v[k], std::sqrt(v[k - 1] * v[k - 1] + 2.0 * a_mm_s2 * length));
+  }
+  for (std::size_t k = n - 1; k >= 2; --k) {
+    const double length = segment_mm[static_cast<Eigen::Index>(k)];
+    if (length > 0.0) v[k - 1] = std::min(v[k - 1], std::sqrt(v[k] * v[k] + 2.0 * a_mm_s2 * length));
+  }
+  return v;
+}
+
+// The dwell that runs the shaped speeds: longer where a speed was lowered, unchanged elsewhere.
+Eigen::VectorXd ShapedDwell(const Eigen::VectorXd& t, const Eigen::VectorXd& segment_mm, const DwellOptions& o) {
+  const std::vector<double> speed = Speeds(t, segment_mm, o);
+  const std::vector<double> shaped = ShapedSpeeds(speed, segment_mm, o.max_acceleration_mm_s2);
+  Eigen::VectorXd out = t;
+  for (Eigen::Index k = 1; k < t.size(); ++k) {
+    const auto i = static_cast<std::size_t>(k);
+    if (shaped[i] < speed[i]) out[k] = std::max(t[k], segment_mm[k] / shaped[i]);
+  }
+  return out;
+}
+
+struct Fit {
+  Eigen::VectorXd dwell_s;
+  int iterations = 0;
+  bool converged = false;
+};
+
+// Accelerated projected gradient from `start`. From a warm start near a solution one plain gradient
+// step is short although the accelerated iteration still has far to go, so there the dwell-change
+// test only counts after kWarmStartIterations.
+constexpr int kWarmStartIterations = 100;
+
+Fit ProjectedGradient(const SparseMatrix& a, const Eigen::VectorXd& target, const Bounds& bounds, double step,
+                      Eigen::VectorXd start, bool warm, const DwellOptions& options) {
+  auto project = [&](const Eigen::VectorXd& t) { return t.cwiseMax(bounds.lower).cwiseMin(bounds.upper).eval(); };
+  Fit fit;
+  Eigen::VectorXd t = project(start), previous = t, y = t;
+  double momentum = 1.0;
+  std::vector<double> history;
+  for (fit.iterations = 1; fit.iterations <= options.max_iterations; ++fit.iterations) {
+    const Eigen::VectorXd residual = a * y - target;
+    if (Stalled(residual.norm(), fit.iterations, options, history)) {
+      fit.converged = true;
+      break;
+    }
+    const Eigen::VectorXd gradient = a.transpose() * residual;
+    previous = t;
+    t = project(y - step * gradient);
+    const double change = (t - previous).norm();
+    if (change <= options.relative_tolerance * t.norm() && (!warm || fit.iterations > kWarmStartIterations)) {
+      fit.converged = true;
+      break;
+    }
+    // O'Donoghue & Candes (2015): restart the momentum when it points uphill.
+    if ((y - t).dot(t - previous) > 0.0) momentum = 1.0;
+    const double next = 0.5 * (1.0 + std::sqrt(1.0 + 4.0 * momentum * momentum));
+    y = t + ((momentum - 1.0) / next) * (t - previous);
+    momentum = next;
+  }
+  fit.iterations = std::min(fit.iterations, options.max_iterations);
+  fit.dwell_s = std::move(t);
+  return fit;
 }
 
 ErrorMap Scatter(const ErrorMap& like, const Rows& rows, const Eigen::VectorXd& values) {
@@ -193,24 +306,46 @@ ErrorMap Scatter(const ErrorMap& like, const Rows& rows, const Eigen::VectorXd& 
 
 }  // namespace
 
-double GaussianRemovalFunction::SigmaMm() const {
-  return fwhm_mm / (2.0 * std::sqrt(2.0 * std::numbers::ln2));
-}
-
-double GaussianRemovalFunction::SupportRadiusMm() const { return 3.5 * SigmaMm(); }
-
-double GaussianRemovalFunction::RateUmPerS(double dx_mm, double dy_mm) const {
-  const double r2 = dx_mm * dx_mm + dy_mm * dy_mm;
-  const double support = SupportRadiusMm();
-  if (r2 > support * support) return 0.0;
-  const double sigma = SigmaMm();
-  return peak_rate_um_per_s * std::exp(-r2 / (2.0 * sigma * sigma));
-}
-
-std::vector<Eigen::Vector2d> RasterPath(const grinding::Aperture& aperture, const RasterOptions& o) {
+namespace {
+void CheckPathOptions(const RasterOptions& o) {
   if (!(o.line_spacing_mm > 0.0)) Invalid(fmt::format("line_spacing_mm = {} violates > 0", o.line_spacing_mm));
   if (!(o.point_spacing_mm > 0.0)) Invalid(fmt::format("point_spacing_mm = {} violates > 0", o.point_spacing_mm));
   if (!(o.extension_mm >= 0.0)) Invalid(fmt::format("extension_mm = {} violates >= 0", o.extension_mm));
+}
+}  // namespace
+
+std::vector<Eigen::Vector2d> SpiralPath(const grinding::Aperture& aperture, const RasterOptions& o) {
+  CheckPathOptions(o);
+  const bool circle = aperture.shape == grinding::Aperture::Shape::kCircle;
+  const double radius = circle ? aperture.HalfY() + o.extension_mm
+                               : std::hypot(aperture.HalfX() + o.extension_mm, aperture.HalfY() + o.extension_mm);
+  const double b = o.line_spacing_mm / (2.0 * std::numbers::pi);
+  // Arc length from the centre to angle theta, in closed form, and its derivative.
+  auto arc = [b](double theta) { return 0.5 * b * (theta * std::sqrt(1.0 + theta * theta) + std::asinh(theta)); };
+  auto darc = [b](double theta) { return b * std::sqrt(1.0 + theta * theta); };
+  const double theta_end = radius / b;
+  const double total = arc(theta_end);
+  const int steps = std::max(1, static_cast<int>(std::ceil(total / o.point_spacing_mm - 1e-9)));
+  std::vector<Eigen::Vector2d> path;
+  path.reserve(static_cast<std::size_t>(steps) + 1);
+  double theta = 0.0;
+  for (int k = 0; k <= steps; ++k) {
+    const double wanted = total * k / steps;
+    // Newton on the convex, increasing arc length: from the previous angle it lands past the
+    // root, then closes in from above.
+    for (int it = 0; it < 60 && k > 0; ++it) {
+      const double delta = (arc(theta) - wanted) / darc(theta);
+      theta -= delta;
+      if (std::abs(delta) <= 1e-14 * std::max(1.0, theta)) break;
+    }
+    if (k == steps) theta = theta_end;
+    path.emplace_back(b * theta * std::cos(theta), b * theta * std::sin(theta));
+  }
+  return path;
+}
+
+std::vector<Eigen::Vector2d> RasterPath(const grinding::Aperture& aperture, const RasterOptions& o) {
+  CheckPathOptions(o);
   const bool circle = aperture.shape == grinding::Aperture::Shape::kCircle;
   const double half_y = aperture.HalfY() + o.extension_mm;
   const int lines = static_cast<int>(std::ceil(2.0 * half_y / o.line_spacing_mm - 1e-9)) + 1;
@@ -233,60 +368,54 @@ std::vector<Eigen::Vector2d> RasterPath(const grinding::Aperture& aperture, cons
 }
 
 DwellSolution SolveDwell(const ErrorMap& target, const grinding::Aperture& aperture,
-                         std::span<const Eigen::Vector2d> path, const GaussianRemovalFunction& removal,
+                         std::span<const Eigen::Vector2d> path, const RemovalFunction& removal,
                          const DwellOptions& options) {
-  CheckOptions(removal, options);
+  CheckOptions(removal, options, path.size());
   if (path.size() < 2) Invalid(fmt::format("the path has {} point(s); it needs two or more", path.size()));
   const Rows rows = ApertureRows(target, aperture);
   const SparseMatrix a = RemovalMatrix(target, rows, path, removal);
-  const Bounds bounds = DwellBounds(path, options);
+  Bounds bounds = DwellBounds(path, options);
   CheckReachable(a, rows, target, bounds, options);
+  AddLeastDwell(bounds, path, options);
 
-  auto project = [&](const Eigen::VectorXd& t) { return t.cwiseMax(bounds.lower).cwiseMin(bounds.upper).eval(); };
   // Start from the correlation A^T b scaled to fit best: the right shape at low frequencies.
-  Eigen::VectorXd t = a.transpose() * rows.target;
-  const Eigen::VectorXd at = a * t;
-  const double scale = at.squaredNorm() > 0.0 ? at.dot(rows.target) / at.squaredNorm() : 0.0;
-  t = project(scale * t);
+  Eigen::VectorXd start = a.transpose() * rows.target;
+  const Eigen::VectorXd at = a * start;
+  start *= at.squaredNorm() > 0.0 ? at.dot(rows.target) / at.squaredNorm() : 0.0;
   const double step = 1.0 / GradientLipschitz(a);
-  Eigen::VectorXd previous = t, y = t;
-  double momentum = 1.0;
+  Fit fit = ProjectedGradient(a, rows.target, bounds, step, start, false, options);
   DwellSolution solution;
-  std::vector<double> history;
-  for (solution.iterations = 1; solution.iterations <= options.max_iterations; ++solution.iterations) {
-    const Eigen::VectorXd residual = a * y - rows.target;
-    if (Stalled(residual.norm(), solution.iterations, options, history)) {
-      solution.converged = true;
-      break;
+  solution.iterations = fit.iterations;
+  solution.converged = fit.converged;
+  Eigen::VectorXd t = std::move(fit.dwell_s);
+  if (options.max_acceleration_mm_s2 > 0.0) {
+    const double peak = removal.PeakRateUmPerS();
+    for (;;) {
+      const Eigen::VectorXd shaped = ShapedDwell(t, bounds.segment_mm, options);
+      Eigen::Index worst = 0;
+      const double added_um = peak * (shaped - t).maxCoeff(&worst);
+      // The lengthened dwells become lower bounds; the other points stay free.
+      for (Eigen::Index k = 0; k < t.size(); ++k) {
+        if (shaped[k] > t[k]) bounds.lower[k] = std::max(bounds.lower[k], shaped[k]);
+      }
+      t = shaped;
+      if (added_um <= options.shaping_tolerance_um) break;
+      if (solution.shaping_rounds == options.max_shaping_rounds) NotSettled(path, worst, added_um, options);
+      ++solution.shaping_rounds;
+      fit = ProjectedGradient(a, rows.target, bounds, step, t, true, options);
+      solution.iterations += fit.iterations;
+      solution.converged = solution.converged && fit.converged;
+      t = std::move(fit.dwell_s);
     }
-    const Eigen::VectorXd gradient = a.transpose() * residual;
-    previous = t;
-    t = project(y - step * gradient);
-    const double change = (t - previous).norm();
-    if (change <= options.relative_tolerance * t.norm()) {
-      solution.converged = true;
-      break;
-    }
-    // O'Donoghue & Candes (2015): restart the momentum when it points uphill.
-    if ((y - t).dot(t - previous) > 0.0) momentum = 1.0;
-    const double next = 0.5 * (1.0 + std::sqrt(1.0 + 4.0 * momentum * momentum));
-    y = t + ((momentum - 1.0) / next) * (t - previous);
-    momentum = next;
   }
-  solution.iterations = std::min(solution.iterations, options.max_iterations);
 
   const Eigen::VectorXd removed = a * t;
   solution.nonzeros = static_cast<int>(a.nonZeros());
   solution.dwell_s.assign(t.data(), t.data() + t.size());
   solution.segment_mm.assign(bounds.segment_mm.data(), bounds.segment_mm.data() + bounds.segment_mm.size());
-  solution.speed_mm_s.resize(path.size());
-  for (std::size_t k = 0; k < path.size(); ++k) {
-    solution.speed_mm_s[k] = k == 0 || !(t[static_cast<Eigen::Index>(k)] > 0.0)
-                                 ? options.max_speed_mm_s
-                                 : std::min(options.max_speed_mm_s, solution.segment_mm[k] / t[static_cast<Eigen::Index>(k)]);
-  }
+  solution.speed_mm_s = Speeds(t, bounds.segment_mm, options);
   solution.total_time_s = t.sum();
-  CheckAcceleration(solution, path, options);
+  solution.max_acceleration_mm_s2 = MaxAcceleration(solution.speed_mm_s, bounds.segment_mm);
   solution.predicted_removal_um = Scatter(target, rows, removed);
   solution.residual_um = Scatter(target, rows, rows.target - removed);
   solution.before = StatisticsInAperture(target, aperture);

@@ -3,7 +3,8 @@
 //
 // The removal is the convolution of the dwell with the tool's removal function: the depth removed
 // at map node m is  sum_k R(x_m - x_k, y_m - y_k) t_k,  with t_k the dwell (s) at path point k and
-// R a Gaussian removal rate (um/s) in the part's (x, y) projection. Dwell points lie anywhere along
+// R the tool's removal rate (um/s, removal_function.h: a Gaussian or a measured table) in the
+// part's (x, y) projection. Dwell points lie anywhere along
 // the path (not on the map's grid). The dwell solves the bounded linear least-squares problem
 //     minimise || A t - target ||^2  over the clear-aperture nodes,   t_min_k <= t_k <= t_max_k,
 // where the bounds come from the speed limits (a point stands for the path segment that ends at
@@ -11,8 +12,17 @@
 // edge can be reached by the whole removal function (surface extension); residuals are counted
 // inside the aperture only.
 //
-// A is sparse (the Gaussian is truncated at 3.5 sigma, 0.2 % of the peak); the problem is solved
-// by accelerated projected gradient (FISTA with adaptive restart) on sparse matrix products.
+// A is sparse (the Gaussian is truncated at 3.5 sigma, 0.2 % of the peak; a table ends at its
+// edge); the problem is solved by accelerated projected gradient (FISTA with adaptive restart) on
+// sparse matrix products.
+//
+// With an acceleration limit the speeds are shaped as a motion planner does: a forward and a
+// backward pass cap each speed by what its neighbour allows, v_k <= sqrt(v_(k-1)^2 + 2 a L_k) and
+// v_(k-1) <= sqrt(v_k^2 + 2 a L_k). Shaping only lowers speeds, i.e. lengthens dwells; those
+// dwells become per-point lower bounds and the dwell is solved again, the rest of the path making
+// up for the extra removal. Rounds repeat until the solved dwell needs (almost) no shaping; the
+// bounds only grow, so they settle. The dwell reported is the shaped one of the last round, and
+// the prediction is of that dwell.
 
 #include <Eigen/Core>
 #include <span>
@@ -20,18 +30,10 @@
 #include <vector>
 
 #include "grinding/surface.h"
+#include "polishing/removal_function.h"
 #include "polishing/removal_target.h"
 
 namespace arcwheel::polishing {
-
-struct GaussianRemovalFunction {
-  double peak_rate_um_per_s = 1.0;  // removal rate at the centre, > 0
-  double fwhm_mm = 10.0;            // full width at half maximum, > 0
-  [[nodiscard]] double SigmaMm() const;
-  [[nodiscard]] double SupportRadiusMm() const;  // 3.5 sigma: the truncation radius
-  // Rate at an offset from the centre; zero beyond the support radius.
-  [[nodiscard]] double RateUmPerS(double dx_mm, double dy_mm) const;
-};
 
 struct RasterOptions {
   double line_spacing_mm = 2.0;   // distance between raster lines (along y), > 0
@@ -44,13 +46,27 @@ struct RasterOptions {
 [[nodiscard]] std::vector<Eigen::Vector2d> RasterPath(const grinding::Aperture& aperture,
                                                       const RasterOptions& options);
 
+// An Archimedean spiral r = pitch theta / (2 pi) from the aperture's centre outwards, pitch =
+// line_spacing_mm, cut into equal arc-length steps of at most point_spacing_mm, out to the radius
+// of the grown aperture (a rectangle's: its half diagonal, so the corners are covered).
+// Throws Error{kInvalidOption}.
+[[nodiscard]] std::vector<Eigen::Vector2d> SpiralPath(const grinding::Aperture& aperture,
+                                                      const RasterOptions& options);
+
+enum class PathPattern { kRaster, kSpiral };
+
 struct DwellOptions {
   double max_speed_mm_s = 100.0;  // fastest TCP speed, > 0: sets the least dwell of each point
   double min_speed_mm_s = 0.0;    // slowest TCP speed, [0, max]; 0 = no bound on dwell
   double min_dwell_s = 0.0;       // least dwell of every point after the first (controller), >= 0
-  // Largest TCP acceleration, mm/s^2; 0 = not checked. The speed changes from v_(k-1) to v_k
-  // over the segment into point k, which takes |v_k^2 - v_(k-1)^2| / (2 length_k).
+  // Largest TCP acceleration, mm/s^2; 0 = no limit. The speed changes from v_(k-1) to v_k over
+  // the segment into point k, which takes |v_k^2 - v_(k-1)^2| / (2 length_k); the speeds are
+  // shaped to it (see above).
   double max_acceleration_mm_s2 = 0.0;
+  // Per-point least dwell (s), one per path point (the first, the approach, must be 0), each
+  // >= 0 and <= the point's longest dwell; empty = none. Kept even where it removes more than
+  // the target.
+  std::vector<double> least_dwell_s = {};
   int max_iterations = 5000;      // projected-gradient iterations, >= 1
   double relative_tolerance = 1e-7;  // stop when the dwell changes by less than this, relative
   // Also stop when the residual norm has improved over the last stall_iterations iterations by
@@ -58,6 +74,11 @@ struct DwellOptions {
   // the prediction at the sub-nanometre level. stall_iterations = 0 disables this test.
   int stall_iterations = 100;        // >= 0
   double stall_improvement = 1e-3;   // > 0
+  // Shaping rounds (re-solves) allowed before the speeds count as unreachable, >= 1.
+  int max_shaping_rounds = 20;
+  // A round settles when shaping its dwell adds at most this depth (peak rate x added dwell) at
+  // any point, um, > 0 (1 nm: below what the solve itself resolves on a polished map).
+  double shaping_tolerance_um = 1e-3;
 };
 
 struct DwellSolution {
@@ -70,20 +91,24 @@ struct DwellSolution {
   MapStatistics after;                // of the residual in the aperture
   double total_time_s = 0.0;
   double max_acceleration_mm_s2 = 0.0;  // largest acceleration the speeds imply (see DwellOptions)
-  int iterations = 0;
+  int iterations = 0;                 // projected-gradient iterations, all rounds
+  int shaping_rounds = 0;             // re-solves after shaping the speeds (0: none needed)
   bool converged = false;
   int nonzeros = 0;                   // entries of the sparse removal matrix
 };
 
 // Solves the dwell for a removal target (RemovalTarget) along `path_xy_mm`.
-// Throws Error{kInvalidOption, "polishing.dwell"} for options out of range or speeds that cannot
-// be met (min > max); Error{kBadInput, "polishing.dwell"} for an empty aperture, when running
+// Throws Error{kInvalidOption, "polishing.dwell"} for options out of range (a Gaussian's too) or
+// speeds that cannot be met (min > max, a least_dwell_s above the point's longest dwell);
+// Error{kBadInput, "polishing.removal"} for a malformed table; Error{kBadInput,
+// "polishing.dwell"} for an empty aperture, when running
 // the path at the maximum speed (or the least dwell) already removes more than the target
 // somewhere (naming the point and the uniform layer that would make it reachable), or when the
-// speeds need more than the maximum acceleration (naming the point).
+// speeds shaped to the maximum acceleration do not settle within max_shaping_rounds (naming the
+// point that still needed shaping).
 [[nodiscard]] DwellSolution SolveDwell(const ErrorMap& target, const grinding::Aperture& aperture,
                                        std::span<const Eigen::Vector2d> path_xy_mm,
-                                       const GaussianRemovalFunction& removal,
+                                       const RemovalFunction& removal,
                                        const DwellOptions& options);
 
 }  // namespace arcwheel::polishing

@@ -45,6 +45,23 @@ double FullGaussianRemovalUm(double x, double y, const std::vector<Eigen::Vector
   return sum;
 }
 
+// RMS (about the mean) of target - removal over the disc, the removal recomputed with the whole
+// Gaussian from the solution's dwell.
+double ResidualRmsUm(const ErrorMap& target, const std::vector<Eigen::Vector2d>& path, const std::vector<double>& dwell_s,
+                     double peak, double fwhm) {
+  double sum = 0.0, sum2 = 0.0;
+  int n = 0;
+  for (int j = 0; j < target.ny; ++j) {
+    for (int i = 0; i < target.nx; ++i) {
+      const double x = target.X(i), y = target.Y(j);
+      if (x * x + y * y > 50.0 * 50.0) continue;
+      const double r = target.At(i, j) - FullGaussianRemovalUm(x, y, path, dwell_s, peak, fwhm);
+      sum += r, sum2 += r * r, ++n;
+    }
+  }
+  return std::sqrt(sum2 / n - (sum / n) * (sum / n));
+}
+
 TEST(SolveDwell, CutsTheResidualRmsTenfoldWithNonNegativeDwellWithinSpeedLimits) {
   const GaussianRemovalFunction tool{.peak_rate_um_per_s = 2.0, .fwhm_mm = 12.0};
   const DwellOptions options{.max_speed_mm_s = 150.0, .min_speed_mm_s = 0.2, .max_iterations = 500};
@@ -85,6 +102,96 @@ TEST(SolveDwell, CutsTheResidualRmsTenfoldWithNonNegativeDwellWithinSpeedLimits)
   }
 }
 
+// An axis-aligned elliptic Gaussian (peak, centre, sigmas) sampled on a grid of tool offsets.
+TabulatedRemovalFunction SampledGaussian(double peak, double cx, double cy, double sx, double sy, double x0, double y0,
+                                         double h, int nx, int ny) {
+  TabulatedRemovalFunction t{.x0_mm = x0, .y0_mm = y0, .dx_mm = h, .dy_mm = h, .nx = nx, .ny = ny};
+  for (int j = 0; j < ny; ++j) {
+    for (int i = 0; i < nx; ++i) {
+      const double x = x0 + i * h - cx, y = y0 + j * h - cy;
+      t.rate_um_per_s.push_back(peak * std::exp(-0.5 * (x * x / (sx * sx) + y * y / (sy * sy))));
+    }
+  }
+  return t;
+}
+
+TEST(SolveDwell, AMeasuredGaussianRemovesAsTheAnalyticOneWithinTheInterpolationBoundAndCutsTheRmsTenfold) {
+  const double peak = 2.0, fwhm = 12.0, sigma = fwhm / std::sqrt(8.0 * std::log(2.0)), h = 0.1;
+  const int n = 2 * static_cast<int>(std::ceil(4.5 * sigma / h)) + 1;
+  const double half_width = (n - 1) / 2 * h;
+  const RemovalFunction table = SampledGaussian(peak, 0.0, 0.0, sigma, sigma, -half_width, -half_width, h, n, n);
+  // Bilinear interpolation errs by at most (hx^2 max|f_xx| + hy^2 max|f_yy|) / 8 (linear
+  // interpolation's h^2/8 max|f''| along each axis in turn); for the Gaussian max|f_xx| = P/sigma^2.
+  const double interpolation_bound = peak * (h * h + h * h) / (8.0 * sigma * sigma);
+  const DwellOptions options{.max_speed_mm_s = 150.0, .min_speed_mm_s = 0.2, .max_iterations = 500};
+  const std::vector<Eigen::Vector2d> path =
+      RasterPath(kDisc, {.line_spacing_mm = 2.0, .point_spacing_mm = 2.5, .extension_mm = 10.0});
+  const ErrorMap target = RemovalTarget(SimulatedErrorMap(1), kDisc, {.uniform_layer_um = 1.5});
+  const DwellSolution solution = SolveDwell(target, kDisc, path, table, options);
+  // Same dwell through the analytic, untruncated Gaussian: inside the table each point's rate is
+  // within the interpolation bound; outside it the table gives 0 for the Gaussian's value.
+  for (int j = 0; j < target.ny; ++j) {
+    for (int i = 0; i < target.nx; ++i) {
+      const double removal = solution.predicted_removal_um.At(i, j);
+      if (std::isnan(removal)) continue;
+      double bound = 0.0;
+      for (std::size_t k = 0; k < path.size(); ++k) {
+        const double dx = target.X(i) - path[k].x(), dy = target.Y(j) - path[k].y();
+        const bool inside = std::abs(dx) <= half_width && std::abs(dy) <= half_width;
+        bound += solution.dwell_s[k] * (inside ? interpolation_bound : peak * std::exp(-(dx * dx + dy * dy) / (2.0 * sigma * sigma)));
+      }
+      const double analytic = FullGaussianRemovalUm(target.X(i), target.Y(j), path, solution.dwell_s, peak, fwhm);
+      EXPECT_LE(std::abs(removal - analytic), bound + 1e-12) << target.X(i) << ", " << target.Y(j);
+    }
+  }
+  const double rms_after = ResidualRmsUm(target, path, solution.dwell_s, peak, fwhm);
+  EXPECT_LT(rms_after, solution.before.rms_um / 10.0) << solution.before.rms_um << " -> " << rms_after;
+  EXPECT_LT(solution.after.rms_um, solution.before.rms_um / 10.0);
+}
+
+// Bilinear interpolation written as the weighted sum of the four surrounding nodes.
+double BruteForceRate(const TabulatedRemovalFunction& t, double x, double y) {
+  const double u = (x - t.x0_mm) / t.dx_mm, v = (y - t.y0_mm) / t.dy_mm;
+  if (u < 0.0 || v < 0.0 || u > t.nx - 1 || v > t.ny - 1) return 0.0;
+  double sum = 0.0;
+  for (int j = static_cast<int>(std::floor(v)); j <= static_cast<int>(std::floor(v)) + 1 && j < t.ny; ++j) {
+    for (int i = static_cast<int>(std::floor(u)); i <= static_cast<int>(std::floor(u)) + 1 && i < t.nx; ++i) {
+      sum += (1.0 - std::abs(u - i)) * (1.0 - std::abs(v - j)) * t.rate_um_per_s[static_cast<std::size_t>(j * t.nx + i)];
+    }
+  }
+  return sum;
+}
+
+TEST(SolveDwell, PredictsTheRemovalOfAnOffsetEllipticFootprintAsABruteForceConvolution) {
+  // Removal centred 2 mm in +x and 1 mm in -y of the tool centre, sigmas 3 and 1.5 mm, on a
+  // 0.5 mm table: the interpolation is visible at the map's 1 mm nodes.
+  const TabulatedRemovalFunction table = SampledGaussian(3.0, 2.0, -1.0, 3.0, 1.5, -6.0, -6.0, 0.5, 33, 21);
+  const grinding::Aperture square{.width_x_mm = 30.0, .width_y_mm = 30.0};
+  ErrorMap error{.x0_mm = -15.0, .y0_mm = -15.0, .dx_mm = 1.0, .dy_mm = 1.0, .nx = 31, .ny = 31};
+  for (int j = 0; j < error.ny; ++j) {
+    for (int i = 0; i < error.nx; ++i) {
+      error.error_um.push_back(0.2 * std::cos(error.X(i) / 6.0) * std::sin(error.Y(j) / 5.0) + 0.003 * error.X(i));
+    }
+  }
+  const ErrorMap target = RemovalTarget(error, square, {.uniform_layer_um = 0.5});
+  const std::vector<Eigen::Vector2d> path =
+      RasterPath(square, {.line_spacing_mm = 1.0, .point_spacing_mm = 1.0, .extension_mm = 6.0});
+  const DwellSolution solution = SolveDwell(target, square, path, table, {.max_speed_mm_s = 500.0, .max_iterations = 1000});
+  double most = 0.0;
+  for (int j = 0; j < target.ny; ++j) {
+    for (int i = 0; i < target.nx; ++i) {
+      double removal = 0.0;
+      for (std::size_t k = 0; k < path.size(); ++k) {
+        removal += solution.dwell_s[k] * BruteForceRate(table, target.X(i) - path[k].x(), target.Y(j) - path[k].y());
+      }
+      EXPECT_NEAR(solution.predicted_removal_um.At(i, j), removal, 1e-9) << target.X(i) << ", " << target.Y(j);
+      most = std::max(most, removal);
+    }
+  }
+  EXPECT_GT(most, 0.5);
+  EXPECT_LT(solution.after.rms_um, solution.before.rms_um / 10.0) << solution.before.rms_um << " -> " << solution.after.rms_um;
+}
+
 TEST(SolveDwell, RecoversAKnownDwellToWithinTheConditioningOfTheProblem) {
   // Target made by a known smooth dwell through the same model: the residual must vanish.
   const GaussianRemovalFunction tool{.peak_rate_um_per_s = 1.0, .fwhm_mm = 10.0};
@@ -122,6 +229,17 @@ TEST(SolveDwell, RefusesUnreachableSpeedsNamingThePointAndTheLayer) {
   EXPECT_THROW((void)SolveDwell(target, kDisc, path, tool, {.max_speed_mm_s = 5.0, .min_speed_mm_s = 6.0}), Error);
 }
 
+// The largest |v_k^2 - v_(k-1)^2| / (2 L_k) over k >= 2, recomputed from the path and the speeds.
+double LargestAcceleration(const std::vector<Eigen::Vector2d>& path, const DwellSolution& s) {
+  double most = 0.0;
+  for (std::size_t k = 2; k < path.size(); ++k) {
+    const double length = (path[k] - path[k - 1]).norm();
+    const double v0 = s.speed_mm_s[k - 1], v1 = s.speed_mm_s[k];
+    most = std::max(most, std::abs(v1 * v1 - v0 * v0) / (2.0 * length));
+  }
+  return most;
+}
+
 TEST(SolveDwell, KeepsTheLeastDwellAndReportsTheAccelerationTheSpeedsNeed) {
   const GaussianRemovalFunction tool{.peak_rate_um_per_s = 2.0, .fwhm_mm = 12.0};
   const std::vector<Eigen::Vector2d> path =
@@ -129,22 +247,101 @@ TEST(SolveDwell, KeepsTheLeastDwellAndReportsTheAccelerationTheSpeedsNeed) {
   const ErrorMap target = RemovalTarget(SimulatedErrorMap(4), kDisc, {.uniform_layer_um = 1.5});
   const DwellOptions options{.max_speed_mm_s = 200.0, .min_dwell_s = 0.03, .max_iterations = 300};
   const DwellSolution solution = SolveDwell(target, kDisc, path, tool, options);
-  double acceleration = 0.0;
-  for (std::size_t k = 1; k < path.size(); ++k) {
-    EXPECT_GE(solution.dwell_s[k], 0.03);
-    if (k < 2) continue;
-    const double length = (path[k] - path[k - 1]).norm();
-    const double v0 = solution.speed_mm_s[k - 1];
-    acceleration = std::max(acceleration, std::abs(solution.speed_mm_s[k] * solution.speed_mm_s[k] - v0 * v0) / (2.0 * length));
-  }
+  for (std::size_t k = 1; k < path.size(); ++k) EXPECT_GE(solution.dwell_s[k], 0.03);
+  const double acceleration = LargestAcceleration(path, solution);
   EXPECT_NEAR(solution.max_acceleration_mm_s2, acceleration, 1e-9 * acceleration);
-  DwellOptions limited = options;
-  limited.max_acceleration_mm_s2 = 0.5 * acceleration;
+  EXPECT_EQ(solution.shaping_rounds, 0);
+}
+
+TEST(SolveDwell, ShapesTheSpeedsToTheAccelerationLimitAndStillCutsTheResidualTenfold) {
+  const double peak = 2.0, fwhm = 12.0;
+  const GaussianRemovalFunction tool{.peak_rate_um_per_s = peak, .fwhm_mm = fwhm};
+  const DwellOptions free{.max_speed_mm_s = 150.0, .min_speed_mm_s = 0.2, .max_iterations = 500};
+  const std::vector<Eigen::Vector2d> path =
+      RasterPath(kDisc, {.line_spacing_mm = 2.0, .point_spacing_mm = 2.5, .extension_mm = 10.0});
+  for (const unsigned seed : {1u, 2u, 3u}) {
+    const ErrorMap error = SimulatedErrorMap(seed);
+    const ErrorMap target = RemovalTarget(error, kDisc, {.uniform_layer_um = 1.5});
+    const DwellSolution unshaped = SolveDwell(target, kDisc, path, tool, free);
+    const double limit = 1000.0;  // mm/s^2
+    // The unshaped speeds need more than the limit: shaping has work to do.
+    ASSERT_GT(LargestAcceleration(path, unshaped), 2.0 * limit) << "seed " << seed;
+    DwellOptions limited = free;
+    limited.max_acceleration_mm_s2 = limit;
+    const DwellSolution solution = SolveDwell(target, kDisc, path, tool, limited);
+    EXPECT_GE(solution.shaping_rounds, 1);
+    for (std::size_t k = 1; k < path.size(); ++k) {
+      const double length = (path[k] - path[k - 1]).norm();
+      EXPECT_GE(solution.dwell_s[k], 0.0);
+      EXPECT_LE(solution.speed_mm_s[k], free.max_speed_mm_s * (1.0 + 1e-12));
+      EXPECT_GE(solution.speed_mm_s[k], free.min_speed_mm_s * (1.0 - 1e-12));
+      EXPECT_NEAR(solution.speed_mm_s[k] * solution.dwell_s[k], length, 1e-9);
+      if (k < 2) continue;
+      const double v0 = solution.speed_mm_s[k - 1], v1 = solution.speed_mm_s[k];
+      EXPECT_LE(std::abs(v1 * v1 - v0 * v0) / (2.0 * length), limit * (1.0 + 1e-9)) << "seed " << seed << " point " << k;
+    }
+    EXPECT_NEAR(solution.max_acceleration_mm_s2, LargestAcceleration(path, solution), 1e-9 * limit);
+    // The prediction is of the final dwell (same truncated model, summed here point by point).
+    for (int j = 0; j < target.ny; j += 7) {
+      for (int i = 0; i < target.nx; i += 7) {
+        if (std::isnan(solution.predicted_removal_um.At(i, j))) continue;
+        double removal = 0.0;
+        for (std::size_t k = 0; k < path.size(); ++k) {
+          removal += tool.RateUmPerS(target.X(i) - path[k].x(), target.Y(j) - path[k].y()) * solution.dwell_s[k];
+        }
+        EXPECT_NEAR(solution.predicted_removal_um.At(i, j), removal, 1e-9);
+      }
+    }
+    const double rms_after = ResidualRmsUm(target, path, solution.dwell_s, peak, fwhm);
+    EXPECT_LT(rms_after, solution.before.rms_um / 10.0) << "seed " << seed << ": " << solution.before.rms_um << " -> " << rms_after;
+  }
+}
+
+TEST(SolveDwell, RefusesSpeedsThatDoNotSettleWithinTheShapingRounds) {
+  const GaussianRemovalFunction tool{.peak_rate_um_per_s = 2.0, .fwhm_mm = 12.0};
+  const std::vector<Eigen::Vector2d> path =
+      RasterPath(kDisc, {.line_spacing_mm = 2.0, .point_spacing_mm = 2.5, .extension_mm = 10.0});
+  const ErrorMap target = RemovalTarget(SimulatedErrorMap(1), kDisc, {.uniform_layer_um = 1.5});
+  const DwellOptions options{.max_speed_mm_s = 150.0, .min_speed_mm_s = 0.2, .max_acceleration_mm_s2 = 1000.0,
+                             .max_iterations = 500, .max_shaping_rounds = 1};
   try {
-    (void)SolveDwell(target, kDisc, path, tool, limited);
+    (void)SolveDwell(target, kDisc, path, tool, options);
     FAIL() << "accepted";
   } catch (const Error& e) {
-    EXPECT_NE(std::string(e.what()).find("above max_acceleration_mm_s2"), std::string::npos) << e.what();
+    EXPECT_EQ(e.code(), ErrorCode::kBadInput);
+    EXPECT_NE(std::string(e.what()).find("after 1 shaping rounds the speeds still exceed max_acceleration_mm_s2 = 1000: "
+                                         "slowing down into path point"),
+              std::string::npos) << e.what();
+  }
+}
+
+TEST(SolveDwell, HoldsThePerPointLeastDwellAndRefusesOneOutOfRange) {
+  const GaussianRemovalFunction tool{.peak_rate_um_per_s = 2.0, .fwhm_mm = 12.0};
+  const std::vector<Eigen::Vector2d> path =
+      RasterPath(kDisc, {.line_spacing_mm = 3.0, .point_spacing_mm = 3.0, .extension_mm = 8.0});
+  const ErrorMap target = RemovalTarget(SimulatedErrorMap(4), kDisc, {.uniform_layer_um = 1.5});
+  DwellOptions options{.max_speed_mm_s = 200.0, .min_speed_mm_s = 1.0, .max_iterations = 300};
+  options.least_dwell_s.assign(path.size(), 0.0);
+  for (std::size_t k = 1; k < path.size(); k += 17) options.least_dwell_s[k] = 0.5;
+  const DwellSolution solution = SolveDwell(target, kDisc, path, tool, options);
+  for (std::size_t k = 1; k < path.size(); ++k) EXPECT_GE(solution.dwell_s[k], options.least_dwell_s[k]) << k;
+  DwellOptions bad = options;
+  bad.least_dwell_s.pop_back();
+  EXPECT_THROW((void)SolveDwell(target, kDisc, path, tool, bad), Error);
+  bad = options;
+  bad.least_dwell_s[0] = 0.1;  // the approach takes no dwell
+  EXPECT_THROW((void)SolveDwell(target, kDisc, path, tool, bad), Error);
+  bad = options;
+  bad.least_dwell_s[5] = -1.0;
+  EXPECT_THROW((void)SolveDwell(target, kDisc, path, tool, bad), Error);
+  bad = options;
+  bad.least_dwell_s[5] = 10.0;  // above length / min_speed = 3 s
+  try {
+    (void)SolveDwell(target, kDisc, path, tool, bad);
+    FAIL() << "accepted";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.code(), ErrorCode::kInvalidOption);
+    EXPECT_NE(std::string(e.what()).find("least_dwell_s[5] = 10 s"), std::string::npos) << e.what();
   }
 }
 
@@ -165,6 +362,35 @@ TEST(RasterPath, CoversTheGrownDiscInZigzagWithStepsNoLongerThanAsked) {
   }
   EXPECT_DOUBLE_EQ(path.front().y(), -55.0);
   EXPECT_DOUBLE_EQ(path.back().y(), 55.0);
+}
+
+TEST(SpiralPath, FollowsTheArchimedeanSpiralInEqualArcLengthSteps) {
+  const double pitch = 2.0, step = 2.5;
+  const auto path = SpiralPath(kDisc, {.line_spacing_mm = pitch, .point_spacing_mm = step, .extension_mm = 5.0});
+  const double b = pitch / (2.0 * std::numbers::pi);
+  // Arc length of r = b theta from the centre: (b/2) (theta sqrt(1 + theta^2) + asinh theta).
+  auto arc = [b](double theta) { return 0.5 * b * (theta * std::sqrt(1.0 + theta * theta) + std::asinh(theta)); };
+  EXPECT_EQ(path.front().norm(), 0.0);
+  EXPECT_NEAR(path.back().norm(), 55.0, 1e-9);
+  const double total = arc(55.0 / b);
+  const double expected_step = total / std::ceil(total / step);
+  for (std::size_t k = 1; k < path.size(); ++k) {
+    const double theta = path[k].norm() / b;  // on the spiral, the polar angle is theta mod 2 pi
+    EXPECT_NEAR(std::remainder(std::atan2(path[k].y(), path[k].x()) - theta, 2.0 * std::numbers::pi), 0.0, 1e-9) << k;
+    EXPECT_NEAR(arc(theta) - arc(path[k - 1].norm() / b), expected_step, 1e-9) << k;
+    EXPECT_LE((path[k] - path[k - 1]).norm(), step + 1e-9);
+  }
+  EXPECT_LE(expected_step, step);
+}
+
+TEST(SpiralPath, CarriesADwellThatCutsTheResidualRmsTenfold) {
+  const GaussianRemovalFunction tool{.peak_rate_um_per_s = 2.0, .fwhm_mm = 12.0};
+  const auto path = SpiralPath(kDisc, {.line_spacing_mm = 2.0, .point_spacing_mm = 2.5, .extension_mm = 10.0});
+  const ErrorMap target = RemovalTarget(SimulatedErrorMap(1), kDisc, {.uniform_layer_um = 1.5});
+  const DwellSolution solution =
+      SolveDwell(target, kDisc, path, tool, {.max_speed_mm_s = 150.0, .min_speed_mm_s = 0.2, .max_iterations = 500});
+  const double rms_after = ResidualRmsUm(target, path, solution.dwell_s, 2.0, 12.0);
+  EXPECT_LT(rms_after, solution.before.rms_um / 10.0) << solution.before.rms_um << " -> " << rms_after;
 }
 
 }  // namespace

@@ -194,7 +194,7 @@ void ReadMachine(Section& s, PolishJob& job) {
     s.Fail("min_dwell_s", "is unreachable together with min_speed_mm_s: give one of them");
   }
   job.dwell.max_acceleration_mm_s2 = s.Number("max_acceleration_mm_s2", 0.0);
-  if (!(job.dwell.max_acceleration_mm_s2 >= 0.0)) s.Fail("max_acceleration_mm_s2", "must be >= 0 (0 = not checked)");
+  if (!(job.dwell.max_acceleration_mm_s2 >= 0.0)) s.Fail("max_acceleration_mm_s2", "must be >= 0 (0 = no limit)");
   job.robot_side = s.Choice("robot_side", {"+x", "-x"}) == "+x" ? RobotSide::kPlusX : RobotSide::kMinusX;
 }
 
@@ -210,88 +210,71 @@ void ReadTool(Section& s, PolishJob& job) {
   job.tool.centre_of_gravity_mm = {cog[0], cog[1], cog[2]};
 }
 
-[[noreturn]] void MapFail(const std::filesystem::path& path, std::size_t line, const std::string& what) {
-  throw Error(ErrorCode::kBadInput, "polishing.map", fmt::format("'{}' line {}: {}", path.string(), line, what));
-}
-
-// Index of `v` on a grid of spacing d from v0, or -1 if it is not within 1e-6 d of a node.
-int GridIndex(double v, double v0, double d) {
-  const double u = (v - v0) / d;
-  const double r = std::round(u);
-  return std::abs(u - r) <= 1e-6 ? static_cast<int>(r) : -1;
-}
-
-// The grid spacing along one axis: the median gap between the distinct coordinates, so that a
-// stray off-grid value is reported as such rather than taken for the spacing.
-double MedianGap(const std::set<double>& values) {
-  std::vector<double> gaps;
-  for (auto it = std::next(values.begin()); it != values.end(); ++it) gaps.push_back(*it - *std::prev(it));
-  std::nth_element(gaps.begin(), gaps.begin() + static_cast<std::ptrdiff_t>(gaps.size() / 2), gaps.end());
-  return gaps[gaps.size() / 2];
+// The error_map section: the file, its format and, for interferometer maps, the placement in the
+// part frame (docs/polishing.md, "Error-map formats").
+ErrorMap ReadErrorMapSection(Section& s, const std::filesystem::path& file) {
+  std::vector<std::string> formats = {"csv", "dat", "datx", "h5"};
+  if (!s.Has("format")) {
+    try {
+      const ErrorMapFormat implied = FormatFromExtension(file);
+      std::rotate(formats.begin(), formats.begin() + static_cast<int>(implied), formats.begin() + static_cast<int>(implied) + 1);
+    } catch (const Error&) {
+      s.Fail("format", fmt::format("is required: the extension of '{}' names no format (csv, dat, datx, h5)", file.string()));
+    }
+  }
+  const std::string format = s.Choice("format", formats);
+  ErrorMapOptions options;
+  options.format = format == "csv" ? ErrorMapFormat::kCsv : format == "dat" ? ErrorMapFormat::kDat
+                 : format == "datx" ? ErrorMapFormat::kDatx : ErrorMapFormat::kHdf5;
+  options.placement.scale = s.Number("scale", 1.0);
+  if (options.placement.scale == 0.0) s.Fail("scale", "must be non-zero (+1: height = material to remove, -1: depth)");
+  const bool pixels = options.format == ErrorMapFormat::kDat || options.format == ErrorMapFormat::kDatx;
+  for (const char* key : {"pixel_mm", "centre_px", "centre_mm", "rotation_deg", "flip"}) {
+    if (!pixels && s.Has(key)) s.Fail(key, "applies only to interferometer maps (format \"dat\" or \"datx\")");
+  }
+  if (options.format != ErrorMapFormat::kCsv && s.Has("layout")) s.Fail("layout", "applies only to format \"csv\"");
+  if (options.format == ErrorMapFormat::kCsv) {
+    const bool scattered = s.Choice("layout", {"grid", "scattered"}) == "scattered";
+    options.layout = scattered ? ErrorMapLayout::kScattered : ErrorMapLayout::kGrid;
+    if (!scattered && s.Has("grid_spacing_mm")) s.Fail("grid_spacing_mm", "applies only to layout \"scattered\"");
+    if (scattered && s.Has("grid_spacing_mm")) {
+      options.grid_spacing_mm = s.Number("grid_spacing_mm", 0.0);
+      if (!(options.grid_spacing_mm > 0.0)) s.Fail("grid_spacing_mm", "must be > 0");
+    }
+  } else if (s.Has("grid_spacing_mm")) {
+    s.Fail("grid_spacing_mm", "applies only to format \"csv\" with layout \"scattered\"");
+  }
+  if (!pixels) {
+    ErrorMap map = ReadErrorMap(file, options);
+    if (options.layout == ErrorMapLayout::kScattered) s.SetResolved("grid_spacing_mm", map.dx_mm);
+    return map;
+  }
+  const PixelMap raw = options.format == ErrorMapFormat::kDat ? ReadMetroProDat(file) : ReadZygoDatx(file);
+  MapPlacement& p = options.placement;
+  if (s.Has("pixel_mm")) {
+    p.pixel_mm = s.Number("pixel_mm", 0.0);
+    if (!(p.pixel_mm > 0.0)) s.Fail("pixel_mm", "must be > 0");
+  } else if (raw.pixel_x_mm == raw.pixel_y_mm) {
+    s.SetResolved("pixel_mm", raw.pixel_x_mm);  // the file's square pixels (none: PlaceInPartFrame refuses)
+  }
+  const std::array<double, 2> centre = ValidDataCentrePx(raw, file.string());
+  const std::vector<double> centre_px = s.Numbers("centre_px", {centre[0], centre[1]});
+  p.centre_column = centre_px[0];
+  p.centre_row = centre_px[1];
+  const std::vector<double> centre_mm = s.Numbers("centre_mm", {0.0, 0.0});
+  p.centre_x_mm = centre_mm[0];
+  p.centre_y_mm = centre_mm[1];
+  const double rotation = s.Number("rotation_deg", 0.0);
+  if (rotation != 0.0 && rotation != 90.0 && rotation != 180.0 && rotation != 270.0) {
+    s.Fail("rotation_deg", fmt::format("= {} is not 0, 90, 180 or 270 (counter-clockwise)", rotation));
+  }
+  p.rotation_deg = static_cast<int>(rotation);
+  const std::string flip = s.Choice("flip", {"none", "x", "y"});
+  p.flip = flip == "x" ? MapPlacement::Flip::kX : flip == "y" ? MapPlacement::Flip::kY : MapPlacement::Flip::kNone;
+  return PlaceInPartFrame(raw, p, file.string());
 }
 
 }  // namespace
-
-ErrorMap ReadErrorMapCsv(const std::filesystem::path& path) {
-  std::ifstream in(path);
-  if (!in) throw Error(ErrorCode::kIo, "polishing.map", fmt::format("cannot open '{}'", path.string()));
-  struct Node {
-    double x, y, e;
-    std::size_t line;
-  };
-  std::vector<Node> nodes;
-  std::string text;
-  std::size_t line = 0;
-  bool header = false;
-  while (std::getline(in, text)) {
-    ++line;
-    if (!text.empty() && text.back() == '\r') text.pop_back();
-    if (text.empty() || text[0] == '#') continue;
-    if (!header) {
-      if (text != "x_mm,y_mm,error_um") MapFail(path, line, fmt::format("header '{}' is not 'x_mm,y_mm,error_um'", text));
-      header = true;
-      continue;
-    }
-    std::stringstream cells(text);
-    std::string cell;
-    double v[3];
-    int count = 0;
-    while (std::getline(cells, cell, ',')) {
-      if (count == 3) MapFail(path, line, "has more than 3 values");
-      char* end = nullptr;
-      v[count] = std::strtod(cell.c_str(), &end);
-      if (cell.empty() || *end != '\0') MapFail(path, line, fmt::format("'{}' is not a number", cell));
-      ++count;
-    }
-    if (count != 3) MapFail(path, line, fmt::format("has {} values, needs x_mm,y_mm,error_um", count));
-    if (!std::isfinite(v[0]) || !std::isfinite(v[1])) MapFail(path, line, "x_mm and y_mm must be finite");
-    nodes.push_back({v[0], v[1], v[2], line});
-  }
-  if (nodes.size() < 2) MapFail(path, line, "the map needs at least two nodes");
-  std::set<double> xs, ys;
-  for (const Node& n : nodes) xs.insert(n.x), ys.insert(n.y);
-  ErrorMap map;
-  map.x0_mm = *xs.begin();
-  map.y0_mm = *ys.begin();
-  map.dx_mm = xs.size() > 1 ? MedianGap(xs) : 1.0;
-  map.dy_mm = ys.size() > 1 ? MedianGap(ys) : 1.0;
-  map.nx = static_cast<int>(std::lround((*xs.rbegin() - map.x0_mm) / map.dx_mm)) + 1;
-  map.ny = static_cast<int>(std::lround((*ys.rbegin() - map.y0_mm) / map.dy_mm)) + 1;
-  if (static_cast<double>(map.nx) * map.ny > 1e8) MapFail(path, line, "the grid would exceed 1e8 nodes");
-  map.error_um.assign(static_cast<std::size_t>(map.nx) * map.ny, std::numeric_limits<double>::quiet_NaN());
-  std::vector<bool> seen(map.error_um.size(), false);
-  for (const Node& n : nodes) {
-    const int i = GridIndex(n.x, map.x0_mm, map.dx_mm), j = GridIndex(n.y, map.y0_mm, map.dy_mm);
-    if (i < 0 || j < 0) {
-      MapFail(path, n.line, fmt::format("({}, {}) mm is not on the regular grid of spacing {} x {} mm", n.x, n.y, map.dx_mm, map.dy_mm));
-    }
-    const std::size_t index = static_cast<std::size_t>(j) * map.nx + i;
-    if (seen[index]) MapFail(path, n.line, fmt::format("({}, {}) mm appears twice", n.x, n.y));
-    seen[index] = true;
-    map.error_um[index] = n.e;
-  }
-  return map;
-}
 
 PolishJob ReadPolishJob(const std::filesystem::path& path) {
   std::ifstream in(path);
@@ -322,26 +305,38 @@ PolishJob ReadPolishJob(const std::filesystem::path& path) {
   section("aperture", [&](Section& c) { job.aperture = ReadAperture(c); });
   section("error_map", [&](Section& c) {
     const std::string file = c.String("file", "");
-    if (file.empty()) c.Fail("file", "is required: a CSV of x_mm,y_mm,error_um");
+    if (file.empty()) c.Fail("file", "is required: the error map (.csv, .dat, .datx or .h5)");
     job.error_map_file = std::filesystem::path(file).is_absolute() ? std::filesystem::path(file) : path.parent_path() / file;
-    job.error_map = ReadErrorMapCsv(job.error_map_file);
+    job.error_map = ReadErrorMapSection(c, job.error_map_file);
   });
   section("removal_target", [&](Section& c) {
     job.target.uniform_layer_um = c.Number("uniform_layer_um", 0.0);
     if (!(job.target.uniform_layer_um >= 0.0)) c.Fail("uniform_layer_um", "must be >= 0");
   });
   section("removal_function", [&](Section& c) {
-    job.removal.peak_rate_um_per_s = c.RequiredNumber("peak_rate_um_per_s");
-    if (!(job.removal.peak_rate_um_per_s > 0.0)) c.Fail("peak_rate_um_per_s", "must be > 0");
-    job.removal.fwhm_mm = c.RequiredNumber("fwhm_mm");
-    if (!(job.removal.fwhm_mm > 0.0)) c.Fail("fwhm_mm", "must be > 0");
+    if (c.Has("file")) {
+      if (c.Has("peak_rate_um_per_s") || c.Has("fwhm_mm")) {
+        c.Fail("file", "is an alternative to peak_rate_um_per_s and fwhm_mm: give one or the other");
+      }
+      const std::filesystem::path file = c.String("file", "");
+      job.removal = ReadRemovalFunction(file.is_absolute() ? file : path.parent_path() / file);
+      return;
+    }
+    GaussianRemovalFunction gaussian;
+    gaussian.peak_rate_um_per_s = c.RequiredNumber("peak_rate_um_per_s");
+    if (!(gaussian.peak_rate_um_per_s > 0.0)) c.Fail("peak_rate_um_per_s", "must be > 0");
+    gaussian.fwhm_mm = c.RequiredNumber("fwhm_mm");
+    if (!(gaussian.fwhm_mm > 0.0)) c.Fail("fwhm_mm", "must be > 0");
+    job.removal = gaussian;
   });
   section("path", [&](Section& c) {
-    job.path.line_spacing_mm = c.Number("line_spacing_mm", job.removal.fwhm_mm / 5.0);
+    job.path_pattern = c.Choice("type", {"raster", "spiral"}) == "spiral" ? PathPattern::kSpiral : PathPattern::kRaster;
+    // Defaults from the removal function's (equivalent) width: see removal_function.h.
+    job.path.line_spacing_mm = c.Number("line_spacing_mm", job.removal.EquivalentFwhmMm() / 5.0);
     if (!(job.path.line_spacing_mm > 0.0)) c.Fail("line_spacing_mm", "must be > 0");
     job.path.point_spacing_mm = c.Number("point_spacing_mm", job.path.line_spacing_mm);
     if (!(job.path.point_spacing_mm > 0.0)) c.Fail("point_spacing_mm", "must be > 0");
-    job.path.extension_mm = c.Number("extension_mm", job.removal.SupportRadiusMm() / 2.0);
+    job.path.extension_mm = c.Number("extension_mm", 1.75 * job.removal.EquivalentSigmaMm());
     if (!(job.path.extension_mm >= 0.0)) c.Fail("extension_mm", "must be >= 0");
   });
   section("machine", [&](Section& c) { ReadMachine(c, job); });
@@ -413,7 +408,8 @@ std::string ResidualCsv(const ErrorMap& target, const DwellSolution& d) {
 }  // namespace
 
 PolishRunReport RunPolishJob(const PolishJob& job, const std::filesystem::path& output_folder) {
-  const std::vector<Eigen::Vector2d> path = RasterPath(job.aperture, job.path);
+  const std::vector<Eigen::Vector2d> path =
+      job.path_pattern == PathPattern::kSpiral ? SpiralPath(job.aperture, job.path) : RasterPath(job.aperture, job.path);
   CheckOnSurface(job, path);
   const ErrorMap target = RemovalTarget(job.error_map, job.aperture, job.target);
   PolishRunReport report;
@@ -427,7 +423,7 @@ PolishRunReport RunPolishJob(const PolishJob& job, const std::filesystem::path& 
       fmt::format("arcwheel {} polish, job '{}'", kVersion, job.name),
       fmt::format("surface: {}", job.surface->Describe()),
       fmt::format("aperture: {}", job.aperture.Describe()),
-      fmt::format("removal function: Gaussian, peak {} um/s, FWHM {} mm", job.removal.peak_rate_um_per_s, job.removal.fwhm_mm)};
+      fmt::format("removal function: {}", job.removal.Describe())};
   json summary = {
       {"arcwheel_version", kVersion},
       {"job", job.resolved},
@@ -439,7 +435,7 @@ PolishRunReport RunPolishJob(const PolishJob& job, const std::filesystem::path& 
       {"speed_mm_s", {{"min", report.min_speed_mm_s}, {"max", report.max_speed_mm_s}}},
       {"max_acceleration_mm_s2", report.dwell.max_acceleration_mm_s2},
       {"solver", {{"iterations", report.dwell.iterations}, {"converged", report.dwell.converged},
-                  {"nonzeros", report.dwell.nonzeros}}}};
+                  {"nonzeros", report.dwell.nonzeros}, {"shaping_rounds", report.dwell.shaping_rounds}}}};
 
   EnsureDirectory(output_folder);
   OutputSet outputs;

@@ -9,6 +9,7 @@
 
 #include "grinding/surface.h"
 #include "polishing/dwell.h"
+#include "polishing/error_map_io.h"
 #include "polishing/removal_target.h"
 #include "polishing/robot_program.h"
 #include "polishing/tool_frame.h"
@@ -23,7 +24,8 @@ struct PolishJob {
   std::filesystem::path error_map_file;
   ErrorMap error_map;
   RemovalTargetOptions target;
-  GaussianRemovalFunction removal;
+  RemovalFunction removal;  // a Gaussian, or a measured table (removal_function.file)
+  PathPattern path_pattern = PathPattern::kRaster;  // path.type
   RasterOptions path;
   DwellOptions dwell;
   RobotSide robot_side = RobotSide::kPlusX;
@@ -32,11 +34,6 @@ struct PolishJob {
   WorkObject work_object;
   nlohmann::json resolved;  // the job with every default filled in
 };
-
-// Reads an error map CSV: a header `x_mm,y_mm,error_um`, then one node of a regular grid per row
-// (any order; missing nodes and `nan` have no data). Throws Error{kIo} if unreadable and
-// Error{kBadInput, "polishing.map"} naming the file and line of anything malformed.
-[[nodiscard]] ErrorMap ReadErrorMapCsv(const std::filesystem::path& path);
 
 // Reads and validates a job; the error map's "file" is relative to the job's folder.
 // Throws Error{kIo} or Error{kBadInput, "polishing.job"} naming the file and the dotted key.

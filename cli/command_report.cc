@@ -1,5 +1,6 @@
 // arcwheel report OUTDIR: renders OUTDIR/report.html and OUTDIR/report.pdf from the
-// summary.json and wheel_map.h5 that `arcwheel process` wrote there.
+// summary.json and wheel_map.h5 that `arcwheel process` wrote there, or OUTDIR/polish_report.html
+// and .pdf from the outputs of `arcwheel polish`.
 
 #include <fmt/core.h>
 
@@ -9,6 +10,8 @@
 #include <vector>
 
 #include "cli/commands.h"
+#include "core/error.h"
+#include "reports/polish_report.h"
 #include "reports/report.h"
 #include "reports/tolerances.h"
 
@@ -21,7 +24,25 @@ struct ReportArguments {
   std::vector<std::string> tolerance_flags;
 };
 
+void RunWheelReport(const ReportArguments& arguments);
+
 void RunReport(const ReportArguments& arguments) {
+  // A folder written by `arcwheel polish` gets the polishing report, one written by `process` the
+  // wheel report (and a folder with neither the wheel report's refusal).
+  const bool polish = std::filesystem::exists(arguments.outdir / "polish_summary.json");
+  const bool wheel = std::filesystem::exists(arguments.outdir / "summary.json");
+  if (polish && !wheel && (!arguments.tolerance_file.empty() || !arguments.tolerance_flags.empty())) {
+    throw Error(ErrorCode::kInvalidOption, "reports",
+                "tolerances apply to the wheel report; '" + arguments.outdir.string() + "' holds no summary.json");
+  }
+  if (polish) {
+    const reports::WrittenPolishReports written = reports::WritePolishReports(arguments.outdir);
+    fmt::print("wrote {}\nwrote {}\n", written.html.string(), written.pdf.string());
+  }
+  if (wheel || !polish) RunWheelReport(arguments);
+}
+
+void RunWheelReport(const ReportArguments& arguments) {
   reports::Tolerances tolerances;
   if (!arguments.tolerance_file.empty()) tolerances = reports::ReadTolerances(arguments.tolerance_file);
   for (const std::string& flag : arguments.tolerance_flags) reports::AddToleranceFlag(tolerances, flag);
@@ -35,8 +56,9 @@ void RunReport(const ReportArguments& arguments) {
 void AddReportCommand(CLI::App& app) {
   auto arguments = std::make_shared<ReportArguments>();
   CLI::App* command = app.add_subcommand(
-      "report", "render OUTDIR/report.html and OUTDIR/report.pdf from OUTDIR/summary.json and wheel_map.h5");
-  command->add_option("OUTDIR", arguments->outdir, "folder written by `arcwheel process`")->required();
+      "report", "render OUTDIR/report.html and OUTDIR/report.pdf from OUTDIR/summary.json and wheel_map.h5, or "
+                "OUTDIR/polish_report.html and .pdf from the outputs of `arcwheel polish`");
+  command->add_option("OUTDIR", arguments->outdir, "folder written by `arcwheel process` or `arcwheel polish`")->required();
   command->add_option("--tolerances", arguments->tolerance_file,
                       "JSON file of limits by headline key, e.g. {\"max_runout_um\": 10, "
                       "\"mean_arc_radius_mm\": {\"min\": 74.9, \"max\": 75.1}}");

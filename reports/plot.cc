@@ -122,7 +122,9 @@ void DrawTitle(cairo_t* cr, const std::string& title, double width) {
   DrawText(cr, title, width / 2.0, 9.0, 0.5);
 }
 
-int MaxTicks(double length_pt, double spacing_pt) { return std::max(2, static_cast<int>(length_pt / spacing_pt)); }
+// At least three ticks, so that a small plot (a map half a page wide) still shows a scale on
+// both sides of zero.
+int MaxTicks(double length_pt, double spacing_pt) { return std::max(3, static_cast<int>(length_pt / spacing_pt)); }
 
 void DrawAxes(cairo_t* cr, const Frame& frame, const Axis& x_axis, const Axis& y_axis, bool grid) {
   const Rect& a = frame.area;
@@ -369,10 +371,12 @@ void CheckGrid(std::size_t n_x, std::size_t n_y, std::size_t cells, const std::v
       << "grid '" << title << "' sizes do not match";
 }
 
-Range ColourRange(const HeatMap& map) {
+// The 0.5 and 99.5 percentiles of the finite values, replaced by the fixed limits when given.
+Range ColourRange(const std::vector<double>& values, const std::optional<double>& colour_min,
+                  const std::optional<double>& colour_max) {
   std::vector<double> finite;
-  finite.reserve(map.values.size());
-  for (double v : map.values) {
+  finite.reserve(values.size());
+  for (double v : values) {
     if (std::isfinite(v)) finite.push_back(v);
   }
   Range range{0.0, 1.0};
@@ -384,8 +388,8 @@ Range ColourRange(const HeatMap& map) {
     };
     range = {percentile(0.005), percentile(0.995)};
   }
-  if (map.colour_min) range.low = *map.colour_min;
-  if (map.colour_max) range.high = *map.colour_max;
+  if (colour_min) range.low = *colour_min;
+  if (colour_max) range.high = *colour_max;
   if (!(range.high > range.low)) range = Padded(range.low, range.high);
   return range;
 }
@@ -426,14 +430,25 @@ void DrawColourBar(cairo_t* cr, const Rect& area, const Range& range, const std:
   DrawText(cr, label, bar.x + bar.width + 44.0, bar.y + bar.height / 2.0, 0.5, M_PI / 2.0);
 }
 
+// Shrinks the plot area (keeping its top-left corner) so that a unit of x and of y have the same
+// length on the page.
+Frame EqualAspect(Frame frame) {
+  const double per_unit = std::min(frame.area.width / (frame.x.high - frame.x.low),
+                                   frame.area.height / (frame.y.high - frame.y.low));
+  frame.area.width = per_unit * (frame.x.high - frame.x.low);
+  frame.area.height = per_unit * (frame.y.high - frame.y.low);
+  return frame;
+}
+
 void DrawHeatMap(cairo_t* cr, const HeatMap& map, double width, double height) {
   CheckGrid(map.n_x, map.n_y, map.values.size(), map.x_nodes, map.y_nodes, map.title);
   const Range x_extent = CellExtent(map.x_nodes);
   const Range y_extent = CellExtent(map.y_nodes);
-  const Frame frame{PlotArea(width, height, false, kColourBarWidth_pt + 62.0),
-                    ResolveRange(map.x, x_extent.low, x_extent.high, false),
-                    ResolveRange(map.y, y_extent.low, y_extent.high, false)};
-  const Range colours = ColourRange(map);
+  Frame frame{PlotArea(width, height, false, kColourBarWidth_pt + 62.0),
+              ResolveRange(map.x, x_extent.low, x_extent.high, false),
+              ResolveRange(map.y, y_extent.low, y_extent.high, false)};
+  if (map.equal_aspect) frame = EqualAspect(frame);
+  const Range colours = ColourRange(map.values, map.colour_min, map.colour_max);
   SurfacePtr image = GridImage(map.n_x, map.n_y, [&](std::size_t i0, std::size_t i1, std::size_t j0, std::size_t j1) {
     double sum = 0.0;
     int count = 0;
@@ -451,6 +466,45 @@ void DrawHeatMap(cairo_t* cr, const HeatMap& map, double width, double height) {
   DrawTitle(cr, map.title, width);
   PaintGridImage(cr, frame, image.get(), x_extent, y_extent);
   DrawAxes(cr, frame, map.x, map.y, false);
+  DrawColourBar(cr, frame.area, colours, map.colour_bar_label);
+}
+
+void DrawPathMap(cairo_t* cr, const PathMap& map, double width, double height) {
+  ARCWHEEL_CHECK(map.y_points.size() == map.x_points.size() && map.values.size() == map.x_points.size())
+      << "path '" << map.title << "' sizes do not match";
+  double x_low = INFINITY, x_high = -INFINITY, y_low = INFINITY, y_high = -INFINITY;
+  for (std::size_t k = 0; k < map.x_points.size(); ++k) {
+    Extend(map.x_points[k], x_low, x_high);
+    Extend(map.y_points[k], y_low, y_high);
+  }
+  for (const Series& overlay : map.overlays) {
+    CheckSeries(overlay);
+    for (std::size_t i = 0; i < overlay.x.size(); ++i) {
+      Extend(overlay.x[i], x_low, x_high);
+      Extend(overlay.y[i], y_low, y_high);
+    }
+  }
+  Frame frame{PlotArea(width, height, false, kColourBarWidth_pt + 62.0), ResolveRange(map.x, x_low, x_high, true),
+              ResolveRange(map.y, y_low, y_high, true)};
+  if (map.equal_aspect) frame = EqualAspect(frame);
+  const Range colours = ColourRange(map.values, map.colour_min, map.colour_max);
+  DrawTitle(cr, map.title, width);
+  DrawAxes(cr, frame, map.x, map.y, true);
+  cairo_save(cr);
+  cairo_rectangle(cr, frame.area.x, frame.area.y, frame.area.width, frame.area.height);
+  cairo_clip(cr);
+  cairo_set_line_width(cr, 1.2);
+  cairo_set_line_cap(cr, CAIRO_LINE_CAP_ROUND);
+  for (std::size_t k = 1; k < map.x_points.size(); ++k) {
+    const double x0 = map.x_points[k - 1], y0 = map.y_points[k - 1], x1 = map.x_points[k], y1 = map.y_points[k];
+    if (!std::isfinite(x0) || !std::isfinite(y0) || !std::isfinite(x1) || !std::isfinite(y1)) continue;
+    SetColour(cr, Viridis((map.values[k] - colours.low) / (colours.high - colours.low)));
+    cairo_move_to(cr, frame.Px(x0), frame.Py(y0));
+    cairo_line_to(cr, frame.Px(x1), frame.Py(y1));
+    cairo_stroke(cr);
+  }
+  for (const Series& overlay : map.overlays) DrawSeries(cr, frame, overlay);
+  cairo_restore(cr);
   DrawColourBar(cr, frame.area, colours, map.colour_bar_label);
 }
 
@@ -580,6 +634,7 @@ void Draw(cairo_t* cr, const Figure& figure, double width_pt, double height_pt) 
         if constexpr (std::is_same_v<T, LinePlot>) DrawLinePlot(cr, plot, width_pt, height_pt);
         if constexpr (std::is_same_v<T, HeatMap>) DrawHeatMap(cr, plot, width_pt, height_pt);
         if constexpr (std::is_same_v<T, CategoryMap>) DrawCategoryMap(cr, plot, width_pt, height_pt);
+        if constexpr (std::is_same_v<T, PathMap>) DrawPathMap(cr, plot, width_pt, height_pt);
       },
       figure);
   cairo_restore(cr);

@@ -1,6 +1,6 @@
 #pragma once
-// The project's one plotting layer. A figure is a plain description (line plot, heat map or
-// category map); Draw() paints it with cairo, so the same drawing code makes the inline SVG of
+// The project's one plotting layer. A figure is a plain description (line plot, heat map,
+// category map or coloured path); Draw() paints it with cairo, so the same drawing code makes the inline SVG of
 // the HTML report, the vector plots of the PDF report and PNG images.
 //
 // Lengths are in points (1/72 inch); colours are sRGB in [0, 1]. Axis labels carry their unit,
@@ -88,6 +88,27 @@ struct HeatMap {
   // extreme cells do not wash out the rest; cells beyond the range take the end colours).
   std::optional<double> colour_min;
   std::optional<double> colour_max;
+  // One unit of x as long as one unit of y on the page (a disc stays round); the plot area
+  // shrinks to keep it.
+  bool equal_aspect = false;
+};
+
+// A path in the plane coloured by a value along it (viridis, with a colour bar), e.g. a tool
+// path coloured by speed: the segment from point k-1 to point k takes the colour of values[k].
+// `overlays` are line series drawn on top (e.g. an outline), without a legend.
+struct PathMap {
+  std::string title;
+  Axis x;
+  Axis y;
+  std::vector<double> x_points;
+  std::vector<double> y_points;  // size of x_points
+  std::vector<double> values;    // size of x_points
+  std::string colour_bar_label;  // with the unit, e.g. "speed (mm/s)"
+  // Colour range; when absent, the 0.5 and 99.5 percentiles of the finite values (as HeatMap).
+  std::optional<double> colour_min;
+  std::optional<double> colour_max;
+  std::vector<Series> overlays;
+  bool equal_aspect = true;
 };
 
 struct Category {
@@ -108,7 +129,7 @@ struct CategoryMap {
   std::vector<Category> categories;
 };
 
-using Figure = std::variant<LinePlot, HeatMap, CategoryMap>;
+using Figure = std::variant<LinePlot, HeatMap, CategoryMap, PathMap>;
 
 // Paints `figure` into the rectangle [0, width_pt] x [0, height_pt] of the current user space
 // of `cr` (translate first to place it). Throws Error{kInternal} on malformed figures (sizes

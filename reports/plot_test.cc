@@ -7,6 +7,7 @@
 #include <regex>
 #include <set>
 
+#include "core/error.h"
 #include "core/testing/testing.h"
 
 namespace arcwheel::reports::plot {
@@ -126,6 +127,58 @@ TEST(HeatMap, PaintsTwoEqualHalvesInTheColoursOfTheirValues) {
   const int high = histogram.count(Packed(Viridis(1.0))) ? histogram.at(Packed(Viridis(1.0))) : 0;
   EXPECT_GT(low, 10000) << "the left half is painted in viridis(0)";
   EXPECT_NEAR(static_cast<double>(high) / low, 1.0, 0.03) << "the halves are equal";
+}
+
+TEST(HeatMap, KeepsEqualScalesOnBothAxesWhenAsked) {
+  // Cells span 10 x 5 units. The plot area of a 400 x 300 pt figure leaves 270 x 252 pt for the
+  // map (50 pt left, 80 right for the colour bar, 18 top, 30 bottom), so at equal scales the map
+  // is 270 pt wide and 135 pt high.
+  HeatMap map;
+  map.n_x = 10;
+  map.n_y = 5;
+  for (std::size_t i = 0; i < map.n_x; ++i) map.x_nodes.push_back(static_cast<double>(i));
+  for (std::size_t j = 0; j < map.n_y; ++j) map.y_nodes.push_back(static_cast<double>(j));
+  map.values.assign(map.n_x * map.n_y, 1.0);
+  map.colour_min = 0.0;
+  map.colour_max = 1.0;
+  map.equal_aspect = true;
+  const auto histogram = PixelHistogram(RenderPng(map, 400.0, 300.0, 1.0));
+  const auto yellow = histogram.find(Packed(Viridis(1.0)));
+  ASSERT_NE(yellow, histogram.end());
+  EXPECT_NEAR(yellow->second, 270.0 * 135.0, 0.03 * 270.0 * 135.0);
+}
+
+TEST(PathMap, ColoursEachSegmentByTheValueAtItsEnd) {
+  // Two segments of equal length: into point 1 (value 1, yellow) and into point 2 (value 0, purple).
+  PathMap path;
+  path.x.label = "x (mm)";
+  path.y.label = "y (mm)";
+  path.x_points = {0.0, 10.0, 10.0};
+  path.y_points = {0.0, 0.0, 10.0};
+  path.values = {0.5, 1.0, 0.0};
+  path.colour_min = 0.0;
+  path.colour_max = 1.0;
+  const auto histogram = PixelHistogram(RenderPng(path, 300.0, 300.0, 2.0));
+  auto count = [&](double t) {
+    const auto it = histogram.find(Packed(Viridis(t)));
+    return it == histogram.end() ? 0 : it->second;
+  };
+  EXPECT_GT(count(1.0), 300) << "the first segment";
+  EXPECT_GT(count(0.0), 300) << "the second segment";
+  EXPECT_NEAR(static_cast<double>(count(1.0)) / count(0.0), 1.0, 0.2) << "segments of equal length";
+}
+
+TEST(PathMap, RefusesSizesThatDoNotMatch) {
+  PathMap path;
+  path.x_points = {0.0, 1.0};
+  path.y_points = {0.0, 1.0};
+  path.values = {1.0};
+  try {
+    (void)RenderPng(path, 200.0, 200.0, 1.0);
+    ADD_FAILURE() << "mismatched sizes were drawn";
+  } catch (const Error& error) {
+    EXPECT_EQ(error.code(), ErrorCode::kInternal);
+  }
 }
 
 TEST(LinePlot, DrawsEachSeriesInItsColour) {

@@ -361,6 +361,12 @@ SectionResidual SectionResiduals(const ReportInputs& inputs, std::size_t phase_i
   return residual;
 }
 
+std::vector<KeyValue> FlattenJson(const nlohmann::json& object) {
+  std::vector<KeyValue> rows;
+  if (!object.empty()) Flatten(object, "", rows);
+  return rows;
+}
+
 ReportContent ComposeReport(const ReportInputs& inputs, const Tolerances& tolerances) {
   const Summary& s = inputs.summary;
   ReportContent content;

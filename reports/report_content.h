@@ -46,6 +46,10 @@ struct ReportContent {
 // Builds the report from the two inputs and the tolerances. Pure: no I/O.
 [[nodiscard]] ReportContent ComposeReport(const ReportInputs& inputs, const Tolerances& tolerances);
 
+// A JSON object's leaves as dotted keys ("despike.threshold_um"), strings unquoted, other values
+// as JSON text.
+[[nodiscard]] std::vector<KeyValue> FlattenJson(const nlohmann::json& object);
+
 // "PASS", "FAIL" or "NO TOLERANCE".
 [[nodiscard]] std::string VerdictText(Verdict verdict);
 

@@ -1,0 +1,349 @@
+#include "reports/polish_report_inputs.h"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <charconv>
+#include <cmath>
+#include <fstream>
+#include <limits>
+#include <map>
+#include <set>
+#include <sstream>
+
+#include "core/error.h"
+#include "core/sha256.h"
+
+namespace arcwheel::reports {
+namespace {
+
+using nlohmann::json;
+constexpr const char* kStage = "reports.polish";
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+// A residual map is an aperture's nodes; a grid larger than this is a broken file, not a map.
+constexpr double kMaxGridNodes = 1e7;
+
+[[noreturn]] void Bad(const std::string& what) { throw Error(ErrorCode::kBadInput, kStage, what); }
+
+[[noreturn]] void BadLine(const std::string& source, std::size_t line, const std::string& what) {
+  Bad(fmt::format("'{}' line {}: {}", source, line, what));
+}
+
+// One line of a CSV text with its 1-based line number; "\r\n" endings are accepted.
+class Lines {
+ public:
+  explicit Lines(std::string_view text) : text_(text) {}
+  bool Next(std::string_view& line) {
+    if (position_ >= text_.size()) return false;
+    const std::size_t end = std::min(text_.find('\n', position_), text_.size());
+    line = text_.substr(position_, end - position_);
+    if (!line.empty() && line.back() == '\r') line.remove_suffix(1);
+    position_ = end + 1;
+    ++number_;
+    return true;
+  }
+  [[nodiscard]] std::size_t number() const { return number_; }
+
+ private:
+  std::string_view text_;
+  std::size_t position_ = 0;
+  std::size_t number_ = 0;
+};
+
+std::vector<std::string_view> SplitCells(std::string_view line) {
+  std::vector<std::string_view> cells;
+  std::size_t start = 0;
+  for (;;) {
+    const std::size_t comma = line.find(',', start);
+    cells.push_back(line.substr(start, comma == std::string_view::npos ? std::string_view::npos : comma - start));
+    if (comma == std::string_view::npos) return cells;
+    start = comma + 1;
+  }
+}
+
+// A whole cell as a double (from_chars: no locale, no leading space or '+'); "nan" is accepted.
+bool ParseDouble(std::string_view cell, double& value) {
+  const auto [end, error] = std::from_chars(cell.data(), cell.data() + cell.size(), value);
+  return error == std::errc() && end == cell.data() + cell.size() && !cell.empty();
+}
+
+// Header cells to column indices; every name of `required` must be present.
+std::vector<std::size_t> Columns(std::string_view header, const std::vector<std::string>& required,
+                                 const std::string& source, std::size_t line) {
+  std::map<std::string, std::size_t, std::less<>> index;
+  const std::vector<std::string_view> cells = SplitCells(header);
+  for (std::size_t c = 0; c < cells.size(); ++c) index.emplace(std::string(cells[c]), c);
+  std::vector<std::size_t> columns;
+  for (const std::string& name : required) {
+    const auto it = index.find(name);
+    if (it == index.end()) {
+      BadLine(source, line, fmt::format("header '{}' has no column '{}' (needs {})", header, name, fmt::join(required, ",")));
+    }
+    columns.push_back(it->second);
+  }
+  return columns;
+}
+
+// Reads the data rows of a CSV with the named columns: `row(values, line)` gets the values in
+// the order of `required`. Lines starting with '#' are passed to `comment`.
+template <typename Row, typename Comment>
+void ReadCsv(std::string_view text, const std::string& source, const std::vector<std::string>& required,
+             const Row& row, const Comment& comment) {
+  Lines lines(text);
+  std::string_view line;
+  std::vector<std::size_t> columns;
+  std::size_t width = 0;
+  std::vector<double> values(required.size());
+  while (lines.Next(line)) {
+    if (line.empty()) continue;
+    if (line.front() == '#') {
+      comment(line);
+      continue;
+    }
+    if (columns.empty()) {
+      columns = Columns(line, required, source, lines.number());
+      width = SplitCells(line).size();
+      continue;
+    }
+    const std::vector<std::string_view> cells = SplitCells(line);
+    if (cells.size() != width) BadLine(source, lines.number(), fmt::format("has {} values, the header names {}", cells.size(), width));
+    for (std::size_t k = 0; k < required.size(); ++k) {
+      if (!ParseDouble(cells[columns[k]], values[k])) {
+        BadLine(source, lines.number(), fmt::format("{} '{}' is not a number", required[k], cells[columns[k]]));
+      }
+    }
+    row(values, lines.number());
+  }
+  if (columns.empty()) BadLine(source, lines.number(), fmt::format("has no header line ({})", fmt::join(required, ",")));
+}
+
+// Grid nodes of one axis from the distinct coordinates: spacing = the median gap (a stray value
+// is then reported as off the grid rather than taken for the spacing).
+std::vector<double> GridNodes(const std::set<double>& values, const std::string& source, const char* axis) {
+  if (values.size() == 1) return {*values.begin()};
+  std::vector<double> gaps;
+  for (auto it = std::next(values.begin()); it != values.end(); ++it) gaps.push_back(*it - *std::prev(it));
+  std::nth_element(gaps.begin(), gaps.begin() + static_cast<std::ptrdiff_t>(gaps.size() / 2), gaps.end());
+  const double step = gaps[gaps.size() / 2];
+  const double count = std::round((*values.rbegin() - *values.begin()) / step) + 1.0;
+  if (!(count <= kMaxGridNodes)) Bad(fmt::format("'{}': the {} nodes would need a grid of {} nodes", source, axis, count));
+  std::vector<double> nodes(static_cast<std::size_t>(count));
+  for (std::size_t i = 0; i < nodes.size(); ++i) nodes[i] = *values.begin() + static_cast<double>(i) * step;
+  return nodes;
+}
+
+// Index of `v` among regular `nodes`, or -1 when it is not within 1e-6 spacing of one.
+std::ptrdiff_t NodeIndex(const std::vector<double>& nodes, double v) {
+  if (nodes.size() == 1) return v == nodes.front() ? 0 : -1;
+  const double u = (v - nodes.front()) / (nodes[1] - nodes[0]);
+  const double r = std::round(u);
+  return std::abs(u - r) <= 1e-6 && r >= 0.0 && r < static_cast<double>(nodes.size()) ? static_cast<std::ptrdiff_t>(r) : -1;
+}
+
+// Locates a value in the summary for messages: "'OUTDIR/polish_summary.json' key 'before.pv_um'".
+class JsonReader {
+ public:
+  JsonReader(const json& root, std::string source) : root_(root), source_(std::move(source)) {}
+
+  [[noreturn]] void Fail(const std::string& key, const std::string& problem) const {
+    Bad(fmt::format("'{}' key '{}' {}", source_, key, problem));
+  }
+  // The value at a dotted key, or nullptr when a part of it is absent.
+  [[nodiscard]] const json* Find(const std::string& key) const {
+    const json* node = &root_;
+    std::size_t start = 0;
+    for (;;) {
+      const std::size_t dot = key.find('.', start);
+      const std::string part = key.substr(start, dot == std::string::npos ? std::string::npos : dot - start);
+      if (!node->is_object()) Fail(key.substr(0, start == 0 ? 0 : start - 1), "is not a JSON object");
+      const auto it = node->find(part);
+      if (it == node->end()) return nullptr;
+      node = &*it;
+      if (dot == std::string::npos) return node;
+      start = dot + 1;
+    }
+  }
+  [[nodiscard]] const json& Require(const std::string& key) const {
+    const json* value = Find(key);
+    if (value == nullptr) Fail(key, "is missing");
+    return *value;
+  }
+  [[nodiscard]] double Number(const std::string& key) const {
+    const json& value = Require(key);
+    if (!value.is_number() || !std::isfinite(value.get<double>())) Fail(key, "is not a finite number (found " + value.dump() + ")");
+    return value.get<double>();
+  }
+  [[nodiscard]] double OptionalNumber(const std::string& key, double fallback) const {
+    return Find(key) == nullptr ? fallback : Number(key);
+  }
+  [[nodiscard]] std::int64_t Count(const std::string& key) const {
+    const json& value = Require(key);
+    if (!value.is_number_integer() || value.get<std::int64_t>() < 0) {
+      Fail(key, "is not a non-negative integer (found " + value.dump() + ")");
+    }
+    return value.get<std::int64_t>();
+  }
+  [[nodiscard]] std::string String(const std::string& key) const {
+    const json& value = Require(key);
+    if (!value.is_string()) Fail(key, "is not a string (found " + value.dump() + ")");
+    return value.get<std::string>();
+  }
+  [[nodiscard]] bool Boolean(const std::string& key) const {
+    const json& value = Require(key);
+    if (!value.is_boolean()) Fail(key, "is not true or false (found " + value.dump() + ")");
+    return value.get<bool>();
+  }
+  // The number as the file writes it (nlohmann's shortest round-trip form, as the writer used).
+  [[nodiscard]] std::string NumberText(const std::string& key) const {
+    (void)Number(key);
+    return Require(key).dump();
+  }
+
+ private:
+  const json& root_;
+  std::string source_;
+};
+
+std::string ReadWhole(const std::filesystem::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) {
+    const std::string why = std::filesystem::exists(path) ? "cannot be read" : "does not exist";
+    throw Error(ErrorCode::kIo, kStage, fmt::format("'{}' {} (is this a folder written by `arcwheel polish`?)", path.string(), why));
+  }
+  std::ostringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
+}  // namespace
+
+ResidualMap ParseResidualMapCsv(std::string_view text, const std::string& source_name) {
+  struct Node {
+    double x, y, target, removal, residual;
+    std::size_t line;
+  };
+  std::vector<Node> nodes;
+  ReadCsv(
+      text, source_name, {"x_mm", "y_mm", "target_um", "removal_um", "residual_um"},
+      [&](const std::vector<double>& v, std::size_t line) {
+        if (!std::isfinite(v[0]) || !std::isfinite(v[1])) BadLine(source_name, line, "x_mm and y_mm must be finite");
+        nodes.push_back({v[0], v[1], v[2], v[3], v[4], line});
+      },
+      [](std::string_view) {});
+  if (nodes.empty()) Bad(fmt::format("'{}' has no aperture node", source_name));
+  std::set<double> xs, ys;
+  for (const Node& n : nodes) xs.insert(n.x), ys.insert(n.y);
+  ResidualMap map;
+  map.x_mm = GridNodes(xs, source_name, "x_mm");
+  map.y_mm = GridNodes(ys, source_name, "y_mm");
+  if (static_cast<double>(map.n_x()) * static_cast<double>(map.n_y()) > kMaxGridNodes) {
+    Bad(fmt::format("'{}': a grid of {} x {} nodes is too large for a residual map", source_name, map.n_x(), map.n_y()));
+  }
+  const std::size_t cells = map.n_x() * map.n_y();
+  map.target_um.assign(cells, kNaN);
+  map.removal_um.assign(cells, kNaN);
+  map.residual_um.assign(cells, kNaN);
+  std::vector<bool> seen(cells, false);
+  for (const Node& n : nodes) {
+    const std::ptrdiff_t i = NodeIndex(map.x_mm, n.x), j = NodeIndex(map.y_mm, n.y);
+    if (i < 0 || j < 0) BadLine(source_name, n.line, fmt::format("node ({}, {}) mm is not on the grid of the other nodes", n.x, n.y));
+    const std::size_t k = static_cast<std::size_t>(i) * map.n_y() + static_cast<std::size_t>(j);
+    if (seen[k]) BadLine(source_name, n.line, fmt::format("node ({}, {}) mm appears twice", n.x, n.y));
+    seen[k] = true;
+    map.target_um[k] = n.target;
+    map.removal_um[k] = n.removal;
+    map.residual_um[k] = n.residual;
+  }
+  map.nodes = nodes.size();
+  return map;
+}
+
+PolishingPathTable ParsePolishingPathCsv(std::string_view text, const std::string& source_name) {
+  PolishingPathTable path;
+  ReadCsv(
+      text, source_name, {"x", "y", "z", "q1", "q2", "q3", "q4", "speed_mm_s", "dwell_s"},
+      [&](const std::vector<double>& v, std::size_t line) {
+        for (double value : v) {
+          if (!std::isfinite(value)) BadLine(source_name, line, "every value must be finite");
+        }
+        if (!(v[7] > 0.0)) BadLine(source_name, line, fmt::format("speed_mm_s = {} is not > 0", v[7]));
+        if (!(v[8] >= 0.0)) BadLine(source_name, line, fmt::format("dwell_s = {} is negative", v[8]));
+        double length = 0.0;
+        if (!path.x_mm.empty()) {
+          length = path.path_length_mm.back() + std::hypot(v[0] - path.x_mm.back(), v[1] - path.y_mm.back(), v[2] - path.z_mm.back());
+        }
+        path.x_mm.push_back(v[0]);
+        path.y_mm.push_back(v[1]);
+        path.z_mm.push_back(v[2]);
+        path.speed_mm_s.push_back(v[7]);
+        path.dwell_s.push_back(v[8]);
+        path.path_length_mm.push_back(length);
+      },
+      [&](std::string_view comment) {
+        comment.remove_prefix(1);
+        if (!comment.empty() && comment.front() == ' ') comment.remove_prefix(1);
+        path.comments.emplace_back(comment);
+      });
+  if (path.size() == 0) Bad(fmt::format("'{}' has no path point", source_name));
+  return path;
+}
+
+PolishSummary ParsePolishSummary(const std::string& text, const std::string& source_name) {
+  json root;
+  try {
+    root = json::parse(text);
+  } catch (const json::parse_error& e) {
+    Bad(fmt::format("'{}' is not valid JSON: {}", source_name, e.what()));
+  }
+  if (!root.is_object()) Bad(fmt::format("'{}' is not a JSON object", source_name));
+  const JsonReader r(root, source_name);
+  PolishSummary s;
+  s.arcwheel_version = r.String("arcwheel_version");
+  if (!r.Require("job").is_object()) r.Fail("job", "is not a JSON object");
+  s.job = r.Require("job");
+  s.job_name = r.String("job.name");
+  if (r.Find("job.error_map.file") != nullptr) s.error_map_file = r.String("job.error_map.file");
+  s.points = r.Count("points");
+  s.aperture_nodes = r.Count("aperture_nodes");
+  s.total_time_s = r.Number("total_time_s");
+  s.before_pv_um = r.Number("before.pv_um");
+  s.before_rms_um = r.Number("before.rms_um");
+  s.after_pv_um = r.Number("after.pv_um");
+  s.after_rms_um = r.Number("after.rms_um");
+  s.min_speed_mm_s = r.Number("speed_mm_s.min");
+  s.max_speed_mm_s = r.Number("speed_mm_s.max");
+  s.max_acceleration_mm_s2 = r.Number("max_acceleration_mm_s2");
+  s.solver_iterations = r.Count("solver.iterations");
+  s.solver_converged = r.Boolean("solver.converged");
+  s.limit_max_speed_mm_s = r.Number("job.machine.max_speed_mm_s");
+  s.limit_min_speed_mm_s = r.OptionalNumber("job.machine.min_speed_mm_s", 0.0);
+  s.limit_max_acceleration_mm_s2 = r.OptionalNumber("job.machine.max_acceleration_mm_s2", 0.0);
+  s.total_time_text = r.NumberText("total_time_s");
+  s.before_pv_text = r.NumberText("before.pv_um");
+  s.before_rms_text = r.NumberText("before.rms_um");
+  s.after_pv_text = r.NumberText("after.pv_um");
+  s.after_rms_text = r.NumberText("after.rms_um");
+  return s;
+}
+
+PolishReportInputs ReadPolishReportInputs(const std::filesystem::path& outdir) {
+  const std::filesystem::path summary_path = outdir / "polish_summary.json";
+  const std::filesystem::path residual_path = outdir / "residual_map.csv";
+  const std::filesystem::path path_path = outdir / "polishing_path.csv";
+  PolishReportInputs inputs;
+  inputs.summary = ParsePolishSummary(ReadWhole(summary_path), summary_path.string());
+  inputs.residual = ParseResidualMapCsv(ReadWhole(residual_path), residual_path.string());
+  inputs.path = ParsePolishingPathCsv(ReadWhole(path_path), path_path.string());
+  if (inputs.path.size() != static_cast<std::size_t>(inputs.summary.points)) {
+    Bad(fmt::format("'{}' has {} points but '{}' key 'points' says {}", path_path.string(), inputs.path.size(),
+                    summary_path.string(), inputs.summary.points));
+  }
+  if (inputs.residual.nodes != static_cast<std::size_t>(inputs.summary.aperture_nodes)) {
+    Bad(fmt::format("'{}' has {} nodes but '{}' key 'aperture_nodes' says {}", residual_path.string(), inputs.residual.nodes,
+                    summary_path.string(), inputs.summary.aperture_nodes));
+  }
+  for (const auto& file : {summary_path, residual_path, path_path}) inputs.sources.push_back({file, Sha256OfFile(file)});
+  return inputs;
+}
+
+}  // namespace arcwheel::reports

@@ -1,29 +1,65 @@
 #!/usr/bin/env bash
-# Builds the libFuzzer targets (clang, AddressSanitizer + UndefinedBehaviorSanitizer) and runs
-# each for SECONDS (default 30) on the seeds in fuzz/seeds/. A crash leaves its input in
-# fuzz/crashes/<target>/ and fails the script; turn it into a regression test.
-#   scripts/fuzz.sh            # short run, as CI does
-#   scripts/fuzz.sh 600        # ten minutes per target
+# Builds the libFuzzer targets (preset asan: clang, AddressSanitizer + UndefinedBehaviorSanitizer)
+# and runs each for SECONDS (default 20) on its seeds in fuzz/seeds/<target>/. A crash, leak, hang
+# or sanitizer report leaves its input in fuzz/crashes/<target>/ and fails the script; turn it into
+# a regression test in tests/.
+#   scripts/fuzz.sh                         # every target, 20 s each (CI)
+#   scripts/fuzz.sh 600                     # ten minutes per target
+#   scripts/fuzz.sh 600 scan_hdf5_fuzzer    # one target
+#   FUZZ_JOBS=3 scripts/fuzz.sh 600         # three targets at a time
 set -euo pipefail
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
-seconds=${1:-30}
+seconds=${1:-20}
+shift || true
+if (($# > 0)); then
+  targets=("$@")
+else
+  mapfile -t targets < <(cd "$root/fuzz" && ls ./*_fuzzer.cc | sed -e 's|^\./||' -e 's|\.cc$||')
+fi
+jobs=${FUZZ_JOBS:-1}
 "$root/scripts/install_deps.sh"
-CC=clang CXX=clang++ cmake -S "$root" -B "$root/build-fuzz" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo \
-  -DARCWHEEL_FUZZ=ON -DARCWHEEL_BUILD_TESTS=OFF -DARCWHEEL_BUILD_BENCHMARKS=OFF \
-  "-DARCWHEEL_SANITIZE=address;undefined" >/dev/null
-targets=(scan_csv_fuzzer scan_hdf5_fuzzer)
-cmake --build "$root/build-fuzz" --parallel "$(nproc)" --target "${targets[@]}"
-for target in "${targets[@]}"; do
+cd "$root"
+cmake --preset asan >/dev/null
+cmake --build --preset asan --parallel "$(nproc)" --target "${targets[@]}"
+export ASAN_OPTIONS=allocator_may_return_null=1:detect_leaks=1:suppressions="$root/scripts/asan.supp"
+export LSAN_OPTIONS=suppressions="$root/scripts/lsan.supp"
+export UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
+
+# Runs one target; prints one line; exits non-zero if it found anything.
+fuzz_one() {
+  local target=$1 corpus work crashes status=0 runs
   corpus=$(mktemp -d)
-  cp "$root"/fuzz/seeds/* "$corpus"/
-  mkdir -p "$root/fuzz/crashes/$target"
-  echo "fuzz: $target for ${seconds} s"
-  ASAN_OPTIONS=detect_leaks=1 "$root/build-fuzz/fuzz/$target" "$corpus" -max_total_time="$seconds" \
-    -timeout=10 -rss_limit_mb=2048 -max_len=262144 -artifact_prefix="$root/fuzz/crashes/$target/" \
-    -print_final_stats=1 2>&1 | grep -E "^(stat::number_of_executed_units|#[0-9]+ +DONE|==[0-9]+==ERROR|SUMMARY)" || true
-  rm -rf "$corpus"
-  if compgen -G "$root/fuzz/crashes/$target/*" >/dev/null; then
-    echo "fuzz: $target found a failing input: $(ls "$root/fuzz/crashes/$target")" >&2
-    exit 1
+  work=$(mktemp -d)
+  cp "$root/fuzz/seeds/$target"/* "$corpus"/
+  crashes="$root/fuzz/crashes/$target"
+  mkdir -p "$crashes"
+  TMPDIR=$work "$root/build-asan/fuzz/$target" "$corpus" -max_total_time="$seconds" -timeout=10 \
+    -rss_limit_mb=2048 -max_len=262144 -artifact_prefix="$crashes/" -print_final_stats=1 \
+    >"$work/log" 2>&1 || status=$?
+  runs=$(sed -n 's/^stat::number_of_executed_units: *//p' "$work/log")
+  echo "fuzz: $target: ${seconds} s, ${runs:-?} executions, exit $status"
+  if ((status != 0)) || compgen -G "$crashes/*" >/dev/null; then
+    grep -E "ERROR|SUMMARY|==[0-9]+==|Test unit written" "$work/log" | head -20 >&2 || true
+    echo "fuzz: $target failed; inputs kept in $crashes" >&2
+    rm -rf "$corpus" "$work"
+    return 1
+  fi
+  rmdir "$crashes" 2>/dev/null || true
+  rm -rf "$corpus" "$work"
+}
+
+failed=0
+running=0
+for target in "${targets[@]}"; do
+  fuzz_one "$target" &
+  running=$((running + 1))
+  if ((running >= jobs)); then
+    wait -n || failed=1
+    running=$((running - 1))
   fi
 done
+while ((running > 0)); do
+  wait -n || failed=1
+  running=$((running - 1))
+done
+exit "$failed"

@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
-# The whole test suite built with AddressSanitizer and UndefinedBehaviorSanitizer (preset asan).
+# The whole test suite built with AddressSanitizer and UndefinedBehaviorSanitizer (preset asan:
+# clang, with the fuzz targets of scripts/fuzz.sh in the same build).
 set -euo pipefail
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 "$root/scripts/install_deps.sh"
@@ -8,7 +9,7 @@ cmake --preset asan >/dev/null
 cmake --build --preset asan --parallel "$(nproc)"
 # A damaged HDF5 header may make the library ask for an absurd buffer; like glibc, return NULL
 # (HDF5 reports the failure) instead of aborting. fontconfig's caches are not our leaks.
-export ASAN_OPTIONS=allocator_may_return_null=1:detect_leaks=1
+export ASAN_OPTIONS=allocator_may_return_null=1:detect_leaks=1:suppressions="$root/scripts/asan.supp"
 export LSAN_OPTIONS=suppressions="$root/scripts/lsan.supp"
 export UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
 ctest --preset asan --parallel "$(nproc)" "$@"

@@ -1,0 +1,18 @@
+// libFuzzer target: the error-map CSV grid reader of the polishing stage. Any input must give a
+// map whose node array matches its grid, or throw arcwheel::Error.
+
+#include <cstddef>
+#include <cstdint>
+
+#include "core/error.h"
+#include "fuzz/fuzz_input.h"
+#include "polishing/job.h"
+
+extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
+  try {
+    const auto map = arcwheel::polishing::ReadErrorMapCsv(arcwheel::fuzz::WriteInput(data, size, "map.csv"));
+    if (map.nx <= 0 || map.ny <= 0 || map.error_um.size() != static_cast<size_t>(map.nx) * map.ny) __builtin_trap();
+  } catch (const arcwheel::Error&) {
+  }
+  return 0;
+}

@@ -11,6 +11,7 @@
 #include <chrono>
 #include <cstdlib>
 #include <fstream>
+#include <map>
 #include <sstream>
 #include <string>
 #include <thread>
@@ -96,6 +97,60 @@ TEST(Faults, WriteFailingPartWayLeavesEarlierOutputsIntact) {
   EXPECT_EQ(testing::ListFolder(dir / "out"), "summary.json\nwheel_map.h5\n");
   EXPECT_EQ(Slurp(dir / "out" / "summary.json"), summary_before);
 }
+
+// Every stage that writes several files commits them together: a full disk part way through the
+// second run leaves the first run's files exactly as they were, and no new file.
+struct StageRun {
+  const char* name;
+  const char* arguments;  // with {src} for the source folder and {out} for the output folder
+  int file_size_limit_kib;  // above the smallest output, below the largest
+};
+
+class StageOutputs : public ::testing::TestWithParam<StageRun> {};
+
+std::map<std::string, std::string> FolderContents(const std::filesystem::path& folder) {
+  std::map<std::string, std::string> contents;
+  for (const auto& entry : std::filesystem::directory_iterator(folder)) {
+    contents[entry.path().filename().string()] = Slurp(entry.path());
+  }
+  return contents;
+}
+
+std::string Expand(std::string text, const std::string& key, const std::string& value) {
+  for (auto at = text.find(key); at != std::string::npos; at = text.find(key, at + value.size())) {
+    text.replace(at, key.size(), value);
+  }
+  return text;
+}
+
+TEST_P(StageOutputs, AFullDiskLeavesTheEarlierRunIntact) {
+  const StageRun& run = GetParam();
+  TempDir dir;
+  const std::string arguments =
+      Expand(Expand(run.arguments, "{src}", testing::SourceDir().string()), "{out}", (dir / "out").string());
+  ASSERT_EQ(RunArcwheel(arguments).exit_status, 0) << arguments;
+  const auto before = FolderContents(dir / "out");
+  ASSERT_GE(before.size(), 2U);
+
+  const std::string command = "bash -c 'trap \"\" XFSZ; ulimit -f " + std::to_string(run.file_size_limit_kib) +
+                              "; exec \"" + std::string(std::getenv("ARCWHEEL_BINARY")) + "\" " + arguments + "' 2>&1";
+  FILE* pipe = ::popen(command.c_str(), "r");
+  ASSERT_NE(pipe, nullptr);
+  std::string output;
+  char buffer[512];
+  while (std::fgets(buffer, sizeof buffer, pipe) != nullptr) output += buffer;
+  const int status = ::pclose(pipe);
+  ASSERT_TRUE(WIFEXITED(status));
+  EXPECT_EQ(WEXITSTATUS(status), 4) << output;
+  EXPECT_EQ(FolderContents(dir / "out"), before) << output;
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    EveryWritingStage, StageOutputs,
+    ::testing::Values(
+        StageRun{"Toolpath", "toolpath {src}/grinding/examples/trial_part.json -o {out}", 1024},
+        StageRun{"Polish", "polish {src}/polishing/examples/disc_job.json -o {out} --report pdf", 100}),
+    [](const ::testing::TestParamInfo<StageRun>& info) { return std::string(info.param.name); });
 
 }  // namespace
 }  // namespace arcwheel

@@ -16,6 +16,7 @@
 #include "cli/output.h"
 #include "core/atomic_file.h"
 #include "core/error.h"
+#include "core/json_text.h"
 #include "frames/three_point_frame.h"
 #include "frames/transform_json.h"
 
@@ -93,15 +94,7 @@ void AddPmac(CLI::App& frame) {
   AddPmacOptions(*pmac, args->pmac, true);
   pmac->add_option("-o,--output", args->output, "write the lines here instead of stdout");
   pmac->callback([args] {
-    std::ifstream in(args->frame_json);
-    if (!in) throw Error(ErrorCode::kIo, "frame.pmac", fmt::format("cannot open '{}'", args->frame_json));
-    nlohmann::json json;
-    try {
-      json = nlohmann::json::parse(in);
-    } catch (const nlohmann::json::parse_error& error) {
-      throw Error(ErrorCode::kBadInput, "frame.pmac",
-                  fmt::format("'{}' is not valid JSON: {}", args->frame_json, error.what()));
-    }
+    const nlohmann::json json = ReadJsonFile(args->frame_json, "frame.pmac");
     const frames::Transform transform = frames::TransformFromJson(json, args->frame_json);
     std::string text =
         fmt::format("; workpiece frame from {} (counts per mm {}, {}, {})\n", args->frame_json,

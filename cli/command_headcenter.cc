@@ -21,6 +21,7 @@
 #include "cli/output.h"
 #include "core/atomic_file.h"
 #include "core/error.h"
+#include "core/json_text.h"
 #include "frames/csv_table.h"
 #include "frames/force_centre.h"
 #include "frames/force_record_io.h"
@@ -108,13 +109,7 @@ nlohmann::json TareJson(const SolveArgs& args, const frames::Wrench& tare) {
 }
 
 frames::Transform ReadCalibration(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) throw Error(ErrorCode::kIo, kStage, fmt::format("cannot open '{}'", path));
-  try {
-    return frames::TransformFromJson(nlohmann::json::parse(in), path);
-  } catch (const nlohmann::json::parse_error& error) {
-    throw Error(ErrorCode::kBadInput, kStage, fmt::format("'{}' is not valid JSON: {}", path, error.what()));
-  }
+  return frames::TransformFromJson(ReadJsonFile(path, kStage), path);
 }
 
 Eigen::Vector2d ToMachine(const frames::Transform& calibration, const Eigen::Vector2d& sensor) {

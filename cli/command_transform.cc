@@ -15,6 +15,7 @@
 #include "cli/output.h"
 #include "core/atomic_file.h"
 #include "core/error.h"
+#include "core/json_text.h"
 #include "frames/csv_table.h"
 #include "frames/program_transform.h"
 #include "frames/transform_fit.h"
@@ -65,11 +66,7 @@ std::string ReadText(const std::string& path, const char* stage) {
 }
 
 nlohmann::json ReadJson(const std::string& path, const char* stage) {
-  try {
-    return nlohmann::json::parse(ReadText(path, stage));
-  } catch (const nlohmann::json::parse_error& error) {
-    throw Error(ErrorCode::kBadInput, stage, fmt::format("'{}' is not valid JSON: {}", path, error.what()));
-  }
+  return ParseJsonText(ReadText(path, stage), path, stage);
 }
 
 std::string FitSummary(const frames::TransformFit& fit) {

@@ -127,6 +127,16 @@ size_t File::ElementSize(const std::string& dataset) const {
 
 namespace {
 
+// A damaged header can give a number any byte size, and HDF5 then allocates conversion buffers of
+// that size per value: numbers are 1 to 16 bytes (long double), nothing else is read.
+void CheckNumberSize(hid_t type, const std::string& what) {
+  const size_t size = H5Tget_size(type);
+  if (size == 0 || size > 16) {
+    throw Error(ErrorCode::kBadInput, kStage,
+                what + " has numbers of " + std::to_string(size) + " bytes (damaged?)");
+  }
+}
+
 template <typename T>
 std::vector<T> ReadNumeric(hid_t file_id, const Handle& data, hid_t memory_type, const std::string& where) {
   const Handle type(H5Dget_type(data.id()), H5Tclose);
@@ -134,6 +144,7 @@ std::vector<T> ReadNumeric(hid_t file_id, const Handle& data, hid_t memory_type,
   if (type_class != H5T_FLOAT && type_class != H5T_INTEGER) {
     throw Error(ErrorCode::kBadInput, kStage, where + " is not numeric");
   }
+  CheckNumberSize(type.id(), where);
   const Handle space(H5Dget_space(data.id()), H5Sclose);
   const hssize_t count = H5Sget_simple_extent_npoints(space.id());
   if (count < 0) throw Error(ErrorCode::kBadInput, kStage, "cannot read the size of " + where);
@@ -241,6 +252,7 @@ std::optional<double> File::ReadAttributeDouble(const std::string& object, const
   if (type_class != H5T_FLOAT && type_class != H5T_INTEGER) {
     throw Error(ErrorCode::kBadInput, kStage, "attribute '" + name + "' on " + Where(object) + " is not numeric");
   }
+  CheckNumberSize(type.id(), "attribute '" + name + "' on " + Where(object));
   const Handle space(H5Aget_space(attribute.id()), H5Sclose);
   if (H5Sget_simple_extent_npoints(space.id()) != 1) {
     throw Error(ErrorCode::kBadInput, kStage,
@@ -260,6 +272,7 @@ std::optional<std::string> File::ReadAttributeString(const std::string& object, 
   const Handle type(H5Aget_type(attribute.id()), H5Tclose);
   const H5T_class_t type_class = H5Tget_class(type.id());
   if (type_class == H5T_FLOAT || type_class == H5T_INTEGER) {
+    CheckNumberSize(type.id(), "attribute '" + name + "' on " + Where(object));
     double value = 0.0;
     H5Aread(attribute.id(), H5T_NATIVE_DOUBLE, &value);
     std::string text = std::to_string(value);
@@ -280,6 +293,11 @@ std::optional<std::string> File::ReadAttributeString(const std::string& object, 
     return result;
   }
   const size_t size = H5Tget_size(type.id());
+  if (size > (1U << 20)) {
+    throw Error(ErrorCode::kBadInput, kStage,
+                "attribute '" + name + "' on " + Where(object) + " declares " + std::to_string(size) +
+                    " bytes of text (damaged?)");
+  }
   std::string buffer(size, '\0');
   const Handle memory_type(H5Tcopy(H5T_C_S1), H5Tclose);
   H5Tset_size(memory_type.id(), size);

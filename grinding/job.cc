@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include "core/error.h"
+#include "core/json_text.h"
 
 namespace arcwheel::grinding {
 namespace {
@@ -418,12 +419,7 @@ void Validate(const Section& root, Job& job) {
 
 Job ParseJob(const std::string& text, const std::filesystem::path& source,
              const std::optional<std::filesystem::path>& wheel_summary_override) {
-  json document;
-  try {
-    document = json::parse(text);
-  } catch (const json::parse_error& e) {
-    throw Error(ErrorCode::kBadInput, kStage, fmt::format("'{}' is not valid JSON: {}", source.string(), e.what()));
-  }
+  json document = ParseJsonText(text, source.string(), kStage);
   Section root(&document, "", source);
   Job job;
   job.source = source;

@@ -8,6 +8,7 @@
 #include <nlohmann/json.hpp>
 
 #include "core/error.h"
+#include "core/json_text.h"
 
 namespace arcwheel::grinding {
 namespace {
@@ -106,15 +107,7 @@ std::vector<std::string> Wheel::Problems() const {
 }
 
 WheelSummary ReadWheelSummary(const std::filesystem::path& path) {
-  std::ifstream in(path);
-  if (!in) throw Error(ErrorCode::kIo, kStage, fmt::format("cannot open '{}'", path.string()));
-  json root;
-  try {
-    root = json::parse(in);
-  } catch (const json::parse_error& e) {
-    throw Error(ErrorCode::kBadInput, kStage,
-                fmt::format("'{}' is not valid JSON: {}", path.string(), e.what()));
-  }
+  const json root = ReadJsonFile(path, kStage);
   if (!root.is_object()) Bad(path, "(root)", "must be a JSON object");
   WheelSummary s;
   s.mean_arc_radius_mm = RequiredNumber(root, path, "mean_arc_radius_mm");

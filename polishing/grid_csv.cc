@@ -93,6 +93,13 @@ CsvGrid ReadCsvGrid(const std::filesystem::path& path, std::string_view value_co
   const double nx = std::round((*xs.rbegin() - grid.x0_mm) / grid.dx_mm) + 1.0;
   const double ny = std::round((*ys.rbegin() - grid.y0_mm) / grid.dy_mm) + 1.0;
   if (!(nx * ny <= kMaxNodes)) LineFail(stage, path, grid.last_line, "the grid would exceed 1e8 nodes");
+  // A measured map fills most of its grid; a few rows spanning a vast grid are not a grid at all.
+  if (nx * ny > 64.0 * static_cast<double>(rows.size()) + 4096.0) {
+    LineFail(stage, path, grid.last_line,
+             fmt::format("{} nodes spread over a grid of {} x {}: not the nodes of one regular grid (scattered "
+                         "points? set error_map.layout to scattered)",
+                         rows.size(), nx, ny));
+  }
   grid.nx = static_cast<int>(nx);
   grid.ny = static_cast<int>(ny);
   grid.values.assign(static_cast<std::size_t>(grid.nx) * static_cast<std::size_t>(grid.ny),

@@ -14,6 +14,7 @@
 
 #include "core/atomic_file.h"
 #include "core/error.h"
+#include "core/json_text.h"
 #include "core/version.h"
 
 namespace arcwheel::polishing {
@@ -277,16 +278,7 @@ ErrorMap ReadErrorMapSection(Section& s, const std::filesystem::path& file) {
 }  // namespace
 
 PolishJob ReadPolishJob(const std::filesystem::path& path) {
-  std::ifstream in(path);
-  if (!in) throw Error(ErrorCode::kIo, kStage, fmt::format("cannot open '{}'", path.string()));
-  std::stringstream buffer;
-  buffer << in.rdbuf();
-  json root;
-  try {
-    root = json::parse(buffer.str());
-  } catch (const json::parse_error& e) {
-    throw Error(ErrorCode::kBadInput, kStage, fmt::format("'{}' is not valid JSON: {}", path.string(), e.what()));
-  }
+  json root = ReadJsonFile(path, kStage);
   PolishJob job;
   job.source = path;
   Section s(&root, "", path);

@@ -12,6 +12,7 @@
 #include <sstream>
 
 #include "core/error.h"
+#include "core/json_text.h"
 #include "core/sha256.h"
 
 namespace arcwheel::reports {
@@ -236,8 +237,14 @@ ResidualMap ParseResidualMapCsv(std::string_view text, const std::string& source
   ResidualMap map;
   map.x_mm = GridNodes(xs, source_name, "x_mm");
   map.y_mm = GridNodes(ys, source_name, "y_mm");
-  if (static_cast<double>(map.n_x()) * static_cast<double>(map.n_y()) > kMaxGridNodes) {
+  const double grid_nodes = static_cast<double>(map.n_x()) * static_cast<double>(map.n_y());
+  if (grid_nodes > kMaxGridNodes) {
     Bad(fmt::format("'{}': a grid of {} x {} nodes is too large for a residual map", source_name, map.n_x(), map.n_y()));
+  }
+  // Aperture nodes fill most of their grid; a few nodes spanning a vast grid are not a map.
+  if (grid_nodes > 64.0 * static_cast<double>(nodes.size()) + 4096.0) {
+    Bad(fmt::format("'{}': {} nodes spread over a grid of {} x {}: not the nodes of one regular grid", source_name,
+                    nodes.size(), map.n_x(), map.n_y()));
   }
   const std::size_t cells = map.n_x() * map.n_y();
   map.target_um.assign(cells, kNaN);
@@ -289,12 +296,7 @@ PolishingPathTable ParsePolishingPathCsv(std::string_view text, const std::strin
 }
 
 PolishSummary ParsePolishSummary(const std::string& text, const std::string& source_name) {
-  json root;
-  try {
-    root = json::parse(text);
-  } catch (const json::parse_error& e) {
-    Bad(fmt::format("'{}' is not valid JSON: {}", source_name, e.what()));
-  }
+  const json root = ParseJsonText(text, source_name, kStage);
   if (!root.is_object()) Bad(fmt::format("'{}' is not a JSON object", source_name));
   const JsonReader r(root, source_name);
   PolishSummary s;

@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include "core/error.h"
+#include "core/json_text.h"
 #include "core/hdf5.h"
 
 namespace arcwheel::reports {
@@ -226,12 +227,7 @@ std::vector<double> ReadAxisDataset(const hdf5::File& file, const std::string& d
 }  // namespace
 
 Summary ParseSummary(const std::string& text, const std::string& name) {
-  json root;
-  try {
-    root = json::parse(text);
-  } catch (const json::parse_error& error) {
-    throw Error(ErrorCode::kBadInput, kSummaryStage, "'" + name + "' is not valid JSON: " + error.what());
-  }
+  const json root = ParseJsonText(text, name, kSummaryStage);
   const JsonWhere top{name, ""};
   if (!root.is_object()) throw Error(ErrorCode::kBadInput, kSummaryStage, "'" + name + "' is not a JSON object");
   Summary summary;

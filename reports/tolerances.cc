@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include "core/error.h"
+#include "core/json_text.h"
 
 namespace arcwheel::reports {
 namespace {
@@ -88,12 +89,7 @@ Verdict Judge(double value, const std::optional<Limit>& limit) {
 }
 
 Tolerances ParseTolerances(const std::string& text, const std::string& name) {
-  nlohmann::json root;
-  try {
-    root = nlohmann::json::parse(text);
-  } catch (const nlohmann::json::parse_error& error) {
-    throw Error(ErrorCode::kBadInput, kStage, "'" + name + "' is not valid JSON: " + error.what());
-  }
+  const nlohmann::json root = ParseJsonText(text, name, kStage);
   if (!root.is_object()) throw Error(ErrorCode::kBadInput, kStage, "'" + name + "' is not a JSON object");
   Tolerances tolerances;
   for (const auto& [key, value] : root.items()) {

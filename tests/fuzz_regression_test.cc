@@ -1,0 +1,106 @@
+// Every input the fuzzers found (testdata/fuzz_regressions/), run through the command that reads
+// it as a user would: a clear refusal naming the file, exit status 3, nothing written. Before
+// their fixes these exhausted memory, ran for seconds on a 5 kB file, or escaped as an internal
+// error.
+
+#include <gtest/gtest.h>
+
+#include <fstream>
+#include <string>
+
+#include "core/testing/testing.h"
+
+namespace arcwheel {
+namespace {
+
+using testing::RunArcwheel;
+using testing::TempDir;
+
+struct Finding {
+  const char* name;
+  const char* file;       // in testdata/fuzz_regressions/
+  const char* arguments;  // {in}: the file, {dir}: a scratch folder
+  const char* message;    // part of the refusal
+};
+
+class FuzzFinding : public ::testing::TestWithParam<Finding> {};
+
+std::string Expand(std::string text, const std::string& key, const std::string& value) {
+  for (auto at = text.find(key); at != std::string::npos; at = text.find(key, at + value.size())) {
+    text.replace(at, key.size(), value);
+  }
+  return text;
+}
+
+TEST_P(FuzzFinding, IsRefusedClearlyAndWritesNothing) {
+  const Finding& finding = GetParam();
+  TempDir dir;
+  std::ofstream(dir / "points.csv") << "x_mm,y_mm,z_mm\n1,2,3\n";
+  const std::string input = (testing::SourceDir() / "testdata" / "fuzz_regressions" / finding.file).string();
+  const std::string arguments = Expand(Expand(finding.arguments, "{in}", input), "{dir}", dir.path().string());
+  const auto run = RunArcwheel(arguments);
+  EXPECT_EQ(run.exit_status, 3) << run.output;
+  EXPECT_NE(run.output.find(finding.file), std::string::npos) << "the message names the file: " << run.output;
+  EXPECT_NE(run.output.find(finding.message), std::string::npos) << run.output;
+  EXPECT_EQ(testing::ListFolder(dir.path()), "points.csv\n");
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    Found, FuzzFinding,
+    ::testing::Values(
+        // scan_hdf5_fuzzer: a header declaring 2e14 values (read from memory; acquisition/readers_test.cc
+        // checks that path). From the file, the library already finds the dataset missing.
+        Finding{"ScanDatasetLargerThanItsFile", "scan_hdf5_huge_dataset.h5", "process {in} -o {dir}/out",
+                "bad input: acquisition.hdf5"},
+        // force_record_hdf5_fuzzer: a float type of 688 MB per value.
+        Finding{"ForceRecordNumberOfAbsurdSize", "force_record_huge_number_type.h5",
+                "headcenter solve {in} --z0-mm 20 -o {dir}/centre.json", "has numbers of 687865864 bytes"},
+        // transform_json_fuzzer: a number that overflows a double escaped the JSON readers.
+        Finding{"JsonNumberOverflow", "transform_number_overflow.json",
+                "transform apply {in} {dir}/points.csv -o {dir}/out.csv", "number overflow"}),
+    [](const ::testing::TestParamInfo<Finding>& info) { return std::string(info.param.name); });
+
+// Report inputs are read from an output folder: the finding stands in for one file of it, the
+// others are the fuzzers' seeds (valid files of their kind).
+struct FolderFinding {
+  const char* name;
+  const char* file;             // in testdata/fuzz_regressions/
+  const char* as;               // its name in the output folder
+  const char* seeds[2];         // fuzz/seeds/<target>/<file> copied beside it
+  const char* message;
+};
+
+class FuzzFindingInAFolder : public ::testing::TestWithParam<FolderFinding> {};
+
+TEST_P(FuzzFindingInAFolder, IsRefusedClearlyAndWritesNothing) {
+  const FolderFinding& finding = GetParam();
+  TempDir dir;
+  const auto source = testing::SourceDir();
+  std::filesystem::copy_file(source / "testdata" / "fuzz_regressions" / finding.file, dir / finding.as);
+  for (const char* seed : finding.seeds) {
+    if (seed == nullptr) continue;
+    const std::filesystem::path path = source / "fuzz" / "seeds" / seed;
+    std::filesystem::copy_file(path, dir / path.filename());
+  }
+  const std::string before = testing::ListFolder(dir.path());
+  const auto run = RunArcwheel("report " + dir.path().string());
+  EXPECT_EQ(run.exit_status, 3) << run.output;
+  EXPECT_NE(run.output.find(finding.as), std::string::npos) << "the message names the file: " << run.output;
+  EXPECT_NE(run.output.find(finding.message), std::string::npos) << run.output;
+  EXPECT_EQ(testing::ListFolder(dir.path()), before);
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    Found, FuzzFindingInAFolder,
+    ::testing::Values(
+        // report_wheel_map_fuzzer: a number type of absurd size made HDF5 ask for 2 GB.
+        FolderFinding{"WheelMapNumberOfAbsurdSize", "report_wheel_map_huge_number_type.h5", "wheel_map.h5",
+                      {"report_summary_fuzzer/summary.json", nullptr}, "(damaged?)"},
+        // polish_residual_map_fuzzer: a few nodes spanning a grid of millions took seconds to place.
+        FolderFinding{"ResidualMapOfFewNodesOnAVastGrid", "polish_residual_map_sparse_grid.csv", "residual_map.csv",
+                      {"polish_summary_fuzzer/polish_summary.json", "polish_path_fuzzer/polishing_path.csv"},
+                      "not the nodes of one regular grid"}),
+    [](const ::testing::TestParamInfo<FolderFinding>& info) { return std::string(info.param.name); });
+
+}  // namespace
+}  // namespace arcwheel

@@ -39,6 +39,21 @@ void PrepareEarlierOutputs(const TempDir& dir) {
   ASSERT_EQ(RunArcwheel("process -q " + (dir / "short.h5").string() + " -o " + (dir / "out").string()).exit_status, 0);
 }
 
+// Runs arcwheel with `arguments` under a file-size limit of `limit_kib`, with SIGXFSZ ignored so
+// that a write beyond it fails with EFBIG, as on a full disk.
+testing::CommandResult RunWithFileSizeLimit(const std::string& arguments, int limit_kib) {
+  const std::string command = "bash -c 'trap \"\" XFSZ; ulimit -f " + std::to_string(limit_kib) + "; exec \"" +
+                              std::string(std::getenv("ARCWHEEL_BINARY")) + "\" " + arguments + "' 2>&1";
+  testing::CommandResult result;
+  FILE* pipe = ::popen(command.c_str(), "r");
+  if (pipe == nullptr) return result;
+  char buffer[512];
+  while (std::fgets(buffer, sizeof buffer, pipe) != nullptr) result.output += buffer;
+  const int status = ::pclose(pipe);
+  result.exit_status = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  return result;
+}
+
 TEST(Faults, InterruptDuringProcessingLeavesEarlierOutputsIntact) {
   TempDir dir;
   PrepareEarlierOutputs(dir);
@@ -81,19 +96,10 @@ TEST(Faults, WriteFailingPartWayLeavesEarlierOutputsIntact) {
   TempDir dir;
   PrepareEarlierOutputs(dir);
   const std::string summary_before = Slurp(dir / "out" / "summary.json");
-  // A 512 KiB file-size limit: the summary fits, the new map (~0.9 MB) does not (SIGXFSZ ignored, so the
-  // write fails with EFBIG as on a full disk).
-  const std::string command = "bash -c 'trap \"\" XFSZ; ulimit -f 512; exec \"" + std::string(std::getenv("ARCWHEEL_BINARY")) +
-                              "\" process -q " + (dir / "short.h5").string() + " -o " + (dir / "out").string() + "' 2>&1";
-  FILE* pipe = ::popen(command.c_str(), "r");
-  ASSERT_NE(pipe, nullptr);
-  std::string output;
-  char buffer[512];
-  while (std::fgets(buffer, sizeof buffer, pipe) != nullptr) output += buffer;
-  const int status = ::pclose(pipe);
-  ASSERT_TRUE(WIFEXITED(status));
-  EXPECT_EQ(WEXITSTATUS(status), 4) << output;
-  EXPECT_NE(output.find("wheel_map.h5"), std::string::npos) << output;
+  // A 512 KiB limit: the summary fits, the new map (~0.9 MB) does not.
+  const auto run = RunWithFileSizeLimit("process -q " + (dir / "short.h5").string() + " -o " + (dir / "out").string(), 512);
+  EXPECT_EQ(run.exit_status, 4) << run.output;
+  EXPECT_NE(run.output.find("wheel_map.h5"), std::string::npos) << run.output;
   EXPECT_EQ(testing::ListFolder(dir / "out"), "summary.json\nwheel_map.h5\n");
   EXPECT_EQ(Slurp(dir / "out" / "summary.json"), summary_before);
 }
@@ -132,17 +138,9 @@ TEST_P(StageOutputs, AFullDiskLeavesTheEarlierRunIntact) {
   const auto before = FolderContents(dir / "out");
   ASSERT_GE(before.size(), 2U);
 
-  const std::string command = "bash -c 'trap \"\" XFSZ; ulimit -f " + std::to_string(run.file_size_limit_kib) +
-                              "; exec \"" + std::string(std::getenv("ARCWHEEL_BINARY")) + "\" " + arguments + "' 2>&1";
-  FILE* pipe = ::popen(command.c_str(), "r");
-  ASSERT_NE(pipe, nullptr);
-  std::string output;
-  char buffer[512];
-  while (std::fgets(buffer, sizeof buffer, pipe) != nullptr) output += buffer;
-  const int status = ::pclose(pipe);
-  ASSERT_TRUE(WIFEXITED(status));
-  EXPECT_EQ(WEXITSTATUS(status), 4) << output;
-  EXPECT_EQ(FolderContents(dir / "out"), before) << output;
+  const auto second = RunWithFileSizeLimit(arguments, run.file_size_limit_kib);
+  EXPECT_EQ(second.exit_status, 4) << second.output;
+  EXPECT_EQ(FolderContents(dir / "out"), before) << second.output;
 }
 
 INSTANTIATE_TEST_SUITE_P(

@@ -102,7 +102,7 @@ TEST(ParsePolishingPathCsv, RefusesBadRowsNamingSourceAndLine) {
       {header + "0, 0,0,1,0,0,0,5,1\n", "'path.csv' line 2: y ' 0' is not a number"},
   };
   for (const auto& [text, message] : cases) {
-    const Error error = ErrorOf([&] { (void)ParsePolishingPathCsv(text, "path.csv"); });
+    const Error error = ErrorOf([&, &input = text] { (void)ParsePolishingPathCsv(input, "path.csv"); });
     EXPECT_EQ(error.code(), ErrorCode::kBadInput) << text;
     EXPECT_THAT(error.what(), HasSubstr(message)) << text;
   }
@@ -153,7 +153,7 @@ TEST(ParsePolishSummary, RefusesMissingOrMistypedKeysByDottedName) {
       {"{\"arcwheel_version\": ", "'sum.json' is not valid JSON"},
   };
   for (const auto& [text, message] : cases) {
-    const Error error = ErrorOf([&] { (void)ParsePolishSummary(text, "sum.json"); });
+    const Error error = ErrorOf([&, &input = text] { (void)ParsePolishSummary(input, "sum.json"); });
     EXPECT_EQ(error.code(), ErrorCode::kBadInput);
     EXPECT_THAT(error.what(), HasSubstr(message));
   }

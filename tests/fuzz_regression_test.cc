@@ -55,6 +55,10 @@ INSTANTIATE_TEST_SUITE_P(
         // force_record_hdf5_fuzzer: a float type of 688 MB per value.
         Finding{"ForceRecordNumberOfAbsurdSize", "force_record_huge_number_type.h5",
                 "headcenter solve {in} --z0-mm 20 -o {dir}/centre.json", "has numbers of 687865864 bytes"},
+        // force_record_hdf5_fuzzer: a damaged object header made libhdf5 ask for 4 GB while opening
+        // the file; whether that allocation succeeds or not, the file is refused.
+        Finding{"ForceRecordDamagedObjectHeader", "force_record_damaged_object_header.h5",
+                "headcenter solve {in} --z0-mm 20 -o {dir}/centre.json", "bad input"},
         // transform_json_fuzzer: a number that overflows a double escaped the JSON readers.
         Finding{"JsonNumberOverflow", "transform_number_overflow.json",
                 "transform apply {in} {dir}/points.csv -o {dir}/out.csv", "number overflow"}),

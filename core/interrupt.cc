@@ -3,6 +3,7 @@
 #include <pthread.h>
 
 #include <csignal>
+#include <cstdlib>
 
 #include "core/error.h"
 
@@ -11,7 +12,13 @@ namespace {
 
 volatile std::sig_atomic_t g_interrupted = 0;
 
-extern "C" void OnSignal(int /*signal*/) { g_interrupted = 1; }
+// The first signal asks the run to unwind at its next check, so that nothing partial is left. A
+// second one stops at once: a run stuck where it never checks (inside a library) can still be
+// ended; at that point only temporary files can be left, never a damaged output.
+extern "C" void OnSignal(int /*signal*/) {
+  if (g_interrupted != 0) std::_Exit(130);
+  g_interrupted = 1;
+}
 
 }  // namespace
 

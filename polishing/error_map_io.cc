@@ -580,9 +580,13 @@ ErrorMap InterpolateScattered(std::span<const ScatteredPoint> points, double gri
   const double k_x0 = std::ceil(x_min / d - 1e-9), k_x1 = std::floor(x_max / d + 1e-9);
   const double k_y0 = std::ceil(y_min / d - 1e-9), k_y1 = std::floor(y_max / d + 1e-9);
   const double nodes = (k_x1 - k_x0 + 1.0) * (k_y1 - k_y0 + 1.0);
-  if (!(nodes <= kMaxNodes) || k_x1 < k_x0 || k_y1 < k_y0) {
-    Fail(name, fmt::format("a grid of spacing {} mm over [{}, {}] x [{}, {}] mm would hold {} nodes (1 .. 1e8)", d, x_min,
-                           x_max, y_min, y_max, nodes));
+  // At most 1e7 nodes (a 3000 x 3000 map) and 1e4 per point: a stray point far from the others
+  // would otherwise make a grid of tens of millions of empty nodes.
+  const double most_nodes = std::min(1e7, 1e4 * static_cast<double>(points.size()));
+  if (!(nodes <= most_nodes) || k_x1 < k_x0 || k_y1 < k_y0) {
+    Fail(name, fmt::format("a grid of spacing {} mm over [{}, {}] x [{}, {}] mm would hold {} nodes, more than {} for {} "
+                           "points (a stray point? or set error_map.grid_spacing_mm)",
+                           d, x_min, x_max, y_min, y_max, nodes, most_nodes, points.size()));
   }
   ErrorMap map;
   map.dx_mm = map.dy_mm = d;

@@ -114,7 +114,7 @@ struct ScatteredPoint {
 // box; nodes outside the convex hull have no data. grid_spacing_mm <= 0 or NaN selects the median
 // distance from a point to its nearest neighbour. Throws Error{kBadInput, "polishing.map"}
 // naming `name` for fewer than 3 points, all points on one line, two points at one place, or a
-// grid of more than 1e8 nodes.
+// grid of more than 1e7 nodes or 1e4 per point.
 [[nodiscard]] ErrorMap InterpolateScattered(std::span<const ScatteredPoint> points, double grid_spacing_mm,
                                             const std::string& name);
 

@@ -320,6 +320,7 @@ std::uint32_t PackArgb(const Rgb& c) {
 }
 
 using SurfacePtr = std::unique_ptr<cairo_surface_t, decltype(&cairo_surface_destroy)>;
+using ContextPtr = std::unique_ptr<cairo_t, decltype(&cairo_destroy)>;
 
 // Builds the display image of an n_x x n_y grid: columns follow x, rows follow y from the top
 // (largest y) down. `colour_of_block(i0, i1, j0, j1)` gives the colour of a block of cells.
@@ -646,9 +647,11 @@ std::string RenderSvg(const Figure& figure, double width_pt, double height_pt, c
     SurfacePtr surface(cairo_svg_surface_create_for_stream(AppendToString, &svg, width_pt, height_pt),
                        cairo_surface_destroy);
     CheckSurface(surface.get(), "cannot create an SVG surface");
-    cairo_t* cr = cairo_create(surface.get());
-    Draw(cr, figure, width_pt, height_pt);
-    cairo_destroy(cr);
+    {
+      // Owned, so that a figure that throws while drawing does not keep the surface alive.
+      const ContextPtr cr(cairo_create(surface.get()), cairo_destroy);
+      Draw(cr.get(), figure, width_pt, height_pt);
+    }
     cairo_surface_finish(surface.get());
     CheckSurface(surface.get(), "cannot draw the SVG plot");
   }
@@ -666,10 +669,11 @@ std::string RenderPng(const Figure& figure, double width_pt, double height_pt, d
   const int height_px = static_cast<int>(std::ceil(height_pt * pixels_per_pt));
   SurfacePtr surface(cairo_image_surface_create(CAIRO_FORMAT_ARGB32, width_px, height_px), cairo_surface_destroy);
   CheckSurface(surface.get(), "cannot create a PNG image");
-  cairo_t* cr = cairo_create(surface.get());
-  cairo_scale(cr, pixels_per_pt, pixels_per_pt);
-  Draw(cr, figure, width_pt, height_pt);
-  cairo_destroy(cr);
+  {
+    const ContextPtr cr(cairo_create(surface.get()), cairo_destroy);
+    cairo_scale(cr.get(), pixels_per_pt, pixels_per_pt);
+    Draw(cr.get(), figure, width_pt, height_pt);
+  }
   std::string png;
   if (cairo_surface_write_to_png_stream(surface.get(), AppendToString, &png) != CAIRO_STATUS_SUCCESS) {
     throw Error(ErrorCode::kIo, "reports.plot", "cannot encode the PNG image");

@@ -36,13 +36,18 @@ TEST_P(FuzzFinding, IsRefusedClearlyAndWritesNothing) {
   const Finding& finding = GetParam();
   TempDir dir;
   std::ofstream(dir / "points.csv") << "x_mm,y_mm,z_mm\n1,2,3\n";
+  // A polishing job that takes the finding as its scattered error map.
+  std::ofstream(dir / "job.json") << R"({"surface": {"vertex_radius_mm": 400}, "aperture": {"diameter_mm": 30},
+    "error_map": {"file": ")" << (testing::SourceDir() / "testdata" / "fuzz_regressions" / finding.file).string()
+                                  << R"(", "layout": "scattered"},
+    "removal_function": {"peak_rate_um_per_s": 1, "fwhm_mm": 8}, "machine": {"max_speed_mm_s": 100}})";
   const std::string input = (testing::SourceDir() / "testdata" / "fuzz_regressions" / finding.file).string();
   const std::string arguments = Expand(Expand(finding.arguments, "{in}", input), "{dir}", dir.path().string());
   const auto run = RunArcwheel(arguments);
   EXPECT_EQ(run.exit_status, 3) << run.output;
   EXPECT_NE(run.output.find(finding.file), std::string::npos) << "the message names the file: " << run.output;
   EXPECT_NE(run.output.find(finding.message), std::string::npos) << run.output;
-  EXPECT_EQ(testing::ListFolder(dir.path()), "points.csv\n");
+  EXPECT_EQ(testing::ListFolder(dir.path()), "job.json\npoints.csv\n");
 }
 
 INSTANTIATE_TEST_SUITE_P(
@@ -59,6 +64,9 @@ INSTANTIATE_TEST_SUITE_P(
         // the file; whether that allocation succeeds or not, the file is refused.
         Finding{"ForceRecordDamagedObjectHeader", "force_record_damaged_object_header.h5",
                 "headcenter solve {in} --z0-mm 20 -o {dir}/centre.json", "bad input"},
+        // polishing_scattered_fuzzer: one stray point 8 km away made a grid of 6e7 empty nodes.
+        Finding{"ScatteredMapWithAStrayPoint", "polishing_scattered_stray_point.csv", "polish {dir}/job.json -o {dir}/out",
+                "a stray point?"},
         // transform_json_fuzzer: a number that overflows a double escaped the JSON readers.
         Finding{"JsonNumberOverflow", "transform_number_overflow.json",
                 "transform apply {in} {dir}/points.csv -o {dir}/out.csv", "number overflow"}),

@@ -2,7 +2,10 @@
 
 #include <algorithm>
 #include <cstddef>
+#include <cstdint>
 #include <cstring>
+#include <set>
+#include <string_view>
 #include <utility>
 
 #include "core/error.h"
@@ -61,7 +64,9 @@ File File::OpenImage(const void* data, size_t size, const std::string& name) {
   }
   const hid_t id = H5Fopen(name.c_str(), H5F_ACC_RDONLY, access.id());
   if (id < 0) throw Error(ErrorCode::kBadInput, kStage, "'" + name + "' is not an HDF5 file (or is truncated)");
-  return File(Handle(id, H5Fclose), name);
+  File file(Handle(id, H5Fclose), name);
+  file.image_ = std::make_shared<const std::string>(static_cast<const char*>(data), size);
+  return file;
 }
 
 File File::Create(const std::filesystem::path& path) {
@@ -72,7 +77,12 @@ File File::Create(const std::filesystem::path& path) {
 }
 
 std::string File::Where(const std::string& object) const {
-  return "'" + path_.string() + "' " + object;
+  // Appended piece by piece: GCC 12 warns falsely (-Wrestrict) on "'" + std::string.
+  std::string where(1, '\'');
+  where += path_.string();
+  where += "' ";
+  where += object;
+  return where;
 }
 
 bool File::HasObject(const std::string& name) const {
@@ -282,6 +292,7 @@ std::optional<std::string> File::ReadAttributeString(const std::string& object, 
     throw Error(ErrorCode::kBadInput, kStage, "attribute '" + name + "' on " + Where(object) + " is not text");
   }
   if (H5Tis_variable_str(type.id()) > 0) {
+    CheckHeapReferences(attribute.id(), type.id(), "attribute '" + name + "' on " + Where(object));
     const Handle memory_type(H5Tcopy(H5T_C_S1), H5Tclose);
     H5Tset_size(memory_type.id(), H5T_VARIABLE);
     char* text = nullptr;
@@ -390,15 +401,23 @@ std::optional<File::Compound> File::ReadAttributeCompound(const std::string& obj
     throw Error(ErrorCode::kBadInput, kStage, where + " holds " + std::to_string(elements) + " elements");
   }
   Compound result;
+  std::set<std::string> names;
   const int members = H5Tget_nmembers(type.id());
   for (int m = 0; m < members; ++m) {
     char* raw_name = H5Tget_member_name(type.id(), static_cast<unsigned>(m));
     if (raw_name == nullptr) continue;
     const std::string member(raw_name);
     H5free_memory(raw_name);
+    // The library converts by name: two members of one name would both be read into one.
+    if (!names.insert(member).second) {
+      throw Error(ErrorCode::kBadInput, kStage, where + " has two members named '" + member + "' (damaged?)");
+    }
     const Handle member_type(H5Tget_member_type(type.id(), static_cast<unsigned>(m)), H5Tclose);
     const std::optional<MemberReader> reader = MakeMemberReader(member_type.id(), member.c_str());
     if (!reader) continue;
+    if (reader->kind == MemberReader::Kind::kVariableString || reader->kind == MemberReader::Kind::kVariableNumbers) {
+      CheckHeapReferences(attribute.id(), member_type.id(), "member '" + member + "' of " + where, member.c_str());
+    }
     // max_align_t storage: the buffer holds pointers (variable-length members) and doubles.
     std::vector<std::max_align_t> buffer(
         (static_cast<size_t>(elements) * reader->element_size + sizeof(std::max_align_t) - 1) / sizeof(std::max_align_t));

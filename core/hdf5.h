@@ -5,8 +5,10 @@
 
 #include <hdf5.h>
 
+#include <cstdint>
 #include <filesystem>
 #include <map>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -84,9 +86,17 @@ class File {
   File(Handle handle, std::filesystem::path path) : handle_(std::move(handle)), path_(std::move(path)) {}
   [[nodiscard]] Handle OpenDataset(const std::string& dataset) const;
   [[nodiscard]] std::string Where(const std::string& object) const;
+  // Before libhdf5 reads a variable-length attribute (or `member` of a compound one) of
+  // `stored_type`: throws Error{kBadInput} unless every global heap object it refers to is one the
+  // library can read safely (see hdf5_heap.cc).
+  void CheckHeapReferences(hid_t attribute, hid_t stored_type, const std::string& what,
+                           const char* member = nullptr) const;
+  // `size` bytes at `address` (relative to the HDF5 base address); shorter at the end of the file.
+  [[nodiscard]] std::string ReadRawBytes(uint64_t address, uint64_t size) const;
 
   Handle handle_;
   std::filesystem::path path_;
+  std::shared_ptr<const std::string> image_;  // the bytes of a file opened from memory
 };
 
 }  // namespace arcwheel::hdf5

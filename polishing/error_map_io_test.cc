@@ -13,6 +13,7 @@
 #include <iterator>
 #include <random>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "core/error.h"
@@ -404,6 +405,61 @@ TEST(ReadZygoDatx, RefusesAFileWithoutTheSurfaceDatasetOrAHeightUnit) {
   WriteDatx(dir / "volts.datx", spec, 3, 2, DatxHeightNm);
   message = ErrorOf([&] { (void)ReadZygoDatx(dir / "volts.datx"); });
   EXPECT_TRUE(Contains(message, "volts.datx'") && Contains(message, "Z Converter") && Contains(message, "Volts")) << message;
+}
+
+// libhdf5 1.10 steps through a global heap collection by each object's size and never returns from
+// a zero-size object. Zeroing the body of the collection that holds the converters' strings makes
+// its first object exactly that; the reader must refuse the file instead of handing it on.
+TEST(ReadZygoDatx, RefusesAGlobalHeapThatWouldHangTheLibrary) {
+  arcwheel::testing::TempDir dir;
+  WriteDatx(dir / "part.datx", DatxSpec{}, 6, 4, DatxHeightNm);
+  std::vector<unsigned char> bytes = FileBytes(dir / "part.datx");
+  const std::string_view text(reinterpret_cast<const char*>(bytes.data()), bytes.size());
+  const std::size_t collection = text.find("GCOL");
+  ASSERT_NE(collection, std::string_view::npos) << "variable-length converters live in a global heap";
+  EXPECT_EQ(text.find("GCOL", collection + 1), std::string_view::npos);
+  // Header: "GCOL", version, 3 reserved bytes, 8-byte collection size; objects follow at byte 16.
+  std::uint64_t size = 0;
+  std::memcpy(&size, &bytes[collection + 8], sizeof size);
+  ASSERT_LE(collection + size, bytes.size());
+  std::fill(bytes.begin() + static_cast<std::ptrdiff_t>(collection + 16),
+            bytes.begin() + static_cast<std::ptrdiff_t>(collection + size), 0);
+  const std::string message =
+      ErrorOf([&] { (void)ReadZygoDatx(hdf5::File::OpenImage(bytes.data(), bytes.size(), "zeroed.datx")); });
+  EXPECT_TRUE(Contains(message, "zeroed.datx'") &&
+              Contains(message, "global heap at byte " + std::to_string(collection) + " is damaged"))
+      << message;
+}
+
+// A global heap object is a 16-byte header (id: 2 bytes, references: 2, reserved: 4, size: 8)
+// followed by its bytes. Corrupting the header of the object that holds the Z converter's
+// "HeightCat" either orphans the reference (libhdf5 1.10.8 then reads through a null pointer) or
+// makes the object longer than the reference (the library then overruns its buffer).
+TEST(ReadZygoDatx, RefusesAReferenceToAMissingOrLongerHeapObject) {
+  arcwheel::testing::TempDir dir;
+  WriteDatx(dir / "part.datx", DatxSpec{}, 6, 4, DatxHeightNm);
+  const std::vector<unsigned char> good = FileBytes(dir / "part.datx");
+  const std::string_view text(reinterpret_cast<const char*>(good.data()), good.size());
+  const std::size_t object = text.find("HeightCat") - 16;
+  std::uint64_t size = 0;
+  std::memcpy(&size, &good[object + 8], sizeof size);
+  ASSERT_EQ(size, 9U) << "the header of the object holding \"HeightCat\"";
+
+  std::vector<unsigned char> orphaned = good;
+  orphaned[object] = 0xff;
+  orphaned[object + 1] = 0x7f;
+  std::string message =
+      ErrorOf([&] { (void)ReadZygoDatx(hdf5::File::OpenImage(orphaned.data(), orphaned.size(), "orphaned.datx")); });
+  EXPECT_TRUE(Contains(message, "orphaned.datx'") && Contains(message, "'Category' of attribute 'Z Converter'") &&
+              Contains(message, "which has none"))
+      << message;
+
+  std::vector<unsigned char> longer = good;
+  longer[object + 8] = 15;  // same step through the collection: 15 and 9 both align to 16
+  message = ErrorOf([&] { (void)ReadZygoDatx(hdf5::File::OpenImage(longer.data(), longer.size(), "longer.datx")); });
+  EXPECT_TRUE(Contains(message, "longer.datx'") && Contains(message, "refers to 9 bytes") &&
+              Contains(message, "which holds 15"))
+      << message;
 }
 
 // ------------------------------------------------------------------------------------------------

@@ -15,9 +15,7 @@ shift || true
 if (($# > 0)); then
   targets=("$@")
 else
-  # zygo_datx_fuzzer finds, within seconds, a hang inside libhdf5 1.10.8 itself (H5HG_read on a
-  # damaged variable-length attribute; docs/known_issues.md): run it by name, not by default.
-  mapfile -t targets < <(cd "$root/fuzz" && ls ./*_fuzzer.cc | sed -e 's|^\./||' -e 's|\.cc$||' | grep -v '^zygo_datx_fuzzer$')
+  mapfile -t targets < <(cd "$root/fuzz" && ls ./*_fuzzer.cc | sed -e 's|^\./||' -e 's|\.cc$||')
 fi
 jobs=${FUZZ_JOBS:-1}
 cd "$root"

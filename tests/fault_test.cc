@@ -148,7 +148,7 @@ INSTANTIATE_TEST_SUITE_P(
     ::testing::Values(
         StageRun{"Toolpath", "toolpath {src}/grinding/examples/trial_part.json -o {out}", 1024},
         StageRun{"Polish", "polish {src}/polishing/examples/disc_job.json -o {out} --report pdf", 100}),
-    [](const ::testing::TestParamInfo<StageRun>& info) { return std::string(info.param.name); });
+    [](const ::testing::TestParamInfo<StageRun>& test) { return std::string(test.param.name); });
 
 }  // namespace
 }  // namespace arcwheel

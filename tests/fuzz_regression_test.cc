@@ -21,6 +21,9 @@ struct Finding {
   const char* file;       // in testdata/fuzz_regressions/
   const char* arguments;  // {in}: the file, {dir}: a scratch folder
   const char* message;    // part of the refusal
+  // The polishing job takes the finding as its error map: a CSV is read as scattered points,
+  // other files by their extension.
+  bool scattered_map = true;
 };
 
 class FuzzFinding : public ::testing::TestWithParam<Finding> {};
@@ -36,10 +39,9 @@ TEST_P(FuzzFinding, IsRefusedClearlyAndWritesNothing) {
   const Finding& finding = GetParam();
   TempDir dir;
   std::ofstream(dir / "points.csv") << "x_mm,y_mm,z_mm\n1,2,3\n";
-  // A polishing job that takes the finding as its scattered error map.
   std::ofstream(dir / "job.json") << R"({"surface": {"vertex_radius_mm": 400}, "aperture": {"diameter_mm": 30},
     "error_map": {"file": ")" << (testing::SourceDir() / "testdata" / "fuzz_regressions" / finding.file).string()
-                                  << R"(", "layout": "scattered"},
+                                  << (finding.scattered_map ? R"(", "layout": "scattered"},)" : R"("},)") << R"(
     "removal_function": {"peak_rate_um_per_s": 1, "fwhm_mm": 8}, "machine": {"max_speed_mm_s": 100}})";
   const std::string input = (testing::SourceDir() / "testdata" / "fuzz_regressions" / finding.file).string();
   const std::string arguments = Expand(Expand(finding.arguments, "{in}", input), "{dir}", dir.path().string());
@@ -69,8 +71,26 @@ INSTANTIATE_TEST_SUITE_P(
                 "a stray point?"},
         // transform_json_fuzzer: a number that overflows a double escaped the JSON readers.
         Finding{"JsonNumberOverflow", "transform_number_overflow.json",
-                "transform apply {in} {dir}/points.csv -o {dir}/out.csv", "number overflow"}),
-    [](const ::testing::TestParamInfo<Finding>& info) { return std::string(info.param.name); });
+                "transform apply {in} {dir}/points.csv -o {dir}/out.csv", "number overflow"},
+        // zygo_datx_fuzzer: a global heap object of size 0 under a converter attribute made
+        // libhdf5 1.10.8 loop for ever while reading it; the heap is now checked first.
+        Finding{"DatxGlobalHeapThatHangsTheLibrary", "zygo_datx_heap_hang.datx", "polish {dir}/job.json -o {dir}/out",
+                "global heap at byte 6528 is damaged", false},
+        // zygo_datx_fuzzer: a reference to a heap object the collection does not hold made
+        // libhdf5 1.10.8 read through a null pointer; references are now checked first.
+        Finding{"DatxReferenceToAMissingHeapObject", "zygo_datx_missing_heap_object.datx",
+                "polish {dir}/job.json -o {dir}/out", "refers to object 8388616 of the global heap at byte 6528", false},
+        // zygo_datx_fuzzer: a damaged attribute message that libhdf5 1.10.8 decodes by copying
+        // from past the end of its own buffer (a library bug, scripts/asan.supp); the converter
+        // that comes out names no heap collection, and the file is refused.
+        Finding{"DatxDamagedAttributeMessage", "zygo_datx_damaged_attribute_message.datx",
+                "polish {dir}/job.json -o {dir}/out", "bad input: hdf5", false},
+        // zygo_datx_fuzzer: a damaged converter type on which reading the stored references into a
+        // wider type made libhdf5 grow the element past its buffer; they are now read at their
+        // stored size.
+        Finding{"DatxDamagedConverterType", "zygo_datx_damaged_converter_type.datx", "polish {dir}/job.json -o {dir}/out",
+                "refers to object 0 of the global heap at byte 6528", false}),
+    [](const ::testing::TestParamInfo<Finding>& test) { return std::string(test.param.name); });
 
 // Report inputs are read from an output folder: the finding stands in for one file of it, the
 // others are the fuzzers' seeds (valid files of their kind).
@@ -112,7 +132,7 @@ INSTANTIATE_TEST_SUITE_P(
         FolderFinding{"ResidualMapOfFewNodesOnAVastGrid", "polish_residual_map_sparse_grid.csv", "residual_map.csv",
                       {"polish_summary_fuzzer/polish_summary.json", "polish_path_fuzzer/polishing_path.csv"},
                       "not the nodes of one regular grid"}),
-    [](const ::testing::TestParamInfo<FolderFinding>& info) { return std::string(info.param.name); });
+    [](const ::testing::TestParamInfo<FolderFinding>& test) { return std::string(test.param.name); });
 
 }  // namespace
 }  // namespace arcwheel

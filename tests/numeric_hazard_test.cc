@@ -228,7 +228,9 @@ TEST(NumericHazards, SectionFitsThatDoNotConvergeAreFlaggedAndLeftOut) {
       EXPECT_NE(phase.flag.find("did not converge"), std::string::npos) << phase.flag;
     }
     EXPECT_EQ(fit.usable_phases + flagged, static_cast<int>(fit.phases.size()));
-    if (flagged > 0) EXPECT_FALSE(fit.warnings.empty());
+    if (flagged > 0) {
+      EXPECT_FALSE(fit.warnings.empty());
+    }
   } catch (const Error& e) {
     EXPECT_EQ(e.code(), ErrorCode::kFitFailed);
     EXPECT_NE(std::string(e.what()).find("did not converge"), std::string::npos) << e.what();

@@ -384,6 +384,33 @@ std::optional<MemberReader> MakeMemberReader(hid_t member_type, const char* memb
   return reader;
 }
 
+// libhdf5 1.10.8 converts a compound by moving each member from its stored offset, trusting the
+// stored layout: a damaged type whose member lies past the end of the compound makes it copy from
+// outside its buffer. A layout written by the library has members inside the compound and apart.
+void CheckCompoundLayout(hid_t type, const std::string& where) {
+  const size_t size = H5Tget_size(type);
+  const int members = H5Tget_nmembers(type);
+  std::vector<std::pair<size_t, size_t>> spans;  // [offset, end) of each member
+  for (int m = 0; m < members; ++m) {
+    const Handle member_type(H5Tget_member_type(type, static_cast<unsigned>(m)), H5Tclose);
+    const size_t offset = H5Tget_member_offset(type, static_cast<unsigned>(m));
+    const size_t member_size = member_type.valid() ? H5Tget_size(member_type.id()) : 0;
+    if (member_size == 0 || offset > size || member_size > size - offset) {
+      throw Error(ErrorCode::kBadInput, kStage,
+                  where + " has a member of " + std::to_string(member_size) + " bytes at byte " + std::to_string(offset) +
+                      " of a compound of " + std::to_string(size) + " bytes (damaged?)");
+    }
+    spans.emplace_back(offset, offset + member_size);
+  }
+  std::sort(spans.begin(), spans.end());
+  for (size_t k = 1; k < spans.size(); ++k) {
+    if (spans[k].first < spans[k - 1].second) {
+      throw Error(ErrorCode::kBadInput, kStage,
+                  where + " has members overlapping at byte " + std::to_string(spans[k].first) + " (damaged?)");
+    }
+  }
+}
+
 }  // namespace
 
 std::optional<File::Compound> File::ReadAttributeCompound(const std::string& object, const std::string& name) const {
@@ -400,6 +427,7 @@ std::optional<File::Compound> File::ReadAttributeCompound(const std::string& obj
   if (elements < 1 || elements > (1 << 16)) {
     throw Error(ErrorCode::kBadInput, kStage, where + " holds " + std::to_string(elements) + " elements");
   }
+  CheckCompoundLayout(type.id(), where);
   Compound result;
   std::set<std::string> names;
   const int members = H5Tget_nmembers(type.id());

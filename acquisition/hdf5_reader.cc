@@ -33,7 +33,10 @@ void ReadAttributes(const hdf5::File& file, ScanMetadata& metadata) {
 
 }  // namespace
 
-Scan ReadHdf5Scan(const std::filesystem::path& path) { return ReadHdf5Scan(hdf5::File::OpenReadOnly(path)); }
+Scan ReadHdf5Scan(const std::filesystem::path& path) {
+  hdf5::ReadFirstInChildProcess(path, [&] { (void)ReadHdf5Scan(hdf5::File::OpenReadOnly(path)); });
+  return ReadHdf5Scan(hdf5::File::OpenReadOnly(path));
+}
 
 Scan ReadHdf5Scan(const hdf5::File& file) {
   const std::filesystem::path& path = file.path();

@@ -161,6 +161,7 @@ ForceRecordFile ReadCsv(const std::filesystem::path& path, const ForceRecordRead
 }
 
 ForceRecordFile ReadHdf5(const std::filesystem::path& path, const ForceRecordReadOptions& options) {
+  hdf5::ReadFirstInChildProcess(path, [&] { (void)ReadHdf5(path, options); });
   const hdf5::File h5 = hdf5::File::OpenReadOnly(path);
   const std::string where = fmt::format("'{}'", path.string());
   std::map<std::string, std::string> notes;

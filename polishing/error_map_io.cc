@@ -496,7 +496,10 @@ PixelMap ReadZygoDatx(const hdf5::File& file) {
   return map;
 }
 
-PixelMap ReadZygoDatx(const std::filesystem::path& path) { return ReadZygoDatx(hdf5::File::OpenReadOnly(path)); }
+PixelMap ReadZygoDatx(const std::filesystem::path& path) {
+  hdf5::ReadFirstInChildProcess(path, [&] { (void)ReadZygoDatx(hdf5::File::OpenReadOnly(path)); });
+  return ReadZygoDatx(hdf5::File::OpenReadOnly(path));
+}
 
 ErrorMap ReadErrorMapHdf5(const hdf5::File& file) {
   const std::string name = file.path().string();
@@ -526,7 +529,10 @@ ErrorMap ReadErrorMapHdf5(const hdf5::File& file) {
   return map;
 }
 
-ErrorMap ReadErrorMapHdf5(const std::filesystem::path& path) { return ReadErrorMapHdf5(hdf5::File::OpenReadOnly(path)); }
+ErrorMap ReadErrorMapHdf5(const std::filesystem::path& path) {
+  hdf5::ReadFirstInChildProcess(path, [&] { (void)ReadErrorMapHdf5(hdf5::File::OpenReadOnly(path)); });
+  return ReadErrorMapHdf5(hdf5::File::OpenReadOnly(path));
+}
 
 void WriteErrorMapHdf5(const ErrorMap& map, const std::filesystem::path& path) {
   OutputSet outputs;

@@ -151,6 +151,7 @@ TabulatedRemovalFunction ReadRemovalFunctionCsv(const std::filesystem::path& pat
 }
 
 TabulatedRemovalFunction ReadRemovalFunctionHdf5(const std::filesystem::path& path) {
+  hdf5::ReadFirstInChildProcess(path, [&] { (void)ReadRemovalFunctionHdf5(path); });
   const hdf5::File file = hdf5::File::OpenReadOnly(path);
   const std::string dataset = "rate_um_per_s";
   auto fail = [&](const std::string& what) { Bad(fmt::format("'{}' dataset '/{}': {}", path.string(), dataset, what)); };

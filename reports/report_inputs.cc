@@ -257,6 +257,7 @@ WheelMapData ReadWheelMap(const std::filesystem::path& path) {
   if (!std::filesystem::exists(path)) {
     throw Error(ErrorCode::kIo, kMapStage, "'" + path.string() + "' does not exist (run `arcwheel process` first)");
   }
+  hdf5::ReadFirstInChildProcess(path, [&] { (void)ReadWheelMap(path); });
   const hdf5::File file = hdf5::File::OpenReadOnly(path);
   WheelMapData map;
   map.phase_deg = ReadAxisDataset(file, "/map/phase_deg");

@@ -15,9 +15,9 @@ shift || true
 if (($# > 0)); then
   targets=("$@")
 else
-  # zygo_datx_fuzzer can reach, within minutes, a crash inside libhdf5 1.10.8 itself that no check
-  # of ours can prevent (docs/known_issues.md); left out of the default (CI) set so that CI stays
-  # deterministic, and run by name.
+  # zygo_datx_fuzzer reads each input as the command line does, first in a child process that
+  # libhdf5 1.10.8 itself may crash (docs/known_issues.md): about ten inputs a second, and a
+  # sanitizer report from each such child. Left out of the default (CI) set; run it by name.
   mapfile -t targets < <(cd "$root/fuzz" && ls ./*_fuzzer.cc | sed -e 's|^\./||' -e 's|\.cc$||' | grep -v '^zygo_datx_fuzzer$')
 fi
 jobs=${FUZZ_JOBS:-1}

@@ -80,11 +80,6 @@ INSTANTIATE_TEST_SUITE_P(
         // libhdf5 1.10.8 read through a null pointer; references are now checked first.
         Finding{"DatxReferenceToAMissingHeapObject", "zygo_datx_missing_heap_object.datx",
                 "polish {dir}/job.json -o {dir}/out", "refers to object 8388616 of the global heap at byte 6528", false},
-        // zygo_datx_fuzzer: a damaged attribute message that libhdf5 1.10.8 decodes by copying
-        // from past the end of its own buffer (a library bug, scripts/asan.supp); the converter
-        // that comes out names no heap collection, and the file is refused.
-        Finding{"DatxDamagedAttributeMessage", "zygo_datx_damaged_attribute_message.datx",
-                "polish {dir}/job.json -o {dir}/out", "bad input: hdf5", false},
         // zygo_datx_fuzzer: converter types whose members lie past the end of the compound made
         // libhdf5 1.10.8 copy from outside its buffer while converting them; the layout of a
         // compound is now checked before it is read.
@@ -92,7 +87,13 @@ INSTANTIATE_TEST_SUITE_P(
                 "polish {dir}/job.json -o {dir}/out", "has a member of 8 bytes at byte 8 of a compound of 9 bytes", false},
         Finding{"DatxConverterMemberFarPastItsCompound", "zygo_datx_member_past_compound.datx",
                 "polish {dir}/job.json -o {dir}/out", "has a member of 16 bytes at byte 9371664 of a compound of 32 bytes",
-                false}),
+                false},
+        // zygo_datx_fuzzer: a group heap declaring 30 GB; where that allocation fails, libhdf5
+        // 1.10.8 copies into the null pointer it got back. Read first in a child process, the file
+        // is refused when the child dies (core/hdf5_child_test.cc checks that message); where the
+        // allocation succeeds, the library's own read fails. Either way: refused, nothing written.
+        Finding{"DatxThatCrashesTheLibrary", "zygo_datx_local_heap_crashes_libhdf5.datx",
+                "polish {dir}/job.json -o {dir}/out", "bad input", false}),
     [](const ::testing::TestParamInfo<Finding>& test) { return std::string(test.param.name); });
 
 // Report inputs are read from an output folder: the finding stands in for one file of it, the

@@ -2,10 +2,8 @@
 
 #include <algorithm>
 #include <cstddef>
-#include <cstdint>
 #include <cstring>
 #include <set>
-#include <string_view>
 #include <utility>
 
 #include "core/error.h"

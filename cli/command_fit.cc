@@ -16,7 +16,7 @@
 namespace arcwheel::cli {
 namespace {
 
-constexpr const char* kStage = "fit.circle";
+constexpr const char* kCircleFitStage = "fit.circle";
 
 struct Points {
   std::vector<double> x, y;
@@ -37,7 +37,7 @@ std::vector<std::string> SplitCells(const std::string& line) {
 
 Points ReadPoints(const std::string& path, const std::string& x_name, const std::string& y_name) {
   std::ifstream in(path);
-  if (!in) throw Error(ErrorCode::kIo, kStage, "cannot open '" + path + "'");
+  if (!in) throw Error(ErrorCode::kIo, kCircleFitStage, "cannot open '" + path + "'");
   std::string line;
   std::size_t number = 0;
   std::vector<std::string> header;
@@ -51,7 +51,7 @@ Points ReadPoints(const std::string& path, const std::string& x_name, const std:
     for (std::size_t i = 0; i < header.size(); ++i) {
       if (header[i] == name) return i;
     }
-    throw Error(ErrorCode::kBadInput, kStage, "'" + path + "': the header has no column '" + name + "'");
+    throw Error(ErrorCode::kBadInput, kCircleFitStage, "'" + path + "': the header has no column '" + name + "'");
   };
   const std::size_t ix = find(x_name);
   const std::size_t iy = find(y_name);
@@ -61,7 +61,7 @@ Points ReadPoints(const std::string& path, const std::string& x_name, const std:
     if (line.find_first_not_of(" \t\r") == std::string::npos) continue;
     const std::vector<std::string> cells = SplitCells(line);
     if (cells.size() != header.size()) {
-      throw Error(ErrorCode::kBadInput, kStage,
+      throw Error(ErrorCode::kBadInput, kCircleFitStage,
                   fmt::format("'{}' line {}: {} cells, the header names {}", path, number, cells.size(), header.size()));
     }
     for (const std::size_t column : {ix, iy}) {
@@ -69,7 +69,7 @@ Points ReadPoints(const std::string& path, const std::string& x_name, const std:
       const std::string& cell = cells[column];
       const auto [end, error] = std::from_chars(cell.data(), cell.data() + cell.size(), value);
       if (error != std::errc() || end != cell.data() + cell.size() || !std::isfinite(value)) {
-        throw Error(ErrorCode::kBadInput, kStage,
+        throw Error(ErrorCode::kBadInput, kCircleFitStage,
                     fmt::format("'{}' line {}: cannot read {} value '{}'", path, number, header[column], cell));
       }
       (column == ix ? points.x : points.y).push_back(value);
@@ -95,7 +95,7 @@ void AddFitCommand(CLI::App& app) {
     const Points points = ReadPoints(*path, (*columns)[0], (*columns)[1]);
     const fitting::CircleFit result = fitting::FitCircle(points.x, points.y, {}, {});
     if (!result.IsUsable()) {
-      throw Error(ErrorCode::kFitFailed, kStage, "'" + *path + "': " + result.message);
+      throw Error(ErrorCode::kFitFailed, kCircleFitStage, "'" + *path + "': " + result.message);
     }
     nlohmann::json out;
     out["center"] = {result.center_mm.x(), result.center_mm.y()};

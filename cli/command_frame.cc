@@ -23,7 +23,7 @@
 namespace arcwheel::cli {
 namespace {
 
-constexpr const char* kStage = "frame";
+constexpr const char* kFrameStage = "frame";
 
 struct PmacArgs {
   std::vector<double> counts_per_mm;
@@ -143,7 +143,7 @@ void AddFrameCommand(CLI::App& app) {
                                        {&args->x_point, "--x-point"},
                                        {&args->xy_point, "--xy-point"}}) {
       if (values->size() != 3)
-        throw Error(ErrorCode::kInvalidOption, kStage, fmt::format("{} X,Y,Z is required", name));
+        throw Error(ErrorCode::kInvalidOption, kFrameStage, fmt::format("{} X,Y,Z is required", name));
     }
     const std::array<Eigen::Vector3d, 3> probes = {Point(args->origin), Point(args->x_point),
                                                    Point(args->xy_point)};

@@ -32,7 +32,7 @@ namespace arcwheel::cli {
 namespace {
 
 namespace fs = std::filesystem;
-constexpr const char* kStage = "headcenter";
+constexpr const char* kHeadcenterStage = "headcenter";
 
 struct SolveArgs {
   std::optional<double> z0_mm;
@@ -72,7 +72,7 @@ Solved SolveRecord(const std::string& path, const SolveArgs& args, const frames:
   const frames::ForceRecordFile file = frames::ReadForceRecord(path, args.units);
   const std::optional<double> z0 = args.z0_mm ? args.z0_mm : file.platform_height_mm;
   if (!z0) {
-    throw Error(ErrorCode::kInvalidOption, kStage,
+    throw Error(ErrorCode::kInvalidOption, kHeadcenterStage,
                 fmt::format("'{}' has no platform_height_mm note: give --z0-mm", path));
   }
   Solved solved;
@@ -109,7 +109,7 @@ nlohmann::json TareJson(const SolveArgs& args, const frames::Wrench& tare) {
 }
 
 frames::Transform ReadCalibration(const std::string& path) {
-  return frames::TransformFromJson(ReadJsonFile(path, kStage), path);
+  return frames::TransformFromJson(ReadJsonFile(path, kHeadcenterStage), path);
 }
 
 Eigen::Vector2d ToMachine(const frames::Transform& calibration, const Eigen::Vector2d& sensor) {
@@ -123,14 +123,14 @@ struct RecordRow {
 };
 
 std::vector<RecordRow> ReadRecordList(const std::string& list, const char* x_name, const char* y_name) {
-  const frames::CsvTable table = frames::ReadCsvTable(list, kStage);
-  const size_t record = table.Require("record", kStage), x = table.Require(x_name, kStage),
-               y = table.Require(y_name, kStage);
+  const frames::CsvTable table = frames::ReadCsvTable(list, kHeadcenterStage);
+  const size_t record = table.Require("record", kHeadcenterStage), x = table.Require(x_name, kHeadcenterStage),
+               y = table.Require(y_name, kHeadcenterStage);
   std::vector<RecordRow> rows;
   for (size_t row = 0; row < table.cells.size(); ++row) {
     fs::path path = table.cells[row][record];
     if (path.is_relative()) path = fs::path(list).parent_path() / path;
-    rows.push_back({path.string(), {table.Number(row, x, kStage), table.Number(row, y, kStage)}});
+    rows.push_back({path.string(), {table.Number(row, x, kHeadcenterStage), table.Number(row, y, kHeadcenterStage)}});
   }
   return rows;
 }
@@ -154,7 +154,7 @@ void AddSolve(CLI::App& headcenter) {
   solve->add_option("-o,--output", args->output, "write the JSON here instead of stdout");
   solve->callback([args] {
     if (!args->commanded.empty() && args->calibration.empty()) {
-      throw Error(ErrorCode::kInvalidOption, kStage,
+      throw Error(ErrorCode::kInvalidOption, kHeadcenterStage,
                   "--commanded-mm needs --calibration (the sensor -> machine transform)");
     }
     const Solved solved = SolveRecord(args->record, args->solve, ReadTare(args->solve));
@@ -223,7 +223,7 @@ void AddCalibrate(CLI::App& headcenter) {
       fit = frames::FitTransform(pairs, frames::TransformModel::kRigid2d, args->fit);
     } catch (const Error& error) {
       if (error.code() != ErrorCode::kBadInput && error.code() != ErrorCode::kFitFailed) throw;
-      throw Error(error.code(), kStage, fmt::format("'{}': {}", args->presses, error.what()));
+      throw Error(error.code(), kHeadcenterStage, fmt::format("'{}': {}", args->presses, error.what()));
     }
     nlohmann::json out = frames::TransformFitToJson(fit);
     out["source_frame"] = "sensor";
@@ -346,7 +346,7 @@ void AddSimulate(CLI::App& headcenter) {
     frames::ForceSimulation s = args->simulation;
     if (!(s.duration_s > 0.0 && s.sample_rate_hz > 0.0 && s.duration_s * s.sample_rate_hz >= 1.0 &&
           s.duration_s * s.sample_rate_hz <= 1e8)) {
-      throw Error(ErrorCode::kInvalidOption, kStage,
+      throw Error(ErrorCode::kInvalidOption, kHeadcenterStage,
                   "--duration-s and --rate-hz must give between 1 and 1e8 samples");
     }
     s.centre_mm = {args->centre[0], args->centre[1]};

@@ -24,22 +24,22 @@
 namespace arcwheel::cli {
 namespace {
 
-constexpr const char* kFitStage = "transform.fit";
+constexpr const char* kTransformFitStage = "transform.fit";
 constexpr const char* kApplyStage = "transform.apply";
 
 std::vector<frames::PointPair> ReadPairs(const std::string& path, frames::TransformModel model) {
-  const frames::CsvTable table = frames::ReadCsvTable(path, kFitStage);
+  const frames::CsvTable table = frames::ReadCsvTable(path, kTransformFitStage);
   const int d = frames::ModelDimension(model);
   const char* names[2][3] = {{"xs_mm", "ys_mm", "zs_mm"}, {"xt_mm", "yt_mm", "zt_mm"}};
   std::vector<size_t> columns;
   for (const auto& side : names) {
-    for (int k = 0; k < d; ++k) columns.push_back(table.Require(side[k], kFitStage));
+    for (int k = 0; k < d; ++k) columns.push_back(table.Require(side[k], kTransformFitStage));
   }
   std::vector<frames::PointPair> pairs(table.cells.size());
   for (size_t row = 0; row < table.cells.size(); ++row) {
     for (int k = 0; k < d; ++k) {
-      pairs[row].source_mm(k) = table.Number(row, columns[k], kFitStage);
-      pairs[row].target_mm(k) = table.Number(row, columns[d + k], kFitStage);
+      pairs[row].source_mm(k) = table.Number(row, columns[k], kTransformFitStage);
+      pairs[row].target_mm(k) = table.Number(row, columns[d + k], kTransformFitStage);
     }
   }
   return pairs;
@@ -52,7 +52,7 @@ frames::TransformFit FitNamingFile(const std::vector<frames::PointPair>& pairs, 
     return frames::FitTransform(pairs, model, options);
   } catch (const Error& error) {
     if (error.code() != ErrorCode::kBadInput && error.code() != ErrorCode::kFitFailed) throw;
-    throw Error(error.code(), kFitStage, fmt::format("'{}': {}", path, error.what()));
+    throw Error(error.code(), kTransformFitStage, fmt::format("'{}': {}", path, error.what()));
   }
 }
 

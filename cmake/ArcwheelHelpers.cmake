@@ -1,5 +1,7 @@
 # arcwheel_add_library(NAME n SRCS ... DEPS ...): target arcwheel_<n>, alias arcwheel::<n>.
-# arcwheel_add_test(NAME n SRCS ... DEPS ...): a GoogleTest binary registered with CTest as <folder>/<n>.
+# arcwheel_add_test(NAME n SRCS ... DEPS ... [SHARDS k]): a GoogleTest binary registered with CTest
+#   as <folder>/<n>, or with SHARDS as <folder>/<n>/<i> for i < k, each running every k-th test
+#   (GoogleTest's sharding), so that CTest runs a long binary on both cores.
 # arcwheel_add_benchmark(NAME n SRCS ... DEPS ...): a Google Benchmark binary.
 
 set(ARCWHEEL_WARNINGS -Wall -Wextra -Wpedantic -Wshadow -Wconversion -Wno-sign-conversion)
@@ -25,16 +27,24 @@ function(arcwheel_add_test)
   if(NOT ARCWHEEL_BUILD_TESTS)
     return()
   endif()
-  cmake_parse_arguments(ARG "" "NAME" "SRCS;DEPS" ${ARGN})
+  cmake_parse_arguments(ARG "" "NAME;SHARDS" "SRCS;DEPS" ${ARGN})
   get_filename_component(_folder ${CMAKE_CURRENT_SOURCE_DIR} NAME)
   set(_target ${_folder}_${ARG_NAME})
   add_executable(${_target} ${ARG_SRCS})
   target_link_libraries(${_target} PRIVATE ${ARG_DEPS} arcwheel::testing GTest::gtest GTest::gmock)
   target_compile_options(${_target} PRIVATE ${ARCWHEEL_WARNINGS})
-  add_test(NAME ${_folder}/${ARG_NAME} COMMAND ${_target}
-           WORKING_DIRECTORY ${PROJECT_SOURCE_DIR})
-  set_tests_properties(${_folder}/${ARG_NAME} PROPERTIES
-                       ENVIRONMENT "ARCWHEEL_SOURCE_DIR=${PROJECT_SOURCE_DIR};ARCWHEEL_BINARY=$<TARGET_FILE:arcwheel>")
+  set(_environment "ARCWHEEL_SOURCE_DIR=${PROJECT_SOURCE_DIR};ARCWHEEL_BINARY=$<TARGET_FILE:arcwheel>")
+  if(NOT ARG_SHARDS)
+    add_test(NAME ${_folder}/${ARG_NAME} COMMAND ${_target} WORKING_DIRECTORY ${PROJECT_SOURCE_DIR})
+    set_tests_properties(${_folder}/${ARG_NAME} PROPERTIES ENVIRONMENT "${_environment}")
+    return()
+  endif()
+  math(EXPR _last "${ARG_SHARDS} - 1")
+  foreach(_shard RANGE ${_last})
+    add_test(NAME ${_folder}/${ARG_NAME}/${_shard} COMMAND ${_target} WORKING_DIRECTORY ${PROJECT_SOURCE_DIR})
+    set_tests_properties(${_folder}/${ARG_NAME}/${_shard} PROPERTIES ENVIRONMENT
+                         "${_environment};GTEST_TOTAL_SHARDS=${ARG_SHARDS};GTEST_SHARD_INDEX=${_shard}")
+  endforeach()
 endfunction()
 
 function(arcwheel_add_benchmark)

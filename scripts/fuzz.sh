@@ -1,13 +1,17 @@
 #!/usr/bin/env bash
-# Builds the libFuzzer targets (preset asan: clang, AddressSanitizer + UndefinedBehaviorSanitizer)
-# and runs each for SECONDS (default 20) on its seeds in fuzz/seeds/<target>/. A crash, leak, hang
-# or sanitizer report leaves its input in fuzz/crashes/<target>/ and fails the script; turn it into
-# a regression test in tests/.
-#   scripts/fuzz.sh                         # every target, 20 s each (CI)
+# Builds the libFuzzer targets (clang, AddressSanitizer + UndefinedBehaviorSanitizer) and runs each
+# for SECONDS (default 20) on its seeds in fuzz/seeds/<target>/. A crash, leak, hang or sanitizer
+# report leaves its input in fuzz/crashes/<target>/ and fails the script; turn it into a regression
+# test in tests/.
+# The build is preset fuzz (build-fuzz/): coverage feedback from every library, for runs that are
+# to find something. CI passes FUZZ_PRESET=asan: the sanitizer suite's build, whose libraries carry
+# no coverage instrumentation, so there the targets replay and mutate their seeds, little guided.
+#   scripts/fuzz.sh                         # every target, 20 s each
 #   scripts/fuzz.sh 600                     # ten minutes per target
 #   scripts/fuzz.sh 600 scan_hdf5_fuzzer    # one target
 #   FUZZ_JOBS=3 scripts/fuzz.sh 600         # three targets at a time
-#   FUZZ_BUILD=0 scripts/fuzz.sh 600        # the binaries already in build-asan/fuzz/
+#   FUZZ_BUILD=0 scripts/fuzz.sh 600        # the binaries already in build-fuzz/fuzz/
+#   FUZZ_PRESET=asan scripts/fuzz.sh 20     # the targets of the sanitizer suite's build (CI)
 set -euo pipefail
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 seconds=${1:-20}
@@ -21,11 +25,17 @@ else
   mapfile -t targets < <(cd "$root/fuzz" && ls ./*_fuzzer.cc | sed -e 's|^\./||' -e 's|\.cc$||' | grep -v '^zygo_datx_fuzzer$')
 fi
 jobs=${FUZZ_JOBS:-1}
+preset=${FUZZ_PRESET:-fuzz}
+case $preset in
+  fuzz) build_dir=$root/build-fuzz ;;
+  asan) build_dir=$root/build-asan ;;
+  *) echo "fuzz: FUZZ_PRESET must be fuzz or asan, not '$preset'" >&2; exit 1 ;;
+esac
 cd "$root"
 if [[ ${FUZZ_BUILD:-1} != 0 ]]; then
   "$root/scripts/install_deps.sh"
-  cmake --preset asan >/dev/null
-  cmake --build --preset asan --parallel "$(nproc)" --target "${targets[@]}"
+  cmake --preset "$preset" >/dev/null
+  cmake --build --preset "$preset" --parallel "$(nproc)" --target "${targets[@]}"
 fi
 # libhdf5 itself may ask for gigabytes while opening a damaged file (H5Fopen reading an object
 # header): such a request returns NULL, which the library reports as a failed open, instead of
@@ -43,7 +53,7 @@ fuzz_one() {
   cp "$root/fuzz/seeds/$target"/* "$corpus"/
   crashes="$root/fuzz/crashes/$target"
   mkdir -p "$crashes"
-  TMPDIR=$work "$root/build-asan/fuzz/$target" "$corpus" -max_total_time="$seconds" -timeout=10 \
+  TMPDIR=$work "$build_dir/fuzz/$target" "$corpus" -max_total_time="$seconds" -timeout=10 \
     -rss_limit_mb=2048 -malloc_limit_mb=65536 -max_len=262144 -artifact_prefix="$crashes/" -print_final_stats=1 \
     >"$work/log" 2>&1 || status=$?
   runs=$(sed -n 's/^stat::number_of_executed_units: *//p' "$work/log")

@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # The whole test suite built with AddressSanitizer and UndefinedBehaviorSanitizer (preset asan:
-# clang, with the fuzz targets of scripts/fuzz.sh in the same build).
+# clang; the fuzz targets are in the same build, but no library carries the fuzzer's coverage
+# instrumentation, which would slow every test several times over).
 set -euo pipefail
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 "$root/scripts/install_deps.sh"

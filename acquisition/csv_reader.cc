@@ -15,6 +15,7 @@
 #include "acquisition/scan_reader.h"
 #include "acquisition/scan_metadata_keys.h"
 #include "core/error.h"
+#include "core/text_encoding.h"
 
 namespace arcwheel::acquisition {
 namespace {
@@ -22,7 +23,7 @@ namespace {
 constexpr const char* kStage = "acquisition.csv";
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
-enum class Column { kZ, kT, kAngle, kY };
+enum class Column { kZ, kT, kAngle, kY, kIndex };
 
 class CsvParser {
  public:
@@ -31,6 +32,8 @@ class CsvParser {
   Scan Parse() {
     Scan scan;
     scan.path = path_;
+    // Excel writes a UTF-8 byte-order mark before the first cell.
+    if (text_.starts_with("\xEF\xBB\xBF")) position_ = 3;
     ReadMetadata(scan.metadata);
     ReadHeader();
     ReadRows(scan);
@@ -59,22 +62,48 @@ class CsvParser {
     return s;
   }
 
+  // Blanks off both ends, but not the separator: in a tab-separated file a trailing tab ends an
+  // empty last cell (an invalid sample), it is not white space.
+  std::string_view TrimLine(std::string_view s) const {
+    auto blank = [this](char c) { return c != separator_ && std::isspace(static_cast<unsigned char>(c)); };
+    while (!s.empty() && blank(s.front())) s.remove_prefix(1);
+    while (!s.empty() && blank(s.back())) s.remove_suffix(1);
+    return s;
+  }
+
   void ReadMetadata(ScanMetadata& metadata) {
-    // Leading `#` lines: `# key: value` for known keys; any other `#` line is a comment.
-    while (position_ < text_.size() && text_[position_] == '#') {
+    // Leading `#` lines: `# key: value`; a `#` line without a colon is a comment. A spreadsheet
+    // that saved them quotes the whole line when it holds the separator.
+    MetadataSetter setter(metadata);
+    while (position_ < text_.size() && (text_[position_] == '#' || text_.compare(position_, 2, "\"#") == 0)) {
       std::string_view line;
       NextLine(line);
+      std::string unquoted;
+      if (line.starts_with('"')) {
+        unquoted = Unquote(Trim(line));
+        line = unquoted;
+      }
       line.remove_prefix(1);
       const size_t colon = line.find(':');
       if (colon == std::string_view::npos) continue;
-      const std::string key(Trim(line.substr(0, colon)));
-      const std::string value(Trim(line.substr(colon + 1)));
       try {
-        SetMetadata(metadata, key, value);
+        const std::string key = setter.Claim(Trim(line.substr(0, colon)));
+        if (!key.empty()) setter.SetText(key, Trim(line.substr(colon + 1)));
       } catch (const Error& error) {
         Refuse(error.what());
       }
     }
+  }
+
+  // RFC 4180: a cell in double quotes, "" standing for one quote inside it.
+  static std::string Unquote(std::string_view cell) {
+    if (cell.size() < 2 || cell.front() != '"' || cell.back() != '"') return std::string(cell);
+    std::string out;
+    for (size_t i = 1; i + 1 < cell.size(); ++i) {
+      out += cell[i];
+      if (cell[i] == '"' && cell[i + 1] == '"') ++i;
+    }
+    return out;
   }
 
   void ReadHeader() {
@@ -86,13 +115,18 @@ class CsvParser {
                  : line.find(';') != std::string_view::npos ? ';'
                  : line.find('\t') != std::string_view::npos ? '\t'
                                                               : ',';
-    for (std::string_view name : Split(line)) {
-      name = Trim(name);
+    const std::vector<std::string_view> names = Split(TrimLine(line));
+    for (size_t j = 0; j < names.size(); ++j) {
+      const std::string name = AsciiLower(Trim(names[j]));
       if (name == "z_mm") columns_.push_back(Column::kZ);
       else if (name == "t_s") columns_.push_back(Column::kT);
       else if (name == "angle_deg") columns_.push_back(Column::kAngle);
       else if (name == "y_mm") columns_.push_back(Column::kY);
-      else Refuse("unknown column '" + std::string(name) + "' (expected z_mm, t_s, angle_deg, y_mm)");
+      else if (j == 0 && (name.empty() || name == "unnamed: 0")) columns_.push_back(Column::kIndex);
+      else {
+        bool latin1 = false;
+        Refuse("unknown column '" + AsUtf8(name, latin1) + "' (expected z_mm, t_s, angle_deg, y_mm)");
+      }
     }
     for (const Column c : {Column::kZ, Column::kT, Column::kAngle, Column::kY}) {
       if (std::count(columns_.begin(), columns_.end(), c) > 1) Refuse("a column is named twice");
@@ -102,15 +136,53 @@ class CsvParser {
     }
   }
 
-  std::vector<std::string_view> Split(std::string_view line) const {
+  // The line's cells, unquoted (RFC 4180). A line without quotes (nearly every line of a scan) is
+  // cut in place; one with quotes is unquoted into quoted_, which the views then point into.
+  std::vector<std::string_view> Split(std::string_view line) {
     std::vector<std::string_view> cells;
-    size_t start = 0;
-    while (true) {
-      const size_t next = line.find(separator_, start);
-      cells.push_back(line.substr(start, next == std::string_view::npos ? std::string_view::npos : next - start));
-      if (next == std::string_view::npos) break;
-      start = next + 1;
+    if (line.find('"') == std::string_view::npos) {
+      size_t start = 0;
+      while (true) {
+        const size_t next = line.find(separator_, start);
+        cells.push_back(line.substr(start, next == std::string_view::npos ? std::string_view::npos : next - start));
+        if (next == std::string_view::npos) break;
+        start = next + 1;
+      }
+      return cells;
     }
+    quoted_.clear();
+    std::vector<std::pair<size_t, size_t>> spans;  // into quoted_, which may reallocate while it grows
+    size_t i = 0;
+    while (true) {
+      while (i < line.size() && line[i] == ' ') ++i;
+      const size_t begin = quoted_.size();
+      if (i < line.size() && line[i] == '"') {
+        for (++i;; ++i) {
+          if (i >= line.size()) Refuse("a quoted cell is not closed on its line");
+          if (line[i] == '"') {
+            if (i + 1 < line.size() && line[i + 1] == '"') {
+              quoted_ += '"';
+              ++i;
+              continue;
+            }
+            ++i;
+            break;
+          }
+          quoted_ += line[i];
+        }
+        while (i < line.size() && line[i] == ' ') ++i;
+        if (i < line.size() && line[i] != separator_) Refuse("text after a quoted cell");
+      } else {
+        while (i < line.size() && line[i] != separator_) {
+          if (line[i] == '"') Refuse("a quote inside an unquoted cell");
+          quoted_ += line[i++];
+        }
+      }
+      spans.emplace_back(begin, quoted_.size() - begin);
+      if (i >= line.size()) break;
+      ++i;  // the separator
+    }
+    for (const auto& [begin, length] : spans) cells.push_back(std::string_view(quoted_).substr(begin, length));
     return cells;
   }
 
@@ -161,6 +233,9 @@ class CsvParser {
   }
 
   void ReadRows(Scan& scan) {
+    if (columns_.front() == Column::kIndex) {
+      scan.metadata.notes.push_back("column 1 has no name (a row index, as pandas writes it): ignored");
+    }
     const bool one_column = columns_.size() == 1;
     for (const Column c : columns_) {
       if (c == Column::kT) has_t_ = true;
@@ -175,7 +250,7 @@ class CsvParser {
     std::string_view line;
     std::vector<std::string_view> cells;
     while (NextLine(line)) {
-      const std::string_view trimmed = Trim(line);
+      const std::string_view trimmed = TrimLine(line);
       if (trimmed.empty()) {
         // In a one-column file a blank line is an invalid sample; trailing blank lines are not.
         if (one_column && position_ < text_.size()) scan.z_mm.push_back(kNaN);
@@ -192,6 +267,7 @@ class CsvParser {
           case Column::kT: scan.t_s.push_back(ParseRequired(cell, "t_s")); break;
           case Column::kAngle: scan.angle_deg.push_back(ParseRequired(cell, "angle_deg")); break;
           case Column::kY: scan.y_mm.push_back(ParseRequired(cell, "y_mm")); break;
+          case Column::kIndex: break;
         }
       }
     }
@@ -211,6 +287,7 @@ class CsvParser {
   bool has_t_ = false;
   bool has_angle_ = false;
   bool has_y_ = false;
+  std::string quoted_;  // the unquoted cells of the current line, when it has quotes
 };
 
 std::string ReadWholeFile(const std::filesystem::path& path) {
@@ -229,7 +306,7 @@ Scan ReadCsvScan(const std::filesystem::path& path) { return ParseCsvScan(ReadWh
 Scan ParseCsvScan(std::string text, const std::string& name) {
   CsvParser parser(name, std::move(text));
   Scan scan = parser.Parse();
-  ApplyInvalidMarkers(scan, /*compare_as_float=*/false);
+  ApplyInvalidMarkers(scan, SentinelComparison::kAsDouble);
   ValidateScan(scan);
   return scan;
 }

@@ -1,5 +1,7 @@
 // formats.md 2.1.
 
+#include <cmath>
+#include <limits>
 #include <string>
 
 #include "acquisition/scan_metadata_keys.h"
@@ -22,13 +24,59 @@ std::vector<double> ReadColumn(const hdf5::File& file, const std::string& name) 
   return file.ReadDoubles(name);
 }
 
+// Every attribute on /scan, matched to formats.md's keys case-insensitively; the unused ones noted.
 void ReadAttributes(const hdf5::File& file, ScanMetadata& metadata) {
-  for (const char* key : kNumericMetadataKeys) {
-    if (const auto value = file.ReadAttributeDouble("/scan", key)) SetNumericMetadata(metadata, key, *value);
+  MetadataSetter setter(metadata);
+  // The setter's messages name the key; the file's own name the file and the attribute.
+  const auto in_this_file = [&](const auto& step) {
+    try {
+      return step();
+    } catch (const Error& error) {
+      if (error.code() != ErrorCode::kBadInput) throw;
+      throw Error(ErrorCode::kBadInput, kStage, "'" + file.path().string() + "' /scan: " + error.what());
+    }
+  };
+  for (const std::string& attribute : file.AttributeNames("/scan")) {
+    const std::string key = in_this_file([&] { return setter.Claim(attribute); });
+    if (key.empty()) continue;
+    if (MetadataSetter::IsNumeric(key)) {
+      const double value = *file.ReadAttributeDouble("/scan", attribute);
+      in_this_file([&] { setter.SetNumber(key, value); });
+    } else {
+      const std::string value = *file.ReadAttributeString("/scan", attribute);
+      in_this_file([&] { setter.SetText(key, value); });
+    }
   }
-  for (const char* key : kTextMetadataKeys) {
-    if (const auto value = file.ReadAttributeString("/scan", key)) SetMetadata(metadata, key, *value);
+}
+
+// z in mm. Integer z are sensor counts: they need the CF convention's `scale_factor` (mm per count)
+// and optional `add_offset` (mm) on /scan/z; invalid_value is then compared with the counts.
+std::vector<double> ReadZ(const hdf5::File& file, ScanMetadata& metadata, SentinelComparison& comparison) {
+  const std::string name = "/scan/z";
+  std::vector<double> z = ReadColumn(file, name);
+  const H5T_class_t type_class = file.ElementClass(name);
+  if (type_class == H5T_FLOAT) {
+    comparison = file.ElementSize(name) == 4 ? SentinelComparison::kAsFloat : SentinelComparison::kAsDouble;
+    return z;
   }
+  const std::optional<double> scale = file.ReadAttributeDouble(name, "scale_factor");
+  if (!scale) {
+    throw Error(ErrorCode::kBadInput, kStage,
+                "'" + file.path().string() + "' dataset /scan/z stores integers (sensor counts?), not millimetres: "
+                "give their scale as attribute scale_factor (mm per count, and add_offset in mm if any) on /scan/z, "
+                "or store z as float in mm");
+  }
+  const double offset = file.ReadAttributeDouble(name, "add_offset").value_or(0.0);
+  if (!std::isfinite(*scale) || *scale == 0.0 || !std::isfinite(offset)) {
+    throw Error(ErrorCode::kBadInput, kStage,
+                "'" + file.path().string() + "' /scan/z: scale_factor must be finite and not 0, add_offset finite");
+  }
+  for (double& value : z) {
+    value = metadata.invalid_value && value == *metadata.invalid_value ? std::numeric_limits<double>::quiet_NaN()
+                                                                        : value * *scale + offset;
+  }
+  comparison = SentinelComparison::kDone;
+  return z;
 }
 
 }  // namespace
@@ -49,12 +97,12 @@ Scan ReadHdf5Scan(const hdf5::File& file) {
   if (!file.HasObject("/scan/z")) {
     throw Error(ErrorCode::kBadInput, kStage, "'" + path.string() + "' has no dataset /scan/z");
   }
-  scan.z_mm = ReadColumn(file, "/scan/z");
+  SentinelComparison comparison = SentinelComparison::kAsDouble;
+  scan.z_mm = ReadZ(file, scan.metadata, comparison);
   if (file.HasObject("/scan/t")) scan.t_s = ReadColumn(file, "/scan/t");
   if (file.HasObject("/scan/angle")) scan.angle_deg = ReadColumn(file, "/scan/angle");
   if (file.HasObject("/scan/y")) scan.y_mm = ReadColumn(file, "/scan/y");
-  const bool stored_as_float = file.ElementClass("/scan/z") == H5T_FLOAT && file.ElementSize("/scan/z") == 4;
-  ApplyInvalidMarkers(scan, stored_as_float);
+  ApplyInvalidMarkers(scan, comparison);
   ValidateScan(scan);
   return scan;
 }

@@ -26,6 +26,9 @@ struct ScanMetadata {
   std::string sensor;
   std::string operator_name;
   std::string timestamp;  // ISO 8601, as given
+  // What the reader noticed and the user should see (summary.json `warnings`): keys it did not
+  // use, text it read as Latin-1, an index column it skipped.
+  std::vector<std::string> notes;
 };
 
 // Column-wise samples. `z_mm` always has one entry per row of the file; invalid samples are NaN

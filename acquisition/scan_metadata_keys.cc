@@ -1,65 +1,96 @@
 #include "acquisition/scan_metadata_keys.h"
 
+#include <algorithm>
 #include <charconv>
 #include <cmath>
+#include <iterator>
 #include <limits>
 
 #include "core/error.h"
+#include "core/text_encoding.h"
 
 namespace arcwheel::acquisition {
 namespace {
 
-double ParseValue(const std::string& key, const std::string& value) {
-  std::string_view text(value);
+constexpr const char* kStage = "acquisition";
+
+double ParseValue(const std::string& key, std::string_view text) {
+  const std::string_view written = text;
+  while (!text.empty() && (text.front() == ' ' || text.front() == '\t')) text.remove_prefix(1);
+  while (!text.empty() && (text.back() == ' ' || text.back() == '\t')) text.remove_suffix(1);
   if (!text.empty() && text.front() == '+') text.remove_prefix(1);
   double number = 0.0;
   const auto [end, error] = std::from_chars(text.data(), text.data() + text.size(), number);
-  if (error != std::errc() || end != text.data() + text.size()) {
-    throw Error(ErrorCode::kBadInput, "acquisition", "metadata '" + key + "' is not a number: '" + value + "'");
+  if (text.empty() || error != std::errc() || end != text.data() + text.size()) {
+    bool latin1 = false;
+    throw Error(ErrorCode::kBadInput, kStage,
+                "metadata '" + key + "' is not a number: '" + AsUtf8(written, latin1) + "'");
   }
   return number;
 }
 
+bool IsOneOf(const std::string& name, const auto& keys) {
+  return std::find_if(std::begin(keys), std::end(keys), [&](const char* k) { return name == k; }) != std::end(keys);
+}
+
 }  // namespace
 
-bool SetNumericMetadata(ScanMetadata& m, const std::string& key, double value) {
-  if (key == "spindle_rpm") m.spindle_rpm = value;
-  else if (key == "feed_mm_per_min") m.feed_mm_per_min = value;
-  else if (key == "sample_period_s") m.sample_period_s = value;
-  else if (key == "radius_sign") m.radius_sign = value;
-  else if (key == "start_y_mm") m.start_y_mm = value;
-  else if (key == "start_phase_deg") m.start_phase_deg = value;
-  else if (key == "invalid_value") m.invalid_value = value;
-  else if (key == "range_min_mm") m.range_min_mm = value;
-  else if (key == "range_max_mm") m.range_max_mm = value;
-  else if (key == "wheel_diameter_mm") m.wheel_diameter_mm = value;
-  else if (key == "wheel_width_mm") m.wheel_width_mm = value;
-  else return false;
-  return true;
+std::string MetadataSetter::Claim(std::string_view key) {
+  std::string name = AsciiLower(key);
+  if (!IsOneOf(name, kNumericMetadataKeys) && !IsOneOf(name, kTextMetadataKeys)) {
+    bool latin1 = false;
+    metadata_.notes.push_back("metadata key '" + AsUtf8(key, latin1) +
+                              "' is not one arcwheel reads (formats.md 2.1): ignored");
+    return {};
+  }
+  if (!claimed_.insert(name).second) {
+    throw Error(ErrorCode::kBadInput, kStage,
+                "metadata '" + name + "' is given twice (keys match case-insensitively)");
+  }
+  return name;
 }
 
-void SetMetadata(ScanMetadata& m, const std::string& key, const std::string& value) {
-  if (key == "wheel_id") m.wheel_id = value;
-  else if (key == "sensor") m.sensor = value;
-  else if (key == "operator") m.operator_name = value;
-  else if (key == "timestamp") m.timestamp = value;
-  else if (IsNumericMetadataKey(key)) SetNumericMetadata(m, key, ParseValue(key, value));
+bool MetadataSetter::IsNumeric(const std::string& name) { return IsOneOf(name, kNumericMetadataKeys); }
+
+void MetadataSetter::SetNumber(const std::string& name, double value) {
+  ScanMetadata& m = metadata_;
+  if (name == "spindle_rpm") m.spindle_rpm = value;
+  else if (name == "feed_mm_per_min") m.feed_mm_per_min = value;
+  else if (name == "sample_period_s") m.sample_period_s = value;
+  else if (name == "radius_sign") m.radius_sign = value;
+  else if (name == "start_y_mm") m.start_y_mm = value;
+  else if (name == "start_phase_deg") m.start_phase_deg = value;
+  else if (name == "invalid_value") m.invalid_value = value;
+  else if (name == "range_min_mm") m.range_min_mm = value;
+  else if (name == "range_max_mm") m.range_max_mm = value;
+  else if (name == "wheel_diameter_mm") m.wheel_diameter_mm = value;
+  else if (name == "wheel_width_mm") m.wheel_width_mm = value;
+  else throw Error(ErrorCode::kInternal, kStage, "metadata '" + name + "' is not numeric");
 }
 
-bool IsNumericMetadataKey(const std::string& key) {
-  ScanMetadata probe;
-  return SetNumericMetadata(probe, key, 0.0);
+void MetadataSetter::SetText(const std::string& name, std::string_view value) {
+  if (IsNumeric(name)) return SetNumber(name, ParseValue(name, value));
+  bool latin1 = false;
+  std::string text = AsUtf8(value, latin1);
+  if (latin1) metadata_.notes.push_back("metadata '" + name + "' is not valid UTF-8: read as Latin-1");
+  ScanMetadata& m = metadata_;
+  if (name == "wheel_id") m.wheel_id = std::move(text);
+  else if (name == "sensor") m.sensor = std::move(text);
+  else if (name == "operator") m.operator_name = std::move(text);
+  else if (name == "timestamp") m.timestamp = std::move(text);
+  else throw Error(ErrorCode::kInternal, kStage, "metadata '" + name + "' is not text");
 }
 
-void ApplyInvalidMarkers(Scan& scan, bool compare_as_float) {
+void ApplyInvalidMarkers(Scan& scan, SentinelComparison comparison) {
   const ScanMetadata& m = scan.metadata;
   const double low = m.range_min_mm.value_or(-std::numeric_limits<double>::infinity());
   const double high = m.range_max_mm.value_or(std::numeric_limits<double>::infinity());
-  const bool has_sentinel = m.invalid_value.has_value();
+  const bool has_sentinel = m.invalid_value.has_value() && comparison != SentinelComparison::kDone;
+  const bool as_float = comparison == SentinelComparison::kAsFloat;
   const double sentinel = m.invalid_value.value_or(0.0);
   const float sentinel_float = static_cast<float>(sentinel);
   for (double& z : scan.z_mm) {
-    const bool is_sentinel = has_sentinel && (compare_as_float ? static_cast<float>(z) == sentinel_float : z == sentinel);
+    const bool is_sentinel = has_sentinel && (as_float ? static_cast<float>(z) == sentinel_float : z == sentinel);
     // +-Inf is a float sensor's over-range reading: an invalid sample, like NaN.
     if (is_sentinel || !std::isfinite(z) || !(z >= low && z <= high)) z = std::numeric_limits<double>::quiet_NaN();
   }

@@ -1,6 +1,9 @@
 #include "core/hdf5.h"
 
+#include <dlfcn.h>
+
 #include <algorithm>
+#include <charconv>
 #include <cstddef>
 #include <cstring>
 #include <set>
@@ -13,9 +16,16 @@ namespace {
 
 constexpr const char* kStage = "hdf5";
 
+// Debian 12's hdf5-plugin-lzf calls lzf_compress/lzf_decompress without declaring liblzf as a
+// dependency, so libhdf5's dlopen of the plugin fails on an undefined symbol and an LZF dataset
+// (h5py's own filter) cannot be read. Loading liblzf globally first lets the plugin resolve them;
+// where liblzf is missing nothing changes, and such a file is refused naming the filter.
+void LoadLzfForTheLzfPlugin() { (void)::dlopen("liblzf.so.1", RTLD_NOW | RTLD_GLOBAL); }
+
 void SilenceHdf5ErrorStack() {
   static const bool silenced = [] {
     H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);
+    LoadLzfForTheLzfPlugin();
     return true;
   }();
   (void)silenced;
@@ -145,6 +155,31 @@ void CheckNumberSize(hid_t type, const std::string& what) {
   }
 }
 
+// A filter libhdf5 cannot apply (a plugin that is not installed) fails H5Dread with no word of
+// why: after a failed read, name it, with the Debian package that brings it where there is one.
+// (libhdf5 1.10 loads a plugin only when a read needs it, so H5Zfilter_avail says "no" for an
+// installed one until then: it is asked only after the read.)
+void CheckFiltersAvailable(const Handle& data, const std::string& where) {
+  const Handle creation(H5Dget_create_plist(data.id()), H5Pclose);
+  const int filters = creation.valid() ? H5Pget_nfilters(creation.id()) : 0;
+  for (int k = 0; k < filters; ++k) {
+    unsigned flags = 0, config = 0;
+    size_t values = 0;
+    char name[256] = {};
+    const H5Z_filter_t id = H5Pget_filter2(creation.id(), static_cast<unsigned>(k), &flags, &values, nullptr,
+                                           sizeof name, name, &config);
+    if (id < 0 || H5Zfilter_avail(id) > 0) continue;
+    std::string package;
+    if (id == 32000) package = " (Debian package hdf5-plugin-lzf)";
+    if (id == 307 || id == 32004 || id == 32008) package = " (Debian package hdf5-filter-plugin)";
+    if (id == 32001) package = " (Debian package hdf5-filter-plugin-blosc-serial)";
+    throw Error(ErrorCode::kBadInput, kStage,
+                where + " is compressed with HDF5 filter " + std::to_string(id) + (name[0] ? " '" + std::string(name) + "'" : "") +
+                    ", which this HDF5 installation cannot decode: install its plugin" + package +
+                    " or rewrite the file with gzip");
+  }
+}
+
 template <typename T>
 std::vector<T> ReadNumeric(hid_t file_id, const Handle& data, hid_t memory_type, const std::string& where) {
   const Handle type(H5Dget_type(data.id()), H5Tclose);
@@ -169,6 +204,7 @@ std::vector<T> ReadNumeric(hid_t file_id, const Handle& data, hid_t memory_type,
   std::vector<T> values(static_cast<size_t>(count));
   if (count > 0 &&
       H5Dread(data.id(), memory_type, H5S_ALL, H5S_ALL, H5P_DEFAULT, values.data()) < 0) {
+    CheckFiltersAvailable(data, where);
     throw Error(ErrorCode::kBadInput, kStage,
                 "cannot read " + where + " (file truncated or damaged?)");
   }
@@ -275,46 +311,91 @@ std::optional<double> File::ReadAttributeDouble(const std::string& object, const
 
 std::optional<std::string> File::ReadAttributeString(const std::string& object, const std::string& name) const {
   if (!HasAttribute(object, name)) return std::nullopt;
+  const std::string where = "attribute '" + name + "' on " + Where(object);
   const Handle attribute(H5Aopen_by_name(handle_.id(), object.c_str(), name.c_str(), H5P_DEFAULT, H5P_DEFAULT),
                          H5Aclose);
   const Handle type(H5Aget_type(attribute.id()), H5Tclose);
   const H5T_class_t type_class = H5Tget_class(type.id());
+  const Handle space(H5Aget_space(attribute.id()), H5Sclose);
+  // Scalar or a one-element array (as MATLAB and some h5py scripts write): one value either way.
+  const hssize_t count = H5Sget_simple_extent_npoints(space.id());
+  if (count != 1) {
+    throw Error(ErrorCode::kBadInput, kStage, where + " holds " + std::to_string(count) + " values; expected one");
+  }
   if (type_class == H5T_FLOAT || type_class == H5T_INTEGER) {
-    CheckNumberSize(type.id(), "attribute '" + name + "' on " + Where(object));
-    double value = 0.0;
-    H5Aread(attribute.id(), H5T_NATIVE_DOUBLE, &value);
-    std::string text = std::to_string(value);
-    return text;
+    const std::optional<double> value = ReadAttributeDouble(object, name);
+    char text[32];
+    const auto end = std::to_chars(text, text + sizeof text, *value).ptr;  // shortest exact form: 3, not 3.000000
+    return std::string(text, end);
   }
   if (type_class != H5T_STRING) {
-    throw Error(ErrorCode::kBadInput, kStage, "attribute '" + name + "' on " + Where(object) + " is not text");
+    throw Error(ErrorCode::kBadInput, kStage, where + " is not text");
   }
+  // The memory type keeps the stored character set: libhdf5 refuses to convert UTF-8 to ASCII.
+  const H5T_cset_t charset = H5Tget_cset(type.id());
   if (H5Tis_variable_str(type.id()) > 0) {
-    CheckHeapReferences(attribute.id(), type.id(), "attribute '" + name + "' on " + Where(object));
+    CheckHeapReferences(attribute.id(), type.id(), where);
     const Handle memory_type(H5Tcopy(H5T_C_S1), H5Tclose);
     H5Tset_size(memory_type.id(), H5T_VARIABLE);
+    H5Tset_cset(memory_type.id(), charset);
     char* text = nullptr;
-    if (H5Aread(attribute.id(), memory_type.id(), &text) < 0 || text == nullptr) {
-      throw Error(ErrorCode::kBadInput, kStage, "cannot read attribute '" + name + "' on " + Where(object));
+    if (H5Aread(attribute.id(), memory_type.id(), &text) < 0) {
+      throw Error(ErrorCode::kBadInput, kStage, "cannot read " + where);
     }
-    std::string result(text);
+    std::string result = text == nullptr ? std::string() : std::string(text);
     H5free_memory(text);
     return result;
   }
   const size_t size = H5Tget_size(type.id());
   if (size > (1U << 20)) {
-    throw Error(ErrorCode::kBadInput, kStage,
-                "attribute '" + name + "' on " + Where(object) + " declares " + std::to_string(size) +
-                    " bytes of text (damaged?)");
+    throw Error(ErrorCode::kBadInput, kStage, where + " declares " + std::to_string(size) + " bytes of text (damaged?)");
   }
+  // Read the stored bytes as they are (a null-padded memory type of the same size and character
+  // set: no conversion), then take off the padding the file declares. A null-terminated memory type
+  // would make libhdf5 drop the last character of a full null-padded string to fit its terminator.
   std::string buffer(size, '\0');
   const Handle memory_type(H5Tcopy(H5T_C_S1), H5Tclose);
   H5Tset_size(memory_type.id(), size);
+  H5Tset_cset(memory_type.id(), charset);
+  H5Tset_strpad(memory_type.id(), H5T_STR_NULLPAD);
   if (H5Aread(attribute.id(), memory_type.id(), buffer.data()) < 0) {
-    throw Error(ErrorCode::kBadInput, kStage, "cannot read attribute '" + name + "' on " + Where(object));
+    throw Error(ErrorCode::kBadInput, kStage, "cannot read " + where);
   }
-  buffer.resize(buffer.find('\0') == std::string::npos ? buffer.size() : buffer.find('\0'));
+  // Whether or not libhdf5 converted the padding on the way, the text ends at the first NUL and,
+  // space-padded, before its trailing blanks.
+  buffer.resize(std::min(buffer.size(), buffer.find('\0')));
+  if (H5Tget_strpad(type.id()) == H5T_STR_SPACEPAD) {
+    const size_t last = buffer.find_last_not_of(' ');
+    buffer.resize(last == std::string::npos ? 0 : last + 1);
+  }
   return buffer;
+}
+
+namespace {
+
+herr_t CollectAttributeName(hid_t, const char* name, const H5A_info_t*, void* names) {
+  static_cast<std::vector<std::string>*>(names)->emplace_back(name);
+  return 0;
+}
+
+}  // namespace
+
+std::vector<std::string> File::AttributeNames(const std::string& object) const {
+  std::vector<std::string> names;
+  if (object != "/" && !HasObject(object)) return names;
+  // Creation order is tracked only when the writer asked for it; name order always works.
+  hsize_t position = 0;
+  if (H5Aiterate_by_name(handle_.id(), object.c_str(), H5_INDEX_CRT_ORDER, H5_ITER_INC, &position,
+                         CollectAttributeName, &names, H5P_DEFAULT) >= 0) {
+    return names;
+  }
+  names.clear();
+  position = 0;
+  if (H5Aiterate_by_name(handle_.id(), object.c_str(), H5_INDEX_NAME, H5_ITER_INC, &position, CollectAttributeName,
+                         &names, H5P_DEFAULT) < 0) {
+    throw Error(ErrorCode::kBadInput, kStage, "cannot list the attributes of " + Where(object));
+  }
+  return names;
 }
 
 namespace {

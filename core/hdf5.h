@@ -76,8 +76,12 @@ class File {
   [[nodiscard]] bool HasAttribute(const std::string& object, const std::string& name) const;
   [[nodiscard]] std::optional<double> ReadAttributeDouble(const std::string& object,
                                                           const std::string& name) const;
+  // Text stored in any way HDF5 allows (variable or fixed length, ASCII or UTF-8, null-terminated,
+  // null- or space-padded, scalar or one-element array), byte-exact; a number as its shortest form.
   [[nodiscard]] std::optional<std::string> ReadAttributeString(const std::string& object,
                                                                const std::string& name) const;
+  // The names of the attributes on `object`, in creation order where the file tracks it.
+  [[nodiscard]] std::vector<std::string> AttributeNames(const std::string& object) const;
   // The first element of a compound attribute (e.g. Zygo's `Z Converter`): its string members
   // (fixed or variable length) and numeric members (a number, a fixed array or a variable-length
   // sequence, converted to double) by member name; other member kinds are left out.

@@ -89,6 +89,7 @@ ProcessedScan ProcessScan(acquisition::Scan scan, const ProcessOptions& options)
   }
   ProcessedScan out;
   out.samples = scan.size();
+  out.warnings = scan.metadata.notes;  // what the reader noticed comes first
   ToRadialCoordinate(scan);
   std::vector<double>& rho = scan.z_mm;
   out.valid_samples = static_cast<std::size_t>(std::count_if(rho.begin(), rho.end(), [](double v) { return std::isfinite(v); }));

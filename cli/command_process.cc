@@ -12,6 +12,7 @@
 #include "core/interrupt.h"
 #include "core/progress.h"
 #include "core/sha256.h"
+#include "core/text_encoding.h"
 #include "fitting/outputs.h"
 #include "fitting/wheel_fit.h"
 #include "processing/process_scan.h"
@@ -36,7 +37,10 @@ struct ProcessArgs {
 
 fitting::RunRecord MakeRecord(const ProcessArgs& args, const acquisition::Scan& scan) {
   fitting::RunRecord record;
-  record.input_path = args.scan_path;
+  // The path as the file system gives it may be in a legacy encoding; summary.json must stay UTF-8
+  // (docs/inputs.md).
+  bool latin1_path = false;
+  record.input_path = AsUtf8(args.scan_path, latin1_path);
   const std::string extension = std::filesystem::path(args.scan_path).extension().string();
   record.input_format = extension == ".h5" || extension == ".hdf5" ? "hdf5" : "csv";
   record.metadata = scan.metadata;

@@ -173,6 +173,16 @@ TEST_F(ForeignFiles, Latin1MetadataBecomesValidUtf8AndTheSummarySaysSo) {
   }
 }
 
+TEST_F(ForeignFiles, APathInALegacyEncodingStillGivesAValidUtf8Summary) {
+  TempDir out;
+  const std::filesystem::path latin1 = out / "M\xFCller.csv";  // as a Latin-1 file system names it
+  std::filesystem::copy_file(Good("pandas_no_index.csv"), latin1);
+  const auto run = RunArcwheel("process -q '" + latin1.string() + "' -o " + (out / "x").string());
+  ASSERT_EQ(run.exit_status, 0) << run.output;
+  const json summary = ReadJson(out / "x" / "summary.json");
+  EXPECT_EQ(summary["input"]["path"].get<std::string>(), (out / "M\xC3\xBCller.csv").string());
+}
+
 TEST_F(ForeignFiles, BadVariantsAreRefusedNamingTheFileAndTheReasonAndWriteNothing) {
   TempDir out;
   int refused = 0;

@@ -95,9 +95,11 @@ void Run(ProcessArgs& args) {
   args.fit.fit_span = fitting::ParseFitSpan(args.fit_span);
   Progress progress(!args.quiet);
   progress.Update("reading", 0.0);
-  // The input's SHA-256 is computed on the second core while the first one works.
-  auto sha256 = std::async(std::launch::async, [path = args.scan_path] { return Sha256OfFile(path); });
+  // ReadScan forks (an HDF5 file is read first in a child process, core/hdf5_child.cc), and no
+  // thread may be alive at fork(): the input's SHA-256 starts after it, on the second core while
+  // the first one processes.
   acquisition::Scan scan = acquisition::ReadScan(args.scan_path);
+  auto sha256 = std::async(std::launch::async, [path = args.scan_path] { return Sha256OfFile(path); });
   fitting::RunRecord record = MakeRecord(args, scan);
   ThrowIfInterrupted();
   progress.Update("processing", 0.3);

@@ -39,6 +39,7 @@ TEST(ThreePointFrame, RefusesCoincidentAndCollinearPoints) {
   EXPECT_THROW((void)ThreePointFrame(p1, p2, Eigen::Vector3d(-300, 0.01, 0)), Error);  // on the -X side
   try {
     (void)ThreePointFrame(p1, p2, Eigen::Vector3d(50, 0, 0));
+    ADD_FAILURE() << "three collinear points were accepted";
   } catch (const Error& error) {
     EXPECT_EQ(error.code(), ErrorCode::kBadInput);
     EXPECT_NE(std::string(error.what()).find("collinear"), std::string::npos);

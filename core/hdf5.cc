@@ -383,6 +383,12 @@ herr_t CollectAttributeName(hid_t, const char* name, const H5A_info_t*, void* na
 std::vector<std::string> File::AttributeNames(const std::string& object) const {
   std::vector<std::string> names;
   if (object != "/" && !HasObject(object)) return names;
+  // libhdf5 1.10.8 builds a table of all attributes to iterate, and if one of them fails to decode
+  // it frees the half-built table through a null pointer. Looking up a name that is not there
+  // decodes every attribute message the same way without that table: a damaged one fails here.
+  if (H5Aexists_by_name(handle_.id(), object.c_str(), "\x01 no such attribute", H5P_DEFAULT) < 0) {
+    throw Error(ErrorCode::kBadInput, kStage, "cannot list the attributes of " + Where(object) + " (damaged?)");
+  }
   // Creation order is tracked only when the writer asked for it; name order always works.
   hsize_t position = 0;
   if (H5Aiterate_by_name(handle_.id(), object.c_str(), H5_INDEX_CRT_ORDER, H5_ITER_INC, &position,

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <utility>
 #include <fstream>
 #include <iterator>
 #include <limits>
@@ -123,12 +124,17 @@ std::shared_ptr<const grinding::Surface> ReadSurface(Section& s) {
     for (std::size_t k = 0; k < s.Raw("terms").size(); ++k) {
       Section t(&s.Raw("terms")[k], s.Dotted(fmt::format("terms[{}]", k)), s.source());
       grinding::XyPolynomialTerm term;
-      term.x_power = static_cast<int>(t.Number("x_power", 0.0));
-      term.y_power = static_cast<int>(t.Number("y_power", 0.0));
-      term.coefficient = t.RequiredNumber("coefficient");
-      if (term.x_power < 0 || term.y_power < 0 || term.x_power > 20 || term.y_power > 20) {
-        t.Fail("x_power", "and y_power must be whole numbers within 0 .. 20");
+      // Checked as doubles first: a power of 2.5 is refused, not computed as 2, and one beyond
+      // int's range is never cast (undefined behaviour).
+      const double x_power = t.Number("x_power", 0.0), y_power = t.Number("y_power", 0.0);
+      for (const auto& [key, power] : {std::pair{"x_power", x_power}, std::pair{"y_power", y_power}}) {
+        if (!(power >= 0.0 && power <= 20.0) || power != std::floor(power)) {
+          t.Fail(key, fmt::format("must be a whole number within 0 .. 20, got {}", power));
+        }
       }
+      term.x_power = static_cast<int>(x_power);
+      term.y_power = static_cast<int>(y_power);
+      term.coefficient = t.RequiredNumber("coefficient");
       t.Finish();
       terms.push_back(term);
       resolved.push_back(t.resolved());

@@ -121,6 +121,20 @@ TEST(PolishCommand, ReadsFreeformAndAsphereSurfacesInTheGrindingJobsForm) {
   EXPECT_GT(rows, 500);
 }
 
+TEST(PolishCommand, RefusesAPowerThatIsNotAWholeNumberInRangeNamingItsValue) {
+  TempDir dir;
+  WriteMap(dir / "map.csv");
+  // 2.5 was computed as 2 while 2.5 went into the summary; 3e110 was cast to int (undefined).
+  for (const std::string power : {"2.5", "3e110", "-1"}) {
+    WriteText(dir / "job.json", WithSurface(R"({"type": "xy_polynomial", "terms": [
+        {"x_power": 2, "coefficient": -0.001}, {"y_power": )" + power + R"(, "coefficient": -0.0012}]})"));
+    const auto result = RunArcwheel(fmt::format("polish {} -o {}", (dir / "job.json").string(), (dir / "out").string()));
+    EXPECT_EQ(result.exit_status, 3) << result.output;
+    EXPECT_NE(result.output.find("terms[1].y_power' must be a whole number within 0 .. 20, got"), std::string::npos) << result.output;
+    EXPECT_FALSE(std::filesystem::exists(dir / "out"));
+  }
+}
+
 TEST(PolishCommand, TiltsThePrecessingBonnetByTheJobsAngle) {
   TempDir dir;
   WriteMap(dir / "map.csv");

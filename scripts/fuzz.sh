@@ -12,6 +12,7 @@
 #   FUZZ_JOBS=3 scripts/fuzz.sh 600         # three targets at a time
 #   FUZZ_BUILD=0 scripts/fuzz.sh 600        # the binaries already in build-fuzz/fuzz/
 #   FUZZ_PRESET=asan scripts/fuzz.sh 20     # the targets of the sanitizer suite's build (CI)
+#   FUZZ_SEED=1 scripts/fuzz.sh 20          # the same mutations every run (CI: a gate, not a search)
 set -euo pipefail
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 seconds=${1:-20}
@@ -55,6 +56,7 @@ fuzz_one() {
   mkdir -p "$crashes"
   TMPDIR=$work "$build_dir/fuzz/$target" "$corpus" -max_total_time="$seconds" -timeout=10 \
     -rss_limit_mb=2048 -malloc_limit_mb=65536 -max_len=262144 -artifact_prefix="$crashes/" -print_final_stats=1 \
+    -seed="${FUZZ_SEED:-0}" \
     >"$work/log" 2>&1 || status=$?
   runs=$(sed -n 's/^stat::number_of_executed_units: *//p' "$work/log")
   echo "fuzz: $target: ${seconds} s, ${runs:-?} executions, exit $status"

@@ -91,6 +91,14 @@ double WheelModel::RadiusMm(double phase_deg, double y_mm) const {
   return smooth + grit_sigma_um * gaussian / 1000.0;
 }
 
+WheelModel LobedTestWheel() {
+  WheelModel w;
+  w.radial_harmonics_um = {{1, 5.0, 30.0}, {3, 1.5, 10.0}, {5, 0.8, 100.0}};
+  w.center_axial_harmonics_mm = {{1, 0.004, 60.0}};
+  w.arc_radius_harmonics_mm = {{2, 0.010, 45.0}};
+  return w;
+}
+
 SimulatedScan SimulateScan(const WheelModel& wheel, const ScanSettings& s) {
   Require(s.spindle_rpm_true > 0 && s.spindle_rpm_nominal > 0, "spindle speeds must be positive");
   Require(s.feed_mm_per_min > 0, "feed_mm_per_min must be positive");
@@ -126,7 +134,10 @@ SimulatedScan SimulateScan(const WheelModel& wheel, const ScanSettings& s) {
   if (s.write_encoder) scan.angle_deg.resize(n);
   if (s.write_axial) scan.y_mm.resize(n);
 
+  // Noise and defects come from separate streams, so that a scan with spikes and dropouts carries
+  // the same noise as the clean scan of the same seed: tests compare the two sample for sample.
   std::mt19937_64 rng(s.seed);
+  std::mt19937_64 events(s.seed ^ 0x9e3779b97f4a7c15ULL);
   std::normal_distribution<double> noise(0.0, s.noise_um / 1000.0);
   std::uniform_real_distribution<double> unit(0.0, 1.0);
   int burst_left = 0;
@@ -150,16 +161,16 @@ SimulatedScan SimulateScan(const WheelModel& wheel, const ScanSettings& s) {
       const double height = std::sqrt(radius * radius - beam2);
       z = s.radius_sign * (height - s.sensor_zero_radius_mm);
       if (s.noise_um > 0) z += noise(rng);
-      if (burst_left == 0 && s.burst_rate > 0 && unit(rng) < s.burst_rate) {
-        burst_left = 2 + static_cast<int>(unit(rng) * (s.burst_length_max - 1));
-        burst_offset_mm = (unit(rng) < 0.5 ? -1.0 : 1.0) * s.spike_amplitude_um * (0.5 + 0.5 * unit(rng)) / 1000.0;
+      if (burst_left == 0 && s.burst_rate > 0 && unit(events) < s.burst_rate) {
+        burst_left = 2 + static_cast<int>(unit(events) * (s.burst_length_max - 1));
+        burst_offset_mm = (unit(events) < 0.5 ? -1.0 : 1.0) * s.spike_amplitude_um * (0.5 + 0.5 * unit(events)) / 1000.0;
       }
       if (burst_left > 0) {
-        z += burst_offset_mm * (0.8 + 0.4 * unit(rng));
+        z += burst_offset_mm * (0.8 + 0.4 * unit(events));
         --burst_left;
         ++counts.spikes;
-      } else if (s.spike_rate > 0 && unit(rng) < s.spike_rate) {
-        z += (unit(rng) < 0.5 ? -1.0 : 1.0) * s.spike_amplitude_um * (0.5 + 0.5 * unit(rng)) / 1000.0;
+      } else if (s.spike_rate > 0 && unit(events) < s.spike_rate) {
+        z += (unit(events) < 0.5 ? -1.0 : 1.0) * s.spike_amplitude_um * (0.5 + 0.5 * unit(events)) / 1000.0;
         ++counts.spikes;
       }
       if (std::abs(z) > s.sensor_range_mm) z = kNaN;
@@ -167,8 +178,8 @@ SimulatedScan SimulateScan(const WheelModel& wheel, const ScanSettings& s) {
     if (!std::isfinite(z)) {
       ++counts.off_rim;
     } else {
-      if (dropout_left == 0 && s.dropout_rate > 0 && unit(rng) < s.dropout_rate) {
-        dropout_left = 1 + static_cast<int>(unit(rng) * s.dropout_length_max);
+      if (dropout_left == 0 && s.dropout_rate > 0 && unit(events) < s.dropout_rate) {
+        dropout_left = 1 + static_cast<int>(unit(events) * s.dropout_length_max);
       }
       if (dropout_left > 0) {
         z = kNaN;

@@ -58,6 +58,11 @@ struct WheelModel {
   [[nodiscard]] double RadiusMm(double phase_deg, double y_mm) const;
 };
 
+// A wheel with each phase-dependent error of method.md A, for tests and benchmarks: 5 um of
+// eccentricity, lobes of orders 3 and 5, a 4 um axial wobble of the arc centre and a 10 um
+// second-order variation of the arc radius; no profile error.
+[[nodiscard]] WheelModel LobedTestWheel();
+
 struct ScanSettings {
   double spindle_rpm_nominal = 500.0;
   double spindle_rpm_true = 500.0;

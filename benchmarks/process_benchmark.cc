@@ -57,6 +57,37 @@ void BM_ProcessEndToEnd(benchmark::State& state) {
   state.counters["samples"] = static_cast<double>(samples);
 }
 
+// Not a speed figure: the error of the mean arc radius against the simulated truth, in reported
+// sigmas, at sizes beyond what the test suite runs (issue "Real-world scans", point 5). One
+// iteration each; the counters carry the figures.
+void BM_MeanRadiusAgainstTruth(benchmark::State& state) {
+  const acquisition::WheelModel wheel = acquisition::LobedTestWheel();
+  acquisition::ScanSettings settings;
+  settings.noise_um = 0.5;
+  const auto samples = static_cast<double>(state.range(0));
+  settings.feed_mm_per_min = (settings.end_y_mm - settings.start_y_mm) / (samples * settings.sample_period_s) * 60.0;
+  settings.spindle_rpm_true = state.range(1) != 0 ? 1.002 * settings.spindle_rpm_nominal : settings.spindle_rpm_nominal;
+  settings.write_encoder = state.range(1) == 1;
+  double error_um = 0.0, sigma_um = 0.0;
+  for (auto _ : state) {
+    const auto simulated = acquisition::SimulateScan(wheel, settings);
+    const auto processed = processing::ProcessScan(simulated.scan, {});
+    const auto fit = fitting::FitWheel(processed.map, {});
+    error_um = (fit.mean_arc_radius_mm - wheel.arc_radius_mm) * 1000.0;
+    sigma_um = fit.mean_arc_radius_sigma_mm * 1000.0;
+  }
+  state.counters["error_um"] = error_um;
+  state.counters["sigma_um"] = sigma_um;
+  state.counters["z"] = error_um / sigma_um;
+}
+
+// Second argument: 0 nominal speed, 1 encoder with the spindle 0.2 % fast, 2 the same without encoder.
+BENCHMARK(BM_MeanRadiusAgainstTruth)
+    ->ArgsProduct({{100'000'000}, {0, 1, 2}})
+    ->Iterations(1)
+    ->Unit(benchmark::kSecond)
+    ->UseRealTime();
+
 BENCHMARK(BM_ProcessEndToEnd)->Arg(1'000'000)->Arg(10'000'000)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 }  // namespace

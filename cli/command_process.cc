@@ -56,6 +56,7 @@ fitting::RunRecord MakeRecord(const ProcessArgs& args, const acquisition::Scan& 
       {"speed_max_harmonic", p.speed.max_harmonic},
       {"speed_significance_sigmas", p.speed.significance_sigmas},
       {"map_min_support", p.map.min_support},
+      {"map_max_sigma_ratio", p.map.max_sigma_ratio},
       {"fit_min_points", args.fit.min_points},
       {"fit_min_band_coverage", args.fit.min_band_coverage},
       {"runout_min_phase_coverage", args.fit.min_phase_coverage},

@@ -132,11 +132,92 @@ std::vector<Sample> RejectInParallel(std::span<const double> z, int w, double th
   return first;
 }
 
-void DespikeByMedian(std::span<double> z, int w, double threshold_mm, DespikeResult& result) {
-  for (const Sample& s : RejectInParallel<WindowMedian>(z, w, threshold_mm)) {
-    z[s.index] = kNaN;
-    result.indices.push_back(s.index);
+// Up to w valid samples on each side of i (i itself left out), none further than 4w positions
+// from it: across a dropout the wheel has turned on, and the readings there (several
+// micrometres away where the arc radius varies with phase) would outvote i's own neighbours.
+std::vector<std::size_t> NeighbourIndices(std::span<const double> z, std::size_t i, int w) {
+  const std::size_t reach = 4 * static_cast<std::size_t>(w);
+  std::vector<std::size_t> found;
+  std::size_t left = 0;
+  for (std::size_t k = i; k > 0 && i - k < reach && left < static_cast<std::size_t>(w);) {
+    if (std::isfinite(z[--k])) {
+      found.push_back(k);
+      ++left;
+    }
   }
+  std::size_t right = 0;
+  for (std::size_t k = i + 1; k < z.size() && k - i <= reach && right < static_cast<std::size_t>(w); ++k) {
+    if (std::isfinite(z[k])) {
+      found.push_back(k);
+      ++right;
+    }
+  }
+  return found;
+}
+
+std::vector<double> Neighbours(std::span<const double> z, std::size_t i, int w) {
+  std::vector<double> values;
+  for (const std::size_t k : NeighbourIndices(z, i, w)) values.push_back(z[k]);
+  return values;
+}
+
+double MedianOf(std::vector<double> values) {
+  if (values.empty()) return kNaN;
+  SortedWindow sorted;
+  for (const double v : values) sorted.Insert(v);
+  return sorted.Median();
+}
+
+// The neighbours (as NeighbourIndices) of any of `removed`, sorted and unique.
+std::vector<std::size_t> SamplesNear(std::span<const double> z, const std::vector<std::size_t>& removed, int w) {
+  std::vector<std::size_t> near;
+  for (const std::size_t r : removed) {
+    const std::vector<std::size_t> found = NeighbourIndices(z, r, w);
+    near.insert(near.end(), found.begin(), found.end());
+  }
+  std::sort(near.begin(), near.end());
+  near.erase(std::unique(near.begin(), near.end()), near.end());
+  return near;
+}
+
+// A window in which spikes are the majority (a 5-sample burst beside an isolated spike) has a
+// spike for its median, so one pass keeps a spike there and may drop a good sample. Later passes
+// judge again, without the samples already dropped, every sample whose window held one; they
+// stop when nothing more is dropped. Last, every dropped sample is judged against its kept
+// neighbours, and the good ones an early, spiked median condemned come back.
+void DespikeByMedian(std::span<double> z, int w, double threshold_mm, DespikeResult& result) {
+  constexpr int kMaxPasses = 8;
+  std::vector<std::pair<std::size_t, double>> dropped;  // index, reading
+  std::vector<std::size_t> newly;
+  for (const Sample& s : RejectInParallel<WindowMedian>(z, w, threshold_mm)) newly.push_back(s.index);
+  for (int pass = 1; !newly.empty(); ++pass) {
+    for (const std::size_t i : newly) {
+      dropped.emplace_back(i, z[i]);
+      z[i] = kNaN;
+    }
+    if (pass == kMaxPasses) break;
+    std::vector<std::size_t> next;
+    for (const std::size_t i : SamplesNear(z, newly, w)) {
+      std::vector<double> window = Neighbours(z, i, w);
+      window.push_back(z[i]);
+      if (std::abs(z[i] - MedianOf(std::move(window))) > threshold_mm) next.push_back(i);
+    }
+    newly = std::move(next);
+  }
+  std::vector<std::size_t> restored;
+  for (const auto& [i, reading] : dropped) {
+    const double median = MedianOf(Neighbours(z, i, w));
+    if (std::isfinite(median) && std::abs(reading - median) <= threshold_mm) restored.push_back(i);
+  }
+  std::sort(restored.begin(), restored.end());
+  for (const auto& [i, reading] : dropped) {
+    if (std::binary_search(restored.begin(), restored.end(), i)) {
+      z[i] = reading;
+    } else {
+      result.indices.push_back(i);
+    }
+  }
+  std::sort(result.indices.begin(), result.indices.end());
 }
 
 void DespikeByMovingMean(std::span<double> z, int w, double threshold_mm, DespikeResult& result) {

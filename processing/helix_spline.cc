@@ -11,9 +11,12 @@
 namespace arcwheel::processing {
 namespace {
 
-// Relative weight of the second-difference penalty: small enough to leave a well-sampled
-// spline untouched (bias far below the noise), large enough to bridge a dropout.
-constexpr double kPenaltyRelative = 1e-7;
+// Relative weight (to the mean diagonal of the normal matrix) of the second-difference penalty
+// (a P-spline, Eilers & Marx 1996). Inside a gap it makes the coefficients a straight line
+// between the data around, and it holds the few-sample coefficients at a gap's edge to their
+// neighbours. At 1e-4 it damps a lobe of order 100 (a 3.6 deg wave) by 0.06 % where the samples
+// are dense; at 1e-7 the edge coefficients of a dropout swung by tens of micrometres.
+constexpr double kPenaltyRelative = 1e-4;
 
 std::pair<std::size_t, std::size_t> ValidSpan(std::span<const double> z) {
   std::size_t first = 0;

@@ -4,8 +4,9 @@
 // The wheel map is built from this spline rather than from one interpolated point per turn: at
 // the paper's settings every knot interval (1 deg) holds about three samples, and all of them
 // inform the value at each phase (method.md A, "things learned": ~1.8x less noise per phase).
-// A tiny second-difference penalty keeps the normal matrix definite across dropouts; values
-// there rest on few samples, and support() says how many.
+// A small second-difference penalty keeps the normal matrix definite across dropouts and bridges
+// them with a straight line; values there rest on few samples, Support() says how many and
+// VarianceFactor() how well they are known.
 //
 // Uncertainty: with white noise of sigma per sample, Var g(u) = sigma^2 b(u)^T (A^T A)^-1 b(u),
 // b(u) the four basis values; VarianceFactor() returns the factor after sigma^2. Values at the

@@ -19,6 +19,7 @@ struct MapOptions {
   double knot_step_deg = 0.0;   // helix spline knot spacing; <= 0: 360/phases, widened to >= 2.5 samples
   double axial_step_mm = 0.0;   // map node spacing; <= 0: one helix pitch
   int min_support = 2;          // a section point needs this many valid samples within its two knot intervals
+  double max_sigma_ratio = 1.5; // ... and a sigma at most this many times the median point's; >= 1
   [[nodiscard]] std::vector<std::string> Problems() const;
 };
 

@@ -23,10 +23,7 @@ using acquisition::WheelModel;
 // The paper's wheel with runout, lobing, wobble, a per-phase radius variation and a
 // non-circular profile error.
 WheelModel PaperWheel() {
-  WheelModel w;
-  w.radial_harmonics_um = {{1, 5.0, 30.0}, {3, 1.5, 10.0}, {5, 0.8, 100.0}};
-  w.center_axial_harmonics_mm = {{1, 0.004, 60.0}};
-  w.arc_radius_harmonics_mm = {{2, 0.010, 45.0}};
+  WheelModel w = acquisition::LobedTestWheel();
   w.profile_legendre_um = {0.0, 0.0, 0.6, 0.8, 0.4};
   return w;
 }

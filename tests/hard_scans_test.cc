@@ -1,0 +1,169 @@
+// The scan pipeline on hard data (issue "Real-world scans", points 4 and 5): spikes in bursts and
+// dropouts, and scans of 1e5 to 1e7 samples with and without an encoder and with the spindle off
+// its nominal speed. Expected values come from the simulator's known wheel; the reference for a
+// peak-to-valley metric is the spread the same scans give without the spikes and dropouts (the
+// simulator draws noise and defects from separate streams, so the two carry the same noise).
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <numeric>
+#include <vector>
+
+#include "acquisition/simulate.h"
+#include "fitting/wheel_fit.h"
+#include "processing/process_scan.h"
+
+namespace arcwheel {
+namespace {
+
+using acquisition::ScanSettings;
+using acquisition::WheelModel;
+
+struct PipelineRun {
+  acquisition::SimulatedScan simulated;
+  processing::ProcessedScan processed;
+  fitting::WheelFit fit;
+};
+
+PipelineRun Process(const WheelModel& wheel, const ScanSettings& settings) {
+  PipelineRun r{acquisition::SimulateScan(wheel, settings), {}, {}};
+  r.processed = processing::ProcessScan(r.simulated.scan, {});
+  r.fit = fitting::FitWheel(r.processed.map, {});
+  return r;
+}
+
+// The per-phase truth averages to the nominal values over equally spaced phases.
+double TrueMeanRadiusMm(const WheelModel& wheel) { return wheel.arc_radius_mm; }
+double TrueMeanCenterAxialMm(const WheelModel& wheel) { return wheel.center_axial_mm; }
+
+struct Spread {
+  double mean = 0.0;
+  double sd = 0.0;
+};
+
+Spread SpreadOf(const std::vector<double>& v) {
+  Spread s;
+  s.mean = std::accumulate(v.begin(), v.end(), 0.0) / static_cast<double>(v.size());
+  for (const double x : v) s.sd += (x - s.mean) * (x - s.mean);
+  s.sd = std::sqrt(s.sd / static_cast<double>(v.size() - 1));
+  return s;
+}
+
+TEST(HardScans, SpikesBurstsAndDropoutsLeaveEveryMetricWithinTheNoiseOnlySpread) {
+  const WheelModel wheel = acquisition::LobedTestWheel();
+  std::vector<double> clean_arc_error, clean_runout, clean_roundness;
+  std::vector<fitting::WheelFit> dirty_fits;
+  for (std::uint64_t seed = 1; seed <= 6; ++seed) {
+    ScanSettings s;
+    s.noise_um = 0.5;
+    s.seed = seed;
+    const PipelineRun clean = Process(wheel, s);
+    clean_arc_error.push_back(clean.fit.max_arc_error_um);
+    clean_runout.push_back(clean.fit.max_runout_um);
+    clean_roundness.push_back(clean.fit.max_roundness_um);
+    // 1 % of the samples spiked by 100-200 um, half of them in bursts of 2-5; 0.5 % dropped in
+    // runs of up to 40 samples (12 deg of a turn).
+    s.spike_rate = 0.005;
+    s.burst_rate = 0.0015;
+    s.spike_amplitude_um = 200.0;
+    s.dropout_rate = 2.5e-4;
+    PipelineRun dirty = Process(wheel, s);
+
+    // The despiker removes exactly the spiked samples.
+    std::vector<char> rejected(dirty.simulated.scan.size(), 0);
+    for (const std::size_t i : dirty.processed.despike.indices) rejected[i] = 1;
+    std::size_t missed = 0, wrongly = 0;
+    for (std::size_t i = 0; i < rejected.size(); ++i) {
+      const double before = clean.simulated.scan.z_mm[i];
+      const double after = dirty.simulated.scan.z_mm[i];
+      const bool spiked = std::isfinite(before) && std::isfinite(after) && before != after;
+      missed += spiked && !rejected[i] ? 1 : 0;
+      wrongly += !spiked && rejected[i] ? 1 : 0;
+    }
+    EXPECT_GT(dirty.simulated.counts.spikes, 1000u);
+    EXPECT_EQ(missed, 0u) << "seed " << seed;
+    EXPECT_EQ(wrongly, 0u) << "seed " << seed;
+
+    const auto& f = dirty.fit;
+    EXPECT_EQ(f.usable_phases, 360) << "seed " << seed;
+    EXPECT_LT(std::abs(f.mean_arc_radius_mm - TrueMeanRadiusMm(wheel)), 3.0 * f.mean_arc_radius_sigma_mm) << "seed " << seed;
+    EXPECT_LT(std::abs(f.mean_center_axial_mm - TrueMeanCenterAxialMm(wheel)), 3.0 * f.mean_center_axial_sigma_mm)
+        << "seed " << seed;
+    dirty_fits.push_back(std::move(dirty.fit));
+  }
+  const Spread arc_error = SpreadOf(clean_arc_error);
+  const Spread runout = SpreadOf(clean_runout);
+  const Spread roundness = SpreadOf(clean_roundness);
+  for (std::size_t k = 0; k < dirty_fits.size(); ++k) {
+    const auto& f = dirty_fits[k];
+    EXPECT_LT(std::abs(f.max_arc_error_um - arc_error.mean), 3.0 * arc_error.sd) << "seed " << k + 1;
+    EXPECT_LT(std::abs(f.max_runout_um - runout.mean), 3.0 * runout.sd) << "seed " << k + 1;
+    EXPECT_LT(std::abs(f.max_roundness_um - roundness.mean), 3.0 * roundness.sd) << "seed " << k + 1;
+  }
+  // The spread is noise, not a tolerance wide enough to hide anything: a few tenths of a micrometre.
+  EXPECT_LT(arc_error.sd, 0.3);
+  EXPECT_LT(runout.sd, 0.3);
+  EXPECT_LT(roundness.sd, 0.3);
+}
+
+// Scans of `samples` samples over the same 22 mm of rim at 100 us: the feed sets the count.
+ScanSettings ScanOfSize(double samples, std::uint64_t seed) {
+  ScanSettings s;
+  s.noise_um = 0.5;
+  s.seed = seed;
+  s.feed_mm_per_min = (s.end_y_mm - s.start_y_mm) / (samples * s.sample_period_s) * 60.0;
+  return s;
+}
+
+enum class Timing { kNominal, kEncoderSpeedOff, kEstimatedSpeedOff };
+
+struct SizeCase {
+  double samples;
+  Timing timing;
+  std::uint64_t seed;
+};
+
+class MeanRadius : public ::testing::TestWithParam<SizeCase> {};
+
+TEST_P(MeanRadius, IsWithinThreeReportedSigmasOfTruth) {
+  const SizeCase c = GetParam();
+  const WheelModel wheel = acquisition::LobedTestWheel();
+  ScanSettings s = ScanOfSize(c.samples, c.seed);
+  if (c.timing != Timing::kNominal) s.spindle_rpm_true = 1.002 * s.spindle_rpm_nominal;
+  s.write_encoder = c.timing == Timing::kEncoderSpeedOff;
+  const PipelineRun r = Process(wheel, s);
+  ASSERT_EQ(r.fit.usable_phases, 360);
+  if (c.timing == Timing::kEstimatedSpeedOff) {
+    ASSERT_EQ(r.processed.phase_source, processing::PhaseSource::kEstimated);
+    EXPECT_LT(std::abs(r.processed.rpm_used - s.spindle_rpm_true), 3.0 * r.processed.speed.sigma_rpm);
+  }
+  const double z = (r.fit.mean_arc_radius_mm - TrueMeanRadiusMm(wheel)) / r.fit.mean_arc_radius_sigma_mm;
+  EXPECT_LT(std::abs(z), 3.0) << "error " << (r.fit.mean_arc_radius_mm - TrueMeanRadiusMm(wheel)) * 1000.0
+                              << " um, sigma " << r.fit.mean_arc_radius_sigma_mm * 1000.0 << " um";
+  // The sigma falls as 1/sqrt(N): 0.59 um at 1e5 samples of 0.5 um noise.
+  EXPECT_NEAR(r.fit.mean_arc_radius_sigma_mm * 1000.0, 0.59 * std::sqrt(1e5 / c.samples), 0.1 * 0.59 * std::sqrt(1e5 / c.samples));
+}
+
+std::vector<SizeCase> SizeCases() {
+  std::vector<SizeCase> cases;
+  for (const Timing t : {Timing::kNominal, Timing::kEncoderSpeedOff, Timing::kEstimatedSpeedOff}) {
+    for (std::uint64_t seed = 1; seed <= 4; ++seed) cases.push_back({1e5, t, seed});
+    for (std::uint64_t seed = 1; seed <= 2; ++seed) cases.push_back({1e6, t, seed});
+    cases.push_back({1e7, t, 1});
+  }
+  return cases;
+}
+
+std::string CaseName(const ::testing::TestParamInfo<SizeCase>& info) {
+  const char* timing = info.param.timing == Timing::kNominal           ? "Nominal"
+                       : info.param.timing == Timing::kEncoderSpeedOff ? "EncoderSpeedOff"
+                                                                       : "EstimatedSpeedOff";
+  return "N1e" + std::to_string(static_cast<int>(std::lround(std::log10(info.param.samples)))) + timing + "Seed" +
+         std::to_string(info.param.seed);
+}
+
+INSTANTIATE_TEST_SUITE_P(UpTo1e7Samples, MeanRadius, ::testing::ValuesIn(SizeCases()), CaseName);
+
+}  // namespace
+}  // namespace arcwheel

@@ -67,7 +67,7 @@ struct DwellOptions {
   // >= 0 and <= the point's longest dwell; empty = none. Kept even where it removes more than
   // the target.
   std::vector<double> least_dwell_s = {};
-  int max_iterations = 5000;      // projected-gradient iterations, >= 1
+  int max_iterations = 2000;      // projected-gradient iterations, >= 1 (the job file's default too)
   double relative_tolerance = 1e-7;  // stop when the dwell changes by less than this, relative
   // Also stop when the residual norm has improved over the last stall_iterations iterations by
   // less than stall_improvement times the first residual norm: further iterations only polish

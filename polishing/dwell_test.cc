@@ -212,7 +212,7 @@ TEST(SolveDwell, RecoversAKnownDwellToWithinTheConditioningOfTheProblem) {
     }
   }
   // Without the stall test: this checks that the iteration itself converges to the exact dwell.
-  const DwellSolution solution = SolveDwell(target, square, path, tool, {.max_speed_mm_s = 100.0, .stall_iterations = 0});
+  const DwellSolution solution = SolveDwell(target, square, path, tool, {.max_speed_mm_s = 100.0, .max_iterations = 5000, .stall_iterations = 0});
   EXPECT_LT(solution.after.rms_um, 1e-3 * solution.before.rms_um);
 }
 

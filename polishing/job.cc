@@ -45,6 +45,15 @@ class Section {
     resolved_[key] = v;
     return v;
   }
+  // A count or power: checked as a double first, so 2.5 is refused rather than used as 2 and a
+  // value beyond int's range is never cast (undefined behaviour).
+  int WholeNumber(const std::string& key, int fallback, int low, int high) {
+    const double v = Number(key, fallback);
+    if (!(v >= low && v <= high) || v != std::floor(v)) {
+      Fail(key, fmt::format("must be a whole number within {} .. {}, got {}", low, high, v));
+    }
+    return static_cast<int>(v);
+  }
   double RequiredNumber(const std::string& key) {
     if (!Has(key)) Fail(key, "is required");
     return Number(key, 0.0);
@@ -124,16 +133,8 @@ std::shared_ptr<const grinding::Surface> ReadSurface(Section& s) {
     for (std::size_t k = 0; k < s.Raw("terms").size(); ++k) {
       Section t(&s.Raw("terms")[k], s.Dotted(fmt::format("terms[{}]", k)), s.source());
       grinding::XyPolynomialTerm term;
-      // Checked as doubles first: a power of 2.5 is refused, not computed as 2, and one beyond
-      // int's range is never cast (undefined behaviour).
-      const double x_power = t.Number("x_power", 0.0), y_power = t.Number("y_power", 0.0);
-      for (const auto& [key, power] : {std::pair{"x_power", x_power}, std::pair{"y_power", y_power}}) {
-        if (!(power >= 0.0 && power <= 20.0) || power != std::floor(power)) {
-          t.Fail(key, fmt::format("must be a whole number within 0 .. 20, got {}", power));
-        }
-      }
-      term.x_power = static_cast<int>(x_power);
-      term.y_power = static_cast<int>(y_power);
+      term.x_power = t.WholeNumber("x_power", 0, 0, 20);
+      term.y_power = t.WholeNumber("y_power", 0, 0, 20);
       term.coefficient = t.RequiredNumber("coefficient");
       t.Finish();
       terms.push_back(term);
@@ -339,9 +340,9 @@ PolishJob ReadPolishJob(const std::filesystem::path& path) {
   });
   section("machine", [&](Section& c) { ReadMachine(c, job); });
   section("solver", [&](Section& c) {
-    job.dwell.max_iterations = static_cast<int>(c.Number("max_iterations", 2000));
-    if (job.dwell.max_iterations < 1) c.Fail("max_iterations", "must be >= 1");
-    job.dwell.relative_tolerance = c.Number("relative_tolerance", 1e-7);
+    const DwellOptions defaults;
+    job.dwell.max_iterations = c.WholeNumber("max_iterations", defaults.max_iterations, 1, 10'000'000);
+    job.dwell.relative_tolerance = c.Number("relative_tolerance", defaults.relative_tolerance);
     if (!(job.dwell.relative_tolerance > 0.0)) c.Fail("relative_tolerance", "must be > 0");
   });
   section("tool", [&](Section& c) { ReadTool(c, job); });

@@ -135,6 +135,22 @@ TEST(PolishCommand, RefusesAPowerThatIsNotAWholeNumberInRangeNamingItsValue) {
   }
 }
 
+TEST(PolishCommand, RefusesAnIterationCountThatIsNotAWholeNumberInRange) {
+  TempDir dir;
+  WriteMap(dir / "map.csv");
+  for (const std::string count : {"800.5", "3e10", "0"}) {
+    std::string job = Job();
+    const std::string given = R"("max_iterations": 800)";
+    job.replace(job.find(given), given.size(), R"("max_iterations": )" + count);
+    WriteText(dir / "job.json", job);
+    const auto result = RunArcwheel(fmt::format("polish {} -o {}", (dir / "job.json").string(), (dir / "out").string()));
+    EXPECT_EQ(result.exit_status, 3) << result.output;
+    EXPECT_NE(result.output.find("'solver.max_iterations' must be a whole number within 1 .. 10000000, got"), std::string::npos)
+        << result.output;
+    EXPECT_FALSE(std::filesystem::exists(dir / "out"));
+  }
+}
+
 TEST(PolishCommand, TiltsThePrecessingBonnetByTheJobsAngle) {
   TempDir dir;
   WriteMap(dir / "map.csv");

@@ -86,11 +86,12 @@ TEST(FitCircle, RadiusSigmaMatchesTheScatterOverManyNoisyArcs) {
     sigmas.push_back(fit.radius_sigma_mm());
   }
   double mean = 0, var = 0, mean_sigma = 0;
+  const auto trials = static_cast<double>(radii.size());
   for (std::size_t i = 0; i < radii.size(); ++i) {
-    mean += radii[i] / radii.size();
-    mean_sigma += sigmas[i] / sigmas.size();
+    mean += radii[i] / trials;
+    mean_sigma += sigmas[i] / trials;
   }
-  for (const double r : radii) var += (r - mean) * (r - mean) / (radii.size() - 1);
+  for (const double r : radii) var += (r - mean) * (r - mean) / (trials - 1.0);
   // The scatter's own sampling error over 400 trials is ~3.5 %.
   EXPECT_NEAR(std::sqrt(var) / mean_sigma, 1.0, 0.12);
 }

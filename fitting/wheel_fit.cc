@@ -215,7 +215,7 @@ WheelFit FitWheel(const processing::WheelMap& map, const WheelFitOptions& option
   }
   const auto n = static_cast<double>(radii.size());
   out.usable_phases = static_cast<int>(radii.size());
-  const auto mean = [](const std::vector<double>& v) { return std::accumulate(v.begin(), v.end(), 0.0) / v.size(); };
+  const auto mean = [](const std::vector<double>& v) { return std::accumulate(v.begin(), v.end(), 0.0) / static_cast<double>(v.size()); };
   out.mean_arc_radius_mm = mean(radii);
   out.mean_center_axial_mm = mean(axial);
   out.mean_center_radial_mm = mean(radial);
@@ -253,7 +253,7 @@ WheelFit FitWheel(const processing::WheelMap& map, const WheelFitOptions& option
       }
     }
     out.axial_y_mm.push_back(y);
-    if (rho.size() < options.min_phase_coverage * static_cast<double>(n_phase) || rho.size() < 4) {
+    if (static_cast<double>(rho.size()) < options.min_phase_coverage * static_cast<double>(n_phase) || rho.size() < 4) {
       out.runout_um.push_back(kNaN);
       out.roundness_um.push_back(kNaN);
       continue;

@@ -117,9 +117,11 @@ double HelixSpline::Value(double u) const {
 
 double HelixSpline::VarianceFactor(double u) const {
   const Basis b = BasisAt(u);
+  // The inverse is symmetric: the diagonal once, each entry above it twice.
   double v = 0.0;
   for (int a = 0; a < 4; ++a) {
-    for (int c = 0; c < 4; ++c) v += b.w[a] * b.w[c] * normal_.Inverse(b.first + a, b.first + c);
+    v += b.w[a] * b.w[a] * normal_.InverseInBand(b.first + a, 0);
+    for (int c = a + 1; c < 4; ++c) v += 2.0 * b.w[a] * b.w[c] * normal_.InverseInBand(b.first + a, c - a);
   }
   return v;
 }

@@ -61,7 +61,7 @@ std::vector<double> NoisySine(std::size_t n, double noise_mm, std::uint32_t seed
   std::mt19937 rng(seed);
   std::normal_distribution<double> normal(0.0, noise_mm);
   std::vector<double> z(n);
-  for (std::size_t i = 0; i < n; ++i) z[i] = 0.005 * std::sin(2.0 * std::numbers::pi * i / 1200.0) + normal(rng);
+  for (std::size_t i = 0; i < n; ++i) z[i] = 0.005 * std::sin(2.0 * std::numbers::pi * static_cast<double>(i) / 1200.0) + normal(rng);
   return z;
 }
 

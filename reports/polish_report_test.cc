@@ -181,7 +181,7 @@ TEST(ReportCommand, RefusesACorruptResidualLineNamingFileAndLineAndKeepsTheEarli
   std::ofstream(residual, std::ios::trunc) << corrupted;
   const auto result = RunArcwheel("report '" + (dir / "out").string() + "'");
   EXPECT_EQ(result.exit_status, 3) << result.output;
-  EXPECT_THAT(result.output, HasSubstr("'" + residual.string() + "' line 7: residual_um '0.1.2' is not a number"));
+  EXPECT_THAT(result.output, HasSubstr(fmt::format("'{}' line 7: residual_um '0.1.2' is not a number", residual.string())));
   EXPECT_EQ(ListFolder(dir / "out"), listing) << "no temporary or new file left";
   EXPECT_EQ(ReadText(dir / "out" / "polish_report.pdf"), pdf_before);
   EXPECT_EQ(ReadText(dir / "out" / "polish_report.html"), html_before);

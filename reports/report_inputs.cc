@@ -205,7 +205,7 @@ std::vector<double> ReadDataset(const hdf5::File& file, const std::string& datas
   if (!file.HasObject(dataset)) BadMap(file.path(), dataset, "is missing");
   const std::vector<hsize_t> shape = file.Shape(dataset);
   if (shape != expected_shape) {
-    auto text = [](const std::vector<hsize_t>& dims) { return "[" + fmt::format("{}", fmt::join(dims, ", ")) + "]"; };
+    auto text = [](const std::vector<hsize_t>& dims) { return fmt::format("[{}]", fmt::join(dims, ", ")); };
     BadMap(file.path(), dataset, "has shape " + text(shape) + ", expected " + text(expected_shape));
   }
   return file.ReadDoubles(dataset);

@@ -150,10 +150,10 @@ TEST(ScanPipeline, NoisyScansAreWithinThreeSigmasAndTheSigmasAreHonest) {
     mean_z.push_back(z);
   }
   const auto spread = [](const std::vector<double>& v) {
-    const double m = std::accumulate(v.begin(), v.end(), 0.0) / v.size();
+    const double m = std::accumulate(v.begin(), v.end(), 0.0) / static_cast<double>(v.size());
     double s = 0.0;
     for (const double x : v) s += (x - m) * (x - m);
-    return std::sqrt(s / (v.size() - 1));
+    return std::sqrt(s / static_cast<double>(v.size() - 1));
   };
   // 4320 per-phase z-scores: their spread is 1 within a few percent if the sigmas are honest.
   EXPECT_NEAR(spread(phase_z), 1.0, 0.1);

@@ -1,7 +1,9 @@
 # arcwheel_add_library(NAME n SRCS ... DEPS ...): target arcwheel_<n>, alias arcwheel::<n>.
-# arcwheel_add_test(NAME n SRCS ... DEPS ... [SHARDS k]): a GoogleTest binary registered with CTest
-#   as <folder>/<n>, or with SHARDS as <folder>/<n>/<i> for i < k, each running every k-th test
-#   (GoogleTest's sharding), so that CTest runs a long binary on both cores.
+# arcwheel_add_test(NAME n SRCS ... DEPS ... [SHARDS k] [COST s]): a GoogleTest binary registered with
+#   CTest as <folder>/<n>, or with SHARDS as <folder>/<n>/<i> for i < k, each running every k-th
+#   test (GoogleTest's sharding), so that CTest runs a long binary on both cores. COST (about the
+#   seconds it takes under the sanitizers) makes CTest start the long tests first on a clean
+#   checkout, which has no timings of earlier runs: started last, they ran one after the other.
 # arcwheel_add_benchmark(NAME n SRCS ... DEPS ...): a Google Benchmark binary.
 
 set(ARCWHEEL_WARNINGS -Wall -Wextra -Wpedantic -Wshadow -Wconversion -Wno-sign-conversion)
@@ -27,7 +29,10 @@ function(arcwheel_add_test)
   if(NOT ARCWHEEL_BUILD_TESTS)
     return()
   endif()
-  cmake_parse_arguments(ARG "" "NAME;SHARDS" "SRCS;DEPS" ${ARGN})
+  cmake_parse_arguments(ARG "" "NAME;SHARDS;COST" "SRCS;DEPS" ${ARGN})
+  if(NOT ARG_COST)
+    set(ARG_COST 1)
+  endif()
   get_filename_component(_folder ${CMAKE_CURRENT_SOURCE_DIR} NAME)
   set(_target ${_folder}_${ARG_NAME})
   add_executable(${_target} ${ARG_SRCS})
@@ -36,14 +41,15 @@ function(arcwheel_add_test)
   set(_environment "ARCWHEEL_SOURCE_DIR=${PROJECT_SOURCE_DIR};ARCWHEEL_BINARY=$<TARGET_FILE:arcwheel>")
   if(NOT ARG_SHARDS)
     add_test(NAME ${_folder}/${ARG_NAME} COMMAND ${_target} WORKING_DIRECTORY ${PROJECT_SOURCE_DIR})
-    set_tests_properties(${_folder}/${ARG_NAME} PROPERTIES ENVIRONMENT "${_environment}")
+    set_tests_properties(${_folder}/${ARG_NAME} PROPERTIES ENVIRONMENT "${_environment}" COST ${ARG_COST})
     return()
   endif()
   math(EXPR _last "${ARG_SHARDS} - 1")
   foreach(_shard RANGE ${_last})
     add_test(NAME ${_folder}/${ARG_NAME}/${_shard} COMMAND ${_target} WORKING_DIRECTORY ${PROJECT_SOURCE_DIR})
     set_tests_properties(${_folder}/${ARG_NAME}/${_shard} PROPERTIES ENVIRONMENT
-                         "${_environment};GTEST_TOTAL_SHARDS=${ARG_SHARDS};GTEST_SHARD_INDEX=${_shard}")
+                         "${_environment};GTEST_TOTAL_SHARDS=${ARG_SHARDS};GTEST_SHARD_INDEX=${_shard}"
+                         COST ${ARG_COST})
   endforeach()
 endfunction()
 

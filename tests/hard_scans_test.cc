@@ -52,7 +52,7 @@ Spread SpreadOf(const std::vector<double>& v) {
 
 TEST(HardScans, SpikesBurstsAndDropoutsLeaveEveryMetricWithinTheNoiseOnlySpread) {
   const WheelModel wheel = acquisition::LobedTestWheel();
-  std::vector<double> clean_arc_error, clean_runout, clean_roundness;
+  std::vector<double> clean_arc_error, clean_runout, clean_roundness, clean_range, clean_deviation;
   std::vector<fitting::WheelFit> dirty_fits;
   for (std::uint64_t seed = 1; seed <= 6; ++seed) {
     ScanSettings s;
@@ -62,6 +62,8 @@ TEST(HardScans, SpikesBurstsAndDropoutsLeaveEveryMetricWithinTheNoiseOnlySpread)
     clean_arc_error.push_back(clean.fit.max_arc_error_um);
     clean_runout.push_back(clean.fit.max_runout_um);
     clean_roundness.push_back(clean.fit.max_roundness_um);
+    clean_range.push_back(clean.fit.arc_radius_range_mm * 1000.0);
+    clean_deviation.push_back(clean.fit.center_axial_deviation_mm * 1000.0);
     // 1 % of the samples spiked by 100-200 um, half of them in bursts of 2-5; 0.5 % dropped in
     // runs of up to 40 samples (12 deg of a turn).
     s.spike_rate = 0.005;
@@ -95,11 +97,16 @@ TEST(HardScans, SpikesBurstsAndDropoutsLeaveEveryMetricWithinTheNoiseOnlySpread)
   const Spread arc_error = SpreadOf(clean_arc_error);
   const Spread runout = SpreadOf(clean_runout);
   const Spread roundness = SpreadOf(clean_roundness);
+  const Spread range = SpreadOf(clean_range);
+  const Spread deviation = SpreadOf(clean_deviation);
   for (std::size_t k = 0; k < dirty_fits.size(); ++k) {
     const auto& f = dirty_fits[k];
     EXPECT_LT(std::abs(f.max_arc_error_um - arc_error.mean), 3.0 * arc_error.sd) << "seed " << k + 1;
     EXPECT_LT(std::abs(f.max_runout_um - runout.mean), 3.0 * runout.sd) << "seed " << k + 1;
     EXPECT_LT(std::abs(f.max_roundness_um - roundness.mean), 3.0 * roundness.sd) << "seed " << k + 1;
+    // Ranges over the 360 per-phase fits: set by the per-phase noise (~11 um of radius at 1e5 samples).
+    EXPECT_LT(std::abs(f.arc_radius_range_mm * 1000.0 - range.mean), 3.0 * range.sd) << "seed " << k + 1;
+    EXPECT_LT(std::abs(f.center_axial_deviation_mm * 1000.0 - deviation.mean), 3.0 * deviation.sd) << "seed " << k + 1;
   }
   // The spread is noise, not a tolerance wide enough to hide anything: a few tenths of a micrometre.
   EXPECT_LT(arc_error.sd, 0.3);

@@ -204,17 +204,17 @@ void DespikeByMedian(std::span<double> z, int w, double threshold_mm, DespikeRes
     }
     newly = std::move(next);
   }
-  std::vector<std::size_t> restored;
-  for (const auto& [i, reading] : dropped) {
-    const double median = MedianOf(Neighbours(z, i, w));
-    if (std::isfinite(median) && std::abs(reading - median) <= threshold_mm) restored.push_back(i);
+  // Decided for all before any comes back, so that none is judged with a restored one's help.
+  std::vector<char> agrees(dropped.size(), 0);
+  for (std::size_t k = 0; k < dropped.size(); ++k) {
+    const double median = MedianOf(Neighbours(z, dropped[k].first, w));
+    agrees[k] = std::isfinite(median) && std::abs(dropped[k].second - median) <= threshold_mm;
   }
-  std::sort(restored.begin(), restored.end());
-  for (const auto& [i, reading] : dropped) {
-    if (std::binary_search(restored.begin(), restored.end(), i)) {
-      z[i] = reading;
+  for (std::size_t k = 0; k < dropped.size(); ++k) {
+    if (agrees[k]) {
+      z[dropped[k].first] = dropped[k].second;
     } else {
-      result.indices.push_back(i);
+      result.indices.push_back(dropped[k].first);
     }
   }
   std::sort(result.indices.begin(), result.indices.end());

@@ -123,6 +123,24 @@ ScanSettings ScanOfSize(double samples, std::uint64_t seed) {
   return s;
 }
 
+// Closed form for the sigma of the mean radius, independent of the pipeline. Each section point
+// rests on the samples of its 1-deg phase step on one turn (sigma / sqrt(samples per step)); over
+// the band's half-width b a short arc is rho = c0 + c1 y + c2 y^2 with R = 1 / (2 |c2|), and the
+// least-squares c2 of n points spread evenly over [-b, b] has variance 45 sigma_p^2 / (4 n b^4);
+// sigma_R = 2 R^2 sigma_c2, and the 360 phases are nearly independent.
+double ExpectedMeanRadiusSigmaMm(const ScanSettings& s, const WheelModel& wheel) {
+  constexpr double kBandHalfWidthMm = 8.0;  // fitting's default band
+  constexpr double kPhases = 360.0;
+  const double samples_per_step = 60.0 / (s.spindle_rpm_true * s.sample_period_s) / kPhases;
+  const double point_sigma_mm = s.noise_um / 1000.0 / std::sqrt(samples_per_step);
+  const double turns = (s.end_y_mm - s.start_y_mm) / s.feed_mm_per_min * s.spindle_rpm_true;
+  const double points = 2.0 * kBandHalfWidthMm / ((s.end_y_mm - s.start_y_mm) / turns);
+  const double b2 = kBandHalfWidthMm * kBandHalfWidthMm;
+  const double sigma_c2 = std::sqrt(45.0 / (4.0 * points)) * point_sigma_mm / b2;
+  const double r = wheel.arc_radius_mm;
+  return 2.0 * r * r * sigma_c2 / std::sqrt(kPhases);
+}
+
 enum class Timing { kNominal, kEncoderSpeedOff, kEstimatedSpeedOff };
 
 struct SizeCase {
@@ -148,8 +166,9 @@ TEST_P(MeanRadius, IsWithinThreeReportedSigmasOfTruth) {
   const double z = (r.fit.mean_arc_radius_mm - TrueMeanRadiusMm(wheel)) / r.fit.mean_arc_radius_sigma_mm;
   EXPECT_LT(std::abs(z), 3.0) << "error " << (r.fit.mean_arc_radius_mm - TrueMeanRadiusMm(wheel)) * 1000.0
                               << " um, sigma " << r.fit.mean_arc_radius_sigma_mm * 1000.0 << " um";
-  // The sigma falls as 1/sqrt(N): 0.59 um at 1e5 samples of 0.5 um noise.
-  EXPECT_NEAR(r.fit.mean_arc_radius_sigma_mm * 1000.0, 0.59 * std::sqrt(1e5 / c.samples), 0.1 * 0.59 * std::sqrt(1e5 / c.samples));
+  // The reported sigma is the one a closed form gives: not inflated to pass the z test.
+  const double expected_sigma_mm = ExpectedMeanRadiusSigmaMm(s, wheel);
+  EXPECT_NEAR(r.fit.mean_arc_radius_sigma_mm, expected_sigma_mm, 0.15 * expected_sigma_mm);
 }
 
 std::vector<SizeCase> SizeCases() {

@@ -12,8 +12,8 @@
 #include <string_view>
 #include <vector>
 
-#include "acquisition/scan_reader.h"
 #include "acquisition/scan_metadata_keys.h"
+#include "acquisition/scan_reader.h"
 #include "core/error.h"
 #include "core/text_encoding.h"
 
@@ -42,7 +42,8 @@ class CsvParser {
 
  private:
   [[noreturn]] void Refuse(const std::string& problem) const {
-    throw Error(ErrorCode::kBadInput, kStage, "'" + path_ + "' line " + std::to_string(line_number_) + ": " + problem);
+    throw Error(ErrorCode::kBadInput, kStage,
+                "'" + path_ + "' line " + std::to_string(line_number_) + ": " + problem);
   }
 
   bool NextLine(std::string_view& line) {
@@ -111,18 +112,23 @@ class CsvParser {
     do {
       if (!NextLine(line)) Refuse("no header row (expected column names such as z_mm)");
     } while (Trim(line).empty());
-    separator_ = line.find(',') != std::string_view::npos   ? ','
-                 : line.find(';') != std::string_view::npos ? ';'
+    separator_ = line.find(',') != std::string_view::npos    ? ','
+                 : line.find(';') != std::string_view::npos  ? ';'
                  : line.find('\t') != std::string_view::npos ? '\t'
-                                                              : ',';
+                                                             : ',';
     const std::vector<std::string_view> names = Split(TrimLine(line));
     for (size_t j = 0; j < names.size(); ++j) {
       const std::string name = AsciiLower(Trim(names[j]));
-      if (name == "z_mm") columns_.push_back(Column::kZ);
-      else if (name == "t_s") columns_.push_back(Column::kT);
-      else if (name == "angle_deg") columns_.push_back(Column::kAngle);
-      else if (name == "y_mm") columns_.push_back(Column::kY);
-      else if (j == 0 && (name.empty() || name == "unnamed: 0")) columns_.push_back(Column::kIndex);
+      if (name == "z_mm")
+        columns_.push_back(Column::kZ);
+      else if (name == "t_s")
+        columns_.push_back(Column::kT);
+      else if (name == "angle_deg")
+        columns_.push_back(Column::kAngle);
+      else if (name == "y_mm")
+        columns_.push_back(Column::kY);
+      else if (j == 0 && (name.empty() || name == "unnamed: 0"))
+        columns_.push_back(Column::kIndex);
       else {
         bool latin1 = false;
         Refuse("unknown column '" + AsUtf8(name, latin1) + "' (expected z_mm, t_s, angle_deg, y_mm)");
@@ -144,7 +150,8 @@ class CsvParser {
       size_t start = 0;
       while (true) {
         const size_t next = line.find(separator_, start);
-        cells.push_back(line.substr(start, next == std::string_view::npos ? std::string_view::npos : next - start));
+        cells.push_back(
+            line.substr(start, next == std::string_view::npos ? std::string_view::npos : next - start));
         if (next == std::string_view::npos) break;
         start = next + 1;
       }
@@ -182,7 +189,8 @@ class CsvParser {
       if (i >= line.size()) break;
       ++i;  // the separator
     }
-    for (const auto& [begin, length] : spans) cells.push_back(std::string_view(quoted_).substr(begin, length));
+    for (const auto& [begin, length] : spans)
+      cells.push_back(std::string_view(quoted_).substr(begin, length));
     return cells;
   }
 
@@ -194,7 +202,8 @@ class CsvParser {
       return true;
     }
     if (!cell.empty() && (cell.front() == '+' || cell.front() == '-')) cell.remove_prefix(1);
-    return !cell.empty() && std::all_of(cell.begin(), cell.end(), [](char c) { return c == 'F' || c == 'f'; });
+    return !cell.empty() &&
+           std::all_of(cell.begin(), cell.end(), [](char c) { return c == 'F' || c == 'f'; });
   }
 
   static bool IsNanWord(std::string_view cell) {
@@ -208,9 +217,9 @@ class CsvParser {
   static bool IsInfinityWord(std::string_view cell) {
     if (!cell.empty() && (cell.front() == '+' || cell.front() == '-')) cell.remove_prefix(1);
     auto equals = [cell](std::string_view word) {
-      return cell.size() == word.size() && std::equal(cell.begin(), cell.end(), word.begin(), [](char a, char b) {
-               return std::tolower(static_cast<unsigned char>(a)) == b;
-             });
+      return cell.size() == word.size() &&
+             std::equal(cell.begin(), cell.end(), word.begin(),
+                        [](char a, char b) { return std::tolower(static_cast<unsigned char>(a)) == b; });
     };
     return equals("inf") || equals("infinity");
   }
@@ -242,7 +251,8 @@ class CsvParser {
       if (c == Column::kAngle) has_angle_ = true;
       if (c == Column::kY) has_y_ = true;
     }
-    const size_t estimate = static_cast<size_t>(std::count(text_.begin() + static_cast<long>(position_), text_.end(), '\n')) + 1;
+    const size_t estimate =
+        static_cast<size_t>(std::count(text_.begin() + static_cast<long>(position_), text_.end(), '\n')) + 1;
     scan.z_mm.reserve(estimate);
     if (has_t_) scan.t_s.reserve(estimate);
     if (has_angle_) scan.angle_deg.reserve(estimate);
@@ -258,16 +268,26 @@ class CsvParser {
       }
       cells = Split(trimmed);
       if (cells.size() != columns_.size()) {
-        Refuse("has " + std::to_string(cells.size()) + " cells, the header names " + std::to_string(columns_.size()));
+        Refuse("has " + std::to_string(cells.size()) + " cells, the header names " +
+               std::to_string(columns_.size()));
       }
       for (size_t j = 0; j < cells.size(); ++j) {
         const std::string_view cell = Trim(cells[j]);
         switch (columns_[j]) {
-          case Column::kZ: scan.z_mm.push_back(ParseZ(cell)); break;
-          case Column::kT: scan.t_s.push_back(ParseRequired(cell, "t_s")); break;
-          case Column::kAngle: scan.angle_deg.push_back(ParseRequired(cell, "angle_deg")); break;
-          case Column::kY: scan.y_mm.push_back(ParseRequired(cell, "y_mm")); break;
-          case Column::kIndex: break;
+          case Column::kZ:
+            scan.z_mm.push_back(ParseZ(cell));
+            break;
+          case Column::kT:
+            scan.t_s.push_back(ParseRequired(cell, "t_s"));
+            break;
+          case Column::kAngle:
+            scan.angle_deg.push_back(ParseRequired(cell, "angle_deg"));
+            break;
+          case Column::kY:
+            scan.y_mm.push_back(ParseRequired(cell, "y_mm"));
+            break;
+          case Column::kIndex:
+            break;
         }
       }
     }
@@ -301,7 +321,9 @@ std::string ReadWholeFile(const std::filesystem::path& path) {
 
 }  // namespace
 
-Scan ReadCsvScan(const std::filesystem::path& path) { return ParseCsvScan(ReadWholeFile(path), path.string()); }
+Scan ReadCsvScan(const std::filesystem::path& path) {
+  return ParseCsvScan(ReadWholeFile(path), path.string());
+}
 
 Scan ParseCsvScan(std::string text, const std::string& name) {
   CsvParser parser(name, std::move(text));

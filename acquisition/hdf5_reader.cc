@@ -62,18 +62,22 @@ std::vector<double> ReadZ(const hdf5::File& file, ScanMetadata& metadata, Sentin
   const std::optional<double> scale = file.ReadAttributeDouble(name, "scale_factor");
   if (!scale) {
     throw Error(ErrorCode::kBadInput, kStage,
-                "'" + file.path().string() + "' dataset /scan/z stores integers (sensor counts?), not millimetres: "
-                "give their scale as attribute scale_factor (mm per count, and add_offset in mm if any) on /scan/z, "
-                "or store z as float in mm");
+                "'" + file.path().string() +
+                    "' dataset /scan/z stores integers (sensor counts?), not millimetres: "
+                    "give their scale as attribute scale_factor (mm per count, and add_offset in mm if any) "
+                    "on /scan/z, "
+                    "or store z as float in mm");
   }
   const double offset = file.ReadAttributeDouble(name, "add_offset").value_or(0.0);
   if (!std::isfinite(*scale) || *scale == 0.0 || !std::isfinite(offset)) {
-    throw Error(ErrorCode::kBadInput, kStage,
-                "'" + file.path().string() + "' /scan/z: scale_factor must be finite and not 0, add_offset finite");
+    throw Error(
+        ErrorCode::kBadInput, kStage,
+        "'" + file.path().string() + "' /scan/z: scale_factor must be finite and not 0, add_offset finite");
   }
   for (double& value : z) {
-    value = metadata.invalid_value && value == *metadata.invalid_value ? std::numeric_limits<double>::quiet_NaN()
-                                                                        : value * *scale + offset;
+    value = metadata.invalid_value && value == *metadata.invalid_value
+                ? std::numeric_limits<double>::quiet_NaN()
+                : value * *scale + offset;
   }
   comparison = SentinelComparison::kDone;
   return z;
@@ -113,7 +117,8 @@ Scan ReadScan(const std::filesystem::path& path) {
   if (extension == ".h5" || extension == ".hdf5") return ReadHdf5Scan(path);
   if (extension == ".csv" || extension == ".txt") return ReadCsvScan(path);
   throw Error(ErrorCode::kBadInput, "acquisition",
-              "'" + path.string() + "': unknown scan file type '" + extension + "' (expected .h5, .hdf5, .csv or .txt)");
+              "'" + path.string() + "': unknown scan file type '" + extension +
+                  "' (expected .h5, .hdf5, .csv or .txt)");
 }
 
 }  // namespace arcwheel::acquisition

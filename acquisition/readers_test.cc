@@ -22,13 +22,16 @@ const char* kSettings = "# spindle_rpm: 500\n# feed_mm_per_min: 100\n# sample_pe
 // 3 turns at 500 rpm with 1 ms samples: 360 samples; the reader needs them to accept the file.
 std::string Rows(const std::string& first_rows, char separator = ',') {
   std::string text = first_rows;
-  for (int i = 0; i < 400; ++i) text += "0.5" + std::string(1, separator) + std::to_string(0.01 + i * 0.001) + "\n";
+  for (int i = 0; i < 400; ++i)
+    text += "0.5" + std::string(1, separator) + std::to_string(0.01 + i * 0.001) + "\n";
   return text;
 }
 
 TEST(CsvReader, FoldsAlarmWordsNanAndEmptyCellsIntoInvalidSamples) {
   TempDir dir;
-  std::string text = std::string(kSettings) + "# wheel_id: W-17\n# note without a key\nz_mm\n0.25\n-FFFFFFF\n+FFFF\nalarm\nNaN\n\n0.125\n";
+  std::string text =
+      std::string(kSettings) +
+      "# wheel_id: W-17\n# note without a key\nz_mm\n0.25\n-FFFFFFF\n+FFFF\nalarm\nNaN\n\n0.125\n";
   for (int i = 0; i < 400; ++i) text += "0.5\n";
   WriteText(dir / "scan.csv", text);
   const Scan scan = ReadCsvScan(dir / "scan.csv");
@@ -97,7 +100,8 @@ TEST(Hdf5Reader, RefusesColumnsOfDifferentLengths) {
     (void)ReadHdf5Scan(dir / "scan.h5");
     FAIL();
   } catch (const Error& e) {
-    EXPECT_NE(std::string(e.what()).find("column 't' has 399 values but 'z' has 400"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("column 't' has 399 values but 'z' has 400"), std::string::npos)
+        << e.what();
   }
 }
 

@@ -37,8 +37,8 @@ void CheckColumn(const Scan& scan, const std::vector<double>& column, const char
 void CheckIncreasing(const Scan& scan, const std::vector<double>& column, const char* name) {
   for (size_t i = 1; i < column.size(); ++i) {
     if (!(column[i] > column[i - 1])) {
-      Refuse(scan, std::string("column '") + name + "' does not increase at sample " + std::to_string(i) + " (" +
-                       Number(column[i - 1]) + " then " + Number(column[i]) + ")");
+      Refuse(scan, std::string("column '") + name + "' does not increase at sample " + std::to_string(i) +
+                       " (" + Number(column[i - 1]) + " then " + Number(column[i]) + ")");
     }
   }
 }
@@ -52,7 +52,8 @@ void CheckPositive(const Scan& scan, const std::optional<double>& value, const c
 }  // namespace
 
 size_t Scan::CountValid() const {
-  return static_cast<size_t>(std::count_if(z_mm.begin(), z_mm.end(), [](double z) { return std::isfinite(z); }));
+  return static_cast<size_t>(
+      std::count_if(z_mm.begin(), z_mm.end(), [](double z) { return std::isfinite(z); }));
 }
 
 void ValidateScan(const Scan& scan) {
@@ -72,9 +73,11 @@ void ValidateScan(const Scan& scan) {
   }
   CheckIncreasing(scan, scan.t_s, "t");
 
-  const auto first = std::find_if(scan.z_mm.begin(), scan.z_mm.end(), [](double z) { return std::isfinite(z); });
+  const auto first =
+      std::find_if(scan.z_mm.begin(), scan.z_mm.end(), [](double z) { return std::isfinite(z); });
   if (first == scan.z_mm.end()) Refuse(scan, "has no valid samples");
-  const auto last = std::find_if(scan.z_mm.rbegin(), scan.z_mm.rend(), [](double z) { return std::isfinite(z); });
+  const auto last =
+      std::find_if(scan.z_mm.rbegin(), scan.z_mm.rend(), [](double z) { return std::isfinite(z); });
   const size_t i0 = static_cast<size_t>(first - scan.z_mm.begin());
   const size_t i1 = scan.z_mm.size() - 1 - static_cast<size_t>(last - scan.z_mm.rbegin());
 
@@ -103,12 +106,12 @@ void ValidateScan(const Scan& scan) {
   if (turns < 2.0) {
     Refuse(scan, "its valid samples cover " + Number(turns) + " turns of the wheel; at least 2 are needed");
   }
-  const double axial_span_mm = scan.has_axial() ? std::abs(scan.y_mm[i1] - scan.y_mm[i0])
-                                                : *meta.feed_mm_per_min * duration_s / 60.0;
+  const double axial_span_mm =
+      scan.has_axial() ? std::abs(scan.y_mm[i1] - scan.y_mm[i0]) : *meta.feed_mm_per_min * duration_s / 60.0;
   const double pitch_mm = axial_span_mm / turns;
   if (!(axial_span_mm >= 3.0 * pitch_mm) || !(pitch_mm > 0.0)) {
-    Refuse(scan, "its valid samples span " + Number(axial_span_mm) + " mm along the axis, under 3 helix pitches (" +
-                     Number(3.0 * pitch_mm) + " mm)");
+    Refuse(scan, "its valid samples span " + Number(axial_span_mm) +
+                     " mm along the axis, under 3 helix pitches (" + Number(3.0 * pitch_mm) + " mm)");
   }
 }
 

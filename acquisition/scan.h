@@ -11,14 +11,14 @@ namespace arcwheel::acquisition {
 // The scan's settings and provenance: the HDF5 attributes on /scan, or the CSV's `# key: value`
 // lines. Optional fields are empty when the file does not give them.
 struct ScanMetadata {
-  std::optional<double> spindle_rpm;        // nominal spindle speed, > 0
-  std::optional<double> feed_mm_per_min;    // axial feed of the wheel past the sensor, > 0
-  std::optional<double> sample_period_s;    // time between samples, > 0
-  double radius_sign = 1.0;                 // rho = radius_sign * z; +1 or -1
-  double start_y_mm = 0.0;                  // axial position of the first sample
-  double start_phase_deg = 0.0;             // phase of the first sample (no encoder)
-  std::optional<double> invalid_value;      // z equal to this marks an invalid sample
-  std::optional<double> range_min_mm;       // z outside [range_min_mm, range_max_mm] is invalid
+  std::optional<double> spindle_rpm;      // nominal spindle speed, > 0
+  std::optional<double> feed_mm_per_min;  // axial feed of the wheel past the sensor, > 0
+  std::optional<double> sample_period_s;  // time between samples, > 0
+  double radius_sign = 1.0;               // rho = radius_sign * z; +1 or -1
+  double start_y_mm = 0.0;                // axial position of the first sample
+  double start_phase_deg = 0.0;           // phase of the first sample (no encoder)
+  std::optional<double> invalid_value;    // z equal to this marks an invalid sample
+  std::optional<double> range_min_mm;     // z outside [range_min_mm, range_max_mm] is invalid
   std::optional<double> range_max_mm;
   std::optional<double> wheel_diameter_mm;
   std::optional<double> wheel_width_mm;

@@ -30,7 +30,8 @@ double ParseValue(const std::string& key, std::string_view text) {
 }
 
 bool IsOneOf(const std::string& name, const auto& keys) {
-  return std::find_if(std::begin(keys), std::end(keys), [&](const char* k) { return name == k; }) != std::end(keys);
+  return std::find_if(std::begin(keys), std::end(keys), [&](const char* k) { return name == k; }) !=
+         std::end(keys);
 }
 
 }  // namespace
@@ -54,18 +55,30 @@ bool MetadataSetter::IsNumeric(const std::string& name) { return IsOneOf(name, k
 
 void MetadataSetter::SetNumber(const std::string& name, double value) {
   ScanMetadata& m = metadata_;
-  if (name == "spindle_rpm") m.spindle_rpm = value;
-  else if (name == "feed_mm_per_min") m.feed_mm_per_min = value;
-  else if (name == "sample_period_s") m.sample_period_s = value;
-  else if (name == "radius_sign") m.radius_sign = value;
-  else if (name == "start_y_mm") m.start_y_mm = value;
-  else if (name == "start_phase_deg") m.start_phase_deg = value;
-  else if (name == "invalid_value") m.invalid_value = value;
-  else if (name == "range_min_mm") m.range_min_mm = value;
-  else if (name == "range_max_mm") m.range_max_mm = value;
-  else if (name == "wheel_diameter_mm") m.wheel_diameter_mm = value;
-  else if (name == "wheel_width_mm") m.wheel_width_mm = value;
-  else throw Error(ErrorCode::kInternal, kStage, "metadata '" + name + "' is not numeric");
+  if (name == "spindle_rpm")
+    m.spindle_rpm = value;
+  else if (name == "feed_mm_per_min")
+    m.feed_mm_per_min = value;
+  else if (name == "sample_period_s")
+    m.sample_period_s = value;
+  else if (name == "radius_sign")
+    m.radius_sign = value;
+  else if (name == "start_y_mm")
+    m.start_y_mm = value;
+  else if (name == "start_phase_deg")
+    m.start_phase_deg = value;
+  else if (name == "invalid_value")
+    m.invalid_value = value;
+  else if (name == "range_min_mm")
+    m.range_min_mm = value;
+  else if (name == "range_max_mm")
+    m.range_max_mm = value;
+  else if (name == "wheel_diameter_mm")
+    m.wheel_diameter_mm = value;
+  else if (name == "wheel_width_mm")
+    m.wheel_width_mm = value;
+  else
+    throw Error(ErrorCode::kInternal, kStage, "metadata '" + name + "' is not numeric");
 }
 
 void MetadataSetter::SetText(const std::string& name, std::string_view value) {
@@ -74,11 +87,16 @@ void MetadataSetter::SetText(const std::string& name, std::string_view value) {
   std::string text = AsUtf8(value, latin1);
   if (latin1) metadata_.notes.push_back("metadata '" + name + "' is not valid UTF-8: read as Latin-1");
   ScanMetadata& m = metadata_;
-  if (name == "wheel_id") m.wheel_id = std::move(text);
-  else if (name == "sensor") m.sensor = std::move(text);
-  else if (name == "operator") m.operator_name = std::move(text);
-  else if (name == "timestamp") m.timestamp = std::move(text);
-  else throw Error(ErrorCode::kInternal, kStage, "metadata '" + name + "' is not text");
+  if (name == "wheel_id")
+    m.wheel_id = std::move(text);
+  else if (name == "sensor")
+    m.sensor = std::move(text);
+  else if (name == "operator")
+    m.operator_name = std::move(text);
+  else if (name == "timestamp")
+    m.timestamp = std::move(text);
+  else
+    throw Error(ErrorCode::kInternal, kStage, "metadata '" + name + "' is not text");
 }
 
 void ApplyInvalidMarkers(Scan& scan, SentinelComparison comparison) {
@@ -90,9 +108,11 @@ void ApplyInvalidMarkers(Scan& scan, SentinelComparison comparison) {
   const double sentinel = m.invalid_value.value_or(0.0);
   const float sentinel_float = static_cast<float>(sentinel);
   for (double& z : scan.z_mm) {
-    const bool is_sentinel = has_sentinel && (as_float ? static_cast<float>(z) == sentinel_float : z == sentinel);
+    const bool is_sentinel =
+        has_sentinel && (as_float ? static_cast<float>(z) == sentinel_float : z == sentinel);
     // +-Inf is a float sensor's over-range reading: an invalid sample, like NaN.
-    if (is_sentinel || !std::isfinite(z) || !(z >= low && z <= high)) z = std::numeric_limits<double>::quiet_NaN();
+    if (is_sentinel || !std::isfinite(z) || !(z >= low && z <= high))
+      z = std::numeric_limits<double>::quiet_NaN();
   }
 }
 

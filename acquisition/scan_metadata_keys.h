@@ -11,8 +11,9 @@ namespace arcwheel::acquisition {
 
 // The numeric keys, in formats.md order.
 inline constexpr const char* kNumericMetadataKeys[] = {
-    "spindle_rpm", "feed_mm_per_min", "sample_period_s", "radius_sign", "start_y_mm", "start_phase_deg",
-    "invalid_value", "range_min_mm", "range_max_mm", "wheel_diameter_mm", "wheel_width_mm"};
+    "spindle_rpm",  "feed_mm_per_min",   "sample_period_s", "radius_sign",
+    "start_y_mm",   "start_phase_deg",   "invalid_value",   "range_min_mm",
+    "range_max_mm", "wheel_diameter_mm", "wheel_width_mm"};
 inline constexpr const char* kTextMetadataKeys[] = {"wheel_id", "sensor", "operator", "timestamp"};
 
 // Fills a ScanMetadata from a file's keys as written. Keys match formats.md 2.1 case-insensitively
@@ -39,9 +40,9 @@ class MetadataSetter {
 
 // How ApplyInvalidMarkers compares z with metadata.invalid_value.
 enum class SentinelComparison {
-  kAsDouble,   // z as read
-  kAsFloat,    // z stored as float32: compared as float, so that a float32 sentinel matches exactly
-  kDone,       // the reader already compared the stored values (integer counts before scaling)
+  kAsDouble,  // z as read
+  kAsFloat,   // z stored as float32: compared as float, so that a float32 sentinel matches exactly
+  kDone,      // the reader already compared the stored values (integer counts before scaling)
 };
 
 // Marks as NaN every z equal to metadata.invalid_value (see SentinelComparison), not finite, or

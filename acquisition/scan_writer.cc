@@ -1,7 +1,7 @@
 // Writers for the raw scan layouts (formats.md section 2) and the simulator's truth file.
 
-#include <cmath>
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <nlohmann/json.hpp>
 #include <string>
@@ -20,7 +20,8 @@ void WriteOptional(hdf5::File& file, const char* name, const std::optional<doubl
 
 nlohmann::json HarmonicsJson(const std::vector<Harmonic>& harmonics) {
   nlohmann::json list = nlohmann::json::array();
-  for (const Harmonic& h : harmonics) list.push_back({{"order", h.order}, {"amplitude", h.amplitude}, {"phase_deg", h.phase_deg}});
+  for (const Harmonic& h : harmonics)
+    list.push_back({{"order", h.order}, {"amplitude", h.amplitude}, {"phase_deg", h.phase_deg}});
   return list;
 }
 
@@ -66,7 +67,8 @@ void WriteCsvScan(const Scan& scan, const std::string& path) {
   OutputSet outputs;
   const auto temporary = outputs.Stage(path);
   FILE* out = std::fopen(temporary.c_str(), "w");
-  if (out == nullptr) throw Error(ErrorCode::kIo, "acquisition.csv", "cannot create '" + temporary.string() + "'");
+  if (out == nullptr)
+    throw Error(ErrorCode::kIo, "acquisition.csv", "cannot create '" + temporary.string() + "'");
   const ScanMetadata& m = scan.metadata;
   const auto number = [&](const char* key, const std::optional<double>& value) {
     if (value) std::fprintf(out, "# %s: %.17g\n", key, *value);
@@ -96,8 +98,10 @@ void WriteCsvScan(const Scan& scan, const std::string& path) {
   }
   for (std::size_t i = 0; i < scan.size(); ++i) {
     const double z = scan.z_mm[i];
-    if (std::isfinite(z)) std::fprintf(out, "%.9f", z);
-    else std::fputs(i < first_valid || i > last_valid ? "-FFFFFFF" : "nan", out);
+    if (std::isfinite(z))
+      std::fprintf(out, "%.9f", z);
+    else
+      std::fputs(i < first_valid || i > last_valid ? "-FFFFFFF" : "nan", out);
     if (scan.has_time()) std::fprintf(out, ",%.12g", scan.t_s[i]);
     if (scan.has_encoder()) std::fprintf(out, ",%.12f", scan.angle_deg[i]);
     if (scan.has_axial()) std::fprintf(out, ",%.12f", scan.y_mm[i]);
@@ -110,7 +114,8 @@ void WriteCsvScan(const Scan& scan, const std::string& path) {
   outputs.Commit();
 }
 
-std::string TruthJson(const WheelModel& wheel, const ScanSettings& s, const SimulationCounts& counts, int phases) {
+std::string TruthJson(const WheelModel& wheel, const ScanSettings& s, const SimulationCounts& counts,
+                      int phases) {
   nlohmann::json truth;
   truth["model"] = {{"wheel_diameter_mm", wheel.wheel_diameter_mm},
                     {"width_mm", wheel.width_mm},
@@ -141,8 +146,10 @@ std::string TruthJson(const WheelModel& wheel, const ScanSettings& s, const Simu
                        {"dropout_length_max", s.dropout_length_max},
                        {"encoder", s.write_encoder},
                        {"seed", s.seed}};
-  truth["counts"] = {{"samples", counts.samples}, {"off_rim", counts.off_rim},
-                     {"dropouts", counts.dropouts}, {"spikes", counts.spikes}};
+  truth["counts"] = {{"samples", counts.samples},
+                     {"off_rim", counts.off_rim},
+                     {"dropouts", counts.dropouts},
+                     {"spikes", counts.spikes}};
   nlohmann::json per_phase;
   for (int k = 0; k < phases; ++k) {
     const double c = 360.0 * k / phases;

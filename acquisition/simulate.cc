@@ -15,7 +15,8 @@ constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 double SumHarmonics(const std::vector<Harmonic>& harmonics, double phase_deg) {
   double sum = 0.0;
-  for (const Harmonic& h : harmonics) sum += h.amplitude * std::cos((h.order * phase_deg + h.phase_deg) * kDegToRad);
+  for (const Harmonic& h : harmonics)
+    sum += h.amplitude * std::cos((h.order * phase_deg + h.phase_deg) * kDegToRad);
   return sum;
 }
 
@@ -83,7 +84,8 @@ double WheelModel::RadiusMm(double phase_deg, double y_mm) const {
   const double along = std::fmod(std::fmod(phase_deg, 360.0) + 360.0, 360.0) / 360.0 * circumference_mm;
   const auto i = static_cast<std::int64_t>(std::floor(along / grit_cell_mm));
   const auto j = static_cast<std::int64_t>(std::floor(y_mm / grit_cell_mm));
-  const std::uint64_t h = Mix(grit_seed ^ Mix(static_cast<std::uint64_t>(i) * 0x100000001b3ULL ^ Mix(static_cast<std::uint64_t>(j))));
+  const std::uint64_t h = Mix(
+      grit_seed ^ Mix(static_cast<std::uint64_t>(i) * 0x100000001b3ULL ^ Mix(static_cast<std::uint64_t>(j))));
   // Box-Muller from two hashed uniforms.
   const double u1 = UnitFromHash(h);
   const double u2 = UnitFromHash(Mix(h));
@@ -106,7 +108,8 @@ SimulatedScan SimulateScan(const WheelModel& wheel, const ScanSettings& s) {
   Require(s.end_y_mm > s.start_y_mm, "end_y_mm must exceed start_y_mm");
   Require(s.radius_sign == 1.0 || s.radius_sign == -1.0, "radius_sign must be +1 or -1");
   Require(wheel.arc_radius_mm > wheel.width_mm / 2.0, "arc_radius_mm must exceed half the width");
-  Require(s.burst_length_max >= 2 && s.dropout_length_max >= 1, "burst and dropout lengths must be >= 2 and >= 1");
+  Require(s.burst_length_max >= 2 && s.dropout_length_max >= 1,
+          "burst and dropout lengths must be >= 2 and >= 1");
   const double duration_s = (s.end_y_mm - s.start_y_mm) / s.feed_mm_per_min * 60.0;
   const auto n = static_cast<std::size_t>(std::floor(duration_s / s.sample_period_s)) + 1;
   Require(n <= 2'000'000'000ULL, "the scan would have more than 2e9 samples");
@@ -163,7 +166,8 @@ SimulatedScan SimulateScan(const WheelModel& wheel, const ScanSettings& s) {
       if (s.noise_um > 0) z += noise(rng);
       if (burst_left == 0 && s.burst_rate > 0 && unit(events) < s.burst_rate) {
         burst_left = 2 + static_cast<int>(unit(events) * (s.burst_length_max - 1));
-        burst_offset_mm = (unit(events) < 0.5 ? -1.0 : 1.0) * s.spike_amplitude_um * (0.5 + 0.5 * unit(events)) / 1000.0;
+        burst_offset_mm =
+            (unit(events) < 0.5 ? -1.0 : 1.0) * s.spike_amplitude_um * (0.5 + 0.5 * unit(events)) / 1000.0;
       }
       if (burst_left > 0) {
         z += burst_offset_mm * (0.8 + 0.4 * unit(events));

@@ -37,7 +37,7 @@ struct WheelModel {
   double wheel_diameter_mm = 400.0;  // total diameter at the arc apex (nominal)
   double width_mm = 20.0;            // axial width of the rim; the arc spans a(c) +- width/2
   double arc_radius_mm = 55.4423;
-  double center_axial_mm = 0.0;      // a0, in the scan's axial coordinate
+  double center_axial_mm = 0.0;  // a0, in the scan's axial coordinate
   std::vector<Harmonic> arc_radius_harmonics_mm;
   std::vector<Harmonic> center_axial_harmonics_mm;
   std::vector<Harmonic> radial_harmonics_um;
@@ -75,17 +75,17 @@ struct ScanSettings {
   double sensor_range_mm = 3.0;          // readings beyond +- this are over-range (invalid)
   double radius_sign = 1.0;
   double beam_offset_mm = 0.0;
-  double noise_um = 0.0;                 // white sensor noise, 1 sigma
-  double spike_rate = 0.0;               // isolated spikes per sample
+  double noise_um = 0.0;    // white sensor noise, 1 sigma
+  double spike_rate = 0.0;  // isolated spikes per sample
   double spike_amplitude_um = 50.0;
-  double burst_rate = 0.0;               // bursts of spikes per sample
-  int burst_length_max = 5;              // samples in a burst, 2..max
-  double dropout_rate = 0.0;             // dropouts per sample
-  int dropout_length_max = 40;           // samples in a dropout, 1..max
-  bool write_time = false;               // a t column
-  bool write_encoder = false;            // an angle column (true spindle angle, wrapped)
-  bool write_axial = false;              // a y column
-  bool float32 = true;                   // HDF5 z as float32 (else float64)
+  double burst_rate = 0.0;      // bursts of spikes per sample
+  int burst_length_max = 5;     // samples in a burst, 2..max
+  double dropout_rate = 0.0;    // dropouts per sample
+  int dropout_length_max = 40;  // samples in a dropout, 1..max
+  bool write_time = false;      // a t column
+  bool write_encoder = false;   // an angle column (true spindle angle, wrapped)
+  bool write_axial = false;     // a y column
+  bool float32 = true;          // HDF5 z as float32 (else float64)
   std::uint64_t seed = 1;
   std::string wheel_id = "simulated";
 };

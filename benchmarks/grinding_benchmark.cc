@@ -15,8 +15,8 @@ namespace {
 using namespace arcwheel::grinding;
 
 const EvenAsphere& TrialPart() {  // method.md A.9
-  static const EvenAsphere part({.vertex_radius_mm = 4066.172723, .conic = -0.581986,
-                                 .off_axis_x_mm = 300.0, .off_axis_y_mm = 300.0});
+  static const EvenAsphere part(
+      {.vertex_radius_mm = 4066.172723, .conic = -0.581986, .off_axis_x_mm = 300.0, .off_axis_y_mm = 300.0});
   return part;
 }
 
@@ -28,8 +28,11 @@ Wheel PaperWheel() {
 // Argument: spacing of the global gouge checks, mm (the local check runs at every point).
 void BM_TrialPartControlPoints(benchmark::State& state) {
   const Aperture aperture{.width_x_mm = 430.0, .width_y_mm = 430.0};
-  const ToolpathOptions options{.step_over_mm = 0.1, .point_spacing_mm = 0.1, .feed_mm_per_min = 6000.0,
-                                .lead_in_mm = 0.0, .lead_out_mm = 0.0,
+  const ToolpathOptions options{.step_over_mm = 0.1,
+                                .point_spacing_mm = 0.1,
+                                .feed_mm_per_min = 6000.0,
+                                .lead_in_mm = 0.0,
+                                .lead_out_mm = 0.0,
                                 .gouge_check_spacing_mm = static_cast<double>(state.range(0)),
                                 .threads = 2};
   long long points = 0;
@@ -42,22 +45,36 @@ void BM_TrialPartControlPoints(benchmark::State& state) {
   state.counters["points_per_s"] =
       benchmark::Counter(static_cast<double>(points), benchmark::Counter::kIsIterationInvariantRate);
 }
-BENCHMARK(BM_TrialPartControlPoints)->Arg(10)->Arg(2)->Unit(benchmark::kSecond)->Iterations(1)->Repetitions(3)
+BENCHMARK(BM_TrialPartControlPoints)
+    ->Arg(10)
+    ->Arg(2)
+    ->Unit(benchmark::kSecond)
+    ->Iterations(1)
+    ->Repetitions(3)
     ->UseRealTime();
 
 // The same with each row formatted as the CSV's text in the workers (what `arcwheel toolpath`
 // writes; the text is dropped here so the disk does not enter the figure).
 void BM_TrialPartCsvText(benchmark::State& state) {
   const Aperture aperture{.width_x_mm = 430.0, .width_y_mm = 430.0};
-  const ToolpathOptions options{.step_over_mm = 0.1, .point_spacing_mm = 0.1, .feed_mm_per_min = 6000.0,
-                                .lead_in_mm = 0.0, .lead_out_mm = 0.0, .gouge_check_spacing_mm = 10.0,
+  const ToolpathOptions options{.step_over_mm = 0.1,
+                                .point_spacing_mm = 0.1,
+                                .feed_mm_per_min = 6000.0,
+                                .lead_in_mm = 0.0,
+                                .lead_out_mm = 0.0,
+                                .gouge_check_spacing_mm = 10.0,
                                 .threads = 2};
   std::atomic<long long> bytes = 0;
   for (auto _ : state) {
     bytes = 0;
-    (void)GenerateToolpath(TrialPart(), aperture, PaperWheel(), options,
-                           {.prepare = [](ToolpathRow& row) { row.text.resize(1); AppendCsvLines(row, 6000.0, row.text[0]); },
-                            .consume = [&bytes](ToolpathRow& row) { bytes += static_cast<long long>(row.text[0].size()); }});
+    (void)GenerateToolpath(
+        TrialPart(), aperture, PaperWheel(), options,
+        {.prepare =
+             [](ToolpathRow& row) {
+               row.text.resize(1);
+               AppendCsvLines(row, 6000.0, row.text[0]);
+             },
+         .consume = [&bytes](ToolpathRow& row) { bytes += static_cast<long long>(row.text[0].size()); }});
   }
   state.counters["csv_bytes"] = static_cast<double>(bytes.load());
 }
@@ -67,8 +84,12 @@ BENCHMARK(BM_TrialPartCsvText)->Unit(benchmark::kSecond)->Iterations(1)->Repetit
 void BM_Prediction1000x1000(benchmark::State& state) {
   const EvenAsphere part({.vertex_radius_mm = 800.0, .conic = -2.2, .off_axis_x_mm = 300.0});
   const Aperture aperture{.width_x_mm = 200.0, .width_y_mm = 200.0};
-  PredictionOptions options{.arc_radius_error_mm = 0.1, .spindle_rpm = 1432.4, .feed_mm_per_min = 6000.0,
-                            .nodes_x = 1000, .nodes_y = 1000, .threads = 2};
+  PredictionOptions options{.arc_radius_error_mm = 0.1,
+                            .spindle_rpm = 1432.4,
+                            .feed_mm_per_min = 6000.0,
+                            .nodes_x = 1000,
+                            .nodes_y = 1000,
+                            .threads = 2};
   SetEccentricRunout(2.0, options);
   for (auto _ : state) {
     const FormPrediction p = PredictFormError(part, aperture, PaperWheel(), options);

@@ -16,12 +16,14 @@ using namespace arcwheel::polishing;
 
 void BM_SolveDwell(benchmark::State& state) {
   const double extension_mm = 5.0;
-  const double side_mm = std::round(std::sqrt(static_cast<double>(state.range(0)))) - 1.0 - 2.0 * extension_mm;
+  const double side_mm =
+      std::round(std::sqrt(static_cast<double>(state.range(0)))) - 1.0 - 2.0 * extension_mm;
   const arcwheel::grinding::Aperture aperture{.width_x_mm = side_mm, .width_y_mm = side_mm};
   const std::vector<Eigen::Vector2d> path =
       RasterPath(aperture, {.line_spacing_mm = 1.0, .point_spacing_mm = 1.0, .extension_mm = extension_mm});
   const int nodes = static_cast<int>(side_mm) + 1;
-  ErrorMap error{.x0_mm = -side_mm / 2, .y0_mm = -side_mm / 2, .dx_mm = 1.0, .dy_mm = 1.0, .nx = nodes, .ny = nodes};
+  ErrorMap error{
+      .x0_mm = -side_mm / 2, .y0_mm = -side_mm / 2, .dx_mm = 1.0, .dy_mm = 1.0, .nx = nodes, .ny = nodes};
   for (int j = 0; j < nodes; ++j) {
     for (int i = 0; i < nodes; ++i) {
       const double x = error.X(i) / side_mm, y = error.Y(j) / side_mm;

@@ -23,7 +23,8 @@ const fs::path& ScanWithSamples(double samples) {
   static std::map<double, fs::path> cache;
   auto& path = cache[samples];
   if (path.empty()) {
-    path = fs::temp_directory_path() / ("arcwheel-bench-" + std::to_string(static_cast<long>(samples)) + ".h5");
+    path =
+        fs::temp_directory_path() / ("arcwheel-bench-" + std::to_string(static_cast<long>(samples)) + ".h5");
     acquisition::WheelModel wheel;
     wheel.radial_harmonics_um = {{1, 3.0, 40.0}, {3, 0.8, 15.0}};
     acquisition::ScanSettings settings;
@@ -52,8 +53,8 @@ void BM_ProcessEndToEnd(benchmark::State& state) {
     const auto fit = fitting::FitWheel(processed.map, {});
     fitting::WriteProcessOutputs(outdir, record, processed, fit);
   }
-  state.counters["samples_per_s"] = benchmark::Counter(static_cast<double>(samples) * static_cast<double>(state.iterations()),
-                                                       benchmark::Counter::kIsRate);
+  state.counters["samples_per_s"] = benchmark::Counter(
+      static_cast<double>(samples) * static_cast<double>(state.iterations()), benchmark::Counter::kIsRate);
   state.counters["samples"] = static_cast<double>(samples);
 }
 
@@ -65,8 +66,10 @@ void BM_MeanRadiusAgainstTruth(benchmark::State& state) {
   acquisition::ScanSettings settings;
   settings.noise_um = 0.5;
   const auto samples = static_cast<double>(state.range(0));
-  settings.feed_mm_per_min = (settings.end_y_mm - settings.start_y_mm) / (samples * settings.sample_period_s) * 60.0;
-  settings.spindle_rpm_true = state.range(1) != 0 ? 1.002 * settings.spindle_rpm_nominal : settings.spindle_rpm_nominal;
+  settings.feed_mm_per_min =
+      (settings.end_y_mm - settings.start_y_mm) / (samples * settings.sample_period_s) * 60.0;
+  settings.spindle_rpm_true =
+      state.range(1) != 0 ? 1.002 * settings.spindle_rpm_nominal : settings.spindle_rpm_nominal;
   settings.write_encoder = state.range(1) == 1;
   double error_um = 0.0, sigma_um = 0.0;
   for (auto _ : state) {

@@ -23,7 +23,9 @@ struct Points {
 };
 
 std::vector<std::string> SplitCells(const std::string& line) {
-  const char separator = line.find(',') != std::string::npos ? ',' : line.find(';') != std::string::npos ? ';' : '\t';
+  const char separator = line.find(',') != std::string::npos   ? ','
+                         : line.find(';') != std::string::npos ? ';'
+                                                               : '\t';
   std::vector<std::string> cells;
   std::stringstream stream(line);
   std::string cell;
@@ -51,7 +53,8 @@ Points ReadPoints(const std::string& path, const std::string& x_name, const std:
     for (std::size_t i = 0; i < header.size(); ++i) {
       if (header[i] == name) return i;
     }
-    throw Error(ErrorCode::kBadInput, kCircleFitStage, "'" + path + "': the header has no column '" + name + "'");
+    throw Error(ErrorCode::kBadInput, kCircleFitStage,
+                "'" + path + "': the header has no column '" + name + "'");
   };
   const std::size_t ix = find(x_name);
   const std::size_t iy = find(y_name);
@@ -62,15 +65,17 @@ Points ReadPoints(const std::string& path, const std::string& x_name, const std:
     const std::vector<std::string> cells = SplitCells(line);
     if (cells.size() != header.size()) {
       throw Error(ErrorCode::kBadInput, kCircleFitStage,
-                  fmt::format("'{}' line {}: {} cells, the header names {}", path, number, cells.size(), header.size()));
+                  fmt::format("'{}' line {}: {} cells, the header names {}", path, number, cells.size(),
+                              header.size()));
     }
     for (const std::size_t column : {ix, iy}) {
       double value = 0;
       const std::string& cell = cells[column];
       const auto [end, error] = std::from_chars(cell.data(), cell.data() + cell.size(), value);
       if (error != std::errc() || end != cell.data() + cell.size() || !std::isfinite(value)) {
-        throw Error(ErrorCode::kBadInput, kCircleFitStage,
-                    fmt::format("'{}' line {}: cannot read {} value '{}'", path, number, header[column], cell));
+        throw Error(
+            ErrorCode::kBadInput, kCircleFitStage,
+            fmt::format("'{}' line {}: cannot read {} value '{}'", path, number, header[column], cell));
       }
       (column == ix ? points.x : points.y).push_back(value);
     }
@@ -83,11 +88,14 @@ Points ReadPoints(const std::string& path, const std::string& x_name, const std:
 void AddFitCommand(CLI::App& app) {
   CLI::App* fit = app.add_subcommand("fit", "least-squares fits of point sets");
   fit->require_subcommand(1);
-  CLI::App* circle = fit->add_subcommand("circle", "geometric least-squares circle through 2D points (JSON on stdout)");
+  CLI::App* circle =
+      fit->add_subcommand("circle", "geometric least-squares circle through 2D points (JSON on stdout)");
   auto path = std::make_shared<std::string>();
   auto columns = std::make_shared<std::vector<std::string>>(std::vector<std::string>{"x_mm", "y_mm"});
   circle->add_option("POINTS", *path, "CSV with a header naming the columns")->required();
-  circle->add_option("--columns", *columns, "the two column names to use")->expected(2)->capture_default_str();
+  circle->add_option("--columns", *columns, "the two column names to use")
+      ->expected(2)
+      ->capture_default_str();
   circle->footer(
       "Output: {\"center\": [a, b], \"radius\": r, \"n\": N, \"rms_residual_mm\", \"pv_residual_mm\",\n"
       "\"radius_sigma_mm\", \"center_sigma_mm\"}; sigmas from the residual scatter (unknown noise).");

@@ -124,13 +124,14 @@ struct RecordRow {
 
 std::vector<RecordRow> ReadRecordList(const std::string& list, const char* x_name, const char* y_name) {
   const frames::CsvTable table = frames::ReadCsvTable(list, kHeadcenterStage);
-  const size_t record = table.Require("record", kHeadcenterStage), x = table.Require(x_name, kHeadcenterStage),
-               y = table.Require(y_name, kHeadcenterStage);
+  const size_t record = table.Require("record", kHeadcenterStage),
+               x = table.Require(x_name, kHeadcenterStage), y = table.Require(y_name, kHeadcenterStage);
   std::vector<RecordRow> rows;
   for (size_t row = 0; row < table.cells.size(); ++row) {
     fs::path path = table.cells[row][record];
     if (path.is_relative()) path = fs::path(list).parent_path() / path;
-    rows.push_back({path.string(), {table.Number(row, x, kHeadcenterStage), table.Number(row, y, kHeadcenterStage)}});
+    rows.push_back(
+        {path.string(), {table.Number(row, x, kHeadcenterStage), table.Number(row, y, kHeadcenterStage)}});
   }
   return rows;
 }

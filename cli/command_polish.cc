@@ -24,8 +24,9 @@ void AddPolishCommand(CLI::App& app) {
       "polish", "dwell time, tool frames and an ABB RAPID program that polish an error map away");
   command->add_option("JOB", arguments->job, "job file (JSON, see docs/polishing.md)")->required();
   command->add_option("-o,--output", arguments->output, "output folder")->required();
-  command->add_option("--report", arguments->report_formats,
-                      "also render the polishing report: html,pdf (both are written, docs/reports.md)")
+  command
+      ->add_option("--report", arguments->report_formats,
+                   "also render the polishing report: html,pdf (both are written, docs/reports.md)")
       ->delimiter(',')
       ->check(CLI::IsMember({"html", "pdf"}));
   command->callback([arguments] {
@@ -34,12 +35,13 @@ void AddPolishCommand(CLI::App& app) {
     const polishing::PolishRunReport report = polishing::RunPolishJob(job, arguments->output);
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     const polishing::DwellSolution& d = report.dwell;
-    fmt::print("{} dwell points; error PV {:.4f} um, RMS {:.4f} um -> predicted residual PV {:.4f} um, "
-               "RMS {:.4f} um over {} aperture nodes\n",
-               report.points, d.before.pv_um, d.before.rms_um, d.after.pv_um, d.after.rms_um, d.before.nodes);
+    fmt::print(
+        "{} dwell points; error PV {:.4f} um, RMS {:.4f} um -> predicted residual PV {:.4f} um, "
+        "RMS {:.4f} um over {} aperture nodes\n",
+        report.points, d.before.pv_um, d.before.rms_um, d.after.pv_um, d.after.rms_um, d.before.nodes);
     fmt::print("total dwell {:.1f} s; speeds {:.3f} .. {:.3f} mm/s, up to {:.1f} mm/s^2; {} iterations{}\n",
-               d.total_time_s, report.min_speed_mm_s, report.max_speed_mm_s, d.max_acceleration_mm_s2, d.iterations,
-               d.converged ? "" : " (iteration limit reached)");
+               d.total_time_s, report.min_speed_mm_s, report.max_speed_mm_s, d.max_acceleration_mm_s2,
+               d.iterations, d.converged ? "" : " (iteration limit reached)");
     fmt::print("wrote {} in {:.2f} s\n", arguments->output, seconds);
     if (!arguments->report_formats.empty()) {
       // Drawn from the files just written, exactly as `arcwheel report OUTDIR` would.

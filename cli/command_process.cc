@@ -79,13 +79,14 @@ void PrintHeadline(const ProcessArgs& args, const processing::ProcessedScan& p, 
              p.phase_source == processing::PhaseSource::kEncoder     ? "encoder"
              : p.phase_source == processing::PhaseSource::kEstimated ? "estimated from the data"
                                                                      : "nominal");
-  fmt::print("mean arc radius      {:.5f} +- {:.5f} mm (1 sigma), {} of {} phases usable\n", f.mean_arc_radius_mm,
-             f.mean_arc_radius_sigma_mm, f.usable_phases, f.phases.size());
-  fmt::print("arc radius range     {:.5f} mm ({:.3f} %); real spread beyond noise {:.5f} mm\n", f.arc_radius_range_mm,
-             f.arc_radius_fluctuation_pct, f.arc_radius_excess_std_mm);
-  fmt::print("arc centre axial     {:.5f} mm, deviation {:.5f} mm\n", f.mean_center_axial_mm, f.center_axial_deviation_mm);
-  fmt::print("max arc error        {:.3f} um in the band [{:.3f}, {:.3f}] mm\n", f.max_arc_error_um, f.band_low_mm,
-             f.band_high_mm);
+  fmt::print("mean arc radius      {:.5f} +- {:.5f} mm (1 sigma), {} of {} phases usable\n",
+             f.mean_arc_radius_mm, f.mean_arc_radius_sigma_mm, f.usable_phases, f.phases.size());
+  fmt::print("arc radius range     {:.5f} mm ({:.3f} %); real spread beyond noise {:.5f} mm\n",
+             f.arc_radius_range_mm, f.arc_radius_fluctuation_pct, f.arc_radius_excess_std_mm);
+  fmt::print("arc centre axial     {:.5f} mm, deviation {:.5f} mm\n", f.mean_center_axial_mm,
+             f.center_axial_deviation_mm);
+  fmt::print("max arc error        {:.3f} um in the band [{:.3f}, {:.3f}] mm\n", f.max_arc_error_um,
+             f.band_low_mm, f.band_high_mm);
   fmt::print("max runout           {:.3f} um (wheel + spindle error motion)\n", f.max_runout_um);
   fmt::print("max roundness        {:.3f} um\n", f.max_roundness_um);
 }
@@ -126,9 +127,11 @@ void Run(ProcessArgs& args) {
 
 void AddProcessCommand(CLI::App& app) {
   auto args = std::make_shared<ProcessArgs>();
-  CLI::App* cmd = app.add_subcommand("process", "turn a raw helical wheel scan into summary.json and wheel_map.h5");
+  CLI::App* cmd =
+      app.add_subcommand("process", "turn a raw helical wheel scan into summary.json and wheel_map.h5");
   cmd->footer(
-      "Steps: trim invalid ends; drop stuck-sensor runs; estimate the noise; despike; unwrap the helix (encoder, or the\n"
+      "Steps: trim invalid ends; drop stuck-sensor runs; estimate the noise; despike; unwrap the helix "
+      "(encoder, or the\n"
       "spindle speed estimated from the data when it differs significantly from nominal); fit a\n"
       "least-squares cubic spline along the helix; sample it at every phase on every turn; fit a\n"
       "circle to each phase's section inside the band (Ceres, with 1-sigma uncertainties); map the\n"
@@ -141,25 +144,36 @@ void AddProcessCommand(CLI::App& app) {
   cmd->add_option("-o,--output", args->outdir, "output folder")->required();
   auto& p = args->processing;
   cmd->add_option("--phases", p.map.phases, "phase nodes per turn")->capture_default_str();
-  cmd->add_option("--band-half-width-mm", args->fit.band_half_width_mm, "half width of the grinding band")->capture_default_str();
-  cmd->add_option("--fit-span", args->fit_span, "band: fit inside the band; full: the whole rim")->capture_default_str();
+  cmd->add_option("--band-half-width-mm", args->fit.band_half_width_mm, "half width of the grinding band")
+      ->capture_default_str();
+  cmd->add_option("--fit-span", args->fit_span, "band: fit inside the band; full: the whole rim")
+      ->capture_default_str();
   cmd->add_option("--axial-step-mm", p.map.axial_step_mm, "map node spacing (default one helix pitch)");
   cmd->add_option("--knot-step-deg", p.map.knot_step_deg, "helix spline knot spacing (default 360/phases)");
-  cmd->add_option("--despike", args->despike_method, "median (burst-safe), moving-mean (the paper's), none")->capture_default_str();
-  cmd->add_option("--despike-window", p.despike.window_half_width, "window half-width, samples")->capture_default_str();
-  cmd->add_option("--despike-threshold-um", p.despike.threshold_um, "rejection threshold (default: sigmas x noise)");
-  cmd->add_option("--despike-sigmas", p.despike.threshold_sigmas, "automatic threshold in noise sigmas")->capture_default_str();
-  cmd->add_option("--rpm-source", args->rpm_source, "auto, nominal, encoder or estimate")->capture_default_str();
+  cmd->add_option("--despike", args->despike_method, "median (burst-safe), moving-mean (the paper's), none")
+      ->capture_default_str();
+  cmd->add_option("--despike-window", p.despike.window_half_width, "window half-width, samples")
+      ->capture_default_str();
+  cmd->add_option("--despike-threshold-um", p.despike.threshold_um,
+                  "rejection threshold (default: sigmas x noise)");
+  cmd->add_option("--despike-sigmas", p.despike.threshold_sigmas, "automatic threshold in noise sigmas")
+      ->capture_default_str();
+  cmd->add_option("--rpm-source", args->rpm_source, "auto, nominal, encoder or estimate")
+      ->capture_default_str();
   cmd->add_option("--stuck-run-deg", p.stuck_run_deg,
                   "drop runs of equal readings lasting this much of a turn (stuck sensor); 0 keeps them")
       ->capture_default_str();
-  cmd->add_option("--beam-offset-mm", p.beam_offset_mm, "correct a beam offset from the axis (method.md A.7)")->capture_default_str();
+  cmd->add_option("--beam-offset-mm", p.beam_offset_mm, "correct a beam offset from the axis (method.md A.7)")
+      ->capture_default_str();
   cmd->add_option("--wheel-radius-mm", p.wheel_radius_mm, "wheel radius for the beam-offset correction");
-  cmd->add_option("--min-points", args->fit.min_points, "fewest section points for a usable phase")->capture_default_str();
-  cmd->add_option("--report", args->report_formats, "also render the inspection report: html,pdf (both are written)")
+  cmd->add_option("--min-points", args->fit.min_points, "fewest section points for a usable phase")
+      ->capture_default_str();
+  cmd->add_option("--report", args->report_formats,
+                  "also render the inspection report: html,pdf (both are written)")
       ->delimiter(',')
       ->check(CLI::IsMember({"html", "pdf"}));
-  cmd->add_option("--tolerances", args->tolerance_file, "tolerance file for the report's pass/fail (docs/reports.md)")
+  cmd->add_option("--tolerances", args->tolerance_file,
+                  "tolerance file for the report's pass/fail (docs/reports.md)")
       ->check(CLI::ExistingFile);
   cmd->add_flag("-q,--quiet", args->quiet, "no progress and no headline");
   cmd->callback([args] { Run(*args); });

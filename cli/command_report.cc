@@ -32,8 +32,9 @@ void RunReport(const ReportArguments& arguments) {
   const bool polish = std::filesystem::exists(arguments.outdir / "polish_summary.json");
   const bool wheel = std::filesystem::exists(arguments.outdir / "summary.json");
   if (polish && !wheel && (!arguments.tolerance_file.empty() || !arguments.tolerance_flags.empty())) {
-    throw Error(ErrorCode::kInvalidOption, "reports",
-                "tolerances apply to the wheel report; '" + arguments.outdir.string() + "' holds no summary.json");
+    throw Error(
+        ErrorCode::kInvalidOption, "reports",
+        "tolerances apply to the wheel report; '" + arguments.outdir.string() + "' holds no summary.json");
   }
   if (polish) {
     const reports::WrittenPolishReports written = reports::WritePolishReports(arguments.outdir);
@@ -56,14 +57,18 @@ void RunWheelReport(const ReportArguments& arguments) {
 void AddReportCommand(CLI::App& app) {
   auto arguments = std::make_shared<ReportArguments>();
   CLI::App* command = app.add_subcommand(
-      "report", "render OUTDIR/report.html and OUTDIR/report.pdf from OUTDIR/summary.json and wheel_map.h5, or "
-                "OUTDIR/polish_report.html and .pdf from the outputs of `arcwheel polish`");
-  command->add_option("OUTDIR", arguments->outdir, "folder written by `arcwheel process` or `arcwheel polish`")->required();
+      "report",
+      "render OUTDIR/report.html and OUTDIR/report.pdf from OUTDIR/summary.json and wheel_map.h5, or "
+      "OUTDIR/polish_report.html and .pdf from the outputs of `arcwheel polish`");
+  command
+      ->add_option("OUTDIR", arguments->outdir, "folder written by `arcwheel process` or `arcwheel polish`")
+      ->required();
   command->add_option("--tolerances", arguments->tolerance_file,
                       "JSON file of limits by headline key, e.g. {\"max_runout_um\": 10, "
                       "\"mean_arc_radius_mm\": {\"min\": 74.9, \"max\": 75.1}}");
-  command->add_option("--tolerance", arguments->tolerance_flags,
-                      "one limit KEY=MAX or KEY=MIN:MAX (repeatable; overrides the file), e.g. max_arc_error_um=3");
+  command->add_option(
+      "--tolerance", arguments->tolerance_flags,
+      "one limit KEY=MAX or KEY=MIN:MAX (repeatable; overrides the file), e.g. max_arc_error_um=3");
   command->callback([arguments] { RunReport(*arguments); });
 }
 

@@ -56,10 +56,12 @@ void Run(SimulateArgs& args) {
   } else if (extension == ".csv" || extension == ".txt") {
     acquisition::WriteCsvScan(simulated.scan, args.output);
   } else {
-    throw Error(ErrorCode::kInvalidOption, "simulate", "output '" + args.output + "' must end in .h5, .hdf5, .csv or .txt");
+    throw Error(ErrorCode::kInvalidOption, "simulate",
+                "output '" + args.output + "' must end in .h5, .hdf5, .csv or .txt");
   }
   const std::string truth_path = args.truth.empty() ? output.string() + ".truth.json" : args.truth;
-  WriteFileAtomically(truth_path, acquisition::TruthJson(args.wheel, args.settings, simulated.counts, args.truth_phases));
+  WriteFileAtomically(truth_path,
+                      acquisition::TruthJson(args.wheel, args.settings, simulated.counts, args.truth_phases));
   fmt::print("scan:  {} ({} samples)\ntruth: {}\n", args.output, simulated.counts.samples, truth_path);
 }
 
@@ -67,7 +69,8 @@ void Run(SimulateArgs& args) {
 
 void AddSimulateCommand(CLI::App& app) {
   auto args = std::make_shared<SimulateArgs>();
-  CLI::App* cmd = app.add_subcommand("simulate", "write a synthetic helical scan of a wheel with known geometry");
+  CLI::App* cmd =
+      app.add_subcommand("simulate", "write a synthetic helical scan of a wheel with known geometry");
   cmd->footer(
       "The wheel: rim radius R(c,y) = Rb(c) + sqrt(Ra(c)^2 - (y - a(c))^2) + profile + grit.\n"
       "Harmonics are ORDER:AMPLITUDE[:PHASE_DEG] (amplitude in the option's unit), repeatable.\n"
@@ -78,33 +81,44 @@ void AddSimulateCommand(CLI::App& app) {
   cmd->add_option("--truth", args->truth, "truth JSON path");
   auto& w = args->wheel;
   auto& s = args->settings;
-  cmd->add_option("--wheel-diameter-mm", w.wheel_diameter_mm, "wheel diameter at the arc apex")->capture_default_str();
+  cmd->add_option("--wheel-diameter-mm", w.wheel_diameter_mm, "wheel diameter at the arc apex")
+      ->capture_default_str();
   cmd->add_option("--width-mm", w.width_mm, "rim width")->capture_default_str();
   cmd->add_option("--arc-radius-mm", w.arc_radius_mm, "mean arc radius Ra")->capture_default_str();
-  cmd->add_option("--center-axial-mm", w.center_axial_mm, "axial position of the arc centre")->capture_default_str();
+  cmd->add_option("--center-axial-mm", w.center_axial_mm, "axial position of the arc centre")
+      ->capture_default_str();
   cmd->add_option("--radius-harmonic", args->radius_harmonics, "Ra(c) variation, amplitude in mm");
-  cmd->add_option("--axial-harmonic", args->axial_harmonics, "a(c) variation (axial wobble), amplitude in mm");
-  cmd->add_option("--radial-harmonic", args->radial_harmonics, "radial runout: order 1 eccentricity, >= 2 lobing; um");
-  cmd->add_option("--profile-legendre-um", w.profile_legendre_um, "profile error: coefficients of P0, P1, ... in um")->delimiter(',');
+  cmd->add_option("--axial-harmonic", args->axial_harmonics,
+                  "a(c) variation (axial wobble), amplitude in mm");
+  cmd->add_option("--radial-harmonic", args->radial_harmonics,
+                  "radial runout: order 1 eccentricity, >= 2 lobing; um");
+  cmd->add_option("--profile-legendre-um", w.profile_legendre_um,
+                  "profile error: coefficients of P0, P1, ... in um")
+      ->delimiter(',');
   cmd->add_option("--grit-um", w.grit_sigma_um, "repeatable grit texture, 1 sigma")->capture_default_str();
   cmd->add_option("--grit-cell-mm", w.grit_cell_mm, "grit texture cell size")->capture_default_str();
-  cmd->add_option("--rpm", s.spindle_rpm_nominal, "nominal spindle speed written to the file")->capture_default_str();
+  cmd->add_option("--rpm", s.spindle_rpm_nominal, "nominal spindle speed written to the file")
+      ->capture_default_str();
   cmd->add_option("--true-rpm", s.spindle_rpm_true, "actual spindle speed (defaults to --rpm)");
   cmd->add_option("--feed-mm-per-min", s.feed_mm_per_min, "axial feed")->capture_default_str();
   cmd->add_option("--sample-period-s", s.sample_period_s, "sample period")->capture_default_str();
   cmd->add_option("--start-y-mm", s.start_y_mm, "axial position of the first sample")->capture_default_str();
   cmd->add_option("--end-y-mm", s.end_y_mm, "axial position where the scan stops")->capture_default_str();
   cmd->add_option("--start-phase-deg", s.start_phase_deg, "phase of the first sample")->capture_default_str();
-  cmd->add_option("--sensor-zero-radius-mm", s.sensor_zero_radius_mm, "radius read as 0 (default: wheel radius - 0.5)");
-  cmd->add_option("--radius-sign", s.radius_sign, "+1: larger reading = larger radius; -1: the opposite")->capture_default_str();
-  cmd->add_option("--beam-offset-mm", s.beam_offset_mm, "lateral offset of the beam from the axis")->capture_default_str();
+  cmd->add_option("--sensor-zero-radius-mm", s.sensor_zero_radius_mm,
+                  "radius read as 0 (default: wheel radius - 0.5)");
+  cmd->add_option("--radius-sign", s.radius_sign, "+1: larger reading = larger radius; -1: the opposite")
+      ->capture_default_str();
+  cmd->add_option("--beam-offset-mm", s.beam_offset_mm, "lateral offset of the beam from the axis")
+      ->capture_default_str();
   cmd->add_option("--noise-um", s.noise_um, "white sensor noise, 1 sigma")->capture_default_str();
   cmd->add_option("--spike-rate", s.spike_rate, "isolated spikes per sample")->capture_default_str();
   cmd->add_option("--spike-um", s.spike_amplitude_um, "spike amplitude")->capture_default_str();
   cmd->add_option("--burst-rate", s.burst_rate, "bursts of spikes per sample")->capture_default_str();
   cmd->add_option("--burst-length-max", s.burst_length_max, "longest burst, samples")->capture_default_str();
   cmd->add_option("--dropout-rate", s.dropout_rate, "dropouts per sample")->capture_default_str();
-  cmd->add_option("--dropout-length-max", s.dropout_length_max, "longest dropout, samples")->capture_default_str();
+  cmd->add_option("--dropout-length-max", s.dropout_length_max, "longest dropout, samples")
+      ->capture_default_str();
   cmd->add_flag("--encoder", s.write_encoder, "write an angle column (the true spindle angle)");
   cmd->add_flag("--time-column", s.write_time, "write a t column");
   cmd->add_flag("--axial-column", s.write_axial, "write a y column");

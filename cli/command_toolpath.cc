@@ -35,17 +35,19 @@ void AddToolpathCommand(CLI::App& app) {
     const grinding::ToolpathRunReport report = grinding::RunToolpathJob(job, arguments->output);
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     const grinding::ToolpathSummary& t = report.toolpath;
-    fmt::print("{} control points in {} pass(es) of {} rows; rows straight to {:.2e} mm; "
-               "{} gouge checks, smallest gap {:.3f} um\n",
-               t.control_points, t.passes, t.rows_per_pass, t.max_row_deviation_mm, t.gouge_checks,
-               1e3 * t.min_gouge_gap_mm);
+    fmt::print(
+        "{} control points in {} pass(es) of {} rows; rows straight to {:.2e} mm; "
+        "{} gouge checks, smallest gap {:.3f} um\n",
+        t.control_points, t.passes, t.rows_per_pass, t.max_row_deviation_mm, t.gouge_checks,
+        1e3 * t.min_gouge_gap_mm);
     if (report.predicted) {
       const grinding::FormPrediction& p = report.prediction;
-      fmt::print("predicted form error (arc radius error {} mm{}): PV {:.3f} um, RMS {:.3f} um; "
-                 "after tilt PV {:.3f} um, RMS {:.3f} um; runout ripple PV {:.3f} um\n",
-                 job.prediction.arc_radius_error_mm,
-                 job.prediction.runout_radial_um.empty() ? ", no runout" : ", with runout", p.pv_um,
-                 p.rms_um, p.pv_after_tilt_um, p.rms_after_tilt_um, p.ripple_pv_um);
+      fmt::print(
+          "predicted form error (arc radius error {} mm{}): PV {:.3f} um, RMS {:.3f} um; "
+          "after tilt PV {:.3f} um, RMS {:.3f} um; runout ripple PV {:.3f} um\n",
+          job.prediction.arc_radius_error_mm,
+          job.prediction.runout_radial_um.empty() ? ", no runout" : ", with runout", p.pv_um, p.rms_um,
+          p.pv_after_tilt_um, p.rms_after_tilt_um, p.ripple_pv_um);
     }
     fmt::print("wrote {} in {:.2f} s\n", arguments->output, seconds);
   });

@@ -153,8 +153,8 @@ void AddApply(CLI::App& transform) {
         frames::TransformProgram(text, kind, chosen, args->input, args->options);
     EmitText(result.text, args->output);
     SummariseOnTerminal(fmt::format("{}: {} points in {} lines rewritten ({})\n", args->input,
-                          result.points_transformed, result.lines_changed,
-                          args->inverse ? "inverse" : "forward"));
+                                    result.points_transformed, result.lines_changed,
+                                    args->inverse ? "inverse" : "forward"));
   });
 }
 

@@ -1,8 +1,8 @@
 // arcwheel: one binary, one subcommand per job. main() is the only catch-all.
 
-#include <CLI/CLI.hpp>
 #include <fmt/core.h>
 
+#include <CLI/CLI.hpp>
 #include <cstdio>
 #include <cstdlib>
 #include <exception>
@@ -80,8 +80,9 @@ int main(int argc, char** argv) {
   } catch (const CLI::ParseError& error) {
     const bool unknown_command = app.get_subcommands().empty();
     fmt::print(stderr, "arcwheel: {}\n", error.what());
-    fmt::print(stderr, "{}\n", unknown_command ? "run `arcwheel help` for the list of commands"
-                                              : "run `arcwheel COMMAND --help` for its options");
+    fmt::print(stderr, "{}\n",
+               unknown_command ? "run `arcwheel help` for the list of commands"
+                               : "run `arcwheel COMMAND --help` for its options");
     return unknown_command ? 1 : arcwheel::ExitStatus(ErrorCode::kInvalidOption);
   } catch (const arcwheel::Error& error) {
     if (no_catch) throw;

@@ -71,7 +71,8 @@ File File::OpenImage(const void* data, size_t size, const std::string& name) {
     throw Error(ErrorCode::kBadInput, kStage, "'" + name + "' is not an HDF5 file image");
   }
   const hid_t id = H5Fopen(name.c_str(), H5F_ACC_RDONLY, access.id());
-  if (id < 0) throw Error(ErrorCode::kBadInput, kStage, "'" + name + "' is not an HDF5 file (or is truncated)");
+  if (id < 0)
+    throw Error(ErrorCode::kBadInput, kStage, "'" + name + "' is not an HDF5 file (or is truncated)");
   File file(Handle(id, H5Fclose), name);
   file.image_ = std::make_shared<const std::string>(static_cast<const char*>(data), size);
   return file;
@@ -174,7 +175,8 @@ void CheckFiltersAvailable(const Handle& data, const std::string& where) {
     if (id == 307 || id == 32004 || id == 32008) package = " (Debian package hdf5-filter-plugin)";
     if (id == 32001) package = " (Debian package hdf5-filter-plugin-blosc-serial)";
     throw Error(ErrorCode::kBadInput, kStage,
-                where + " is compressed with HDF5 filter " + std::to_string(id) + (name[0] ? " '" + std::string(name) + "'" : "") +
+                where + " is compressed with HDF5 filter " + std::to_string(id) +
+                    (name[0] ? " '" + std::string(name) + "'" : "") +
                     ", which this HDF5 installation cannot decode: install its plugin" + package +
                     " or rewrite the file with gzip");
   }
@@ -198,15 +200,13 @@ std::vector<T> ReadNumeric(hid_t file_id, const Handle& data, hid_t memory_type,
   const double declared_bytes = static_cast<double>(count) * static_cast<double>(sizeof(T));
   if (declared_bytes > 64.0 * std::max<double>(static_cast<double>(file_bytes), 1 << 20)) {
     throw Error(ErrorCode::kBadInput, kStage,
-                where + " declares " + std::to_string(count) + " values, more than the " + std::to_string(file_bytes) +
-                    "-byte file can hold (damaged?)");
+                where + " declares " + std::to_string(count) + " values, more than the " +
+                    std::to_string(file_bytes) + "-byte file can hold (damaged?)");
   }
   std::vector<T> values(static_cast<size_t>(count));
-  if (count > 0 &&
-      H5Dread(data.id(), memory_type, H5S_ALL, H5S_ALL, H5P_DEFAULT, values.data()) < 0) {
+  if (count > 0 && H5Dread(data.id(), memory_type, H5S_ALL, H5S_ALL, H5P_DEFAULT, values.data()) < 0) {
     CheckFiltersAvailable(data, where);
-    throw Error(ErrorCode::kBadInput, kStage,
-                "cannot read " + where + " (file truncated or damaged?)");
+    throw Error(ErrorCode::kBadInput, kStage, "cannot read " + where + " (file truncated or damaged?)");
   }
   return values;
 }
@@ -223,17 +223,16 @@ std::vector<float> File::ReadFloats(const std::string& dataset) const {
 
 namespace {
 
-void WriteDataset(hid_t file, const std::string& name, hid_t file_type, hid_t memory_type,
-                  const void* data, const std::vector<hsize_t>& shape, const std::string& where) {
+void WriteDataset(hid_t file, const std::string& name, hid_t file_type, hid_t memory_type, const void* data,
+                  const std::vector<hsize_t>& shape, const std::string& where) {
   const Handle space(H5Screate_simple(static_cast<int>(shape.size()), shape.data(), nullptr), H5Sclose);
   // No modification times: the same data give byte-identical files (and SHA-256s).
   const Handle creation(H5Pcreate(H5P_DATASET_CREATE), H5Pclose);
   H5Pset_obj_track_times(creation.id(), 0);
-  const Handle dataset(H5Dcreate2(file, name.c_str(), file_type, space.id(), H5P_DEFAULT,
-                                  creation.id(), H5P_DEFAULT),
-                       H5Dclose);
-  if (!dataset.valid() ||
-      H5Dwrite(dataset.id(), memory_type, H5S_ALL, H5S_ALL, H5P_DEFAULT, data) < 0) {
+  const Handle dataset(
+      H5Dcreate2(file, name.c_str(), file_type, space.id(), H5P_DEFAULT, creation.id(), H5P_DEFAULT),
+      H5Dclose);
+  if (!dataset.valid() || H5Dwrite(dataset.id(), memory_type, H5S_ALL, H5S_ALL, H5P_DEFAULT, data) < 0) {
     throw Error(ErrorCode::kIo, kStage, "cannot write " + where + " (disk full?)");
   }
 }
@@ -251,7 +250,8 @@ void File::WriteDoubles(const std::string& dataset, const std::vector<double>& v
   if (Product(shape) != values.size()) {
     throw Error(ErrorCode::kInternal, kStage, "shape does not match data for " + Where(dataset));
   }
-  WriteDataset(handle_.id(), dataset, H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, values.data(), shape, Where(dataset));
+  WriteDataset(handle_.id(), dataset, H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, values.data(), shape,
+               Where(dataset));
 }
 
 void File::WriteFloats(const std::string& dataset, const std::vector<float>& values,
@@ -277,8 +277,8 @@ bool File::HasAttribute(const std::string& object, const std::string& name) cons
 
 std::optional<double> File::ReadAttributeDouble(const std::string& object, const std::string& name) const {
   if (!HasAttribute(object, name)) return std::nullopt;
-  const Handle attribute(H5Aopen_by_name(handle_.id(), object.c_str(), name.c_str(), H5P_DEFAULT, H5P_DEFAULT),
-                         H5Aclose);
+  const Handle attribute(
+      H5Aopen_by_name(handle_.id(), object.c_str(), name.c_str(), H5P_DEFAULT, H5P_DEFAULT), H5Aclose);
   const Handle type(H5Aget_type(attribute.id()), H5Tclose);
   const H5T_class_t type_class = H5Tget_class(type.id());
   if (type_class == H5T_STRING) {
@@ -294,7 +294,8 @@ std::optional<double> File::ReadAttributeDouble(const std::string& object, const
                 "attribute '" + name + "' on " + Where(object) + " is not a number: '" + *text + "'");
   }
   if (type_class != H5T_FLOAT && type_class != H5T_INTEGER) {
-    throw Error(ErrorCode::kBadInput, kStage, "attribute '" + name + "' on " + Where(object) + " is not numeric");
+    throw Error(ErrorCode::kBadInput, kStage,
+                "attribute '" + name + "' on " + Where(object) + " is not numeric");
   }
   CheckNumberSize(type.id(), "attribute '" + name + "' on " + Where(object));
   const Handle space(H5Aget_space(attribute.id()), H5Sclose);
@@ -309,23 +310,26 @@ std::optional<double> File::ReadAttributeDouble(const std::string& object, const
   return value;
 }
 
-std::optional<std::string> File::ReadAttributeString(const std::string& object, const std::string& name) const {
+std::optional<std::string> File::ReadAttributeString(const std::string& object,
+                                                     const std::string& name) const {
   if (!HasAttribute(object, name)) return std::nullopt;
   const std::string where = "attribute '" + name + "' on " + Where(object);
-  const Handle attribute(H5Aopen_by_name(handle_.id(), object.c_str(), name.c_str(), H5P_DEFAULT, H5P_DEFAULT),
-                         H5Aclose);
+  const Handle attribute(
+      H5Aopen_by_name(handle_.id(), object.c_str(), name.c_str(), H5P_DEFAULT, H5P_DEFAULT), H5Aclose);
   const Handle type(H5Aget_type(attribute.id()), H5Tclose);
   const H5T_class_t type_class = H5Tget_class(type.id());
   const Handle space(H5Aget_space(attribute.id()), H5Sclose);
   // Scalar or a one-element array (as MATLAB and some h5py scripts write): one value either way.
   const hssize_t count = H5Sget_simple_extent_npoints(space.id());
   if (count != 1) {
-    throw Error(ErrorCode::kBadInput, kStage, where + " holds " + std::to_string(count) + " values; expected one");
+    throw Error(ErrorCode::kBadInput, kStage,
+                where + " holds " + std::to_string(count) + " values; expected one");
   }
   if (type_class == H5T_FLOAT || type_class == H5T_INTEGER) {
     const std::optional<double> value = ReadAttributeDouble(object, name);
     char text[32];
-    const auto end = std::to_chars(text, text + sizeof text, *value).ptr;  // shortest exact form: 3, not 3.000000
+    const auto end =
+        std::to_chars(text, text + sizeof text, *value).ptr;  // shortest exact form: 3, not 3.000000
     return std::string(text, end);
   }
   if (type_class != H5T_STRING) {
@@ -348,7 +352,8 @@ std::optional<std::string> File::ReadAttributeString(const std::string& object, 
   }
   const size_t size = H5Tget_size(type.id());
   if (size > (1U << 20)) {
-    throw Error(ErrorCode::kBadInput, kStage, where + " declares " + std::to_string(size) + " bytes of text (damaged?)");
+    throw Error(ErrorCode::kBadInput, kStage,
+                where + " declares " + std::to_string(size) + " bytes of text (damaged?)");
   }
   // Read the stored bytes as they are (a null-padded memory type of the same size and character
   // set: no conversion), then take off the padding the file declares. A null-terminated memory type
@@ -387,7 +392,8 @@ std::vector<std::string> File::AttributeNames(const std::string& object) const {
   // it frees the half-built table through a null pointer. Looking up a name that is not there
   // decodes every attribute message the same way without that table: a damaged one fails here.
   if (H5Aexists_by_name(handle_.id(), object.c_str(), "\x01 no such attribute", H5P_DEFAULT) < 0) {
-    throw Error(ErrorCode::kBadInput, kStage, "cannot list the attributes of " + Where(object) + " (damaged?)");
+    throw Error(ErrorCode::kBadInput, kStage,
+                "cannot list the attributes of " + Where(object) + " (damaged?)");
   }
   // Creation order is tracked only when the writer asked for it; name order always works.
   hsize_t position = 0;
@@ -397,8 +403,8 @@ std::vector<std::string> File::AttributeNames(const std::string& object) const {
   }
   names.clear();
   position = 0;
-  if (H5Aiterate_by_name(handle_.id(), object.c_str(), H5_INDEX_NAME, H5_ITER_INC, &position, CollectAttributeName,
-                         &names, H5P_DEFAULT) < 0) {
+  if (H5Aiterate_by_name(handle_.id(), object.c_str(), H5_INDEX_NAME, H5_ITER_INC, &position,
+                         CollectAttributeName, &names, H5P_DEFAULT) < 0) {
     throw Error(ErrorCode::kBadInput, kStage, "cannot list the attributes of " + Where(object));
   }
   return names;
@@ -463,7 +469,8 @@ std::optional<MemberReader> MakeMemberReader(hid_t member_type, const char* memb
   }
   if (!value_type.valid()) return std::nullopt;
   reader.memory_type = Handle(H5Tcreate(H5T_COMPOUND, reader.element_size), H5Tclose);
-  if (!reader.memory_type.valid() || H5Tinsert(reader.memory_type.id(), member_name, 0, value_type.id()) < 0) {
+  if (!reader.memory_type.valid() ||
+      H5Tinsert(reader.memory_type.id(), member_name, 0, value_type.id()) < 0) {
     return std::nullopt;
   }
   return reader;
@@ -482,27 +489,30 @@ void CheckCompoundLayout(hid_t type, const std::string& where) {
     const size_t member_size = member_type.valid() ? H5Tget_size(member_type.id()) : 0;
     if (member_size == 0 || offset > size || member_size > size - offset) {
       throw Error(ErrorCode::kBadInput, kStage,
-                  where + " has a member of " + std::to_string(member_size) + " bytes at byte " + std::to_string(offset) +
-                      " of a compound of " + std::to_string(size) + " bytes (damaged?)");
+                  where + " has a member of " + std::to_string(member_size) + " bytes at byte " +
+                      std::to_string(offset) + " of a compound of " + std::to_string(size) +
+                      " bytes (damaged?)");
     }
     spans.emplace_back(offset, offset + member_size);
   }
   std::sort(spans.begin(), spans.end());
   for (size_t k = 1; k < spans.size(); ++k) {
     if (spans[k].first < spans[k - 1].second) {
-      throw Error(ErrorCode::kBadInput, kStage,
-                  where + " has members overlapping at byte " + std::to_string(spans[k].first) + " (damaged?)");
+      throw Error(
+          ErrorCode::kBadInput, kStage,
+          where + " has members overlapping at byte " + std::to_string(spans[k].first) + " (damaged?)");
     }
   }
 }
 
 }  // namespace
 
-std::optional<File::Compound> File::ReadAttributeCompound(const std::string& object, const std::string& name) const {
+std::optional<File::Compound> File::ReadAttributeCompound(const std::string& object,
+                                                          const std::string& name) const {
   if (!HasAttribute(object, name)) return std::nullopt;
   const std::string where = "attribute '" + name + "' on " + Where(object);
-  const Handle attribute(H5Aopen_by_name(handle_.id(), object.c_str(), name.c_str(), H5P_DEFAULT, H5P_DEFAULT),
-                         H5Aclose);
+  const Handle attribute(
+      H5Aopen_by_name(handle_.id(), object.c_str(), name.c_str(), H5P_DEFAULT, H5P_DEFAULT), H5Aclose);
   const Handle type(H5Aget_type(attribute.id()), H5Tclose);
   if (!attribute.valid() || !type.valid() || H5Tget_class(type.id()) != H5T_COMPOUND) {
     throw Error(ErrorCode::kBadInput, kStage, where + " is not a compound");
@@ -528,12 +538,15 @@ std::optional<File::Compound> File::ReadAttributeCompound(const std::string& obj
     const Handle member_type(H5Tget_member_type(type.id(), static_cast<unsigned>(m)), H5Tclose);
     const std::optional<MemberReader> reader = MakeMemberReader(member_type.id(), member.c_str());
     if (!reader) continue;
-    if (reader->kind == MemberReader::Kind::kVariableString || reader->kind == MemberReader::Kind::kVariableNumbers) {
-      CheckHeapReferences(attribute.id(), member_type.id(), "member '" + member + "' of " + where, member.c_str());
+    if (reader->kind == MemberReader::Kind::kVariableString ||
+        reader->kind == MemberReader::Kind::kVariableNumbers) {
+      CheckHeapReferences(attribute.id(), member_type.id(), "member '" + member + "' of " + where,
+                          member.c_str());
     }
     // max_align_t storage: the buffer holds pointers (variable-length members) and doubles.
     std::vector<std::max_align_t> buffer(
-        (static_cast<size_t>(elements) * reader->element_size + sizeof(std::max_align_t) - 1) / sizeof(std::max_align_t));
+        (static_cast<size_t>(elements) * reader->element_size + sizeof(std::max_align_t) - 1) /
+        sizeof(std::max_align_t));
     if (H5Aread(attribute.id(), reader->memory_type.id(), buffer.data()) < 0) {
       throw Error(ErrorCode::kBadInput, kStage, "cannot read member '" + member + "' of " + where);
     }
@@ -557,11 +570,13 @@ std::optional<File::Compound> File::ReadAttributeCompound(const std::string& obj
       case MemberReader::Kind::kVariableNumbers: {
         const auto* sequence = reinterpret_cast<const hvl_t*>(first);
         const auto* values = static_cast<const double*>(sequence->p);
-        result.numbers[member] = values == nullptr ? std::vector<double>() : std::vector<double>(values, values + sequence->len);
+        result.numbers[member] =
+            values == nullptr ? std::vector<double>() : std::vector<double>(values, values + sequence->len);
         break;
       }
     }
-    if (reader->kind == MemberReader::Kind::kVariableString || reader->kind == MemberReader::Kind::kVariableNumbers) {
+    if (reader->kind == MemberReader::Kind::kVariableString ||
+        reader->kind == MemberReader::Kind::kVariableNumbers) {
       H5Dvlen_reclaim(reader->memory_type.id(), space.id(), H5P_DEFAULT, buffer.data());
     }
   }

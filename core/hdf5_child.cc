@@ -1,3 +1,4 @@
+#include <fmt/format.h>
 #include <signal.h>
 #include <sys/types.h>
 #include <sys/wait.h>
@@ -12,8 +13,6 @@
 #include <string>
 #include <system_error>
 #include <thread>
-
-#include <fmt/format.h>
 
 #include "core/error.h"
 #include "core/hdf5.h"
@@ -56,7 +55,8 @@ std::optional<int> WaitFor(pid_t child, double timeout_s) {
 
 }  // namespace
 
-void ReadFirstInChildProcess(const std::filesystem::path& path, const std::function<void()>& read, double timeout_s) {
+void ReadFirstInChildProcess(const std::filesystem::path& path, const std::function<void()>& read,
+                             double timeout_s) {
   if (g_in_child) return;
   if (timeout_s <= 0.0) timeout_s = DefaultTimeoutS(path);
   std::fflush(nullptr);  // nothing buffered twice
@@ -76,18 +76,20 @@ void ReadFirstInChildProcess(const std::filesystem::path& path, const std::funct
   const std::string name = fmt::format("'{}'", path.string());
   if (!status) {
     throw Error(ErrorCode::kBadInput, kStage,
-                fmt::format("{}: libhdf5 had not finished reading it after {:g} s (a damaged file?)", name, timeout_s));
+                fmt::format("{}: libhdf5 had not finished reading it after {:g} s (a damaged file?)", name,
+                            timeout_s));
   }
   if (WIFSIGNALED(*status)) {
     const int signal = WTERMSIG(*status);
     throw Error(ErrorCode::kBadInput, kStage,
-                name + ": reading it crashed libhdf5 (signal " + std::to_string(signal) + ", " + strsignal(signal) +
-                    "); the file is damaged");
+                name + ": reading it crashed libhdf5 (signal " + std::to_string(signal) + ", " +
+                    strsignal(signal) + "); the file is damaged");
   }
   if (!WIFEXITED(*status) || WEXITSTATUS(*status) != 0) {
     throw Error(ErrorCode::kBadInput, kStage,
                 name + ": reading it crashed libhdf5 (exit status " +
-                    std::to_string(WIFEXITED(*status) ? WEXITSTATUS(*status) : -1) + "); the file is damaged");
+                    std::to_string(WIFEXITED(*status) ? WEXITSTATUS(*status) : -1) +
+                    "); the file is damaged");
   }
 }
 

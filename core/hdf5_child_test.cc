@@ -33,20 +33,23 @@ TEST(ReadFirstInChildProcess, RefusesAFileWhoseReadKillsTheChild) {
 
 TEST(ReadFirstInChildProcess, ReportsTheExitStatusOfAChildThatEndsItself) {
   const std::string message = MessageOf([] { std::_Exit(7); });
-  EXPECT_NE(message.find("'scan.h5': reading it crashed libhdf5 (exit status 7)"), std::string::npos) << message;
+  EXPECT_NE(message.find("'scan.h5': reading it crashed libhdf5 (exit status 7)"), std::string::npos)
+      << message;
 }
 
 TEST(ReadFirstInChildProcess, RefusesAReadThatDoesNotFinishInTime) {
   const auto start = std::chrono::steady_clock::now();
   const std::string message = MessageOf([] { std::this_thread::sleep_for(std::chrono::seconds(30)); }, 0.3);
   const std::chrono::duration<double> waited = std::chrono::steady_clock::now() - start;
-  EXPECT_NE(message.find("'scan.h5': libhdf5 had not finished reading it after 0.3 s"), std::string::npos) << message;
+  EXPECT_NE(message.find("'scan.h5': libhdf5 had not finished reading it after 0.3 s"), std::string::npos)
+      << message;
   EXPECT_LT(waited.count(), 10.0) << "the child is killed at the timeout, not waited for";
 }
 
 TEST(ReadFirstInChildProcess, LeavesAFinishedOrRefusedReadToTheCaller) {
   EXPECT_EQ(MessageOf([] {}), "");
-  EXPECT_EQ(MessageOf([] { throw Error(ErrorCode::kBadInput, "test", "a refusal of the reader's own"); }), "");
+  EXPECT_EQ(MessageOf([] { throw Error(ErrorCode::kBadInput, "test", "a refusal of the reader's own"); }),
+            "");
 }
 
 TEST(ReadFirstInChildProcess, ReadsDirectlyWhenCalledInsideTheChild) {

@@ -30,11 +30,12 @@ constexpr const char* kStage = "hdf5";
 // wider destination makes the library grow elements in place, which overruns its buffer when a
 // damaged compound type declares overlapping members.)
 herr_t KeepStoredReference(hid_t source, hid_t destination, H5T_cdata_t* cdata, size_t /*count*/,
-                           size_t /*stride*/, size_t /*background_stride*/, void* /*buffer*/, void* /*background*/,
-                           hid_t /*transfer*/) {
+                           size_t /*stride*/, size_t /*background_stride*/, void* /*buffer*/,
+                           void* /*background*/, hid_t /*transfer*/) {
   if (cdata->command == H5T_CONV_INIT) {
     const H5T_class_t source_class = H5Tget_class(source);
-    const bool variable = source_class == H5T_VLEN || (source_class == H5T_STRING && H5Tis_variable_str(source) > 0);
+    const bool variable =
+        source_class == H5T_VLEN || (source_class == H5T_STRING && H5Tis_variable_str(source) > 0);
     cdata->need_bkg = H5T_BKG_NO;
     return variable && H5Tget_size(destination) == H5Tget_size(source) ? 0 : -1;
   }
@@ -48,10 +49,13 @@ void RegisterKeepStoredReference() {
     const Handle text(H5Tcopy(H5T_C_S1), H5Tclose);
     H5Tset_size(text.id(), H5T_VARIABLE);
     const Handle opaque(H5Tcreate(H5T_OPAQUE, 16), H5Tclose);
-    return H5Tregister(H5T_PERS_SOFT, "arcwheel stored sequence", sequence.id(), opaque.id(), KeepStoredReference) >= 0 &&
-           H5Tregister(H5T_PERS_SOFT, "arcwheel stored string", text.id(), opaque.id(), KeepStoredReference) >= 0;
+    return H5Tregister(H5T_PERS_SOFT, "arcwheel stored sequence", sequence.id(), opaque.id(),
+                       KeepStoredReference) >= 0 &&
+           H5Tregister(H5T_PERS_SOFT, "arcwheel stored string", text.id(), opaque.id(),
+                       KeepStoredReference) >= 0;
   }();
-  if (!registered) throw Error(ErrorCode::kInternal, kStage, "cannot register the stored-reference conversion");
+  if (!registered)
+    throw Error(ErrorCode::kInternal, kStage, "cannot register the stored-reference conversion");
 }
 
 // Little-endian unsigned field; UINT64_MAX when it does not fit 64 bits.
@@ -99,16 +103,17 @@ std::optional<std::string> ReferenceProblem(std::string_view collection, const S
     const uint64_t declared = Unsigned(collection, p + 8, length_size);
     const uint64_t step = id > 0 ? object_header + AlignTo8(declared) : declared;
     if (step == 0 || step > size - p) {
-      return at + " is damaged (object " + std::to_string(id) + " at byte " + std::to_string(p) + " declares " +
-             std::to_string(declared) + " bytes)";
+      return at + " is damaged (object " + std::to_string(id) + " at byte " + std::to_string(p) +
+             " declares " + std::to_string(declared) + " bytes)";
     }
     if (id > 0 && id == reference.index) object_size = declared;
     p += step;
   }
-  if (!object_size) return "refers to object " + std::to_string(reference.index) + " of " + at + ", which has none";
+  if (!object_size)
+    return "refers to object " + std::to_string(reference.index) + " of " + at + ", which has none";
   if (*object_size != expected_bytes) {
-    return "refers to " + std::to_string(expected_bytes) + " bytes in object " + std::to_string(reference.index) +
-           " of " + at + ", which holds " + std::to_string(*object_size);
+    return "refers to " + std::to_string(expected_bytes) + " bytes in object " +
+           std::to_string(reference.index) + " of " + at + ", which holds " + std::to_string(*object_size);
   }
   return std::nullopt;
 }
@@ -143,14 +148,16 @@ std::string File::ReadRawBytes(uint64_t address, uint64_t size) const {
   return bytes;
 }
 
-void File::CheckHeapReferences(hid_t attribute, hid_t stored_type, const std::string& what, const char* member) const {
+void File::CheckHeapReferences(hid_t attribute, hid_t stored_type, const std::string& what,
+                               const char* member) const {
   RegisterKeepStoredReference();
   size_t address_size = 0;
   size_t length_size = 0;
   const Handle creation(H5Fget_create_plist(handle_.id()), H5Pclose);
-  if (!creation.valid() || H5Pget_sizes(creation.id(), &address_size, &length_size) < 0 || address_size == 0 ||
-      address_size > 16 || length_size == 0 || length_size > 16) {
-    throw Error(ErrorCode::kBadInput, kStage, "'" + path_.string() + "' declares invalid address or length sizes");
+  if (!creation.valid() || H5Pget_sizes(creation.id(), &address_size, &length_size) < 0 ||
+      address_size == 0 || address_size > 16 || length_size == 0 || length_size > 16) {
+    throw Error(ErrorCode::kBadInput, kStage,
+                "'" + path_.string() + "' declares invalid address or length sizes");
   }
   const Handle space(H5Aget_space(attribute), H5Sclose);
   const hssize_t elements = H5Sget_simple_extent_npoints(space.id());
@@ -181,9 +188,11 @@ void File::CheckHeapReferences(hid_t attribute, hid_t stored_type, const std::st
     const std::string header = ReadRawBytes(reference.address, 4 + 1 + 3 + 16);
     const uint64_t declared = header.size() >= 8 + length_size ? Unsigned(header, 8, length_size) : 0;
     // The collection as far as the file has it (never more than the file).
-    const std::string collection = ReadRawBytes(reference.address, std::max<uint64_t>(declared, header.size()));
-    const uint64_t expected_bytes =
-        element_bytes == 0 || reference.length > UINT64_MAX / element_bytes ? UINT64_MAX : reference.length * element_bytes;
+    const std::string collection =
+        ReadRawBytes(reference.address, std::max<uint64_t>(declared, header.size()));
+    const uint64_t expected_bytes = element_bytes == 0 || reference.length > UINT64_MAX / element_bytes
+                                        ? UINT64_MAX
+                                        : reference.length * element_bytes;
     if (const auto problem = ReferenceProblem(collection, reference, expected_bytes, length_size)) {
       throw Error(ErrorCode::kBadInput, kStage, what + " " + *problem + " (damaged?)");
     }

@@ -11,7 +11,8 @@
 namespace arcwheel {
 
 // Parses `text`, the contents of `name`. Throws Error{kBadInput, stage} naming `name`.
-[[nodiscard]] nlohmann::json ParseJsonText(std::string_view text, const std::string& name, std::string_view stage);
+[[nodiscard]] nlohmann::json ParseJsonText(std::string_view text, const std::string& name,
+                                           std::string_view stage);
 
 // Reads and parses `path`. Throws Error{kIo, stage} if it cannot be read, else as ParseJsonText.
 [[nodiscard]] nlohmann::json ReadJsonFile(const std::filesystem::path& path, std::string_view stage);

@@ -14,14 +14,22 @@ bool IsValidUtf8(std::string_view text) {
     }
     size_t length = 0;
     unsigned char low = 0x80, high = 0xBF;  // the range of the second byte (RFC 3629, table 3-7)
-    if (c >= 0xC2 && c <= 0xDF) length = 2;
-    else if (c == 0xE0) length = 3, low = 0xA0;
-    else if (c == 0xED) length = 3, high = 0x9F;
-    else if (c >= 0xE1 && c <= 0xEF) length = 3;
-    else if (c == 0xF0) length = 4, low = 0x90;
-    else if (c == 0xF4) length = 4, high = 0x8F;
-    else if (c >= 0xF1 && c <= 0xF3) length = 4;
-    else return false;
+    if (c >= 0xC2 && c <= 0xDF)
+      length = 2;
+    else if (c == 0xE0)
+      length = 3, low = 0xA0;
+    else if (c == 0xED)
+      length = 3, high = 0x9F;
+    else if (c >= 0xE1 && c <= 0xEF)
+      length = 3;
+    else if (c == 0xF0)
+      length = 4, low = 0x90;
+    else if (c == 0xF4)
+      length = 4, high = 0x8F;
+    else if (c >= 0xF1 && c <= 0xF3)
+      length = 4;
+    else
+      return false;
     if (i + length > n || s[i + 1] < low || s[i + 1] > high) return false;
     for (size_t k = 2; k < length; ++k) {
       if (s[i + k] < 0x80 || s[i + k] > 0xBF) return false;

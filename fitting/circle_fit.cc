@@ -81,8 +81,8 @@ double WeightedCost(const std::vector<double>& x, const std::vector<double>& y, 
 
 // Levenberg-Marquardt's damping makes its last steps short along the flat direction of a short
 // arc; a few undamped Gauss-Newton steps from its answer reach the minimum to rounding.
-void PolishByGaussNewton(const std::vector<double>& x, const std::vector<double>& y, const std::vector<double>& w,
-                         double p[3]) {
+void PolishByGaussNewton(const std::vector<double>& x, const std::vector<double>& y,
+                         const std::vector<double>& w, double p[3]) {
   const auto n = static_cast<Eigen::Index>(x.size());
   double cost = WeightedCost(x, y, w, p);
   for (int iteration = 0; iteration < 5; ++iteration) {
@@ -110,8 +110,8 @@ void PolishByGaussNewton(const std::vector<double>& x, const std::vector<double>
 
 }  // namespace
 
-CircleFit FitCircle(std::span<const double> x_in, std::span<const double> y_in, std::span<const double> weights,
-                    const CircleFitOptions& options) {
+CircleFit FitCircle(std::span<const double> x_in, std::span<const double> y_in,
+                    std::span<const double> weights, const CircleFitOptions& options) {
   CircleFit fit;
   const std::size_t n = x_in.size();
   fit.n = static_cast<int>(n);
@@ -129,7 +129,8 @@ CircleFit FitCircle(std::span<const double> x_in, std::span<const double> y_in, 
   cx /= static_cast<double>(n);
   cy /= static_cast<double>(n);
   double spread = 0;
-  for (std::size_t i = 0; i < n; ++i) spread += (x_in[i] - cx) * (x_in[i] - cx) + (y_in[i] - cy) * (y_in[i] - cy);
+  for (std::size_t i = 0; i < n; ++i)
+    spread += (x_in[i] - cx) * (x_in[i] - cx) + (y_in[i] - cy) * (y_in[i] - cy);
   const double scale = std::sqrt(spread / static_cast<double>(n));
   if (!(scale > 0)) {
     fit.status = FitStatus::kDegenerate;

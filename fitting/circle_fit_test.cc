@@ -60,8 +60,12 @@ INSTANTIATE_TEST_SUITE_P(FiveToAHundredThousandPoints, HardArc, ::testing::Value
 TEST(FitCircle, TwentyMillimetreChordOnTheWheelsArc) {
   // A 20 mm chord on a 55 mm radius spans 2 asin(10/55) = 20.95 deg.
   std::vector<double> x, y;
-  ExactArc({.center_x = -3.0, .center_y = -199.5, .radius = 55.4423,
-            .arc_deg = 2.0 * std::asin(10.0 / 55.4423) * 180.0 / std::numbers::pi, .count = 81}, x, y);
+  ExactArc({.center_x = -3.0,
+            .center_y = -199.5,
+            .radius = 55.4423,
+            .arc_deg = 2.0 * std::asin(10.0 / 55.4423) * 180.0 / std::numbers::pi,
+            .count = 81},
+           x, y);
   const CircleFit fit = FitCircle(x, y, {}, {});
   ASSERT_TRUE(fit.IsUsable());
   EXPECT_NEAR(fit.radius_mm, 55.4423, 1e-11);

@@ -27,9 +27,12 @@ json Optional(const std::optional<double>& value) { return value ? json(*value) 
 
 std::string PhaseSourceName(processing::PhaseSource source) {
   switch (source) {
-    case processing::PhaseSource::kNominal: return "nominal";
-    case processing::PhaseSource::kEstimated: return "estimated";
-    case processing::PhaseSource::kEncoder: return "encoder";
+    case processing::PhaseSource::kNominal:
+      return "nominal";
+    case processing::PhaseSource::kEstimated:
+      return "estimated";
+    case processing::PhaseSource::kEncoder:
+      return "encoder";
   }
   return "nominal";
 }
@@ -62,8 +65,8 @@ json PhasesJson(const processing::WheelMap& map, const WheelFit& fit) {
   return phases;
 }
 
-void WriteMap(const std::filesystem::path& path, const RunRecord& record, const processing::ProcessedScan& processed,
-              const WheelFit& fit) {
+void WriteMap(const std::filesystem::path& path, const RunRecord& record,
+              const processing::ProcessedScan& processed, const WheelFit& fit) {
   const processing::WheelMap& map = processed.map;
   hdf5::File file = hdf5::File::Create(path);
   const hsize_t n_phase = map.n_phase();
@@ -111,7 +114,8 @@ void WriteMap(const std::filesystem::path& path, const RunRecord& record, const 
 
 }  // namespace
 
-std::string SummaryJson(const RunRecord& record, const processing::ProcessedScan& processed, const WheelFit& fit) {
+std::string SummaryJson(const RunRecord& record, const processing::ProcessedScan& processed,
+                        const WheelFit& fit) {
   const processing::WheelMap& map = processed.map;
   const acquisition::ScanMetadata& m = record.metadata;
   json s;
@@ -143,9 +147,11 @@ std::string SummaryJson(const RunRecord& record, const processing::ProcessedScan
   s["spindle_rpm_fitted"] = processed.speed.available ? json(processed.speed.fitted_rpm) : json(nullptr);
   s["noise_sigma_um"] = processed.noise_sigma_mm * 1000.0;
   std::vector<double> point_sigmas;
-  for (const auto& section : map.sections) point_sigmas.insert(point_sigmas.end(), section.sigma_mm.begin(), section.sigma_mm.end());
+  for (const auto& section : map.sections)
+    point_sigmas.insert(point_sigmas.end(), section.sigma_mm.begin(), section.sigma_mm.end());
   std::sort(point_sigmas.begin(), point_sigmas.end());
-  s["map_sigma_um"] = point_sigmas.empty() ? json(nullptr) : json(point_sigmas[point_sigmas.size() / 2] * 1000.0);
+  s["map_sigma_um"] =
+      point_sigmas.empty() ? json(nullptr) : json(point_sigmas[point_sigmas.size() / 2] * 1000.0);
   s["mean_arc_radius_mm"] = fit.mean_arc_radius_mm;
   s["mean_arc_radius_sigma_mm"] = fit.mean_arc_radius_sigma_mm;
   s["arc_radius_range_mm"] = fit.arc_radius_range_mm;
@@ -171,7 +177,9 @@ std::string SummaryJson(const RunRecord& record, const processing::ProcessedScan
   s["runout_note"] =
       "runout is that of the wheel plus the spindle's error motion: one sensor cannot separate them";
   s["phases"] = PhasesJson(map, fit);
-  s["axial"] = {{"y_mm", fit.axial_y_mm}, {"runout_um", Numbers(fit.runout_um)}, {"roundness_um", Numbers(fit.roundness_um)}};
+  s["axial"] = {{"y_mm", fit.axial_y_mm},
+                {"runout_um", Numbers(fit.runout_um)},
+                {"roundness_um", Numbers(fit.roundness_um)}};
   s["mean_profile"] = {{"u_mm", fit.profile_u_mm}, {"error_um", Numbers(fit.profile_error_um)}};
   json parameters;
   for (const auto& [name, value] : record.numeric_parameters) parameters[name] = value;
@@ -199,7 +207,9 @@ void WriteProcessOutputs(const std::filesystem::path& outdir, const RunRecord& r
     std::ofstream out(summary_path, std::ios::binary);
     out << summary;
     out.flush();
-    if (!out) throw Error(ErrorCode::kIo, "output", "cannot write '" + (outdir / "summary.json").string() + "' (disk full?)");
+    if (!out)
+      throw Error(ErrorCode::kIo, "output",
+                  "cannot write '" + (outdir / "summary.json").string() + "' (disk full?)");
   }
   WriteMap(map_path, record, processed, fit);
   outputs.Commit();

@@ -1,9 +1,10 @@
 #include "fitting/wheel_fit.h"
 
+#include <fmt/core.h>
+
 #include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
-#include <fmt/core.h>
 #include <limits>
 #include <numbers>
 #include <numeric>
@@ -55,11 +56,14 @@ PhaseSolution FitSection(const processing::Section& section, double center_mm, d
   out.circle = FitCircle(y, rho, {}, options.circle);
   if (out.circle.IsUsable() && std::all_of(sigma.begin(), sigma.end(), [](double s) { return s > 0; })) {
     Eigen::VectorXd variance(static_cast<Eigen::Index>(sigma.size()));
-    for (std::size_t k = 0; k < sigma.size(); ++k) variance(static_cast<Eigen::Index>(k)) = sigma[k] * sigma[k];
-    out.circle.covariance = out.circle.sensitivity_to_y * variance.asDiagonal() * out.circle.sensitivity_to_y.transpose();
+    for (std::size_t k = 0; k < sigma.size(); ++k)
+      variance(static_cast<Eigen::Index>(k)) = sigma[k] * sigma[k];
+    out.circle.covariance =
+        out.circle.sensitivity_to_y * variance.asDiagonal() * out.circle.sensitivity_to_y.transpose();
     double chi2 = 0.0;
     for (std::size_t k = 0; k < y.size(); ++k) {
-      const double e = std::hypot(y[k] - out.circle.center_mm.x(), rho[k] - out.circle.center_mm.y()) - out.circle.radius_mm;
+      const double e = std::hypot(y[k] - out.circle.center_mm.x(), rho[k] - out.circle.center_mm.y()) -
+                       out.circle.radius_mm;
       chi2 += e * e / variance(static_cast<Eigen::Index>(k));
     }
     out.circle.chi2 = chi2;
@@ -130,8 +134,10 @@ std::vector<std::string> WheelFitOptions::Problems() const {
   std::vector<std::string> problems;
   if (!(band_half_width_mm > 0)) problems.push_back("band_half_width_mm must be > 0");
   if (min_points < 4) problems.push_back("min_points must be >= 4");
-  if (!(min_band_coverage >= 0 && min_band_coverage <= 1)) problems.push_back("min_band_coverage must be in 0..1");
-  if (!(min_phase_coverage > 0 && min_phase_coverage <= 1)) problems.push_back("min_phase_coverage must be in (0, 1]");
+  if (!(min_band_coverage >= 0 && min_band_coverage <= 1))
+    problems.push_back("min_band_coverage must be in 0..1");
+  if (!(min_phase_coverage > 0 && min_phase_coverage <= 1))
+    problems.push_back("min_phase_coverage must be in (0, 1]");
   if (circle.max_iterations < 1) problems.push_back("circle.max_iterations must be >= 1");
   return problems;
 }
@@ -215,7 +221,9 @@ WheelFit FitWheel(const processing::WheelMap& map, const WheelFitOptions& option
   }
   const auto n = static_cast<double>(radii.size());
   out.usable_phases = static_cast<int>(radii.size());
-  const auto mean = [](const std::vector<double>& v) { return std::accumulate(v.begin(), v.end(), 0.0) / static_cast<double>(v.size()); };
+  const auto mean = [](const std::vector<double>& v) {
+    return std::accumulate(v.begin(), v.end(), 0.0) / static_cast<double>(v.size());
+  };
   out.mean_arc_radius_mm = mean(radii);
   out.mean_center_axial_mm = mean(axial);
   out.mean_center_radial_mm = mean(radial);
@@ -231,8 +239,9 @@ WheelFit FitWheel(const processing::WheelMap& map, const WheelFitOptions& option
   }
   out.arc_radius_std_mm = std::sqrt(var / std::max(1.0, n - 1.0));
   out.arc_radius_noise_std_mm = std::sqrt(noise / n);
-  out.arc_radius_excess_std_mm = std::sqrt(std::max(0.0, out.arc_radius_std_mm * out.arc_radius_std_mm -
-                                                             out.arc_radius_noise_std_mm * out.arc_radius_noise_std_mm));
+  out.arc_radius_excess_std_mm =
+      std::sqrt(std::max(0.0, out.arc_radius_std_mm * out.arc_radius_std_mm -
+                                  out.arc_radius_noise_std_mm * out.arc_radius_noise_std_mm));
   out.median_chi2_per_dof = Median(chi2);
   out.mean_arc_radius_sigma_mm = SigmaOfMean(solutions, 2, map);
   out.mean_center_axial_sigma_mm = SigmaOfMean(solutions, 0, map);
@@ -253,7 +262,8 @@ WheelFit FitWheel(const processing::WheelMap& map, const WheelFitOptions& option
       }
     }
     out.axial_y_mm.push_back(y);
-    if (static_cast<double>(rho.size()) < options.min_phase_coverage * static_cast<double>(n_phase) || rho.size() < 4) {
+    if (static_cast<double>(rho.size()) < options.min_phase_coverage * static_cast<double>(n_phase) ||
+        rho.size() < 4) {
       out.runout_um.push_back(kNaN);
       out.roundness_um.push_back(kNaN);
       continue;

@@ -27,11 +27,11 @@ struct PhaseFit {
   double arc_radius_mm = 0, arc_radius_sigma_mm = 0;
   double center_axial_mm = 0, center_axial_sigma_mm = 0;
   double center_radial_mm = 0, center_radial_sigma_mm = 0;
-  double arc_error_um = 0;   // PV of geometric residuals in the band
-  double chi2_per_dof = 0;   // weighted residuals: ~1 when the section is a circle plus noise
+  double arc_error_um = 0;  // PV of geometric residuals in the band
+  double chi2_per_dof = 0;  // weighted residuals: ~1 when the section is a circle plus noise
   int points = 0;
   bool usable = false;
-  std::string flag;          // empty when usable
+  std::string flag;  // empty when usable
 };
 
 struct WheelFit {

@@ -11,8 +11,8 @@ namespace {
 
 TEST(TransformJson, RoundTripsEveryModelAndItsInverse) {
   Transform similarity{TransformModel::kSimilarity3d,
-                       Eigen::AngleAxisd(0.7, Eigen::Vector3d(1, 1, 0).normalized()).toRotationMatrix(), 1.00003,
-                       Eigen::Vector3d(5, -6, 7)};
+                       Eigen::AngleAxisd(0.7, Eigen::Vector3d(1, 1, 0).normalized()).toRotationMatrix(),
+                       1.00003, Eigen::Vector3d(5, -6, 7)};
   Transform rigid2d{TransformModel::kRigid2d, Eigen::Matrix3d::Identity(), 1.0, Eigen::Vector3d(1, 2, 0)};
   rigid2d.linear.topLeftCorner<2, 2>() = Eigen::Rotation2Dd(-0.4).toRotationMatrix();
   Transform affine{TransformModel::kAffine2d, Eigen::Matrix3d::Identity(), 1.0, Eigen::Vector3d(3, 4, 0)};
@@ -42,12 +42,15 @@ TEST(TransformJson, RefusesMissingOrMalformedKeys) {
     }
   };
   expect_refusal(R"({"rotation_matrix": [[1,0,0],[0,1,0],[0,0,1]], "translation": [0,0,0]})", "key 'model'");
-  expect_refusal(R"({"model": "rigid3d", "rotation_matrix": [[1,0,0],[0,1,0],[0,0,2]], "translation": [0,0,0]})",
-                 "is not a rotation");
-  expect_refusal(R"({"model": "rigid3d", "rotation_matrix": [[1,0,0],[0,1,0],[0,0,-1]], "translation": [0,0,0]})",
-                 "is not a rotation");
-  expect_refusal(R"({"model": "rigid3d", "rotation_matrix": [[1,0,0],[0,1,0],[0,0,1]], "translation": [0,0]})",
-                 "must hold 3 numbers");
+  expect_refusal(
+      R"({"model": "rigid3d", "rotation_matrix": [[1,0,0],[0,1,0],[0,0,2]], "translation": [0,0,0]})",
+      "is not a rotation");
+  expect_refusal(
+      R"({"model": "rigid3d", "rotation_matrix": [[1,0,0],[0,1,0],[0,0,-1]], "translation": [0,0,0]})",
+      "is not a rotation");
+  expect_refusal(
+      R"({"model": "rigid3d", "rotation_matrix": [[1,0,0],[0,1,0],[0,0,1]], "translation": [0,0]})",
+      "must hold 3 numbers");
   expect_refusal(R"({"model": "affine2d", "matrix": [[1,2],[2,4]], "translation": [0,0]})", "is singular");
   expect_refusal(R"({"model": "helmert", "translation": [0,0]})", "unknown model");
 }

@@ -10,7 +10,8 @@
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   try {
-    const auto table = arcwheel::frames::ReadCsvTable(arcwheel::fuzz::WriteInput(data, size, "pairs.csv"), "fuzz");
+    const auto table =
+        arcwheel::frames::ReadCsvTable(arcwheel::fuzz::WriteInput(data, size, "pairs.csv"), "fuzz");
     for (size_t row = 0; row < table.cells.size(); ++row) {
       if (table.cells[row].size() != table.columns.size()) __builtin_trap();
       for (size_t column = 0; column < table.columns.size(); ++column) {

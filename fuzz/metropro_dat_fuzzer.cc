@@ -10,7 +10,8 @@
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   try {
-    const auto map = arcwheel::polishing::ParseMetroProDat(std::span<const unsigned char>(data, size), "fuzz.dat");
+    const auto map =
+        arcwheel::polishing::ParseMetroProDat(std::span<const unsigned char>(data, size), "fuzz.dat");
     if (map.width <= 0 || map.height <= 0 ||
         map.height_um.size() != static_cast<size_t>(map.width) * static_cast<size_t>(map.height)) {
       __builtin_trap();

@@ -1,5 +1,5 @@
-// libFuzzer target: the polishing path CSV (formats.md section 7), as the polish report reads it (reports/polish_report_inputs.h). Any
-// input must be parsed or refused with arcwheel::Error.
+// libFuzzer target: the polishing path CSV (formats.md section 7), as the polish report reads it
+// (reports/polish_report_inputs.h). Any input must be parsed or refused with arcwheel::Error.
 
 #include <cstddef>
 #include <cstdint>
@@ -10,7 +10,8 @@
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   try {
-    (void)arcwheel::reports::ParsePolishingPathCsv(std::string_view(reinterpret_cast<const char*>(data), size), "polishing_path.csv");
+    (void)arcwheel::reports::ParsePolishingPathCsv(
+        std::string_view(reinterpret_cast<const char*>(data), size), "polishing_path.csv");
   } catch (const arcwheel::Error&) {
   }
   return 0;

@@ -17,7 +17,8 @@ void WriteFixedMap() {
   std::string map = "x_mm,y_mm,error_um\n";
   for (int j = -2; j <= 2; ++j) {
     for (int i = -2; i <= 2; ++i) {
-      map += std::to_string(10 * i) + "," + std::to_string(10 * j) + "," + std::to_string(0.01 * (i * i + j)) + "\n";
+      map += std::to_string(10 * i) + "," + std::to_string(10 * j) + "," +
+             std::to_string(0.01 * (i * i + j)) + "\n";
     }
   }
   arcwheel::fuzz::WriteFile("map.csv", map.data(), map.size());

@@ -11,9 +11,11 @@
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   try {
-    const auto points = arcwheel::polishing::ReadScatteredCsv(arcwheel::fuzz::WriteInput(data, size, "points.csv"));
+    const auto points =
+        arcwheel::polishing::ReadScatteredCsv(arcwheel::fuzz::WriteInput(data, size, "points.csv"));
     const auto map = arcwheel::polishing::InterpolateScattered(points, 0.0, "points.csv");
-    if (map.nx <= 0 || map.ny <= 0 || map.error_um.size() != static_cast<size_t>(map.nx) * map.ny) __builtin_trap();
+    if (map.nx <= 0 || map.ny <= 0 || map.error_um.size() != static_cast<size_t>(map.nx) * map.ny)
+      __builtin_trap();
   } catch (const arcwheel::Error&) {
   }
   return 0;

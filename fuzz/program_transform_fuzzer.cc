@@ -2,11 +2,10 @@
 // The first byte picks the program kind. Any input must be rewritten or refused with
 // arcwheel::Error; a rewritten program keeps every line.
 
+#include <Eigen/Geometry>
 #include <cstddef>
 #include <cstdint>
 #include <string_view>
-
-#include <Eigen/Geometry>
 
 #include "core/error.h"
 #include "frames/program_transform.h"

@@ -10,7 +10,8 @@
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   try {
-    (void)arcwheel::reports::ParseSummary(std::string(reinterpret_cast<const char*>(data), size), "summary.json");
+    (void)arcwheel::reports::ParseSummary(std::string(reinterpret_cast<const char*>(data), size),
+                                          "summary.json");
   } catch (const arcwheel::Error&) {
   }
   return 0;

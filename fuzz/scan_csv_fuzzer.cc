@@ -11,8 +11,8 @@
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   try {
-    const arcwheel::acquisition::Scan scan =
-        arcwheel::acquisition::ParseCsvScan(std::string(reinterpret_cast<const char*>(data), size), "fuzz.csv");
+    const arcwheel::acquisition::Scan scan = arcwheel::acquisition::ParseCsvScan(
+        std::string(reinterpret_cast<const char*>(data), size), "fuzz.csv");
     if (scan.z_mm.empty()) __builtin_trap();  // ValidateScan refuses empty scans
   } catch (const arcwheel::Error&) {
   }

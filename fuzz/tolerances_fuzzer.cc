@@ -10,8 +10,8 @@
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   try {
-    const auto tolerances =
-        arcwheel::reports::ParseTolerances(std::string(reinterpret_cast<const char*>(data), size), "tol.json");
+    const auto tolerances = arcwheel::reports::ParseTolerances(
+        std::string(reinterpret_cast<const char*>(data), size), "tol.json");
     for (const auto& [key, limit] : tolerances.limits) {
       if (limit.min && limit.max && *limit.min > *limit.max) __builtin_trap();
     }

@@ -16,8 +16,10 @@
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   static const bool in_memory = std::getenv("ARCWHEEL_FUZZ_DATX_IN_MEMORY") != nullptr;
   try {
-    const auto map = in_memory ? arcwheel::polishing::ReadZygoDatx(arcwheel::hdf5::File::OpenImage(data, size, "fuzz.datx"))
-                               : arcwheel::polishing::ReadZygoDatx(arcwheel::fuzz::WriteInput(data, size, "fuzz.datx"));
+    const auto map =
+        in_memory
+            ? arcwheel::polishing::ReadZygoDatx(arcwheel::hdf5::File::OpenImage(data, size, "fuzz.datx"))
+            : arcwheel::polishing::ReadZygoDatx(arcwheel::fuzz::WriteInput(data, size, "fuzz.datx"));
     if (map.width <= 0 || map.height <= 0 ||
         map.height_um.size() != static_cast<size_t>(map.width) * static_cast<size_t>(map.height)) {
       __builtin_trap();

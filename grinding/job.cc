@@ -104,7 +104,8 @@ class Section {
   }
   std::vector<double> Numbers(const std::string& key, size_t count) {
     used_.insert(key);
-    if (!Has(key) || !object_->at(key).is_array()) Fail(key, fmt::format("must be an array of {} numbers", count));
+    if (!Has(key) || !object_->at(key).is_array())
+      Fail(key, fmt::format("must be an array of {} numbers", count));
     std::vector<double> values;
     for (const json& v : object_->at(key)) {
       if (!v.is_number() || !std::isfinite(v.get<double>())) Fail(key, "must hold finite numbers only");
@@ -324,7 +325,8 @@ WheelSource ReadWheel(Section& s, const std::filesystem::path& job_path,
   }
   const double width = s.RequiredNumber("width_mm");
   w.half_width_mm = 0.5 * width;
-  if (const std::optional<std::string> name = s.OptionalString("name")) w.description = *name + ": " + w.description;
+  if (const std::optional<std::string> name = s.OptionalString("name"))
+    w.description = *name + ": " + w.description;
   if (const auto problems = w.Problems(); !problems.empty()) s.Fail("", "is not usable: " + problems.front());
   return out;
 }
@@ -349,13 +351,11 @@ void ReadGougeCheck(Section& s, ToolpathOptions& o) {
   o.gouge_tolerance_mm = 1e-3 * s.Number("tolerance_um", o.gouge_tolerance_mm * 1e3);
 }
 
-void ReadPrediction(Section& s, const std::optional<WheelSummary>& summary, double feed,
-                    Job& job) {
+void ReadPrediction(Section& s, const std::optional<WheelSummary>& summary, double feed, Job& job) {
   job.predict = s.Boolean("enabled", true);
   PredictionOptions& p = job.prediction;
   p.feed_mm_per_min = feed;
-  p.arc_radius_error_mm = s.Number("arc_radius_error_mm",
-                                   summary ? summary->mean_arc_radius_sigma_mm : 0.0);
+  p.arc_radius_error_mm = s.Number("arc_radius_error_mm", summary ? summary->mean_arc_radius_sigma_mm : 0.0);
   p.keep_total_radius = s.Boolean("keep_total_radius", true);
   const std::optional<double> rpm = s.OptionalNumber("spindle_rpm");
   std::optional<double> tir = s.OptionalNumber("runout_um");
@@ -398,7 +398,8 @@ void Validate(const Section& root, Job& job) {
     root.Fail(first.substr(0, first.find(' ')), first.substr(first.find(' ') + 1));
   }
   if (job.machine.pmac_program < 1) root.Fail("machine.pmac_program", "must be >= 1");
-  if (job.machine.decimals < 1 || job.machine.decimals > 9) root.Fail("machine.decimals", "must be within 1 .. 9");
+  if (job.machine.decimals < 1 || job.machine.decimals > 9)
+    root.Fail("machine.decimals", "must be within 1 .. 9");
   if (!(job.machine.retract_mm >= 0.0)) root.Fail("machine.retract_mm", "must be >= 0");
   if (job.predict) {
     if (const auto problems = job.prediction.Problems(); !problems.empty()) {
@@ -408,8 +409,8 @@ void Validate(const Section& root, Job& job) {
   // Contacts run lead_in / lead_out past the aperture and up to Ra |fy| / N3 < half width
   // across it; the surface must exist there.
   try {
-    CheckApertureInDomain(*job.surface, job.aperture,
-                          std::max(job.path.lead_in_mm, job.path.lead_out_mm), job.wheel.half_width_mm);
+    CheckApertureInDomain(*job.surface, job.aperture, std::max(job.path.lead_in_mm, job.path.lead_out_mm),
+                          job.wheel.half_width_mm);
   } catch (const Error& e) {
     root.Fail("aperture", fmt::format("does not fit the surface: {}", e.what()));
   }
@@ -472,10 +473,14 @@ Job ParseJob(const std::string& text, const std::filesystem::path& source,
 
   job.resolved = root.resolved();
   for (const auto& [key, section] :
-       std::vector<std::pair<std::string, const Section*>>{{"surface", &surface}, {"aperture", &aperture},
-                                                            {"wheel", &wheel}, {"path", &path},
-                                                            {"gouge_check", &gouge}, {"machine", &machine},
-                                                            {"prediction", &prediction}, {"outputs", &outputs}}) {
+       std::vector<std::pair<std::string, const Section*>>{{"surface", &surface},
+                                                           {"aperture", &aperture},
+                                                           {"wheel", &wheel},
+                                                           {"path", &path},
+                                                           {"gouge_check", &gouge},
+                                                           {"machine", &machine},
+                                                           {"prediction", &prediction},
+                                                           {"outputs", &outputs}}) {
     job.resolved[key] = section->resolved();
   }
   job.resolved["name"] = job.name;

@@ -16,8 +16,8 @@
 namespace arcwheel::grinding {
 
 struct MachineOptions {
-  int pmac_program = 1;    // PMAC motion program number, >= 1
-  int decimals = 4;        // decimals of mm in G-code and PMAC moves (4 = 0.1 um), 1 .. 9
+  int pmac_program = 1;     // PMAC motion program number, >= 1
+  int decimals = 4;         // decimals of mm in G-code and PMAC moves (4 = 0.1 um), 1 .. 9
   double retract_mm = 5.0;  // lift between rows (one-way) and between passes, >= 0
 };
 
@@ -39,7 +39,7 @@ struct Job {
   bool predict = true;
   PredictionOptions prediction;
   std::optional<std::filesystem::path> wheel_summary;  // where the wheel came from, if a summary
-  nlohmann::json resolved;  // the job with every default filled in, as used
+  nlohmann::json resolved;                             // the job with every default filled in, as used
 };
 
 // Reads and validates a job. `wheel_summary_override` (the CLI's --wheel) replaces the job's

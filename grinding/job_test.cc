@@ -15,8 +15,8 @@
 namespace arcwheel::grinding {
 namespace {
 
-using ::testing::HasSubstr;
 using nlohmann::json;
+using ::testing::HasSubstr;
 
 json SmallJob() {
   return json::parse(R"({
@@ -42,9 +42,7 @@ std::string ExpectRefused(const json& job, const std::filesystem::path& source =
   return "";
 }
 
-void WriteText(const std::filesystem::path& path, const std::string& text) {
-  std::ofstream(path) << text;
-}
+void WriteText(const std::filesystem::path& path, const std::string& text) { std::ofstream(path) << text; }
 
 TEST(ParseJob, ReadsTheShippedTrialPart) {
   const Job job = ReadJob(testing::SourceDir() / "grinding/examples/trial_part.json", std::nullopt);
@@ -116,8 +114,8 @@ TEST(ParseJob, TakesTheWheelFromASummaryAndNeedsItsTotalRadius) {
   EXPECT_DOUBLE_EQ(parsed.wheel.arc_radius_mm, 55.0);
   EXPECT_DOUBLE_EQ(parsed.wheel.base_radius_mm, 145.0);
   EXPECT_EQ(parsed.wheel.profile_u_mm, (std::vector<double>{-8.0, 8.0}));  // the null node dropped
-  EXPECT_DOUBLE_EQ(parsed.prediction.arc_radius_error_mm, 0.002);  // the summary's 1-sigma
-  EXPECT_NEAR(parsed.prediction.runout_radial_um[0], 0.75, 1e-12);  // TIR / 2 at phase 0
+  EXPECT_DOUBLE_EQ(parsed.prediction.arc_radius_error_mm, 0.002);          // the summary's 1-sigma
+  EXPECT_NEAR(parsed.prediction.runout_radial_um[0], 0.75, 1e-12);         // TIR / 2 at phase 0
 
   job["wheel"]["arc_radius_mm"] = 50.0;
   EXPECT_THAT(ExpectRefused(job, dir / "job.json"), HasSubstr("key 'wheel.arc_radius_mm' conflicts"));
@@ -173,7 +171,8 @@ TEST(ToolpathCommand, WritesTheFilesAndTheCsvIsRightToTheNanometre) {
   const testing::CommandResult run =
       testing::RunArcwheel("toolpath " + (dir / "job.json").string() + " -o " + (dir / "out").string());
   ASSERT_EQ(run.exit_status, 0) << run.output;
-  for (const char* name : {"toolpath.csv", "toolpath.nc", "toolpath.pmc", "prediction.h5", "toolpath_summary.json"}) {
+  for (const char* name :
+       {"toolpath.csv", "toolpath.nc", "toolpath.pmc", "prediction.h5", "toolpath_summary.json"}) {
     EXPECT_TRUE(std::filesystem::exists(dir / "out" / name)) << name;
   }
   std::vector<std::string> comments;
@@ -201,7 +200,8 @@ TEST(ToolpathCommand, WritesTheFilesAndTheCsvIsRightToTheNanometre) {
     EXPECT_EQ(v[9], 6000.0);
   }
   std::ifstream nc(dir / "out/toolpath.nc"), pmc(dir / "out/toolpath.pmc");
-  const std::string gcode((std::istreambuf_iterator<char>(nc)), {}), pmac((std::istreambuf_iterator<char>(pmc)), {});
+  const std::string gcode((std::istreambuf_iterator<char>(nc)), {}),
+      pmac((std::istreambuf_iterator<char>(pmc)), {});
   EXPECT_THAT(gcode, HasSubstr("G90 G21\n"));
   EXPECT_THAT(gcode, HasSubstr(" F6000\n"));
   EXPECT_THAT(gcode, HasSubstr("(surface: even asphere"));
@@ -235,7 +235,6 @@ TEST(ToolpathCommand, RefusesAnUnknownKeyWithExitStatusThree) {
   EXPECT_FALSE(std::filesystem::exists(dir / "out"));
 }
 
-
 TEST(ParseJob, ReadsFreeformAndGridSurfacesAndGrindsTheGrid) {
   json job = SmallJob();
   job["surface"] = json::parse(R"({"type": "xy_polynomial", "terms": [
@@ -253,15 +252,17 @@ TEST(ParseJob, ReadsFreeformAndGridSurfacesAndGrindsTheGrid) {
     }
     rows.push_back(row);
   }
-  job["surface"] = {{"type", "height_grid"}, {"x0_mm", -60.0}, {"y0_mm", -60.0}, {"dx_mm", 5.0},
-                    {"dy_mm", 5.0}, {"heights_mm", rows}};
+  job["surface"] = {{"type", "height_grid"}, {"x0_mm", -60.0}, {"y0_mm", -60.0},
+                    {"dx_mm", 5.0},          {"dy_mm", 5.0},   {"heights_mm", rows}};
   job["aperture"] = {{"shape", "circle"}, {"diameter_mm", 40.0}};
   const Job grid = ParseJob(job.dump(), "job.json", std::nullopt);
   EXPECT_NEAR(grid.surface->Evaluate(7.3, -11.1).z_mm, 1e-3 * 7.3 * 7.3 + 5e-4 * 11.1 * 11.1, 1e-12);
   std::vector<ControlPoint> points;
-  const ToolpathSummary summary = GenerateToolpath(
-      *grid.surface, grid.aperture, grid.wheel, grid.path,
-      {.prepare = nullptr, .consume = [&points](ToolpathRow& r) { points.insert(points.end(), r.points.begin(), r.points.end()); }});
+  const ToolpathSummary summary =
+      GenerateToolpath(*grid.surface, grid.aperture, grid.wheel, grid.path,
+                       {.prepare = nullptr, .consume = [&points](ToolpathRow& r) {
+                          points.insert(points.end(), r.points.begin(), r.points.end());
+                        }});
   EXPECT_LT(summary.max_row_deviation_mm, 1e-9);
   for (const ControlPoint& p : points) {
     // Eq. 5 on the exact paraboloid, written out here.
@@ -289,8 +290,9 @@ TEST(ToolpathCommand, MeasuredWheelProfileMovesTheControlPoints) {
   job["wheel"].erase("total_radius_mm");
   job["outputs"] = {{"gcode", false}, {"pmac", false}};
   WriteText(dir / "job.json", job.dump());
-  const testing::CommandResult run = testing::RunArcwheel("toolpath " + (dir / "job.json").string() + " --wheel " +
-                                                          (dir / "summary.json").string() + " -o " + (dir / "out").string());
+  const testing::CommandResult run =
+      testing::RunArcwheel("toolpath " + (dir / "job.json").string() + " --wheel " +
+                           (dir / "summary.json").string() + " -o " + (dir / "out").string());
   ASSERT_EQ(run.exit_status, 0) << run.output;
   EXPECT_EQ(testing::ListFolder(dir / "out"), "prediction.h5\ntoolpath.csv\ntoolpath_summary.json\n");
   std::vector<std::string> comments;
@@ -313,7 +315,8 @@ TEST(ToolpathCommand, MeasuredWheelProfileMovesTheControlPoints) {
 TEST(ToolpathCommand, RunsTheShippedTrialPart) {
   const testing::TempDir dir;
   const testing::CommandResult run = testing::RunArcwheel(
-      "toolpath " + (testing::SourceDir() / "grinding/examples/trial_part.json").string() + " -o " + (dir / "out").string());
+      "toolpath " + (testing::SourceDir() / "grinding/examples/trial_part.json").string() + " -o " +
+      (dir / "out").string());
   ASSERT_EQ(run.exit_status, 0) << run.output;
   std::ifstream in(dir / "out/toolpath_summary.json");
   const json summary = json::parse(in);

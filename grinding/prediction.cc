@@ -51,7 +51,8 @@ double LookUp(const std::vector<double>& table, double phi_deg) {
   const double position = turns * kRunoutTableSize;
   const int k = std::min(static_cast<int>(position), kRunoutTableSize - 1);
   const double t = position - k;
-  return table[static_cast<size_t>(k)] * (1.0 - t) + table[static_cast<size_t>((k + 1) % kRunoutTableSize)] * t;
+  return table[static_cast<size_t>(k)] * (1.0 - t) +
+         table[static_cast<size_t>((k + 1) % kRunoutTableSize)] * t;
 }
 
 struct NodeError {
@@ -186,15 +187,14 @@ std::vector<std::string> PredictionOptions::Problems() const {
     }
   }
   if (!runout_phase_deg.empty() && !(spindle_rpm > 0.0)) {
-    problems.push_back(fmt::format("prediction.spindle_rpm = {} violates > 0 (needed for runout)",
-                                   spindle_rpm));
+    problems.push_back(
+        fmt::format("prediction.spindle_rpm = {} violates > 0 (needed for runout)", spindle_rpm));
   }
   if (!(feed_mm_per_min > 0.0)) {
     problems.push_back(fmt::format("path.feed_mm_per_min = {} violates > 0", feed_mm_per_min));
   }
   if (nodes_x < 2 || nodes_y < 2) {
-    problems.push_back(
-        fmt::format("prediction.map_nodes = [{}, {}] violates >= 2 each", nodes_x, nodes_y));
+    problems.push_back(fmt::format("prediction.map_nodes = [{}, {}] violates >= 2 each", nodes_x, nodes_y));
   }
   if (threads < 0) problems.push_back(fmt::format("machine.threads = {} violates >= 0", threads));
   return problems;
@@ -210,8 +210,8 @@ void SetEccentricRunout(double total_indicated_runout_um, PredictionOptions& opt
   }
 }
 
-FormPrediction PredictFormError(const Surface& surface, const Aperture& aperture,
-                                const Wheel& wheel, const PredictionOptions& options) {
+FormPrediction PredictFormError(const Surface& surface, const Aperture& aperture, const Wheel& wheel,
+                                const PredictionOptions& options) {
   if (const auto problems = options.Problems(); !problems.empty()) {
     throw Error(ErrorCode::kInvalidOption, kStage, problems.front());
   }
@@ -266,8 +266,7 @@ FormPrediction PredictFormError(const Surface& surface, const Aperture& aperture
 }
 
 void WritePredictionHdf5(const FormPrediction& prediction, const std::filesystem::path& path,
-                         const std::string& surface_description,
-                         const std::string& wheel_description) {
+                         const std::string& surface_description, const std::string& wheel_description) {
   hdf5::File file = hdf5::File::Create(path);
   file.CreateGroup("/prediction");
   const hsize_t nx = prediction.x_mm.size(), ny = prediction.y_mm.size();

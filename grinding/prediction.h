@@ -55,9 +55,9 @@ struct PredictionOptions {
 void SetEccentricRunout(double total_indicated_runout_um, PredictionOptions& options);
 
 struct FormPrediction {
-  std::vector<double> x_mm;      // [nodes_x]
-  std::vector<double> y_mm;      // [nodes_y]
-  std::vector<double> error_um;  // [nodes_y * nodes_x], row-major in y; NaN outside the aperture
+  std::vector<double> x_mm;          // [nodes_x]
+  std::vector<double> y_mm;          // [nodes_y]
+  std::vector<double> error_um;      // [nodes_y * nodes_x], row-major in y; NaN outside the aperture
   std::vector<double> low_order_um;  // the arc-radius part alone, same layout
   double pv_um = 0.0;
   double rms_um = 0.0;  // about the mean
@@ -75,7 +75,6 @@ struct FormPrediction {
 // Writes /prediction/{x_mm, y_mm, error_um, low_order_um} and the PV/RMS figures as attributes to
 // an HDF5 file (through the caller's atomic staging). Throws Error{kIo}.
 void WritePredictionHdf5(const FormPrediction& prediction, const std::filesystem::path& path,
-                         const std::string& surface_description,
-                         const std::string& wheel_description);
+                         const std::string& surface_description, const std::string& wheel_description);
 
 }  // namespace arcwheel::grinding

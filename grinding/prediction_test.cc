@@ -3,12 +3,11 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <Eigen/Dense>
 #include <cmath>
 #include <limits>
 #include <memory>
 #include <numbers>
-
-#include <Eigen/Dense>
 
 #include "core/error.h"
 #include "core/hdf5.h"
@@ -29,8 +28,8 @@ EvenAsphere Fig7Asphere(bool concave = true) {
 Eigen::Vector3d WheelCentre(const Surface& s, const Wheel& w, double x, double y) {
   const SurfacePoint p = s.Evaluate(x, y);
   const double n3 = std::sqrt(p.fx * p.fx + p.fy * p.fy + 1), n2 = std::sqrt(p.fx * p.fx + 1);
-  return {x - w.arc_radius_mm * p.fx / n3 - w.base_radius_mm * p.fx / n2,
-          y - w.arc_radius_mm * p.fy / n3, p.z_mm + w.arc_radius_mm / n3 + w.base_radius_mm / n2};
+  return {x - w.arc_radius_mm * p.fx / n3 - w.base_radius_mm * p.fx / n2, y - w.arc_radius_mm * p.fy / n3,
+          p.z_mm + w.arc_radius_mm / n3 + w.base_radius_mm / n2};
 }
 
 // Lowest point over (x, y) of a torus wheel (arc ra, base rb) centred at c.
@@ -97,8 +96,8 @@ TEST(PredictFormError, ArcRadiusErrorMatchesTheBruteForceEnvelope) {
   const EvenAsphere concave = Fig7Asphere(true), convex = Fig7Asphere(false);
   for (const Surface* s : std::vector<const Surface*>{&concave, &convex}) {
     for (double d_ra : {0.2, -0.1}) {
-      const FormPrediction p = PredictFormError(
-          *s, square, PaperWheel(), {.arc_radius_error_mm = d_ra, .nodes_x = 5, .nodes_y = 5});
+      const FormPrediction p = PredictFormError(*s, square, PaperWheel(),
+                                                {.arc_radius_error_mm = d_ra, .nodes_x = 5, .nodes_y = 5});
       for (size_t j : {0u, 1u, 4u}) {
         for (size_t i : {0u, 2u, 3u}) {
           const double x = p.x_mm[i], y = p.y_mm[j];
@@ -117,11 +116,11 @@ TEST(PredictFormError, Fig7ErrorGrowsLinearlyWithTheRadiusErrorAsFyToTheSecond) 
   const EvenAsphere part = Fig7Asphere();
   std::vector<double> pv;
   for (double d_ra : {0.05, 0.1, 0.2}) {
-    const FormPrediction p =
-        PredictFormError(part, square, PaperWheel(), {.arc_radius_error_mm = d_ra, .nodes_x = 21, .nodes_y = 21});
+    const FormPrediction p = PredictFormError(part, square, PaperWheel(),
+                                              {.arc_radius_error_mm = d_ra, .nodes_x = 21, .nodes_y = 21});
     pv.push_back(p.pv_um);
-    std::printf("fig. 7 part: dRa = %.2f mm -> PV %.3f um, RMS %.3f um (%.3f / %.3f um after tilt)\n",
-                d_ra, p.pv_um, p.rms_um, p.pv_after_tilt_um, p.rms_after_tilt_um);
+    std::printf("fig. 7 part: dRa = %.2f mm -> PV %.3f um, RMS %.3f um (%.3f / %.3f um after tilt)\n", d_ra,
+                p.pv_um, p.rms_um, p.pv_after_tilt_um, p.rms_after_tilt_um);
     for (size_t k = 0; k < p.error_um.size(); ++k) {
       const double x = p.x_mm[k % 21], y = p.y_mm[k / 21];
       const SurfacePoint s = part.Evaluate(x, y);
@@ -134,13 +133,15 @@ TEST(PredictFormError, Fig7ErrorGrowsLinearlyWithTheRadiusErrorAsFyToTheSecond) 
   EXPECT_NEAR(pv[1] / pv[0], 2.0, 0.02);
   EXPECT_NEAR(pv[2] / pv[1], 2.0, 0.02);
   // Cylinder: on the x axis (fy = 0) nothing; it grows with y^2 across the part.
-  const FormPrediction p = PredictFormError(part, square, PaperWheel(), {.arc_radius_error_mm = 0.1, .nodes_x = 21, .nodes_y = 21});
+  const FormPrediction p = PredictFormError(part, square, PaperWheel(),
+                                            {.arc_radius_error_mm = 0.1, .nodes_x = 21, .nodes_y = 21});
   EXPECT_LT(std::abs(p.error_um[10 * 21 + 3]), 1e-3);
   EXPECT_LT(p.error_um[20 * 21 + 10], -0.1);
   // Keeping the base radius instead (the total radius errs too) offsets the surface along its
   // normal by exactly -dRa: a height error of -dRa N3.
   const FormPrediction offset = PredictFormError(
-      part, square, PaperWheel(), {.arc_radius_error_mm = 0.1, .keep_total_radius = false, .nodes_x = 21, .nodes_y = 21});
+      part, square, PaperWheel(),
+      {.arc_radius_error_mm = 0.1, .keep_total_radius = false, .nodes_x = 21, .nodes_y = 21});
   for (size_t k = 0; k < offset.error_um.size(); k += 5) {
     const SurfacePoint s = part.Evaluate(offset.x_mm[k % 21], offset.y_mm[k / 21]);
     EXPECT_NEAR(offset.error_um[k] / std::sqrt(1 + s.fx * s.fx + s.fy * s.fy), -100.0, 0.05);
@@ -172,7 +173,8 @@ TEST(PredictFormError, RunoutRippleMatchesTheBruteForceEnvelopeAlongTheFeed) {
 
 TEST(PredictFormError, RefusesInvalidOptions) {
   PredictionOptions o{.nodes_x = 1};
-  EXPECT_THROW((void)PredictFormError(Fig7Asphere(), {.width_x_mm = 10, .width_y_mm = 10}, PaperWheel(), o), Error);
+  EXPECT_THROW((void)PredictFormError(Fig7Asphere(), {.width_x_mm = 10, .width_y_mm = 10}, PaperWheel(), o),
+               Error);
   o = {.runout_phase_deg = {0.0}, .runout_radial_um = {1.0}};
   try {
     (void)PredictFormError(Fig7Asphere(), {.width_x_mm = 10, .width_y_mm = 10}, PaperWheel(), o);
@@ -184,8 +186,9 @@ TEST(PredictFormError, RefusesInvalidOptions) {
 
 TEST(WritePredictionHdf5, WritesTheMapAndItsFigures) {
   const testing::TempDir dir;
-  const FormPrediction p = PredictFormError(Fig7Asphere(), {.width_x_mm = 100, .width_y_mm = 60}, PaperWheel(),
-                                            {.arc_radius_error_mm = 0.1, .nodes_x = 11, .nodes_y = 7});
+  const FormPrediction p =
+      PredictFormError(Fig7Asphere(), {.width_x_mm = 100, .width_y_mm = 60}, PaperWheel(),
+                       {.arc_radius_error_mm = 0.1, .nodes_x = 11, .nodes_y = 7});
   WritePredictionHdf5(p, dir / "prediction.h5", "surface", "wheel");
   const hdf5::File file = hdf5::File::OpenReadOnly(dir / "prediction.h5");
   EXPECT_EQ(file.Shape("/prediction/error_um"), (std::vector<hsize_t>{7, 11}));

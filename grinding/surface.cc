@@ -55,9 +55,9 @@ HermiteBasis Hermite(double t) {
 // ---------------------------------------------------------------------------------------------
 EvenAsphere::EvenAsphere(const EvenAsphereParameters& parameters) : parameters_(parameters) {
   if (!(parameters.vertex_radius_mm > 0.0) || !std::isfinite(parameters.vertex_radius_mm)) {
-    throw Error(ErrorCode::kBadInput, kStage,
-                fmt::format("vertex_radius_mm = {} must be a finite number > 0",
-                            parameters.vertex_radius_mm));
+    throw Error(
+        ErrorCode::kBadInput, kStage,
+        fmt::format("vertex_radius_mm = {} must be a finite number > 0", parameters.vertex_radius_mm));
   }
   if (parameters.even_coefficients.size() > kMaxEvenTerms) {
     throw Error(ErrorCode::kBadInput, kStage,
@@ -121,10 +121,10 @@ bool EvenAsphere::InDomain(double x_mm, double y_mm) const {
 }
 
 std::string EvenAsphere::Describe() const {
-  std::string text = fmt::format(
-      "even asphere, {}, R0 = {} mm, k = {}, local origin at ({}, {}) mm off the parent axis",
-      parameters_.concave ? "concave" : "convex", parameters_.vertex_radius_mm, parameters_.conic,
-      parameters_.off_axis_x_mm, parameters_.off_axis_y_mm);
+  std::string text =
+      fmt::format("even asphere, {}, R0 = {} mm, k = {}, local origin at ({}, {}) mm off the parent axis",
+                  parameters_.concave ? "concave" : "convex", parameters_.vertex_radius_mm, parameters_.conic,
+                  parameters_.off_axis_x_mm, parameters_.off_axis_y_mm);
   for (size_t m = 0; m < parameters_.even_coefficients.size(); ++m) {
     if (parameters_.even_coefficients[m] != 0.0) {
       text += fmt::format(", A{} = {}", 2 * m + 4, parameters_.even_coefficients[m]);
@@ -186,8 +186,8 @@ HeightGrid::HeightGrid(HeightGridParameters parameters) : p_(std::move(parameter
   const size_t nx = static_cast<size_t>(p_.nx), ny = static_cast<size_t>(p_.ny);
   if (p_.heights_mm.size() != nx * ny) {
     throw Error(ErrorCode::kBadInput, kStage,
-                fmt::format("height grid holds {} heights, {} x {} = {} expected",
-                            p_.heights_mm.size(), nx, ny, nx * ny));
+                fmt::format("height grid holds {} heights, {} x {} = {} expected", p_.heights_mm.size(), nx,
+                            ny, nx * ny));
   }
   for (size_t k = 0; k < p_.heights_mm.size(); ++k) {
     if (!std::isfinite(p_.heights_mm[k])) {
@@ -260,12 +260,8 @@ std::string HeightGrid::Describe() const {
 }
 
 // ---------------------------------------------------------------------------------------------
-double Aperture::HalfX() const {
-  return shape == Shape::kCircle ? diameter_mm / 2.0 : width_x_mm / 2.0;
-}
-double Aperture::HalfY() const {
-  return shape == Shape::kCircle ? diameter_mm / 2.0 : width_y_mm / 2.0;
-}
+double Aperture::HalfX() const { return shape == Shape::kCircle ? diameter_mm / 2.0 : width_x_mm / 2.0; }
+double Aperture::HalfY() const { return shape == Shape::kCircle ? diameter_mm / 2.0 : width_y_mm / 2.0; }
 bool Aperture::Contains(double x_mm, double y_mm) const {
   if (shape == Shape::kCircle) return std::hypot(x_mm, y_mm) <= diameter_mm / 2.0;
   return std::abs(x_mm) <= HalfX() && std::abs(y_mm) <= HalfY();
@@ -296,8 +292,7 @@ void CheckApertureInDomain(const Surface& surface, const Aperture& aperture, dou
         throw Error(ErrorCode::kBadInput, kStage,
                     fmt::format("point ({:.3f}, {:.3f}) mm of the {} (with {} / {} mm lead and "
                                 "reach margins) lies outside the surface's domain ({})",
-                                x, y, aperture.Describe(), margin_x_mm, margin_y_mm,
-                                surface.Describe()));
+                                x, y, aperture.Describe(), margin_x_mm, margin_y_mm, surface.Describe()));
       }
     }
   }

@@ -19,8 +19,8 @@ namespace arcwheel::grinding {
 // Height and derivatives of a surface at one (x, y).
 struct SurfacePoint {
   double z_mm = 0.0;
-  double fx = 0.0;      // dz/dx
-  double fy = 0.0;      // dz/dy
+  double fx = 0.0;          // dz/dx
+  double fy = 0.0;          // dz/dy
   double fxx_per_mm = 0.0;  // d2z/dx2
   double fxy_per_mm = 0.0;  // d2z/dxdy
   double fyy_per_mm = 0.0;  // d2z/dy2

@@ -20,8 +20,7 @@ double ConicSagOtherForm(double r2, double radius, double conic) {
 }
 
 // Central differences of the surface's own heights and slopes (independent of the closed forms).
-void ExpectDerivativesMatchFiniteDifferences(const Surface& s, double x, double y, double tol1,
-                                             double tol2) {
+void ExpectDerivativesMatchFiniteDifferences(const Surface& s, double x, double y, double tol1, double tol2) {
   const double h = 1e-3;
   const SurfacePoint p = s.Evaluate(x, y);
   const double fx = (s.Evaluate(x + h, y).z_mm - s.Evaluate(x - h, y).z_mm) / (2 * h);
@@ -64,8 +63,8 @@ TEST(EvenAsphere, ParaboloidIsExactlyQuadratic) {
 
 TEST(EvenAsphere, OffAxisSegmentIsTheParentSagShiftedToItsOrigin) {
   const double radius = 800.0, conic = -2.2, x0 = 300.0, y0 = -40.0;
-  const EvenAsphere part({.vertex_radius_mm = radius, .conic = conic, .off_axis_x_mm = x0,
-                          .off_axis_y_mm = y0});
+  const EvenAsphere part(
+      {.vertex_radius_mm = radius, .conic = conic, .off_axis_x_mm = x0, .off_axis_y_mm = y0});
   EXPECT_NEAR(part.Evaluate(0, 0).z_mm, 0.0, 1e-13);
   const double origin = ConicSagOtherForm(x0 * x0 + y0 * y0, radius, conic);
   for (double x : {-100.0, 35.0, 100.0}) {
@@ -89,8 +88,9 @@ TEST(EvenAsphere, ConvexIsTheMirrorOfConcave) {
 
 TEST(EvenAsphere, PolynomialTermsAddPowersOfRadius) {
   const EvenAsphere base({.vertex_radius_mm = 2000.0, .conic = -0.7});
-  const EvenAsphere with_terms(
-      {.vertex_radius_mm = 2000.0, .conic = -0.7, .even_coefficients = {1e-10, -2e-16, 0, 0, 0, 0, 0, 0, 3e-50}});
+  const EvenAsphere with_terms({.vertex_radius_mm = 2000.0,
+                                .conic = -0.7,
+                                .even_coefficients = {1e-10, -2e-16, 0, 0, 0, 0, 0, 0, 3e-50}});
   for (double r : {50.0, 200.0}) {
     const double expected = 1e-10 * std::pow(r, 4) - 2e-16 * std::pow(r, 6) + 3e-50 * std::pow(r, 20);
     EXPECT_NEAR(with_terms.Evaluate(r, 0).z_mm - base.Evaluate(r, 0).z_mm, expected, 1e-12);
@@ -100,11 +100,15 @@ TEST(EvenAsphere, PolynomialTermsAddPowersOfRadius) {
 TEST(EvenAsphere, DerivativesMatchFiniteDifferences) {
   std::mt19937 rng(20261123);
   std::uniform_real_distribution<double> where(-200.0, 200.0);
-  const EvenAsphere part({.vertex_radius_mm = 800.0, .conic = -2.2,
-                          .even_coefficients = {3e-11, -1e-16}, .off_axis_x_mm = 300.0,
-                          .off_axis_y_mm = 150.0, .concave = false});
+  const EvenAsphere part({.vertex_radius_mm = 800.0,
+                          .conic = -2.2,
+                          .even_coefficients = {3e-11, -1e-16},
+                          .off_axis_x_mm = 300.0,
+                          .off_axis_y_mm = 150.0,
+                          .concave = false});
   // FD error: h^2 f''' / 6 ~ 1e-12 plus rounding 1e-16 * |z| / h ~ 1e-11.
-  for (int k = 0; k < 50; ++k) ExpectDerivativesMatchFiniteDifferences(part, where(rng), where(rng), 1e-9, 1e-9);
+  for (int k = 0; k < 50; ++k)
+    ExpectDerivativesMatchFiniteDifferences(part, where(rng), where(rng), 1e-9, 1e-9);
 }
 
 TEST(EvenAsphere, ProlateEllipsoidEndsAndApertureBeyondIsRefusedNamingThePoint) {
@@ -149,7 +153,8 @@ double Bicubic(double x, double y) {
 TEST(HeightGrid, ReproducesABicubicPolynomialWithItsDerivatives) {
   HeightGridParameters g{.x0_mm = -20.0, .y0_mm = -15.0, .dx_mm = 2.5, .dy_mm = 3.0, .nx = 17, .ny = 11};
   for (int j = 0; j < g.ny; ++j) {
-    for (int i = 0; i < g.nx; ++i) g.heights_mm.push_back(Bicubic(g.x0_mm + i * g.dx_mm, g.y0_mm + j * g.dy_mm));
+    for (int i = 0; i < g.nx; ++i)
+      g.heights_mm.push_back(Bicubic(g.x0_mm + i * g.dx_mm, g.y0_mm + j * g.dy_mm));
   }
   const HeightGrid grid(g);
   std::mt19937 rng(7);
@@ -174,7 +179,8 @@ TEST(HeightGrid, InterpolatesASmoothSurfaceToSplineAccuracy) {
   HeightGridParameters g{.x0_mm = -100.0, .y0_mm = -100.0, .dx_mm = 5.0, .dy_mm = 5.0, .nx = 41, .ny = 41};
   const EvenAsphere sphere({.vertex_radius_mm = 500.0, .conic = 0.0});
   for (int j = 0; j < g.ny; ++j) {
-    for (int i = 0; i < g.nx; ++i) g.heights_mm.push_back(sphere.Evaluate(-100 + 5.0 * i, -100 + 5.0 * j).z_mm);
+    for (int i = 0; i < g.nx; ++i)
+      g.heights_mm.push_back(sphere.Evaluate(-100 + 5.0 * i, -100 + 5.0 * j).z_mm);
   }
   const HeightGrid grid(g);
   for (double x : {-97.3, -12.1, 0.0, 44.4, 99.0}) {
@@ -186,7 +192,8 @@ TEST(HeightGrid, InterpolatesASmoothSurfaceToSplineAccuracy) {
 }
 
 TEST(HeightGrid, RefusesTooFewNodesAndSizeMismatch) {
-  HeightGridParameters g{.dx_mm = 1.0, .dy_mm = 1.0, .nx = 3, .ny = 5, .heights_mm = std::vector<double>(15, 0.0)};
+  HeightGridParameters g{
+      .dx_mm = 1.0, .dy_mm = 1.0, .nx = 3, .ny = 5, .heights_mm = std::vector<double>(15, 0.0)};
   EXPECT_THROW(HeightGrid{g}, Error);
   g.nx = 4;
   try {

@@ -34,8 +34,8 @@ Eq5 EvaluateEq5(const Surface& surface, const Wheel& wheel, double x, double y) 
   const SurfacePoint& s = e.surface = surface.Evaluate(x, y);
   const double n3 = std::sqrt(s.fx * s.fx + s.fy * s.fy + 1.0);
   const double n2 = std::sqrt(s.fx * s.fx + 1.0);
-  const double ra = wheel.HasProfile() ? wheel.ArcRadiusAt(wheel.arc_radius_mm * s.fy / n3)
-                                       : wheel.arc_radius_mm;
+  const double ra =
+      wheel.HasProfile() ? wheel.ArcRadiusAt(wheel.arc_radius_mm * s.fy / n3) : wheel.arc_radius_mm;
   const double rb = wheel.base_radius_mm;
   e.arc_radius_mm = ra;
   e.point.contact_mm = {x, y, s.z_mm};
@@ -68,8 +68,7 @@ Eq5 SolveEq5(const Surface& surface, const Wheel& wheel, bool fix_contact_x, dou
     if (!std::isfinite(xy.x()) || !std::isfinite(xy.y()) || !surface.InDomain(xy.x(), xy.y())) break;
     const Eq5 e = EvaluateEq5(surface, wheel, xy.x(), xy.y());
     const Eigen::Vector3d& c = e.point.wheel_centre_mm;
-    const Eigen::Vector2d residual(fix_contact_x ? xy.x() - target_x : c.x() - target_x,
-                                   c.y() - target_yw);
+    const Eigen::Vector2d residual(fix_contact_x ? xy.x() - target_x : c.x() - target_x, c.y() - target_yw);
     if (residual.cwiseAbs().maxCoeff() < kNewtonTolerance_mm) return e;
     Eigen::Matrix2d jacobian = JacobianOf(e, wheel.base_radius_mm);
     if (fix_contact_x) jacobian.row(0) << 1.0, 0.0;
@@ -77,12 +76,12 @@ Eq5 SolveEq5(const Surface& surface, const Wheel& wheel, bool fix_contact_x, dou
     if (!(std::abs(det) > 1e-12)) break;
     xy -= jacobian.inverse() * residual;
   }
-  throw Error(ErrorCode::kBadInput, kStage,
-              fmt::format("cannot place the wheel at {} = {:.6f} mm, wheel-centre Y = {:.6f} mm: "
-                          "eq. 5 has no solution there (last contact tried ({:.6f}, {:.6f}) mm); "
-                          "the wheel cannot follow the surface at that point",
-                          fix_contact_x ? "contact X" : "wheel-centre X", target_x, target_yw,
-                          xy.x(), xy.y()));
+  throw Error(
+      ErrorCode::kBadInput, kStage,
+      fmt::format("cannot place the wheel at {} = {:.6f} mm, wheel-centre Y = {:.6f} mm: "
+                  "eq. 5 has no solution there (last contact tried ({:.6f}, {:.6f}) mm); "
+                  "the wheel cannot follow the surface at that point",
+                  fix_contact_x ? "contact X" : "wheel-centre X", target_x, target_yw, xy.x(), xy.y()));
 }
 
 // Hessian of W(x, y) = Zw - sqrt(R(y)^2 - (x - Xw)^2), R(y) = Rb + sqrt(Ra^2 - (y - Yw)^2), the
@@ -140,19 +139,23 @@ class RowBuilder {
     const double lead_low = reversed ? options_.lead_out_mm : options_.lead_in_mm;
     const double lead_high = reversed ? options_.lead_in_mm : options_.lead_out_mm;
     const Eigen::Vector2d mid_xy = middle.point.contact_mm.head<2>();
-    const Eq5 first = SolveEq5(surface_, wheel_, true, -half - lead_low, yw, mid_xy - Eigen::Vector2d(half, 0));
-    const Eq5 last = SolveEq5(surface_, wheel_, true, half + lead_high, yw, mid_xy + Eigen::Vector2d(half, 0));
+    const Eq5 first =
+        SolveEq5(surface_, wheel_, true, -half - lead_low, yw, mid_xy - Eigen::Vector2d(half, 0));
+    const Eq5 last =
+        SolveEq5(surface_, wheel_, true, half + lead_high, yw, mid_xy + Eigen::Vector2d(half, 0));
     const RowContext context{row, yw, &stats};
-    std::vector<ControlPoint> points = options_.chordal_tolerance_um > 0.0 ? Adaptive(first, last, context)
-                                                                           : Uniform(first, last, context);
+    std::vector<ControlPoint> points =
+        options_.chordal_tolerance_um > 0.0 ? Adaptive(first, last, context) : Uniform(first, last, context);
     // Global checks on a grid about gouge_check_spacing_mm wide: every few rows (and the last),
     // along the row every spacing of wheel-centre travel and at both ends.
-    const int row_stride = std::max(1, static_cast<int>(std::lround(options_.gouge_check_spacing_mm / options_.step_over_mm)));
+    const int row_stride =
+        std::max(1, static_cast<int>(std::lround(options_.gouge_check_spacing_mm / options_.step_over_mm)));
     if (row % row_stride != 0 && row != rows_count_ - 1) return points;
     double last_checked_xw = -std::numeric_limits<double>::infinity();
     for (size_t i = 0; i < points.size(); ++i) {
       const double xw = points[i].wheel_centre_mm.x();
-      if (i == 0 || i + 1 == points.size() || xw - last_checked_xw >= options_.gouge_check_spacing_mm - 1e-9) {
+      if (i == 0 || i + 1 == points.size() ||
+          xw - last_checked_xw >= options_.gouge_check_spacing_mm - 1e-9) {
         GlobalGougeCheck(row, static_cast<int>(i), points[i], stats);
         last_checked_xw = xw;
       }
@@ -200,7 +203,8 @@ class RowBuilder {
         const bool to_end = a.wheel_centre_mm.x() + step >= xw1 - 1e-9;
         const double xb = to_end ? xw1 : a.wheel_centre_mm.x() + step;
         const double h = xb - a.wheel_centre_mm.x();
-        const Eq5 b = to_end ? last : SolveEq5(surface_, wheel_, false, xb, context.yw, a_xy + Eigen::Vector2d(h, 0));
+        const Eq5 b =
+            to_end ? last : SolveEq5(surface_, wheel_, false, xb, context.yw, a_xy + Eigen::Vector2d(h, 0));
         const Eq5 mid = SolveEq5(surface_, wheel_, false, a.wheel_centre_mm.x() + 0.5 * h, context.yw,
                                  a_xy + Eigen::Vector2d(0.5 * h, 0));
         const double chord_mm = std::abs(mid.point.wheel_centre_mm.z() -
@@ -236,8 +240,8 @@ class RowBuilder {
                   fmt::format("row {} point {}: contact ({:.6f}, {:.6f}) mm lies {:.4f} mm from the "
                               "arc centre along the wheel axis, beyond the wheel's usable arc "
                               "(half width {} mm{}); the surface is too steep across the feed",
-                              context.row, index, p.contact_mm.x(), p.contact_mm.y(), u,
-                              wheel_.half_width_mm, wheel_.HasProfile() ? " and measured profile" : ""));
+                              context.row, index, p.contact_mm.x(), p.contact_mm.y(), u, wheel_.half_width_mm,
+                              wheel_.HasProfile() ? " and measured profile" : ""));
     }
     const double clearance = SmallestEigenvalue(ClearanceHessianOf(e, wheel_));
     stats.min_local_clearance_per_mm = std::min(stats.min_local_clearance_per_mm, clearance);
@@ -301,8 +305,7 @@ std::vector<double> PlanRows(const Surface& surface, const Aperture& aperture, c
 }  // namespace
 
 // ---------------------------------------------------------------------------------------------
-ControlPoint ControlPointForContact(const Surface& surface, const Wheel& wheel, double x_mm,
-                                    double y_mm) {
+ControlPoint ControlPointForContact(const Surface& surface, const Wheel& wheel, double x_mm, double y_mm) {
   return EvaluateEq5(surface, wheel, x_mm, y_mm).point;
 }
 
@@ -352,8 +355,8 @@ ControlPoint SolveContactForWheelCentre(const Surface& surface, const Wheel& whe
   return SolveEq5(surface, wheel, false, xw_mm, yw_mm, guess_mm).point;
 }
 
-ControlPoint SolveContactOnRow(const Surface& surface, const Wheel& wheel, double contact_x_mm,
-                               double yw_mm, Eigen::Vector2d guess_mm) {
+ControlPoint SolveContactOnRow(const Surface& surface, const Wheel& wheel, double contact_x_mm, double yw_mm,
+                               Eigen::Vector2d guess_mm) {
   return SolveEq5(surface, wheel, true, contact_x_mm, yw_mm, guess_mm).point;
 }
 
@@ -377,12 +380,10 @@ std::vector<std::string> ToolpathOptions::Problems() const {
     if (!ok) problems.push_back(text);
   };
   require(step_over_mm > 0.0, fmt::format("path.step_over_mm = {} violates > 0", step_over_mm));
-  require(point_spacing_mm > 0.0,
-          fmt::format("path.point_spacing_mm = {} violates > 0", point_spacing_mm));
+  require(point_spacing_mm > 0.0, fmt::format("path.point_spacing_mm = {} violates > 0", point_spacing_mm));
   require(chordal_tolerance_um >= 0.0,
           fmt::format("path.chordal_tolerance_um = {} violates >= 0", chordal_tolerance_um));
-  require(feed_mm_per_min > 0.0,
-          fmt::format("path.feed_mm_per_min = {} violates > 0", feed_mm_per_min));
+  require(feed_mm_per_min > 0.0, fmt::format("path.feed_mm_per_min = {} violates > 0", feed_mm_per_min));
   require(depth_per_pass_um >= 0.0,
           fmt::format("path.depth_per_pass_um = {} violates >= 0", depth_per_pass_um));
   require(passes >= 1, fmt::format("path.passes = {} violates >= 1", passes));
@@ -397,9 +398,8 @@ std::vector<std::string> ToolpathOptions::Problems() const {
   return problems;
 }
 
-ToolpathSummary GenerateToolpath(const Surface& surface, const Aperture& aperture,
-                                 const Wheel& wheel, const ToolpathOptions& options,
-                                 const RowSink& sink) {
+ToolpathSummary GenerateToolpath(const Surface& surface, const Aperture& aperture, const Wheel& wheel,
+                                 const ToolpathOptions& options, const RowSink& sink) {
   if (const auto problems = options.Problems(); !problems.empty()) {
     throw Error(ErrorCode::kInvalidOption, kStage, problems.front());
   }
@@ -437,8 +437,8 @@ ToolpathSummary GenerateToolpath(const Surface& surface, const Aperture& apertur
             row.reversed = options.zigzag && row.row % 2 == 1;
             row.z_offset_mm = z_offset_mm;
             for (std::string& text : row.text) text.clear();
-            row.points = builder.Build(row.row, rows[first + k], row.reversed,
-                                       stats[static_cast<size_t>(worker)]);
+            row.points =
+                builder.Build(row.row, rows[first + k], row.reversed, stats[static_cast<size_t>(worker)]);
             if (row.reversed) std::reverse(row.points.begin(), row.points.end());
             for (ControlPoint& p : row.points) {
               p.wheel_centre_mm.z() += z_offset_mm;

@@ -31,15 +31,15 @@ struct ControlPoint {
 // Eq. 5 at contact (x, y): the wheel centre for the surface point there. With a measured profile,
 // Ra is replaced by the profile's effective radius at the contact's axial offset u = Ra fy / N3.
 // Precondition: surface.InDomain(x, y).
-[[nodiscard]] ControlPoint ControlPointForContact(const Surface& surface, const Wheel& wheel,
-                                                  double x_mm, double y_mm);
+[[nodiscard]] ControlPoint ControlPointForContact(const Surface& surface, const Wheel& wheel, double x_mm,
+                                                  double y_mm);
 
 // Lowest point of the wheel (a solid disc with a toroidal rim, width limited to the wheel's
 // half width) above (x, y) when its centre is at `wheel_centre_mm`; +infinity where the wheel does
 // not reach over (x, y). The wheel is ideal (circle of radius Ra); `extra_base_radius_mm` grows
 // Rb and `extra_arc_radius_mm` grows Ra (used to model a wheel with errors).
-[[nodiscard]] double WheelBottomZ(const Wheel& wheel, const Eigen::Vector3d& wheel_centre_mm,
-                                  double x_mm, double y_mm, double extra_arc_radius_mm = 0.0,
+[[nodiscard]] double WheelBottomZ(const Wheel& wheel, const Eigen::Vector3d& wheel_centre_mm, double x_mm,
+                                  double y_mm, double extra_arc_radius_mm = 0.0,
                                   double extra_base_radius_mm = 0.0);
 
 // Signed distance (mm) from `point_mm` to the ideal torus of the wheel placed at
@@ -51,12 +51,10 @@ struct ControlPoint {
 // contact (x, y) to start from. Throws Error{kBadInput, "grinding.toolpath"} naming the target if
 // Newton's method fails (the wheel cannot follow the surface there).
 [[nodiscard]] ControlPoint SolveContactForWheelCentre(const Surface& surface, const Wheel& wheel,
-                                                      double xw_mm, double yw_mm,
-                                                      Eigen::Vector2d guess_mm);
+                                                      double xw_mm, double yw_mm, Eigen::Vector2d guess_mm);
 // The same with the contact's X fixed and Yw given: used for row ends.
-[[nodiscard]] ControlPoint SolveContactOnRow(const Surface& surface, const Wheel& wheel,
-                                             double contact_x_mm, double yw_mm,
-                                             Eigen::Vector2d guess_mm);
+[[nodiscard]] ControlPoint SolveContactOnRow(const Surface& surface, const Wheel& wheel, double contact_x_mm,
+                                             double yw_mm, Eigen::Vector2d guess_mm);
 
 // Jacobian d(Xw, Yw) / d(X, Y) of eq. 5 at contact (x, y), from the surface's exact second
 // derivatives (the slope of a measured profile is neglected).
@@ -83,8 +81,8 @@ struct GougeProbe {
   double x_mm = 0.0;  // where the smallest gap is
   double y_mm = 0.0;
 };
-[[nodiscard]] GougeProbe ProbeGouge(const Surface& surface, const Aperture& aperture,
-                                    const Wheel& wheel, const ControlPoint& point, int samples);
+[[nodiscard]] GougeProbe ProbeGouge(const Surface& surface, const Aperture& aperture, const Wheel& wheel,
+                                    const ControlPoint& point, int samples);
 
 struct ToolpathOptions {
   // Distance between rows (wheel-centre Y), mm, > 0. Rows are spread evenly, never wider.
@@ -118,9 +116,9 @@ struct ToolpathOptions {
 
 struct ToolpathRow {
   int pass = 0;
-  int row = 0;            // index within the pass
-  bool reversed = false;  // fed towards -X
-  double z_offset_mm = 0.0;  // stock left by this pass (added to Zw and to the contact's z)
+  int row = 0;                       // index within the pass
+  bool reversed = false;             // fed towards -X
+  double z_offset_mm = 0.0;          // stock left by this pass (added to Zw and to the contact's z)
   std::vector<ControlPoint> points;  // in machining order, z offset applied
   // Free for the sink's `prepare` step (e.g. formatted output). Row objects are reused from block
   // to block: the strings arrive cleared but keep their capacity.
@@ -149,8 +147,7 @@ struct ToolpathSummary {
 // Generates the toolpath row by row and hands each row to `sink`. Throws
 // Error{kBadInput, "grinding.toolpath"} naming the point where the wheel cannot reach the surface,
 // would leave its usable arc, or would gouge; Error{kInvalidOption} for invalid options.
-ToolpathSummary GenerateToolpath(const Surface& surface, const Aperture& aperture,
-                                 const Wheel& wheel, const ToolpathOptions& options,
-                                 const RowSink& sink);
+ToolpathSummary GenerateToolpath(const Surface& surface, const Aperture& aperture, const Wheel& wheel,
+                                 const ToolpathOptions& options, const RowSink& sink);
 
 }  // namespace arcwheel::grinding

@@ -15,8 +15,8 @@ namespace {
 using ::testing::HasSubstr;
 
 Wheel TestWheel() {
-  return Wheel{.arc_radius_mm = 50.0, .base_radius_mm = 150.0, .half_width_mm = 10.0,
-               .description = "test wheel"};
+  return Wheel{
+      .arc_radius_mm = 50.0, .base_radius_mm = 150.0, .half_width_mm = 10.0, .description = "test wheel"};
 }
 
 struct Case {
@@ -29,11 +29,29 @@ std::vector<Case> Cases() {
   const Aperture square{.width_x_mm = 120.0, .width_y_mm = 80.0};
   const Aperture disc{.shape = Aperture::Shape::kCircle, .diameter_mm = 100.0};
   return {
-      {"concave on axis", std::make_shared<EvenAsphere>(EvenAsphereParameters{.vertex_radius_mm = 800.0, .conic = -2.2}), square},
-      {"concave off axis", std::make_shared<EvenAsphere>(EvenAsphereParameters{.vertex_radius_mm = 800.0, .conic = -2.2, .off_axis_x_mm = 300.0, .off_axis_y_mm = 40.0}), square},
-      {"convex on axis", std::make_shared<EvenAsphere>(EvenAsphereParameters{.vertex_radius_mm = 400.0, .conic = 0.0, .concave = false}), disc},
-      {"convex off axis", std::make_shared<EvenAsphere>(EvenAsphereParameters{.vertex_radius_mm = 600.0, .conic = -0.6, .even_coefficients = {1e-11}, .off_axis_x_mm = 120.0, .off_axis_y_mm = 60.0, .concave = false}), square},
-      {"freeform", std::make_shared<XyPolynomial>(std::vector<XyPolynomialTerm>{{2, 0, 4e-4}, {0, 2, -3e-4}, {1, 1, 1e-4}, {3, 0, 2e-7}}), disc},
+      {"concave on axis",
+       std::make_shared<EvenAsphere>(EvenAsphereParameters{.vertex_radius_mm = 800.0, .conic = -2.2}),
+       square},
+      {"concave off axis",
+       std::make_shared<EvenAsphere>(EvenAsphereParameters{
+           .vertex_radius_mm = 800.0, .conic = -2.2, .off_axis_x_mm = 300.0, .off_axis_y_mm = 40.0}),
+       square},
+      {"convex on axis",
+       std::make_shared<EvenAsphere>(
+           EvenAsphereParameters{.vertex_radius_mm = 400.0, .conic = 0.0, .concave = false}),
+       disc},
+      {"convex off axis",
+       std::make_shared<EvenAsphere>(EvenAsphereParameters{.vertex_radius_mm = 600.0,
+                                                           .conic = -0.6,
+                                                           .even_coefficients = {1e-11},
+                                                           .off_axis_x_mm = 120.0,
+                                                           .off_axis_y_mm = 60.0,
+                                                           .concave = false}),
+       square},
+      {"freeform",
+       std::make_shared<XyPolynomial>(
+           std::vector<XyPolynomialTerm>{{2, 0, 4e-4}, {0, 2, -3e-4}, {1, 1, 1e-4}, {3, 0, 2e-7}}),
+       disc},
   };
 }
 
@@ -119,8 +137,8 @@ TEST(SolveContactForWheelCentre, InvertsEq5) {
   const Wheel wheel = TestWheel();
   for (const Case& c : Cases()) {
     const ControlPoint forward = ControlPointForContact(*c.surface, wheel, 17.0, -9.0);
-    const ControlPoint back = SolveContactForWheelCentre(
-        *c.surface, wheel, forward.wheel_centre_mm.x(), forward.wheel_centre_mm.y(), {0.0, 0.0});
+    const ControlPoint back = SolveContactForWheelCentre(*c.surface, wheel, forward.wheel_centre_mm.x(),
+                                                         forward.wheel_centre_mm.y(), {0.0, 0.0});
     EXPECT_NEAR(back.contact_mm.x(), 17.0, 1e-9) << c.name;
     EXPECT_NEAR(back.contact_mm.y(), -9.0, 1e-9) << c.name;
   }
@@ -145,7 +163,8 @@ struct Collected {
   std::vector<ToolpathRow> rows;
 };
 
-ToolpathSummary RunToolpath(const Case& c, const Wheel& wheel, const ToolpathOptions& options, Collected& out) {
+ToolpathSummary RunToolpath(const Case& c, const Wheel& wheel, const ToolpathOptions& options,
+                            Collected& out) {
   return GenerateToolpath(*c.surface, c.aperture, wheel, options,
                           {.prepare = nullptr, .consume = [&out](ToolpathRow& r) { out.rows.push_back(r); }});
 }
@@ -153,8 +172,12 @@ ToolpathSummary RunToolpath(const Case& c, const Wheel& wheel, const ToolpathOpt
 TEST(GenerateToolpath, RowsAreStraightAndEveryPointTouchesTheSurface) {
   const Wheel wheel = TestWheel();
   for (const Case& c : Cases()) {
-    ToolpathOptions o{.step_over_mm = 2.5, .point_spacing_mm = 1.5, .feed_mm_per_min = 6000,
-                      .lead_in_mm = 4.0, .lead_out_mm = 6.0, .gouge_check_spacing_mm = 3.0,
+    ToolpathOptions o{.step_over_mm = 2.5,
+                      .point_spacing_mm = 1.5,
+                      .feed_mm_per_min = 6000,
+                      .lead_in_mm = 4.0,
+                      .lead_out_mm = 6.0,
+                      .gouge_check_spacing_mm = 3.0,
                       .threads = 2};
     Collected got;
     const ToolpathSummary summary = RunToolpath(c, wheel, o, got);
@@ -175,10 +198,11 @@ TEST(GenerateToolpath, RowsAreStraightAndEveryPointTouchesTheSurface) {
         const ControlPoint& p = row.points[i];
         EXPECT_NEAR(p.wheel_centre_mm.y(), expected_yw, 1e-9) << c.name;  // straight to 1 nm
         EXPECT_NEAR(p.contact_mm.z(), c.surface->Evaluate(p.contact_mm.x(), p.contact_mm.y()).z_mm, 1e-12);
-        const double rho = std::hypot(p.contact_mm.x() - p.wheel_centre_mm.x(),
-                                      p.contact_mm.z() - p.wheel_centre_mm.z());
+        const double rho =
+            std::hypot(p.contact_mm.x() - p.wheel_centre_mm.x(), p.contact_mm.z() - p.wheel_centre_mm.z());
         EXPECT_NEAR(std::hypot(rho - wheel.base_radius_mm, p.contact_mm.y() - p.wheel_centre_mm.y()),
-                    wheel.arc_radius_mm, 1e-9) << c.name;
+                    wheel.arc_radius_mm, 1e-9)
+            << c.name;
         if (i > 0) {
           const double step = p.wheel_centre_mm.x() - row.points[i - 1].wheel_centre_mm.x();
           EXPECT_LE(std::abs(step), 1.5 + 1e-9);
@@ -198,7 +222,8 @@ TEST(GenerateToolpath, RowsAreStraightAndEveryPointTouchesTheSurface) {
 
 TEST(GenerateToolpath, ChordalToleranceBoundsTheMidpointDeviation) {
   const Wheel wheel = TestWheel();
-  const Case c{"sphere", std::make_shared<EvenAsphere>(EvenAsphereParameters{.vertex_radius_mm = 300.0, .conic = 0.0}),
+  const Case c{"sphere",
+               std::make_shared<EvenAsphere>(EvenAsphereParameters{.vertex_radius_mm = 300.0, .conic = 0.0}),
                Aperture{.width_x_mm = 100.0, .width_y_mm = 10.0}};
   ToolpathOptions o{.step_over_mm = 5.0, .point_spacing_mm = 20.0, .chordal_tolerance_um = 0.5, .threads = 1};
   Collected got;
@@ -207,9 +232,9 @@ TEST(GenerateToolpath, ChordalToleranceBoundsTheMidpointDeviation) {
     for (size_t i = 1; i < row.points.size(); ++i) {
       const ControlPoint& a = row.points[i - 1];
       const ControlPoint& b = row.points[i];
-      const ControlPoint mid = SolveContactForWheelCentre(
-          *c.surface, wheel, 0.5 * (a.wheel_centre_mm.x() + b.wheel_centre_mm.x()),
-          a.wheel_centre_mm.y(), a.contact_mm.head<2>());
+      const ControlPoint mid =
+          SolveContactForWheelCentre(*c.surface, wheel, 0.5 * (a.wheel_centre_mm.x() + b.wheel_centre_mm.x()),
+                                     a.wheel_centre_mm.y(), a.contact_mm.head<2>());
       EXPECT_LE(std::abs(mid.wheel_centre_mm.z() - 0.5 * (a.wheel_centre_mm.z() + b.wheel_centre_mm.z())),
                 0.5e-3 + 1e-12);
     }
@@ -222,7 +247,8 @@ TEST(GenerateToolpath, ChordalToleranceBoundsTheMidpointDeviation) {
 TEST(GenerateToolpath, PassesStepDownToTheSurface) {
   const Wheel wheel = TestWheel();
   const Case c = Cases()[0];
-  ToolpathOptions o{.step_over_mm = 20.0, .point_spacing_mm = 10.0, .depth_per_pass_um = 10.0, .passes = 3, .threads = 2};
+  ToolpathOptions o{
+      .step_over_mm = 20.0, .point_spacing_mm = 10.0, .depth_per_pass_um = 10.0, .passes = 3, .threads = 2};
   Collected got;
   const ToolpathSummary s = RunToolpath(c, wheel, o, got);
   ASSERT_EQ(got.rows.size(), static_cast<size_t>(3 * s.rows_per_pass));
@@ -234,7 +260,8 @@ TEST(GenerateToolpath, PassesStepDownToTheSurface) {
 
 TEST(GenerateToolpath, RefusesAConcaveSurfaceMoreCurvedThanTheWheelNamingThePoint) {
   const Wheel wheel = TestWheel();  // total radius 200 mm
-  const Case c{"tight sphere", std::make_shared<EvenAsphere>(EvenAsphereParameters{.vertex_radius_mm = 150.0, .conic = 0.0}),
+  const Case c{"tight sphere",
+               std::make_shared<EvenAsphere>(EvenAsphereParameters{.vertex_radius_mm = 150.0, .conic = 0.0}),
                Aperture{.width_x_mm = 40.0, .width_y_mm = 20.0}};
   Collected got;
   try {
@@ -252,7 +279,9 @@ TEST(GenerateToolpath, RefusesAContactOffTheWheelsUsableArc) {
   Wheel wheel = TestWheel();
   wheel.half_width_mm = 2.0;
   // 300 mm off axis in y on R0 = 800: fy ~ 0.4, so contacts sit ~18 mm from the arc centre.
-  const Case c{"steep", std::make_shared<EvenAsphere>(EvenAsphereParameters{.vertex_radius_mm = 800.0, .conic = 0.0, .off_axis_y_mm = 300.0}),
+  const Case c{"steep",
+               std::make_shared<EvenAsphere>(
+                   EvenAsphereParameters{.vertex_radius_mm = 800.0, .conic = 0.0, .off_axis_y_mm = 300.0}),
                Aperture{.width_x_mm = 20.0, .width_y_mm = 20.0}};
   Collected got;
   try {

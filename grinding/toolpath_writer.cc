@@ -5,8 +5,8 @@
 
 #include <algorithm>
 #include <array>
-#include <charconv>
 #include <cerrno>
+#include <charconv>
 #include <cstring>
 #include <fstream>
 #include <iterator>
@@ -25,7 +25,8 @@ enum Stream { kCsv = 0, kGcode = 1, kPmac = 2 };
 std::ofstream OpenStaged(const std::filesystem::path& path) {
   std::ofstream out(path, std::ios::binary | std::ios::trunc);
   if (!out) {
-    throw Error(ErrorCode::kIo, kStage, fmt::format("cannot create '{}': {}", path.string(), std::strerror(errno)));
+    throw Error(ErrorCode::kIo, kStage,
+                fmt::format("cannot create '{}': {}", path.string(), std::strerror(errno)));
   }
   return out;
 }
@@ -113,7 +114,8 @@ class ProgramWriter {
     }
     if (pmac_ != nullptr) {
       if (has_previous_) *pmac_ << fmt::format("F{}\nZ{:.{}f}\n", feed, safe_z, d);
-      *pmac_ << fmt::format("RAPID\nX{:.{}f} Y{:.{}f} Z{:.{}f}\nLINEAR\n", start.x(), d, start.y(), d, safe_z, d);
+      *pmac_ << fmt::format("RAPID\nX{:.{}f} Y{:.{}f} Z{:.{}f}\nLINEAR\n", start.x(), d, start.y(), d, safe_z,
+                            d);
     }
   }
 
@@ -130,7 +132,8 @@ void WriteHeaders(const Job& job, std::ofstream* csv, std::ofstream* gcode, std:
   const std::vector<std::string> lines = ToolpathHeaderLines(job);
   const int d = job.machine.decimals;
   const std::string rounding = fmt::format(
-      "wheel-centre coordinates in mm, rounded to {} decimals; feed in mm/min; the CSV keeps full precision", d);
+      "wheel-centre coordinates in mm, rounded to {} decimals; feed in mm/min; the CSV keeps full precision",
+      d);
   if (csv != nullptr) {
     for (const std::string& line : lines) *csv << "# " << line << "\n";
     *csv << "xw_mm,yw_mm,zw_mm,x_mm,y_mm,z_mm,nx,ny,nz,feed_mm_min,row,pass\n";
@@ -198,7 +201,8 @@ void AppendCsvLines(const ToolpathRow& row, double feed_mm_per_min, std::string&
     const Eigen::Vector3d& w = p.wheel_centre_mm;
     const Eigen::Vector3d& c = p.contact_mm;
     const Eigen::Vector3d& n = p.normal;
-    for (double v : {w.x(), w.y(), w.z(), c.x(), c.y(), c.z(), n.x(), n.y(), n.z(), feed_mm_per_min}) put(v, ',');
+    for (double v : {w.x(), w.y(), w.z(), c.x(), c.y(), c.z(), n.x(), n.y(), n.z(), feed_mm_per_min})
+      put(v, ',');
     put(row.row, ',');
     put(row.pass, '\n');
     out.append(line.data(), end);
@@ -208,16 +212,18 @@ void AppendCsvLines(const ToolpathRow& row, double feed_mm_per_min, std::string&
 std::vector<std::string> ToolpathHeaderLines(const Job& job) {
   const ToolpathOptions& o = job.path;
   return {
-      fmt::format("arcwheel {} parallel-grinding toolpath (method.md A.8, eq. 5), job '{}'", kVersion, job.name),
+      fmt::format("arcwheel {} parallel-grinding toolpath (method.md A.8, eq. 5), job '{}'", kVersion,
+                  job.name),
       "surface: " + job.surface->Describe(),
       "aperture: " + job.aperture.Describe(),
       "wheel: " + job.wheel.description,
-      fmt::format("path: wheel axis along Y, rows along X at constant wheel-centre Y; step-over {} mm, "
-                  "spacing {} mm{}, feed {} mm/min, {} pass(es) of {} um, lead-in {} mm, lead-out {} mm, {}",
-                  o.step_over_mm, o.point_spacing_mm,
-                  o.chordal_tolerance_um > 0 ? fmt::format(" (chordal tolerance {} um)", o.chordal_tolerance_um) : "",
-                  o.feed_mm_per_min, o.passes, o.depth_per_pass_um, o.lead_in_mm, o.lead_out_mm,
-                  o.zigzag ? "zigzag" : "one way"),
+      fmt::format(
+          "path: wheel axis along Y, rows along X at constant wheel-centre Y; step-over {} mm, "
+          "spacing {} mm{}, feed {} mm/min, {} pass(es) of {} um, lead-in {} mm, lead-out {} mm, {}",
+          o.step_over_mm, o.point_spacing_mm,
+          o.chordal_tolerance_um > 0 ? fmt::format(" (chordal tolerance {} um)", o.chordal_tolerance_um) : "",
+          o.feed_mm_per_min, o.passes, o.depth_per_pass_um, o.lead_in_mm, o.lead_out_mm,
+          o.zigzag ? "zigzag" : "one way"),
   };
 }
 

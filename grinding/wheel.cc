@@ -16,8 +16,7 @@ namespace {
 constexpr const char* kStage = "grinding.wheel";
 using nlohmann::json;
 
-[[noreturn]] void Bad(const std::filesystem::path& path, const std::string& key,
-                      const std::string& what) {
+[[noreturn]] void Bad(const std::filesystem::path& path, const std::string& key, const std::string& what) {
   throw Error(ErrorCode::kBadInput, kStage, fmt::format("'{}': key '{}' {}", path.string(), key, what));
 }
 
@@ -27,8 +26,8 @@ double RequiredNumber(const json& object, const std::filesystem::path& path, con
   return object.at(key).get<double>();
 }
 
-std::vector<double> NumberArray(const json& object, const std::filesystem::path& path,
-                                const std::string& key, const std::string& full_key) {
+std::vector<double> NumberArray(const json& object, const std::filesystem::path& path, const std::string& key,
+                                const std::string& full_key) {
   if (!object.contains(key) || !object.at(key).is_array()) Bad(path, full_key, "must be an array");
   std::vector<double> values;
   for (const json& v : object.at(key)) {
@@ -42,8 +41,7 @@ void ReadPhases(const json& root, const std::filesystem::path& path, WheelSummar
   const json& phases = root.at("phases");
   const std::vector<double> phase = NumberArray(phases, path, "phase_deg", "phases.phase_deg");
   const std::vector<double> ra = NumberArray(phases, path, "arc_radius_mm", "phases.arc_radius_mm");
-  const std::vector<double> rb =
-      NumberArray(phases, path, "center_radial_mm", "phases.center_radial_mm");
+  const std::vector<double> rb = NumberArray(phases, path, "center_radial_mm", "phases.center_radial_mm");
   if (ra.size() != phase.size() || rb.size() != phase.size()) {
     Bad(path, "phases", "arrays differ in length");
   }
@@ -67,8 +65,8 @@ void ReadPhases(const json& root, const std::filesystem::path& path, WheelSummar
 double Wheel::ArcRadiusAt(double u_mm) const {
   if (!HasProfile()) return arc_radius_mm;
   const auto upper = std::upper_bound(profile_u_mm.begin(), profile_u_mm.end(), u_mm);
-  const size_t k = std::clamp<size_t>(static_cast<size_t>(upper - profile_u_mm.begin()), 1,
-                                      profile_u_mm.size() - 1);
+  const size_t k =
+      std::clamp<size_t>(static_cast<size_t>(upper - profile_u_mm.begin()), 1, profile_u_mm.size() - 1);
   const double t = (u_mm - profile_u_mm[k - 1]) / (profile_u_mm[k] - profile_u_mm[k - 1]);
   const double error_um = profile_error_um[k - 1] + t * (profile_error_um[k] - profile_error_um[k - 1]);
   return arc_radius_mm + 1e-3 * error_um;
@@ -85,8 +83,8 @@ std::vector<std::string> Wheel::Problems() const {
     problems.push_back(fmt::format("wheel.arc_radius_mm = {} violates > 0", arc_radius_mm));
   }
   if (!(base_radius_mm >= 0.0)) {
-    problems.push_back(fmt::format(
-        "wheel base radius = total radius - arc radius = {} mm violates >= 0", base_radius_mm));
+    problems.push_back(
+        fmt::format("wheel base radius = total radius - arc radius = {} mm violates >= 0", base_radius_mm));
   }
   if (!(half_width_mm > 0.0) || half_width_mm > arc_radius_mm) {
     problems.push_back(fmt::format("wheel.width_mm / 2 = {} violates 0 < width / 2 <= arc radius {}",
@@ -96,10 +94,11 @@ std::vector<std::string> Wheel::Problems() const {
     problems.push_back("wheel mean profile needs matching u_mm and error_um arrays of >= 2 values");
   }
   for (size_t i = 0; i < profile_u_mm.size(); ++i) {
-    if (!std::isfinite(profile_u_mm[i]) || (i < profile_error_um.size() && !std::isfinite(profile_error_um[i])) ||
+    if (!std::isfinite(profile_u_mm[i]) ||
+        (i < profile_error_um.size() && !std::isfinite(profile_error_um[i])) ||
         (i > 0 && !(profile_u_mm[i] > profile_u_mm[i - 1]))) {
-      problems.push_back(fmt::format(
-          "wheel mean profile node {} is not finite or u_mm is not strictly increasing", i));
+      problems.push_back(
+          fmt::format("wheel mean profile node {} is not finite or u_mm is not strictly increasing", i));
       break;
     }
   }

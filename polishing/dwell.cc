@@ -18,9 +18,7 @@ constexpr const char* kStage = "polishing.dwell";
 // How far the least-dwell removal may exceed the target before the speeds count as unreachable.
 constexpr double kOvershootToleranceUm = 1e-3;
 
-[[noreturn]] void Invalid(const std::string& what) {
-  throw Error(ErrorCode::kInvalidOption, kStage, what);
-}
+[[noreturn]] void Invalid(const std::string& what) { throw Error(ErrorCode::kInvalidOption, kStage, what); }
 
 void CheckOptions(const RemovalFunction& removal, const DwellOptions& o, std::size_t points) {
   removal.Check();
@@ -38,8 +36,9 @@ void CheckOptions(const RemovalFunction& removal, const DwellOptions& o, std::si
     Invalid(fmt::format("max_acceleration_mm_s2 = {} violates >= 0", o.max_acceleration_mm_s2));
   }
   if (o.min_speed_mm_s > 0.0 && o.min_dwell_s > 0.0) {
-    Invalid("unreachable speeds: give min_speed_mm_s or min_dwell_s, not both (a short segment "
-            "cannot satisfy both)");
+    Invalid(
+        "unreachable speeds: give min_speed_mm_s or min_dwell_s, not both (a short segment "
+        "cannot satisfy both)");
   }
   if (o.max_iterations < 1) Invalid(fmt::format("max_iterations = {} violates >= 1", o.max_iterations));
   if (o.stall_iterations < 0) Invalid(fmt::format("stall_iterations = {} violates >= 0", o.stall_iterations));
@@ -49,7 +48,8 @@ void CheckOptions(const RemovalFunction& removal, const DwellOptions& o, std::si
   if (!(o.relative_tolerance > 0.0)) {
     Invalid(fmt::format("relative_tolerance = {} violates > 0", o.relative_tolerance));
   }
-  if (o.max_shaping_rounds < 1) Invalid(fmt::format("max_shaping_rounds = {} violates >= 1", o.max_shaping_rounds));
+  if (o.max_shaping_rounds < 1)
+    Invalid(fmt::format("max_shaping_rounds = {} violates >= 1", o.max_shaping_rounds));
   if (!(o.shaping_tolerance_um > 0.0)) {
     Invalid(fmt::format("shaping_tolerance_um = {} violates > 0", o.shaping_tolerance_um));
   }
@@ -57,7 +57,8 @@ void CheckOptions(const RemovalFunction& removal, const DwellOptions& o, std::si
     Invalid(fmt::format("least_dwell_s has {} values for {} path points", o.least_dwell_s.size(), points));
   }
   for (std::size_t k = 0; k < o.least_dwell_s.size(); ++k) {
-    if (!(o.least_dwell_s[k] >= 0.0) || !std::isfinite(o.least_dwell_s[k]) || (k == 0 && o.least_dwell_s[k] > 0.0)) {
+    if (!(o.least_dwell_s[k] >= 0.0) || !std::isfinite(o.least_dwell_s[k]) ||
+        (k == 0 && o.least_dwell_s[k] > 0.0)) {
       Invalid(fmt::format("least_dwell_s[{}] = {} violates {}", k, o.least_dwell_s[k],
                           k == 0 ? "== 0 (the first point is the approach)" : ">= 0"));
     }
@@ -66,8 +67,8 @@ void CheckOptions(const RemovalFunction& removal, const DwellOptions& o, std::si
 
 // The aperture nodes with data, as rows of the removal matrix.
 struct Rows {
-  std::vector<int> node;              // row -> index into the map
-  std::vector<int> row_of_node;       // map index -> row, or -1
+  std::vector<int> node;         // row -> index into the map
+  std::vector<int> row_of_node;  // map index -> row, or -1
   Eigen::VectorXd target;
 };
 
@@ -105,9 +106,11 @@ SparseMatrix RemovalMatrix(const ErrorMap& map, const Rows& rows, std::span<cons
   for (std::size_t k = 0; k < path.size(); ++k) {
     const Eigen::Vector2d& p = path[k];
     const int i0 = std::max(0, static_cast<int>(std::ceil((p.x() + box.min_x_mm - map.x0_mm) / map.dx_mm)));
-    const int i1 = std::min(map.nx - 1, static_cast<int>(std::floor((p.x() + box.max_x_mm - map.x0_mm) / map.dx_mm)));
+    const int i1 =
+        std::min(map.nx - 1, static_cast<int>(std::floor((p.x() + box.max_x_mm - map.x0_mm) / map.dx_mm)));
     const int j0 = std::max(0, static_cast<int>(std::ceil((p.y() + box.min_y_mm - map.y0_mm) / map.dy_mm)));
-    const int j1 = std::min(map.ny - 1, static_cast<int>(std::floor((p.y() + box.max_y_mm - map.y0_mm) / map.dy_mm)));
+    const int j1 =
+        std::min(map.ny - 1, static_cast<int>(std::floor((p.y() + box.max_y_mm - map.y0_mm) / map.dy_mm)));
     for (int j = j0; j <= j1; ++j) {
       for (int i = i0; i <= i1; ++i) {
         const int row = rows.row_of_node[j * map.nx + i];
@@ -124,7 +127,8 @@ SparseMatrix RemovalMatrix(const ErrorMap& map, const Rows& rows, std::span<cons
 SparseMatrix RemovalMatrix(const ErrorMap& map, const Rows& rows, std::span<const Eigen::Vector2d> path,
                            const RemovalFunction& removal) {
   const FootprintBox box = removal.Footprint();
-  return std::visit([&](const auto& model) { return RemovalMatrix(map, rows, path, model, box); }, removal.model());
+  return std::visit([&](const auto& model) { return RemovalMatrix(map, rows, path, model, box); },
+                    removal.model());
 }
 
 // Largest eigenvalue of A^T A by power iteration: the Lipschitz constant of the gradient.
@@ -177,9 +181,10 @@ void AddLeastDwell(Bounds& b, std::span<const Eigen::Vector2d> path, const Dwell
   for (std::size_t k = 1; k < o.least_dwell_s.size(); ++k) {
     const auto i = static_cast<Eigen::Index>(k);
     if (o.least_dwell_s[k] > b.upper[i]) {
-      Invalid(fmt::format("unreachable speeds: least_dwell_s[{}] = {} s at ({:.3f}, {:.3f}) mm is above the longest "
-                          "dwell {} s that min_speed_mm_s = {} allows", k, o.least_dwell_s[k], path[k].x(),
-                          path[k].y(), b.upper[i], o.min_speed_mm_s));
+      Invalid(fmt::format(
+          "unreachable speeds: least_dwell_s[{}] = {} s at ({:.3f}, {:.3f}) mm is above the longest "
+          "dwell {} s that min_speed_mm_s = {} allows",
+          k, o.least_dwell_s[k], path[k].x(), path[k].y(), b.upper[i], o.min_speed_mm_s));
     }
     b.lower[i] = std::max(b.lower[i], o.least_dwell_s[k]);
   }
@@ -188,17 +193,20 @@ void AddLeastDwell(Bounds& b, std::span<const Eigen::Vector2d> path, const Dwell
 [[noreturn]] void NotSettled(std::span<const Eigen::Vector2d> path, Eigen::Index worst, double added_um,
                              const DwellOptions& o) {
   const auto k = static_cast<std::size_t>(worst);
-  throw Error(ErrorCode::kBadInput, kStage,
-              fmt::format("unreachable speeds: after {} shaping rounds the speeds still exceed max_acceleration_mm_s2 "
-                          "= {}: slowing down into path point {} ({:.3f}, {:.3f}) mm adds {:.3g} um of removal "
-                          "(more than shaping_tolerance_um = {}); raise the acceleration limit, use a wider "
-                          "removal function or a larger uniform layer",
-                          o.max_shaping_rounds, o.max_acceleration_mm_s2, k, path[k].x(), path[k].y(), added_um,
-                          o.shaping_tolerance_um));
+  throw Error(
+      ErrorCode::kBadInput, kStage,
+      fmt::format(
+          "unreachable speeds: after {} shaping rounds the speeds still exceed max_acceleration_mm_s2 "
+          "= {}: slowing down into path point {} ({:.3f}, {:.3f}) mm adds {:.3g} um of removal "
+          "(more than shaping_tolerance_um = {}); raise the acceleration limit, use a wider "
+          "removal function or a larger uniform layer",
+          o.max_shaping_rounds, o.max_acceleration_mm_s2, k, path[k].x(), path[k].y(), added_um,
+          o.shaping_tolerance_um));
 }
 
 // True when the best residual norm so far has improved on the best one stall_iterations ago by
-// less than stall_improvement times the first residual norm. `history` keeps the running best of every iteration.
+// less than stall_improvement times the first residual norm. `history` keeps the running best of every
+// iteration.
 bool Stalled(double residual_norm, int iteration, const DwellOptions& o, std::vector<double>& history) {
   history.push_back(history.empty() ? residual_norm : std::min(history.back(), residual_norm));
   if (o.stall_iterations <= 0 || iteration <= o.stall_iterations) return false;
@@ -218,7 +226,8 @@ double MaxAcceleration(const std::vector<double>& speed, const Eigen::VectorXd& 
   return most;
 }
 
-std::vector<double> Speeds(const Eigen::VectorXd& t, const Eigen::VectorXd& segment_mm, const DwellOptions& o) {
+std::vector<double> Speeds(const Eigen::VectorXd& t, const Eigen::VectorXd& segment_mm,
+                           const DwellOptions& o) {
   std::vector<double> speed(static_cast<std::size_t>(t.size()));
   for (Eigen::Index k = 0; k < t.size(); ++k) {
     speed[static_cast<std::size_t>(k)] =
@@ -243,7 +252,8 @@ std::vector<double> ShapedSpeeds(std::vector<double> v, const Eigen::VectorXd& s
 }
 
 // The dwell that runs the shaped speeds: longer where a speed was lowered, unchanged elsewhere.
-Eigen::VectorXd ShapedDwell(const Eigen::VectorXd& t, const Eigen::VectorXd& segment_mm, const DwellOptions& o) {
+Eigen::VectorXd ShapedDwell(const Eigen::VectorXd& t, const Eigen::VectorXd& segment_mm,
+                            const DwellOptions& o) {
   const std::vector<double> speed = Speeds(t, segment_mm, o);
   const std::vector<double> shaped = ShapedSpeeds(speed, segment_mm, o.max_acceleration_mm_s2);
   Eigen::VectorXd out = t;
@@ -267,7 +277,9 @@ constexpr int kWarmStartIterations = 100;
 
 Fit ProjectedGradient(const SparseMatrix& a, const Eigen::VectorXd& target, const Bounds& bounds, double step,
                       Eigen::VectorXd start, bool warm, const DwellOptions& options) {
-  auto project = [&](const Eigen::VectorXd& t) { return t.cwiseMax(bounds.lower).cwiseMin(bounds.upper).eval(); };
+  auto project = [&](const Eigen::VectorXd& t) {
+    return t.cwiseMax(bounds.lower).cwiseMin(bounds.upper).eval();
+  };
   Fit fit;
   Eigen::VectorXd t = project(start), previous = t, y = t;
   double momentum = 1.0;
@@ -300,7 +312,8 @@ Fit ProjectedGradient(const SparseMatrix& a, const Eigen::VectorXd& target, cons
 ErrorMap Scatter(const ErrorMap& like, const Rows& rows, const Eigen::VectorXd& values) {
   ErrorMap out = like;
   std::fill(out.error_um.begin(), out.error_um.end(), std::numeric_limits<double>::quiet_NaN());
-  for (std::size_t r = 0; r < rows.node.size(); ++r) out.error_um[rows.node[r]] = values[static_cast<Eigen::Index>(r)];
+  for (std::size_t r = 0; r < rows.node.size(); ++r)
+    out.error_um[rows.node[r]] = values[static_cast<Eigen::Index>(r)];
   return out;
 }
 
@@ -308,8 +321,10 @@ ErrorMap Scatter(const ErrorMap& like, const Rows& rows, const Eigen::VectorXd& 
 
 namespace {
 void CheckPathOptions(const RasterOptions& o) {
-  if (!(o.line_spacing_mm > 0.0)) Invalid(fmt::format("line_spacing_mm = {} violates > 0", o.line_spacing_mm));
-  if (!(o.point_spacing_mm > 0.0)) Invalid(fmt::format("point_spacing_mm = {} violates > 0", o.point_spacing_mm));
+  if (!(o.line_spacing_mm > 0.0))
+    Invalid(fmt::format("line_spacing_mm = {} violates > 0", o.line_spacing_mm));
+  if (!(o.point_spacing_mm > 0.0))
+    Invalid(fmt::format("point_spacing_mm = {} violates > 0", o.point_spacing_mm));
   if (!(o.extension_mm >= 0.0)) Invalid(fmt::format("extension_mm = {} violates >= 0", o.extension_mm));
 }
 }  // namespace
@@ -317,11 +332,14 @@ void CheckPathOptions(const RasterOptions& o) {
 std::vector<Eigen::Vector2d> SpiralPath(const grinding::Aperture& aperture, const RasterOptions& o) {
   CheckPathOptions(o);
   const bool circle = aperture.shape == grinding::Aperture::Shape::kCircle;
-  const double radius = circle ? aperture.HalfY() + o.extension_mm
-                               : std::hypot(aperture.HalfX() + o.extension_mm, aperture.HalfY() + o.extension_mm);
+  const double radius =
+      circle ? aperture.HalfY() + o.extension_mm
+             : std::hypot(aperture.HalfX() + o.extension_mm, aperture.HalfY() + o.extension_mm);
   const double b = o.line_spacing_mm / (2.0 * std::numbers::pi);
   // Arc length from the centre to angle theta, in closed form, and its derivative.
-  auto arc = [b](double theta) { return 0.5 * b * (theta * std::sqrt(1.0 + theta * theta) + std::asinh(theta)); };
+  auto arc = [b](double theta) {
+    return 0.5 * b * (theta * std::sqrt(1.0 + theta * theta) + std::asinh(theta));
+  };
   auto darc = [b](double theta) { return b * std::sqrt(1.0 + theta * theta); };
   const double theta_end = radius / b;
   const double total = arc(theta_end);
@@ -352,8 +370,8 @@ std::vector<Eigen::Vector2d> RasterPath(const grinding::Aperture& aperture, cons
   std::vector<Eigen::Vector2d> path;
   for (int line = 0; line < lines; ++line) {
     const double y = -half_y + 2.0 * half_y * line / std::max(1, lines - 1);
-    const double half_x = circle ? std::sqrt(std::max(0.0, half_y * half_y - y * y))
-                                 : aperture.HalfX() + o.extension_mm;
+    const double half_x =
+        circle ? std::sqrt(std::max(0.0, half_y * half_y - y * y)) : aperture.HalfX() + o.extension_mm;
     if (!(half_x > 0.0)) {  // a circle's top and bottom lines are single points
       path.emplace_back(0.0, y);
       continue;

@@ -67,13 +67,13 @@ struct DwellOptions {
   // >= 0 and <= the point's longest dwell; empty = none. Kept even where it removes more than
   // the target.
   std::vector<double> least_dwell_s = {};
-  int max_iterations = 2000;      // projected-gradient iterations, >= 1 (the job file's default too)
+  int max_iterations = 2000;         // projected-gradient iterations, >= 1 (the job file's default too)
   double relative_tolerance = 1e-7;  // stop when the dwell changes by less than this, relative
   // Also stop when the residual norm has improved over the last stall_iterations iterations by
   // less than stall_improvement times the first residual norm: further iterations only polish
   // the prediction at the sub-nanometre level. stall_iterations = 0 disables this test.
-  int stall_iterations = 100;        // >= 0
-  double stall_improvement = 1e-3;   // > 0
+  int stall_iterations = 100;       // >= 0
+  double stall_improvement = 1e-3;  // > 0
   // Shaping rounds (re-solves) allowed before the speeds count as unreachable, >= 1.
   int max_shaping_rounds = 20;
   // A round settles when shaping its dwell adds at most this depth (peak rate x added dwell) at
@@ -82,19 +82,19 @@ struct DwellOptions {
 };
 
 struct DwellSolution {
-  std::vector<double> dwell_s;        // one per path point
-  std::vector<double> speed_mm_s;     // TCP speed into each point (the first: max speed, no dwell)
-  std::vector<double> segment_mm;     // length of the segment ending at each point (first: 0)
-  ErrorMap predicted_removal_um;      // over the aperture nodes; NaN elsewhere
-  ErrorMap residual_um;               // target - removal over the aperture; NaN elsewhere
-  MapStatistics before;               // of the target (= the error) in the aperture
-  MapStatistics after;                // of the residual in the aperture
+  std::vector<double> dwell_s;     // one per path point
+  std::vector<double> speed_mm_s;  // TCP speed into each point (the first: max speed, no dwell)
+  std::vector<double> segment_mm;  // length of the segment ending at each point (first: 0)
+  ErrorMap predicted_removal_um;   // over the aperture nodes; NaN elsewhere
+  ErrorMap residual_um;            // target - removal over the aperture; NaN elsewhere
+  MapStatistics before;            // of the target (= the error) in the aperture
+  MapStatistics after;             // of the residual in the aperture
   double total_time_s = 0.0;
   double max_acceleration_mm_s2 = 0.0;  // largest acceleration the speeds imply (see DwellOptions)
-  int iterations = 0;                 // projected-gradient iterations, all rounds
-  int shaping_rounds = 0;             // re-solves after shaping the speeds (0: none needed)
+  int iterations = 0;                   // projected-gradient iterations, all rounds
+  int shaping_rounds = 0;               // re-solves after shaping the speeds (0: none needed)
   bool converged = false;
-  int nonzeros = 0;                   // entries of the sparse removal matrix
+  int nonzeros = 0;  // entries of the sparse removal matrix
 };
 
 // Solves the dwell for a removal target (RemovalTarget) along `path_xy_mm`.
@@ -108,7 +108,6 @@ struct DwellSolution {
 // point that still needed shaping).
 [[nodiscard]] DwellSolution SolveDwell(const ErrorMap& target, const grinding::Aperture& aperture,
                                        std::span<const Eigen::Vector2d> path_xy_mm,
-                                       const RemovalFunction& removal,
-                                       const DwellOptions& options);
+                                       const RemovalFunction& removal, const DwellOptions& options);
 
 }  // namespace arcwheel::polishing

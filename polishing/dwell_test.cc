@@ -24,13 +24,19 @@ ErrorMap SimulatedErrorMap(unsigned seed, double step_mm = 1.0) {
   const double bx = 25.0 * u(rng), by = 25.0 * u(rng), cx = 25.0 * u(rng), cy = 25.0 * u(rng);
   const int nodes = 2 * static_cast<int>(std::ceil(52.0 / step_mm)) + 1;
   const double half_width_mm = (nodes - 1) / 2 * step_mm;
-  ErrorMap map{.x0_mm = -half_width_mm, .y0_mm = -half_width_mm, .dx_mm = step_mm, .dy_mm = step_mm, .nx = nodes, .ny = nodes};
+  ErrorMap map{.x0_mm = -half_width_mm,
+               .y0_mm = -half_width_mm,
+               .dx_mm = step_mm,
+               .dy_mm = step_mm,
+               .nx = nodes,
+               .ny = nodes};
   for (int j = 0; j < map.ny; ++j) {
     for (int i = 0; i < map.nx; ++i) {
       const double x = map.X(i) / 50.0, y = map.Y(j) / 50.0, r2 = x * x + y * y;
-      map.error_um.push_back(astig * (x * x - y * y) + ring * std::cos(3.0 * std::numbers::pi * r2) +
-                             0.5 * std::exp(-((map.X(i) - bx) * (map.X(i) - bx) + (map.Y(j) - by) * (map.Y(j) - by)) / 200.0) -
-                             0.4 * std::exp(-((map.X(i) - cx) * (map.X(i) - cx) + (map.Y(j) - cy) * (map.Y(j) - cy)) / 300.0));
+      map.error_um.push_back(
+          astig * (x * x - y * y) + ring * std::cos(3.0 * std::numbers::pi * r2) +
+          0.5 * std::exp(-((map.X(i) - bx) * (map.X(i) - bx) + (map.Y(j) - by) * (map.Y(j) - by)) / 200.0) -
+          0.4 * std::exp(-((map.X(i) - cx) * (map.X(i) - cx) + (map.Y(j) - cy) * (map.Y(j) - cy)) / 300.0));
     }
   }
   return map;
@@ -50,8 +56,8 @@ double FullGaussianRemovalUm(double x, double y, const std::vector<Eigen::Vector
 
 // RMS (about the mean) of target - removal over the disc, the removal recomputed with the whole
 // Gaussian from the solution's dwell.
-double ResidualRmsUm(const ErrorMap& target, const std::vector<Eigen::Vector2d>& path, const std::vector<double>& dwell_s,
-                     double peak, double fwhm) {
+double ResidualRmsUm(const ErrorMap& target, const std::vector<Eigen::Vector2d>& path,
+                     const std::vector<double>& dwell_s, double peak, double fwhm) {
   double sum = 0.0, sum2 = 0.0;
   int n = 0;
   for (int j = 0; j < target.ny; ++j) {
@@ -106,8 +112,8 @@ TEST(SolveDwell, CutsTheResidualRmsTenfoldWithNonNegativeDwellWithinSpeedLimits)
 }
 
 // An axis-aligned elliptic Gaussian (peak, centre, sigmas) sampled on a grid of tool offsets.
-TabulatedRemovalFunction SampledGaussian(double peak, double cx, double cy, double sx, double sy, double x0, double y0,
-                                         double h, int nx, int ny) {
+TabulatedRemovalFunction SampledGaussian(double peak, double cx, double cy, double sx, double sy, double x0,
+                                         double y0, double h, int nx, int ny) {
   TabulatedRemovalFunction t{.x0_mm = x0, .y0_mm = y0, .dx_mm = h, .dy_mm = h, .nx = nx, .ny = ny};
   for (int j = 0; j < ny; ++j) {
     for (int i = 0; i < nx; ++i) {
@@ -122,7 +128,8 @@ TEST(SolveDwell, AMeasuredGaussianRemovesAsTheAnalyticOneWithinTheInterpolationB
   const double peak = 2.0, fwhm = 12.0, sigma = fwhm / std::sqrt(8.0 * std::log(2.0)), h = 0.1;
   const int n = 2 * static_cast<int>(std::ceil(4.5 * sigma / h)) + 1;
   const double half_width = (n - 1) / 2 * h;
-  const RemovalFunction table = SampledGaussian(peak, 0.0, 0.0, sigma, sigma, -half_width, -half_width, h, n, n);
+  const RemovalFunction table =
+      SampledGaussian(peak, 0.0, 0.0, sigma, sigma, -half_width, -half_width, h, n, n);
   // Bilinear interpolation errs by at most (hx^2 max|f_xx| + hy^2 max|f_yy|) / 8 (linear
   // interpolation's h^2/8 max|f''| along each axis in turn); for the Gaussian max|f_xx| = P/sigma^2.
   const double interpolation_bound = peak * (h * h + h * h) / (8.0 * sigma * sigma);
@@ -141,9 +148,12 @@ TEST(SolveDwell, AMeasuredGaussianRemovesAsTheAnalyticOneWithinTheInterpolationB
       for (std::size_t k = 0; k < path.size(); ++k) {
         const double dx = target.X(i) - path[k].x(), dy = target.Y(j) - path[k].y();
         const bool inside = std::abs(dx) <= half_width && std::abs(dy) <= half_width;
-        bound += solution.dwell_s[k] * (inside ? interpolation_bound : peak * std::exp(-(dx * dx + dy * dy) / (2.0 * sigma * sigma)));
+        bound +=
+            solution.dwell_s[k] *
+            (inside ? interpolation_bound : peak * std::exp(-(dx * dx + dy * dy) / (2.0 * sigma * sigma)));
       }
-      const double analytic = FullGaussianRemovalUm(target.X(i), target.Y(j), path, solution.dwell_s, peak, fwhm);
+      const double analytic =
+          FullGaussianRemovalUm(target.X(i), target.Y(j), path, solution.dwell_s, peak, fwhm);
       EXPECT_LE(std::abs(removal - analytic), bound + 1e-12) << target.X(i) << ", " << target.Y(j);
     }
   }
@@ -159,7 +169,8 @@ double BruteForceRate(const TabulatedRemovalFunction& t, double x, double y) {
   double sum = 0.0;
   for (int j = static_cast<int>(std::floor(v)); j <= static_cast<int>(std::floor(v)) + 1 && j < t.ny; ++j) {
     for (int i = static_cast<int>(std::floor(u)); i <= static_cast<int>(std::floor(u)) + 1 && i < t.nx; ++i) {
-      sum += (1.0 - std::abs(u - i)) * (1.0 - std::abs(v - j)) * t.rate_um_per_s[static_cast<std::size_t>(j * t.nx + i)];
+      sum += (1.0 - std::abs(u - i)) * (1.0 - std::abs(v - j)) *
+             t.rate_um_per_s[static_cast<std::size_t>(j * t.nx + i)];
     }
   }
   return sum;
@@ -173,26 +184,31 @@ TEST(SolveDwell, PredictsTheRemovalOfAnOffsetEllipticFootprintAsABruteForceConvo
   ErrorMap error{.x0_mm = -15.0, .y0_mm = -15.0, .dx_mm = 1.0, .dy_mm = 1.0, .nx = 31, .ny = 31};
   for (int j = 0; j < error.ny; ++j) {
     for (int i = 0; i < error.nx; ++i) {
-      error.error_um.push_back(0.2 * std::cos(error.X(i) / 6.0) * std::sin(error.Y(j) / 5.0) + 0.003 * error.X(i));
+      error.error_um.push_back(0.2 * std::cos(error.X(i) / 6.0) * std::sin(error.Y(j) / 5.0) +
+                               0.003 * error.X(i));
     }
   }
   const ErrorMap target = RemovalTarget(error, square, {.uniform_layer_um = 0.5});
   const std::vector<Eigen::Vector2d> path =
       RasterPath(square, {.line_spacing_mm = 1.0, .point_spacing_mm = 1.0, .extension_mm = 6.0});
-  const DwellSolution solution = SolveDwell(target, square, path, table, {.max_speed_mm_s = 500.0, .max_iterations = 1000});
+  const DwellSolution solution =
+      SolveDwell(target, square, path, table, {.max_speed_mm_s = 500.0, .max_iterations = 1000});
   double most = 0.0;
   for (int j = 0; j < target.ny; ++j) {
     for (int i = 0; i < target.nx; ++i) {
       double removal = 0.0;
       for (std::size_t k = 0; k < path.size(); ++k) {
-        removal += solution.dwell_s[k] * BruteForceRate(table, target.X(i) - path[k].x(), target.Y(j) - path[k].y());
+        removal +=
+            solution.dwell_s[k] * BruteForceRate(table, target.X(i) - path[k].x(), target.Y(j) - path[k].y());
       }
-      EXPECT_NEAR(solution.predicted_removal_um.At(i, j), removal, 1e-9) << target.X(i) << ", " << target.Y(j);
+      EXPECT_NEAR(solution.predicted_removal_um.At(i, j), removal, 1e-9)
+          << target.X(i) << ", " << target.Y(j);
       most = std::max(most, removal);
     }
   }
   EXPECT_GT(most, 0.5);
-  EXPECT_LT(solution.after.rms_um, solution.before.rms_um / 10.0) << solution.before.rms_um << " -> " << solution.after.rms_um;
+  EXPECT_LT(solution.after.rms_um, solution.before.rms_um / 10.0)
+      << solution.before.rms_um << " -> " << solution.after.rms_um;
 }
 
 TEST(SolveDwell, RecoversAKnownDwellToWithinTheConditioningOfTheProblem) {
@@ -203,16 +219,19 @@ TEST(SolveDwell, RecoversAKnownDwellToWithinTheConditioningOfTheProblem) {
       RasterPath(square, {.line_spacing_mm = 2.0, .point_spacing_mm = 2.0, .extension_mm = 8.0});
   ErrorMap target{.x0_mm = -20.0, .y0_mm = -20.0, .dx_mm = 1.0, .dy_mm = 1.0, .nx = 41, .ny = 41};
   std::vector<double> dwell(path.size(), 0.0);
-  for (std::size_t k = 1; k < path.size(); ++k) dwell[k] = 0.1 + 0.05 * std::cos(path[k].x() / 9.0) * std::sin(path[k].y() / 7.0);
+  for (std::size_t k = 1; k < path.size(); ++k)
+    dwell[k] = 0.1 + 0.05 * std::cos(path[k].x() / 9.0) * std::sin(path[k].y() / 7.0);
   for (int j = 0; j < target.ny; ++j) {
     for (int i = 0; i < target.nx; ++i) {
       double sum = 0.0;
-      for (std::size_t k = 0; k < path.size(); ++k) sum += tool.RateUmPerS(target.X(i) - path[k].x(), target.Y(j) - path[k].y()) * dwell[k];
+      for (std::size_t k = 0; k < path.size(); ++k)
+        sum += tool.RateUmPerS(target.X(i) - path[k].x(), target.Y(j) - path[k].y()) * dwell[k];
       target.error_um.push_back(sum);
     }
   }
   // Without the stall test: this checks that the iteration itself converges to the exact dwell.
-  const DwellSolution solution = SolveDwell(target, square, path, tool, {.max_speed_mm_s = 100.0, .max_iterations = 5000, .stall_iterations = 0});
+  const DwellSolution solution = SolveDwell(
+      target, square, path, tool, {.max_speed_mm_s = 100.0, .max_iterations = 5000, .stall_iterations = 0});
   EXPECT_LT(solution.after.rms_um, 1e-3 * solution.before.rms_um);
 }
 
@@ -226,10 +245,12 @@ TEST(SolveDwell, RefusesUnreachableSpeedsNamingThePointAndTheLayer) {
     FAIL() << "accepted";
   } catch (const Error& e) {
     EXPECT_EQ(e.code(), ErrorCode::kBadInput);
-    EXPECT_NE(std::string(e.what()).find("unreachable speeds: at max_speed_mm_s = 50"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("unreachable speeds: at max_speed_mm_s = 50"), std::string::npos)
+        << e.what();
     EXPECT_NE(std::string(e.what()).find("add a uniform layer of at least"), std::string::npos) << e.what();
   }
-  EXPECT_THROW((void)SolveDwell(target, kDisc, path, tool, {.max_speed_mm_s = 5.0, .min_speed_mm_s = 6.0}), Error);
+  EXPECT_THROW((void)SolveDwell(target, kDisc, path, tool, {.max_speed_mm_s = 5.0, .min_speed_mm_s = 6.0}),
+               Error);
 }
 
 // The largest |v_k^2 - v_(k-1)^2| / (2 L_k) over k >= 2, recomputed from the path and the speeds.
@@ -283,7 +304,8 @@ TEST(SolveDwell, ShapesTheSpeedsToTheAccelerationLimitAndStillCutsTheResidualTen
       EXPECT_NEAR(solution.speed_mm_s[k] * solution.dwell_s[k], length, 1e-9);
       if (k < 2) continue;
       const double v0 = solution.speed_mm_s[k - 1], v1 = solution.speed_mm_s[k];
-      EXPECT_LE(std::abs(v1 * v1 - v0 * v0) / (2.0 * length), limit * (1.0 + 1e-9)) << "seed " << seed << " point " << k;
+      EXPECT_LE(std::abs(v1 * v1 - v0 * v0) / (2.0 * length), limit * (1.0 + 1e-9))
+          << "seed " << seed << " point " << k;
     }
     EXPECT_NEAR(solution.max_acceleration_mm_s2, LargestAcceleration(path, solution), 1e-9 * limit);
     // The prediction is of the final dwell (same truncated model, summed here point by point).
@@ -292,13 +314,15 @@ TEST(SolveDwell, ShapesTheSpeedsToTheAccelerationLimitAndStillCutsTheResidualTen
         if (std::isnan(solution.predicted_removal_um.At(i, j))) continue;
         double removal = 0.0;
         for (std::size_t k = 0; k < path.size(); ++k) {
-          removal += tool.RateUmPerS(target.X(i) - path[k].x(), target.Y(j) - path[k].y()) * solution.dwell_s[k];
+          removal +=
+              tool.RateUmPerS(target.X(i) - path[k].x(), target.Y(j) - path[k].y()) * solution.dwell_s[k];
         }
         EXPECT_NEAR(solution.predicted_removal_um.At(i, j), removal, 1e-9);
       }
     }
     const double rms_after = ResidualRmsUm(target, path, solution.dwell_s, peak, fwhm);
-    EXPECT_LT(rms_after, solution.before.rms_um / 10.0) << "seed " << seed << ": " << solution.before.rms_um << " -> " << rms_after;
+    EXPECT_LT(rms_after, solution.before.rms_um / 10.0)
+        << "seed " << seed << ": " << solution.before.rms_um << " -> " << rms_after;
   }
 }
 
@@ -307,16 +331,21 @@ TEST(SolveDwell, RefusesSpeedsThatDoNotSettleWithinTheShapingRounds) {
   const std::vector<Eigen::Vector2d> path =
       RasterPath(kDisc, {.line_spacing_mm = 3.0, .point_spacing_mm = 3.0, .extension_mm = 8.0});
   const ErrorMap target = RemovalTarget(SimulatedErrorMap(1, 2.0), kDisc, {.uniform_layer_um = 1.5});
-  const DwellOptions options{.max_speed_mm_s = 150.0, .min_speed_mm_s = 0.2, .max_acceleration_mm_s2 = 1000.0,
-                             .max_iterations = 500, .max_shaping_rounds = 1};
+  const DwellOptions options{.max_speed_mm_s = 150.0,
+                             .min_speed_mm_s = 0.2,
+                             .max_acceleration_mm_s2 = 1000.0,
+                             .max_iterations = 500,
+                             .max_shaping_rounds = 1};
   try {
     (void)SolveDwell(target, kDisc, path, tool, options);
     FAIL() << "accepted";
   } catch (const Error& e) {
     EXPECT_EQ(e.code(), ErrorCode::kBadInput);
-    EXPECT_NE(std::string(e.what()).find("after 1 shaping rounds the speeds still exceed max_acceleration_mm_s2 = 1000: "
-                                         "slowing down into path point"),
-              std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find(
+                  "after 1 shaping rounds the speeds still exceed max_acceleration_mm_s2 = 1000: "
+                  "slowing down into path point"),
+              std::string::npos)
+        << e.what();
   }
 }
 
@@ -371,17 +400,22 @@ TEST(RasterPath, CoversTheGrownDiscInZigzagWithStepsNoLongerThanAsked) {
 
 TEST(SpiralPath, FollowsTheArchimedeanSpiralInEqualArcLengthSteps) {
   const double pitch = 2.0, step = 2.5;
-  const auto path = SpiralPath(kDisc, {.line_spacing_mm = pitch, .point_spacing_mm = step, .extension_mm = 5.0});
+  const auto path =
+      SpiralPath(kDisc, {.line_spacing_mm = pitch, .point_spacing_mm = step, .extension_mm = 5.0});
   const double b = pitch / (2.0 * std::numbers::pi);
   // Arc length of r = b theta from the centre: (b/2) (theta sqrt(1 + theta^2) + asinh theta).
-  auto arc = [b](double theta) { return 0.5 * b * (theta * std::sqrt(1.0 + theta * theta) + std::asinh(theta)); };
+  auto arc = [b](double theta) {
+    return 0.5 * b * (theta * std::sqrt(1.0 + theta * theta) + std::asinh(theta));
+  };
   EXPECT_EQ(path.front().norm(), 0.0);
   EXPECT_NEAR(path.back().norm(), 55.0, 1e-9);
   const double total = arc(55.0 / b);
   const double expected_step = total / std::ceil(total / step);
   for (std::size_t k = 1; k < path.size(); ++k) {
     const double theta = path[k].norm() / b;  // on the spiral, the polar angle is theta mod 2 pi
-    EXPECT_NEAR(std::remainder(std::atan2(path[k].y(), path[k].x()) - theta, 2.0 * std::numbers::pi), 0.0, 1e-9) << k;
+    EXPECT_NEAR(std::remainder(std::atan2(path[k].y(), path[k].x()) - theta, 2.0 * std::numbers::pi), 0.0,
+                1e-9)
+        << k;
     EXPECT_NEAR(arc(theta) - arc(path[k - 1].norm() / b), expected_step, 1e-9) << k;
     EXPECT_LE((path[k] - path[k - 1]).norm(), step + 1e-9);
   }
@@ -390,10 +424,11 @@ TEST(SpiralPath, FollowsTheArchimedeanSpiralInEqualArcLengthSteps) {
 
 TEST(SpiralPath, CarriesADwellThatCutsTheResidualRmsTenfold) {
   const GaussianRemovalFunction tool{.peak_rate_um_per_s = 2.0, .fwhm_mm = 12.0};
-  const auto path = SpiralPath(kDisc, {.line_spacing_mm = 2.0, .point_spacing_mm = 2.5, .extension_mm = 10.0});
+  const auto path =
+      SpiralPath(kDisc, {.line_spacing_mm = 2.0, .point_spacing_mm = 2.5, .extension_mm = 10.0});
   const ErrorMap target = RemovalTarget(SimulatedErrorMap(1), kDisc, {.uniform_layer_um = 1.5});
-  const DwellSolution solution =
-      SolveDwell(target, kDisc, path, tool, {.max_speed_mm_s = 150.0, .min_speed_mm_s = 0.2, .max_iterations = 500});
+  const DwellSolution solution = SolveDwell(
+      target, kDisc, path, tool, {.max_speed_mm_s = 150.0, .min_speed_mm_s = 0.2, .max_iterations = 500});
   const double rms_after = ResidualRmsUm(target, path, solution.dwell_s, 2.0, 12.0);
   EXPECT_LT(rms_after, solution.before.rms_um / 10.0) << solution.before.rms_um << " -> " << rms_after;
 }

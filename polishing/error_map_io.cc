@@ -44,20 +44,20 @@ struct MetroProField {
   const char* name;
   std::size_t offset;
 };
-constexpr MetroProField kMagic{"magic_number", 0};             // uint32
-constexpr MetroProField kHeaderFormat{"header_format", 4};     // uint16
-constexpr MetroProField kHeaderSize{"header_size", 6};         // uint32
-constexpr MetroProField kAcWidth{"ac_width", 52};              // uint16, intensity columns
-constexpr MetroProField kAcHeight{"ac_height", 54};            // uint16, intensity rows
-constexpr MetroProField kAcBuckets{"ac_n_buckets", 56};        // uint16, intensity frames
-constexpr MetroProField kCnWidth{"cn_width", 68};              // uint16, phase columns
-constexpr MetroProField kCnHeight{"cn_height", 70};            // uint16, phase rows
+constexpr MetroProField kMagic{"magic_number", 0};               // uint32
+constexpr MetroProField kHeaderFormat{"header_format", 4};       // uint16
+constexpr MetroProField kHeaderSize{"header_size", 6};           // uint32
+constexpr MetroProField kAcWidth{"ac_width", 52};                // uint16, intensity columns
+constexpr MetroProField kAcHeight{"ac_height", 54};              // uint16, intensity rows
+constexpr MetroProField kAcBuckets{"ac_n_buckets", 56};          // uint16, intensity frames
+constexpr MetroProField kCnWidth{"cn_width", 68};                // uint16, phase columns
+constexpr MetroProField kCnHeight{"cn_height", 70};              // uint16, phase rows
 constexpr MetroProField kScaleFactor{"intf_scale_factor", 164};  // float32
-constexpr MetroProField kWavelength{"wavelength_in", 168};     // float32, m
-constexpr MetroProField kObliquity{"obliquity_factor", 176};   // float32
-constexpr MetroProField kLateralRes{"lateral_res", 184};       // float32, m/pixel (camera_res)
-constexpr MetroProField kPhaseRes{"phase_res", 218};           // uint16: 0, 1, 2
-constexpr MetroProField kSign{"sign", 232};                    // uint16, != 0: data inverted
+constexpr MetroProField kWavelength{"wavelength_in", 168};       // float32, m
+constexpr MetroProField kObliquity{"obliquity_factor", 176};     // float32
+constexpr MetroProField kLateralRes{"lateral_res", 184};         // float32, m/pixel (camera_res)
+constexpr MetroProField kPhaseRes{"phase_res", 218};             // uint16: 0, 1, 2
+constexpr MetroProField kSign{"sign", 232};                      // uint16, != 0: data inverted
 
 // Phase codes from 0x7FFFFFF8 up mark pixels without data.
 constexpr std::int32_t kInvalidPhase = 2147483640;
@@ -67,13 +67,18 @@ struct HeaderFormat {
   std::uint16_t format;
   std::uint32_t header_size;
 };
-constexpr std::array<HeaderFormat, 3> kHeaderFormats = {{{0x881B036F, 1, 834}, {0x881B0370, 2, 834}, {0x881B0371, 3, 4096}}};
+constexpr std::array<HeaderFormat, 3> kHeaderFormats = {
+    {{0x881B036F, 1, 834}, {0x881B0370, 2, 834}, {0x881B0371, 3, 4096}}};
 
 class BigEndian {
  public:
   BigEndian(std::span<const unsigned char> bytes, const std::string& name) : bytes_(bytes), name_(name) {}
-  [[nodiscard]] std::uint32_t U32(const MetroProField& f) const { return static_cast<std::uint32_t>(Get(f, 4)); }
-  [[nodiscard]] std::uint16_t U16(const MetroProField& f) const { return static_cast<std::uint16_t>(Get(f, 2)); }
+  [[nodiscard]] std::uint32_t U32(const MetroProField& f) const {
+    return static_cast<std::uint32_t>(Get(f, 4));
+  }
+  [[nodiscard]] std::uint16_t U16(const MetroProField& f) const {
+    return static_cast<std::uint16_t>(Get(f, 2));
+  }
   [[nodiscard]] double F32(const MetroProField& f) const {
     const auto bits = static_cast<std::uint32_t>(Get(f, 4));
     float value = 0.0f;
@@ -90,8 +95,8 @@ class BigEndian {
  private:
   [[nodiscard]] std::uint64_t Get(const MetroProField& f, std::size_t width) const {
     if (f.offset > bytes_.size() || bytes_.size() - f.offset < width) {
-      Fail(name_, fmt::format("MetroPro field '{}' at byte {} lies beyond the {}-byte file (truncated?)", f.name,
-                              f.offset, bytes_.size()));
+      Fail(name_, fmt::format("MetroPro field '{}' at byte {} lies beyond the {}-byte file (truncated?)",
+                              f.name, f.offset, bytes_.size()));
     }
     std::uint64_t v = 0;
     for (std::size_t k = 0; k < width; ++k) v = (v << 8) | bytes_[f.offset + k];
@@ -130,8 +135,9 @@ double MicrometresPer(const std::string& unit) {
 double DatxAttribute(const hdf5::File& file, const std::string& attribute) {
   const std::optional<double> v = file.ReadAttributeDouble(kDatxSurface, attribute);
   if (!v || !std::isfinite(*v) || *v == 0.0) {
-    Fail(file.path().string(), fmt::format("{} attribute '{}' is {} (needed for heights in Fringes)", kDatxSurface,
-                                           attribute, v ? fmt::format("{}", *v) : std::string("missing")));
+    Fail(file.path().string(),
+         fmt::format("{} attribute '{}' is {} (needed for heights in Fringes)", kDatxSurface, attribute,
+                     v ? fmt::format("{}", *v) : std::string("missing")));
   }
   return *v;
 }
@@ -144,7 +150,8 @@ double DatxHeightScaleUm(const hdf5::File& file) {
   const std::string category = z->strings.count("Category") ? z->strings.at("Category") : "";
   const std::string unit = z->strings.count("BaseUnit") ? z->strings.at("BaseUnit") : "";
   if (category != "HeightCat") {
-    Fail(name, fmt::format("{} attribute 'Z Converter' Category = '{}' is not 'HeightCat'", kDatxSurface, category));
+    Fail(name, fmt::format("{} attribute 'Z Converter' Category = '{}' is not 'HeightCat'", kDatxSurface,
+                           category));
   }
   if (unit == "Fringes") {
     // As prysm: fringes * wavelength * interferometric scale factor * obliquity factor = height.
@@ -154,7 +161,8 @@ double DatxHeightScaleUm(const hdf5::File& file) {
   const double um = MicrometresPer(unit);
   if (std::isnan(um)) {
     Fail(name, fmt::format("{} attribute 'Z Converter' BaseUnit = '{}' is not a length (Meters, MilliMeters, "
-                           "MicroMeters, NanoMeters, Angstroms) or Fringes", kDatxSurface, unit));
+                           "MicroMeters, NanoMeters, Angstroms) or Fringes",
+                           kDatxSurface, unit));
   }
   return um;
 }
@@ -162,7 +170,8 @@ double DatxHeightScaleUm(const hdf5::File& file) {
 // mm per pixel from an X or Y converter (Parameters[1] in m), NaN if absent or not lateral.
 double DatxPixelMm(const hdf5::File& file, const std::string& converter) {
   const auto c = file.ReadAttributeCompound(kDatxSurface, converter);
-  if (!c || !c->strings.count("Category") || c->strings.at("Category") != "LateralCat" || !c->numbers.count("Parameters")) {
+  if (!c || !c->strings.count("Category") || c->strings.at("Category") != "LateralCat" ||
+      !c->numbers.count("Parameters")) {
     return kNaN;
   }
   const std::vector<double>& p = c->numbers.at("Parameters");
@@ -186,7 +195,8 @@ std::string PointName(std::span<const ScatteredPoint> points, std::size_t k) {
 }
 
 void CheckSpread(std::span<const ScatteredPoint> points, const std::string& name) {
-  if (points.size() < 3) Fail(name, fmt::format("has {} scattered points, needs at least 3 to triangulate", points.size()));
+  if (points.size() < 3)
+    Fail(name, fmt::format("has {} scattered points, needs at least 3 to triangulate", points.size()));
   for (const ScatteredPoint& p : points) {
     if (!std::isfinite(p.x_mm) || !std::isfinite(p.y_mm) || !std::isfinite(p.error_um)) {
       Fail(name, fmt::format("scattered point ({}, {}, {}) is not finite", p.x_mm, p.y_mm, p.error_um));
@@ -208,7 +218,8 @@ void CheckSpread(std::span<const ScatteredPoint> points, const std::string& name
     }
   }
   if (!(off_line_mm > 1e-9 * far_mm)) {
-    Fail(name, fmt::format("all {} scattered points lie on one line: no area to interpolate over", points.size()));
+    Fail(name,
+         fmt::format("all {} scattered points lie on one line: no area to interpolate over", points.size()));
   }
 }
 
@@ -230,14 +241,18 @@ Triangulation Triangulate(std::span<const ScatteredPoint> points, const std::str
     cv::Subdiv2D subdivision(cv::Rect(-kRect, -kRect, 2 * kRect, 2 * kRect));
     std::vector<int> point_of_vertex;
     for (std::size_t k = 0; k < points.size(); ++k) {
-      const cv::Point2f q(static_cast<float>((points[k].x_mm - cx) * s), static_cast<float>((points[k].y_mm - cy) * s));
+      const cv::Point2f q(static_cast<float>((points[k].x_mm - cx) * s),
+                          static_cast<float>((points[k].y_mm - cy) * s));
       const int vertex = subdivision.insert(q);
-      if (vertex >= static_cast<int>(point_of_vertex.size())) point_of_vertex.resize(static_cast<std::size_t>(vertex) + 1, -1);
+      if (vertex >= static_cast<int>(point_of_vertex.size()))
+        point_of_vertex.resize(static_cast<std::size_t>(vertex) + 1, -1);
       if (point_of_vertex[static_cast<std::size_t>(vertex)] >= 0) {
         const auto other = static_cast<std::size_t>(point_of_vertex[static_cast<std::size_t>(vertex)]);
-        Fail(name, fmt::format("{} ({}, {}) mm and {} ({}, {}) mm lie at one place (closer than 1e-7 of the map's "
-                               "size)", PointName(points, other), points[other].x_mm, points[other].y_mm,
-                               PointName(points, k), points[k].x_mm, points[k].y_mm));
+        Fail(name,
+             fmt::format("{} ({}, {}) mm and {} ({}, {}) mm lie at one place (closer than 1e-7 of the map's "
+                         "size)",
+                         PointName(points, other), points[other].x_mm, points[other].y_mm,
+                         PointName(points, k), points[k].x_mm, points[k].y_mm));
       }
       point_of_vertex[static_cast<std::size_t>(vertex)] = static_cast<int>(k);
     }
@@ -283,14 +298,16 @@ double MedianNearestNeighbour(std::span<const ScatteredPoint> points, const Tria
   for (const double d : nearest) {
     if (std::isfinite(d)) finite.push_back(d);
   }
-  std::nth_element(finite.begin(), finite.begin() + static_cast<std::ptrdiff_t>(finite.size() / 2), finite.end());
+  std::nth_element(finite.begin(), finite.begin() + static_cast<std::ptrdiff_t>(finite.size() / 2),
+                   finite.end());
   return finite[finite.size() / 2];
 }
 
 // Linear interpolation over one triangle onto the nodes of `map` it covers (first triangle wins
 // on shared edges; the interpolant is continuous there).
 void RasterTriangle(std::span<const ScatteredPoint> points, const Triangle& tri, ErrorMap& map) {
-  const ScatteredPoint &a = points[static_cast<std::size_t>(tri.v[0])], &b = points[static_cast<std::size_t>(tri.v[1])],
+  const ScatteredPoint &a = points[static_cast<std::size_t>(tri.v[0])],
+                       &b = points[static_cast<std::size_t>(tri.v[1])],
                        &c = points[static_cast<std::size_t>(tri.v[2])];
   const double den = (b.y_mm - c.y_mm) * (a.x_mm - c.x_mm) + (c.x_mm - b.x_mm) * (a.y_mm - c.y_mm);
   if (den == 0.0) return;
@@ -336,18 +353,23 @@ std::vector<unsigned char> ReadBytes(const std::filesystem::path& path) {
 
 ErrorMap PlaceInPartFrame(const PixelMap& pixels, const MapPlacement& placement, const std::string& name) {
   if (pixels.width <= 0 || pixels.height <= 0 ||
-      pixels.height_um.size() != static_cast<std::size_t>(pixels.width) * static_cast<std::size_t>(pixels.height)) {
-    Fail(name, fmt::format("pixel map of {} x {} pixels holds {} values", pixels.width, pixels.height, pixels.height_um.size()));
+      pixels.height_um.size() !=
+          static_cast<std::size_t>(pixels.width) * static_cast<std::size_t>(pixels.height)) {
+    Fail(name, fmt::format("pixel map of {} x {} pixels holds {} values", pixels.width, pixels.height,
+                           pixels.height_um.size()));
   }
   const int quarter_turns = placement.rotation_deg / 90;
   if (placement.rotation_deg % 90 != 0 || quarter_turns < 0 || quarter_turns > 3) {
-    throw Error(ErrorCode::kInvalidOption, kStage, fmt::format("rotation_deg = {} is not 0, 90, 180 or 270", placement.rotation_deg));
+    throw Error(ErrorCode::kInvalidOption, kStage,
+                fmt::format("rotation_deg = {} is not 0, 90, 180 or 270", placement.rotation_deg));
   }
   if (!std::isfinite(placement.scale) || placement.scale == 0.0) {
-    throw Error(ErrorCode::kInvalidOption, kStage, fmt::format("scale = {} must be finite and non-zero", placement.scale));
+    throw Error(ErrorCode::kInvalidOption, kStage,
+                fmt::format("scale = {} must be finite and non-zero", placement.scale));
   }
   if (!std::isnan(placement.pixel_mm) && !(placement.pixel_mm > 0.0 && std::isfinite(placement.pixel_mm))) {
-    throw Error(ErrorCode::kInvalidOption, kStage, fmt::format("pixel_mm = {} must be > 0", placement.pixel_mm));
+    throw Error(ErrorCode::kInvalidOption, kStage,
+                fmt::format("pixel_mm = {} must be > 0", placement.pixel_mm));
   }
   const double px = std::isnan(placement.pixel_mm) ? pixels.pixel_x_mm : placement.pixel_mm;
   const double py = std::isnan(placement.pixel_mm) ? pixels.pixel_y_mm : placement.pixel_mm;
@@ -358,7 +380,8 @@ ErrorMap PlaceInPartFrame(const PixelMap& pixels, const MapPlacement& placement,
   const double ci = std::isnan(placement.centre_column) ? centre[0] : placement.centre_column;
   const double cj = std::isnan(placement.centre_row) ? centre[1] : placement.centre_row;
   if (!std::isfinite(ci) || !std::isfinite(cj)) {
-    throw Error(ErrorCode::kInvalidOption, kStage, fmt::format("centre pixel ({}, {}) must be finite", ci, cj));
+    throw Error(ErrorCode::kInvalidOption, kStage,
+                fmt::format("centre pixel ({}, {}) must be finite", ci, cj));
   }
   // Pixel (i, j) -> part frame, steps 1-4 of error_map_io.h.
   auto place = [&](int i, int j) {
@@ -416,45 +439,62 @@ PixelMap ParseMetroProDat(std::span<const unsigned char> bytes, const std::strin
   const auto format = std::find_if(kHeaderFormats.begin(), kHeaderFormats.end(),
                                    [&](const HeaderFormat& f) { return f.magic == magic; });
   if (format == kHeaderFormats.end()) {
-    FieldFail(name, kMagic, fmt::format("= 0x{:08X} is not a MetroPro .dat magic number (0x881B036F, 0x881B0370, 0x881B0371)", magic));
+    FieldFail(
+        name, kMagic,
+        fmt::format("= 0x{:08X} is not a MetroPro .dat magic number (0x881B036F, 0x881B0370, 0x881B0371)",
+                    magic));
   }
   const std::uint16_t header_format = in.U16(kHeaderFormat);
   if (header_format != format->format) {
-    FieldFail(name, kHeaderFormat, fmt::format("= {} does not match magic number 0x{:08X} (format {})", header_format, magic, format->format));
+    FieldFail(name, kHeaderFormat,
+              fmt::format("= {} does not match magic number 0x{:08X} (format {})", header_format, magic,
+                          format->format));
   }
   const std::uint32_t header_size = in.U32(kHeaderSize);
   if (header_size != format->header_size) {
-    FieldFail(name, kHeaderSize, fmt::format("= {} is not the {} bytes of header format {}", header_size, format->header_size, format->format));
+    FieldFail(name, kHeaderSize,
+              fmt::format("= {} is not the {} bytes of header format {}", header_size, format->header_size,
+                          format->format));
   }
   if (header_size > bytes.size()) {
-    FieldFail(name, kHeaderSize, fmt::format("= {} bytes lies beyond the {}-byte file (truncated?)", header_size, bytes.size()));
+    FieldFail(name, kHeaderSize,
+              fmt::format("= {} bytes lies beyond the {}-byte file (truncated?)", header_size, bytes.size()));
   }
   // Sizes in 64 bits: three 16-bit factors cannot overflow.
   const std::uint64_t intensity_bytes = 2ull * in.U16(kAcWidth) * in.U16(kAcHeight) * in.U16(kAcBuckets);
   const std::uint64_t phase_offset = header_size + intensity_bytes;
   if (phase_offset > bytes.size()) {
-    Fail(name, fmt::format("MetroPro fields 'ac_width' x 'ac_height' x 'ac_n_buckets' = {} x {} x {} declare {} intensity bytes "
-                           "after the {}-byte header, beyond the {}-byte file (truncated?)", in.U16(kAcWidth), in.U16(kAcHeight),
-                           in.U16(kAcBuckets), intensity_bytes, header_size, bytes.size()));
+    Fail(name, fmt::format("MetroPro fields 'ac_width' x 'ac_height' x 'ac_n_buckets' = {} x {} x {} declare "
+                           "{} intensity bytes "
+                           "after the {}-byte header, beyond the {}-byte file (truncated?)",
+                           in.U16(kAcWidth), in.U16(kAcHeight), in.U16(kAcBuckets), intensity_bytes,
+                           header_size, bytes.size()));
   }
   PixelMap map;
   map.width = in.U16(kCnWidth);
   map.height = in.U16(kCnHeight);
   if (map.width == 0 || map.height == 0) {
-    Fail(name, fmt::format("MetroPro fields 'cn_width' x 'cn_height' = {} x {}: the file holds no phase data", map.width, map.height));
+    Fail(name, fmt::format("MetroPro fields 'cn_width' x 'cn_height' = {} x {}: the file holds no phase data",
+                           map.width, map.height));
   }
-  const std::uint64_t phase_bytes = 4ull * static_cast<std::uint64_t>(map.width) * static_cast<std::uint64_t>(map.height);
+  const std::uint64_t phase_bytes =
+      4ull * static_cast<std::uint64_t>(map.width) * static_cast<std::uint64_t>(map.height);
   if (bytes.size() - phase_offset < phase_bytes) {
-    Fail(name, fmt::format("MetroPro fields 'cn_width' x 'cn_height' = {} x {} declare {} phase bytes from byte {}, beyond "
-                           "the {}-byte file (truncated?)", map.width, map.height, phase_bytes, phase_offset, bytes.size()));
+    Fail(name,
+         fmt::format(
+             "MetroPro fields 'cn_width' x 'cn_height' = {} x {} declare {} phase bytes from byte {}, beyond "
+             "the {}-byte file (truncated?)",
+             map.width, map.height, phase_bytes, phase_offset, bytes.size()));
   }
   const std::uint16_t phase_res = in.U16(kPhaseRes);
   static constexpr std::array<double, 3> kResolution = {4096.0, 32768.0, 131072.0};
-  if (phase_res >= kResolution.size()) FieldFail(name, kPhaseRes, fmt::format("= {} is not 0, 1 or 2", phase_res));
+  if (phase_res >= kResolution.size())
+    FieldFail(name, kPhaseRes, fmt::format("= {} is not 0, 1 or 2", phase_res));
   const double wavelength_m = in.F32(kWavelength);
-  if (!(wavelength_m > 0.0 && std::isfinite(wavelength_m))) FieldFail(name, kWavelength, fmt::format("= {} m must be > 0", wavelength_m));
-  double um_per_count = 1e6 * PositiveFinite(in, kScaleFactor, name) * PositiveFinite(in, kObliquity, name) * wavelength_m /
-                        kResolution[phase_res];
+  if (!(wavelength_m > 0.0 && std::isfinite(wavelength_m)))
+    FieldFail(name, kWavelength, fmt::format("= {} m must be > 0", wavelength_m));
+  double um_per_count = 1e6 * PositiveFinite(in, kScaleFactor, name) * PositiveFinite(in, kObliquity, name) *
+                        wavelength_m / kResolution[phase_res];
   if (in.U16(kSign) != 0) um_per_count = -um_per_count;
   const double lateral_m = in.F32(kLateralRes);
   if (lateral_m > 0.0 && std::isfinite(lateral_m)) map.pixel_x_mm = map.pixel_y_mm = lateral_m * 1e3;
@@ -474,7 +514,8 @@ PixelMap ReadMetroProDat(const std::filesystem::path& path) {
 PixelMap ReadZygoDatx(const hdf5::File& file) {
   const std::string name = file.path().string();
   if (!file.HasObject(kDatxSurface)) {
-    Fail(name, fmt::format("dataset '{}' is missing (not a Zygo Mx .datx surface measurement?)", kDatxSurface));
+    Fail(name,
+         fmt::format("dataset '{}' is missing (not a Zygo Mx .datx surface measurement?)", kDatxSurface));
   }
   const std::vector<hsize_t> shape = file.Shape(kDatxSurface);
   if (shape.size() != 2 || shape[0] == 0 || shape[1] == 0 || shape[0] > 1u << 20 || shape[1] > 1u << 20) {
@@ -483,7 +524,8 @@ PixelMap ReadZygoDatx(const hdf5::File& file) {
     Fail(name, fmt::format("dataset '{}' has shape [{}], needs [rows][columns]", kDatxSurface, dims));
   }
   const H5T_class_t element = file.ElementClass(kDatxSurface);
-  if (element != H5T_FLOAT && element != H5T_INTEGER) Fail(name, fmt::format("dataset '{}' is not numeric", kDatxSurface));
+  if (element != H5T_FLOAT && element != H5T_INTEGER)
+    Fail(name, fmt::format("dataset '{}' is not numeric", kDatxSurface));
   const double um = DatxHeightScaleUm(file);
   const std::optional<double> no_data = file.ReadAttributeDouble(kDatxSurface, "No Data");
   PixelMap map;
@@ -503,15 +545,18 @@ PixelMap ReadZygoDatx(const std::filesystem::path& path) {
 
 ErrorMap ReadErrorMapHdf5(const hdf5::File& file) {
   const std::string name = file.path().string();
-  if (!file.HasObject("/error_um")) Fail(name, "dataset 'error_um' is missing (arcwheel HDF5 error map, docs/polishing.md)");
+  if (!file.HasObject("/error_um"))
+    Fail(name, "dataset 'error_um' is missing (arcwheel HDF5 error map, docs/polishing.md)");
   const std::vector<hsize_t> shape = file.Shape("/error_um");
-  if (shape.size() != 2 || shape[0] == 0 || shape[1] == 0 || static_cast<double>(shape[0]) * static_cast<double>(shape[1]) > kMaxNodes) {
+  if (shape.size() != 2 || shape[0] == 0 || shape[1] == 0 ||
+      static_cast<double>(shape[0]) * static_cast<double>(shape[1]) > kMaxNodes) {
     Fail(name, "dataset 'error_um' must be [ny][nx] with 1 .. 1e8 nodes");
   }
   ErrorMap map;
   auto attribute = [&](const char* key) {
     const std::optional<double> v = file.ReadAttributeDouble("/", key);
-    if (!v || !std::isfinite(*v)) Fail(name, fmt::format("root attribute '{}' is {}", key, v ? "not finite" : "missing"));
+    if (!v || !std::isfinite(*v))
+      Fail(name, fmt::format("root attribute '{}' is {}", key, v ? "not finite" : "missing"));
     return *v;
   };
   map.x0_mm = attribute("x0_mm");
@@ -539,7 +584,8 @@ void WriteErrorMapHdf5(const ErrorMap& map, const std::filesystem::path& path) {
   const std::filesystem::path temporary = outputs.Stage(path);
   {
     hdf5::File file = hdf5::File::Create(temporary);
-    file.WriteDoubles("/error_um", map.error_um, {static_cast<hsize_t>(map.ny), static_cast<hsize_t>(map.nx)});
+    file.WriteDoubles("/error_um", map.error_um,
+                      {static_cast<hsize_t>(map.ny), static_cast<hsize_t>(map.nx)});
     file.WriteAttribute("/", "x0_mm", map.x0_mm);
     file.WriteAttribute("/", "y0_mm", map.y0_mm);
     file.WriteAttribute("/", "dx_mm", map.dx_mm);
@@ -564,7 +610,8 @@ ErrorMap ReadErrorMapCsv(const std::filesystem::path& path) {
 std::vector<ScatteredPoint> ReadScatteredCsv(const std::filesystem::path& path) {
   std::vector<ScatteredPoint> points;
   for (const CsvTriple& n : ReadCsvTriples(path, "error_um", kStage)) {
-    if (!std::isfinite(n.value)) LineFail(path, n.line, "error_um must be finite (leave a scattered point out instead)");
+    if (!std::isfinite(n.value))
+      LineFail(path, n.line, "error_um must be finite (leave a scattered point out instead)");
     points.push_back({n.x_mm, n.y_mm, n.value, n.line});
   }
   return points;
@@ -574,9 +621,12 @@ double MedianNearestNeighbourMm(std::span<const ScatteredPoint> points, const st
   return MedianNearestNeighbour(points, Triangulate(points, name));
 }
 
-ErrorMap InterpolateScattered(std::span<const ScatteredPoint> points, double grid_spacing_mm, const std::string& name) {
+ErrorMap InterpolateScattered(std::span<const ScatteredPoint> points, double grid_spacing_mm,
+                              const std::string& name) {
   const Triangulation t = Triangulate(points, name);
-  const double d = (grid_spacing_mm > 0.0 && std::isfinite(grid_spacing_mm)) ? grid_spacing_mm : MedianNearestNeighbour(points, t);
+  const double d = (grid_spacing_mm > 0.0 && std::isfinite(grid_spacing_mm))
+                       ? grid_spacing_mm
+                       : MedianNearestNeighbour(points, t);
   double x_min = points[0].x_mm, x_max = x_min, y_min = points[0].y_mm, y_max = y_min;
   for (const ScatteredPoint& p : points) {
     x_min = std::min(x_min, p.x_mm), x_max = std::max(x_max, p.x_mm);
@@ -590,9 +640,11 @@ ErrorMap InterpolateScattered(std::span<const ScatteredPoint> points, double gri
   // would otherwise make a grid of tens of millions of empty nodes.
   const double most_nodes = std::min(1e7, 1e4 * static_cast<double>(points.size()));
   if (!(nodes <= most_nodes) || k_x1 < k_x0 || k_y1 < k_y0) {
-    Fail(name, fmt::format("a grid of spacing {} mm over [{}, {}] x [{}, {}] mm would hold {} nodes, more than {} for {} "
-                           "points (a stray point? or set error_map.grid_spacing_mm)",
-                           d, x_min, x_max, y_min, y_max, nodes, most_nodes, points.size()));
+    Fail(name,
+         fmt::format(
+             "a grid of spacing {} mm over [{}, {}] x [{}, {}] mm would hold {} nodes, more than {} for {} "
+             "points (a stray point? or set error_map.grid_spacing_mm)",
+             d, x_min, x_max, y_min, y_max, nodes, most_nodes, points.size()));
   }
   ErrorMap map;
   map.dx_mm = map.dy_mm = d;
@@ -625,7 +677,8 @@ ErrorMap ReadErrorMap(const std::filesystem::path& path, const ErrorMapOptions& 
   }
   const double scale = options.placement.scale;
   if (!std::isfinite(scale) || scale == 0.0) {
-    throw Error(ErrorCode::kInvalidOption, kStage, fmt::format("scale = {} must be finite and non-zero", scale));
+    throw Error(ErrorCode::kInvalidOption, kStage,
+                fmt::format("scale = {} must be finite and non-zero", scale));
   }
   ErrorMap map;
   if (options.format == ErrorMapFormat::kHdf5) {

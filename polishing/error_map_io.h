@@ -119,7 +119,8 @@ struct ScatteredPoint {
                                             const std::string& name);
 
 // The median nearest-neighbour distance of the points (the default grid spacing above).
-[[nodiscard]] double MedianNearestNeighbourMm(std::span<const ScatteredPoint> points, const std::string& name);
+[[nodiscard]] double MedianNearestNeighbourMm(std::span<const ScatteredPoint> points,
+                                              const std::string& name);
 
 enum class ErrorMapFormat { kCsv, kDat, kDatx, kHdf5 };
 enum class ErrorMapLayout { kGrid, kScattered };

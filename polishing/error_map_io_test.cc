@@ -36,14 +36,16 @@ std::string ErrorOf(const std::function<void()>& read, ErrorCode code = ErrorCod
   return "accepted";
 }
 
-bool Contains(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
+bool Contains(const std::string& text, const std::string& part) {
+  return text.find(part) != std::string::npos;
+}
 
 // ------------------------------------------------------------------------------------------------
 // An independent MetroPro writer: the header fields at the byte offsets of the MetroPro Reference
 // Guide (OMP-0347, appendix B), big-endian by hand.
 struct DatSpec {
-  int header_format = 1;          // 1, 2, 3
-  int width = 7, height = 5;      // phase pixels (cn_width, cn_height)
+  int header_format = 1;      // 1, 2, 3
+  int width = 7, height = 5;  // phase pixels (cn_width, cn_height)
   int intensity_width = 3, intensity_height = 2, buckets = 1;
   int phase_res = 1;
   float scale_factor = 0.5f, obliquity = 1.0f, wavelength_m = 632.8e-9f, lateral_res_m = 1.25e-4f;
@@ -142,7 +144,8 @@ TEST(ParseMetroProDat, NegatesHeightsWhenTheSignFlagIsSet) {
   const PixelMap plain = ParseMetroProDat(MetroProImage(spec), "a.dat");
   spec.sign = 1;
   const PixelMap inverted = ParseMetroProDat(MetroProImage(spec), "a.dat");
-  for (std::size_t k = 0; k < plain.height_um.size(); ++k) EXPECT_EQ(inverted.height_um[k], -plain.height_um[k]);
+  for (std::size_t k = 0; k < plain.height_um.size(); ++k)
+    EXPECT_EQ(inverted.height_um[k], -plain.height_um[k]);
 }
 
 TEST(PlaceInPartFrame, PutsEachPixelAtItsLateralPositionWithRowsRunningDownTheCamera) {
@@ -180,8 +183,13 @@ TEST(PlaceInPartFrame, RotatesFlipsScalesAndTranslatesAsTheRigidMotionItNames) {
   for (int k = 0; k < 12; ++k) pixels.height_um.push_back(k + 1.0);
   for (const int rotation : {0, 90, 180, 270}) {
     for (const auto flip : {MapPlacement::Flip::kNone, MapPlacement::Flip::kX, MapPlacement::Flip::kY}) {
-      MapPlacement placement{.centre_column = 1.0, .centre_row = 2.0, .centre_x_mm = 10.0, .centre_y_mm = -4.0,
-                             .rotation_deg = rotation, .flip = flip, .scale = -2.0};
+      MapPlacement placement{.centre_column = 1.0,
+                             .centre_row = 2.0,
+                             .centre_x_mm = 10.0,
+                             .centre_y_mm = -4.0,
+                             .rotation_deg = rotation,
+                             .flip = flip,
+                             .scale = -2.0};
       const ErrorMap map = PlaceInPartFrame(pixels, placement, "m.dat");
       const double a = rotation * M_PI / 180.0;
       for (int j = 0; j < 3; ++j) {
@@ -189,7 +197,8 @@ TEST(PlaceInPartFrame, RotatesFlipsScalesAndTranslatesAsTheRigidMotionItNames) {
           double u = (i - 1.0) * 0.5, v = (2.0 - j) * 0.5;
           if (flip == MapPlacement::Flip::kX) u = -u;
           if (flip == MapPlacement::Flip::kY) v = -v;
-          const double x = std::cos(a) * u - std::sin(a) * v + 10.0, y = std::sin(a) * u + std::cos(a) * v - 4.0;
+          const double x = std::cos(a) * u - std::sin(a) * v + 10.0,
+                       y = std::sin(a) * u + std::cos(a) * v - 4.0;
           const int I = static_cast<int>(std::lround((x - map.x0_mm) / map.dx_mm));
           const int J = static_cast<int>(std::lround((y - map.y0_mm) / map.dy_mm));
           ASSERT_TRUE(I >= 0 && I < map.nx && J >= 0 && J < map.ny);
@@ -224,9 +233,12 @@ TEST(ParseMetroProDat, RefusesCorruptHeadersNamingTheFileAndTheField) {
   std::vector<unsigned char> b = good;
   b[3] = 0x00;
   EXPECT_TRUE(Contains(error(b), "'bad.dat'") && Contains(error(b), "magic_number")) << error(b);
-  EXPECT_TRUE(Contains(error({good.begin(), good.end() - 1}), "'cn_width' x 'cn_height'")) << error({good.begin(), good.end() - 1});
-  EXPECT_TRUE(Contains(error({good.begin(), good.begin() + 500}), "header_size")) << error({good.begin(), good.begin() + 500});
-  EXPECT_TRUE(Contains(error({good.begin(), good.begin() + 5}), "header_format")) << error({good.begin(), good.begin() + 5});
+  EXPECT_TRUE(Contains(error({good.begin(), good.end() - 1}), "'cn_width' x 'cn_height'"))
+      << error({good.begin(), good.end() - 1});
+  EXPECT_TRUE(Contains(error({good.begin(), good.begin() + 500}), "header_size"))
+      << error({good.begin(), good.begin() + 500});
+  EXPECT_TRUE(Contains(error({good.begin(), good.begin() + 5}), "header_format"))
+      << error({good.begin(), good.begin() + 5});
   b = good;
   PutBe(b, 4, 3, 2);  // format 3 with the format-1 magic
   EXPECT_TRUE(Contains(error(b), "header_format")) << error(b);
@@ -278,7 +290,8 @@ void WriteConverter(hid_t dataset, const char* name, const DatxSpec& spec, const
     H5Tinsert(type, "Category", HOFFSET(Converter, category), string_type);
     H5Tinsert(type, "BaseUnit", HOFFSET(Converter, unit), string_type);
     H5Tinsert(type, "Parameters", HOFFSET(Converter, parameters), numbers_type);
-    const Converter value{category.c_str(), unit.c_str(), {parameters.size(), const_cast<double*>(parameters.data())}};
+    const Converter value{
+        category.c_str(), unit.c_str(), {parameters.size(), const_cast<double*>(parameters.data())}};
     buffer.resize(sizeof value);
     std::memcpy(buffer.data(), &value, sizeof value);
   } else {
@@ -329,10 +342,12 @@ void WriteDatx(const std::filesystem::path& path, const DatxSpec& spec, int widt
   if (spec.with_surface) {
     const hsize_t dims[2] = {static_cast<hsize_t>(height), static_cast<hsize_t>(width)};
     const hid_t space = H5Screate_simple(2, dims, nullptr);
-    const hid_t dataset = H5Dcreate2(group, "Surface", H5T_IEEE_F64LE, space, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
+    const hid_t dataset =
+        H5Dcreate2(group, "Surface", H5T_IEEE_F64LE, space, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
     std::vector<double> values;
     for (int j = 0; j < height; ++j) {
-      for (int i = 0; i < width; ++i) values.push_back(std::isnan(heights_in_unit(i, j)) ? spec.no_data : heights_in_unit(i, j));
+      for (int i = 0; i < width; ++i)
+        values.push_back(std::isnan(heights_in_unit(i, j)) ? spec.no_data : heights_in_unit(i, j));
     }
     H5Dwrite(dataset, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, values.data());
     WriteDoublesAttribute(dataset, "No Data", spec.no_data);
@@ -404,7 +419,9 @@ TEST(ReadZygoDatx, RefusesAFileWithoutTheSurfaceDatasetOrAHeightUnit) {
   spec.z_unit = "Volts";
   WriteDatx(dir / "volts.datx", spec, 3, 2, DatxHeightNm);
   message = ErrorOf([&] { (void)ReadZygoDatx(dir / "volts.datx"); });
-  EXPECT_TRUE(Contains(message, "volts.datx'") && Contains(message, "Z Converter") && Contains(message, "Volts")) << message;
+  EXPECT_TRUE(Contains(message, "volts.datx'") && Contains(message, "Z Converter") &&
+              Contains(message, "Volts"))
+      << message;
 }
 
 // libhdf5 1.10 steps through a global heap collection by each object's size and never returns from
@@ -448,15 +465,17 @@ TEST(ReadZygoDatx, RefusesAReferenceToAMissingOrLongerHeapObject) {
   std::vector<unsigned char> orphaned = good;
   orphaned[object] = 0xff;
   orphaned[object + 1] = 0x7f;
-  std::string message =
-      ErrorOf([&] { (void)ReadZygoDatx(hdf5::File::OpenImage(orphaned.data(), orphaned.size(), "orphaned.datx")); });
-  EXPECT_TRUE(Contains(message, "orphaned.datx'") && Contains(message, "'Category' of attribute 'Z Converter'") &&
+  std::string message = ErrorOf(
+      [&] { (void)ReadZygoDatx(hdf5::File::OpenImage(orphaned.data(), orphaned.size(), "orphaned.datx")); });
+  EXPECT_TRUE(Contains(message, "orphaned.datx'") &&
+              Contains(message, "'Category' of attribute 'Z Converter'") &&
               Contains(message, "which has none"))
       << message;
 
   std::vector<unsigned char> longer = good;
   longer[object + 8] = 15;  // same step through the collection: 15 and 9 both align to 16
-  message = ErrorOf([&] { (void)ReadZygoDatx(hdf5::File::OpenImage(longer.data(), longer.size(), "longer.datx")); });
+  message = ErrorOf(
+      [&] { (void)ReadZygoDatx(hdf5::File::OpenImage(longer.data(), longer.size(), "longer.datx")); });
   EXPECT_TRUE(Contains(message, "longer.datx'") && Contains(message, "refers to 9 bytes") &&
               Contains(message, "which holds 15"))
       << message;
@@ -507,11 +526,14 @@ TEST(ErrorMapHdf5, RefusesAMissingAttributeOrDatasetByName) {
 struct P2 {
   double x, y;
 };
-double Cross(const P2& o, const P2& a, const P2& b) { return (a.x - o.x) * (b.y - o.y) - (a.y - o.y) * (b.x - o.x); }
+double Cross(const P2& o, const P2& a, const P2& b) {
+  return (a.x - o.x) * (b.y - o.y) - (a.y - o.y) * (b.x - o.x);
+}
 
 // Convex hull (Andrew's monotone chain), counter-clockwise: an independent check of the hull.
 std::vector<P2> Hull(std::vector<P2> p) {
-  std::sort(p.begin(), p.end(), [](const P2& a, const P2& b) { return a.x < b.x || (a.x == b.x && a.y < b.y); });
+  std::sort(p.begin(), p.end(),
+            [](const P2& a, const P2& b) { return a.x < b.x || (a.x == b.x && a.y < b.y); });
   std::vector<P2> h(2 * p.size());
   std::size_t k = 0;
   for (std::size_t i = 0; i < p.size(); ++i) {
@@ -536,7 +558,8 @@ double InsideBy(const std::vector<P2>& hull, double x, double y) {
   return d;
 }
 
-std::vector<ScatteredPoint> RandomPoints(int count, const std::function<double(double, double)>& f, unsigned seed) {
+std::vector<ScatteredPoint> RandomPoints(int count, const std::function<double(double, double)>& f,
+                                         unsigned seed) {
   std::mt19937 rng(seed);  // fixed seed: a failure must reproduce
   std::uniform_real_distribution<double> u(-20.0, 20.0);
   std::vector<ScatteredPoint> points;
@@ -561,10 +584,12 @@ TEST(InterpolateScattered, ReproducesAPlaneExactlyAndLeavesNodesOutsideTheHullWi
       const double d = InsideBy(hull, map.X(i), map.Y(j));
       if (d > 1e-9) {
         ++inside;
-        ASSERT_TRUE(std::isfinite(map.At(i, j))) << "node (" << map.X(i) << ", " << map.Y(j) << ") inside the hull by " << d;
+        ASSERT_TRUE(std::isfinite(map.At(i, j)))
+            << "node (" << map.X(i) << ", " << map.Y(j) << ") inside the hull by " << d;
         EXPECT_NEAR(map.At(i, j), plane(map.X(i), map.Y(j)), 1e-12);
       } else if (d < -1e-9) {
-        EXPECT_TRUE(std::isnan(map.At(i, j))) << "node (" << map.X(i) << ", " << map.Y(j) << ") outside the hull";
+        EXPECT_TRUE(std::isnan(map.At(i, j)))
+            << "node (" << map.X(i) << ", " << map.Y(j) << ") outside the hull";
       }
     }
   }
@@ -609,12 +634,14 @@ TEST(InterpolateScattered, StaysWithinTheLinearInterpolationBoundOfAQuadratic) {
 }
 
 TEST(InterpolateScattered, DefaultsTheSpacingToTheMedianNearestNeighbourDistance) {
-  const std::vector<ScatteredPoint> points = RandomPoints(101, [](double, double) { return 0.0; }, 99);
+  const std::vector<ScatteredPoint> points = RandomPoints(
+      101, [](double, double) { return 0.0; }, 99);
   std::vector<double> nearest;
   for (std::size_t a = 0; a < points.size(); ++a) {
     double best = std::numeric_limits<double>::infinity();
     for (std::size_t b = 0; b < points.size(); ++b) {
-      if (a != b) best = std::min(best, std::hypot(points[a].x_mm - points[b].x_mm, points[a].y_mm - points[b].y_mm));
+      if (a != b)
+        best = std::min(best, std::hypot(points[a].x_mm - points[b].x_mm, points[a].y_mm - points[b].y_mm));
     }
     nearest.push_back(best);
   }
@@ -627,14 +654,18 @@ TEST(ReadScatteredCsv, RefusesTooFewCollinearOrCoincidentPointsNamingTheFile) {
   arcwheel::testing::TempDir dir;
   auto error = [&](const std::string& text) {
     std::ofstream(dir / "pts.csv") << text;
-    return ErrorOf([&] { (void)InterpolateScattered(ReadScatteredCsv(dir / "pts.csv"), 1.0, (dir / "pts.csv").string()); });
+    return ErrorOf([&] {
+      (void)InterpolateScattered(ReadScatteredCsv(dir / "pts.csv"), 1.0, (dir / "pts.csv").string());
+    });
   };
   std::string m = error("x_mm,y_mm,error_um\n0,0,1\n1,0,2\n");
   EXPECT_TRUE(Contains(m, "pts.csv'") && Contains(m, "2 scattered points")) << m;
   m = error("x_mm,y_mm,error_um\n0,0,1\n1,1,2\n2,2,3\n3,3,1\n");
   EXPECT_TRUE(Contains(m, "pts.csv'") && Contains(m, "one line")) << m;
   m = error("x_mm,y_mm,error_um\n0,0,1\n1,0,2\n0,1,3\n# repeat\n1,0,5\n");
-  EXPECT_TRUE(Contains(m, "pts.csv'") && Contains(m, "line 3") && Contains(m, "line 6") && Contains(m, "one place")) << m;
+  EXPECT_TRUE(Contains(m, "pts.csv'") && Contains(m, "line 3") && Contains(m, "line 6") &&
+              Contains(m, "one place"))
+      << m;
   m = error("x_mm,y_mm,error_um\n0,0,1\n1,0,nan\n0,1,3\n");
   EXPECT_TRUE(Contains(m, "pts.csv' line 3")) << m;
 }
@@ -647,7 +678,8 @@ std::string Job(const std::string& error_map) {
              "aperture": {"diameter_mm": 20.0},
              "removal_function": {"peak_rate_um_per_s": 1.5, "fwhm_mm": 5.0},
              "machine": {"max_speed_mm_s": 150.0},
-             "error_map": )" + error_map + "}";
+             "error_map": )" +
+         error_map + "}";
 }
 
 PolishJob ReadJob(const arcwheel::testing::TempDir& dir, const std::string& error_map) {
@@ -660,10 +692,13 @@ TEST(PolishJobErrorMap, ReadsEachFormatByItsExtensionAndAppliesThePlacementKeys)
   DatSpec spec;
   spec.height_m = TestHeightM;
   const std::vector<unsigned char> dat = MetroProImage(spec);
-  std::ofstream(dir / "map.dat", std::ios::binary).write(reinterpret_cast<const char*>(dat.data()), static_cast<std::streamsize>(dat.size()));
+  std::ofstream(dir / "map.dat", std::ios::binary)
+      .write(reinterpret_cast<const char*>(dat.data()), static_cast<std::streamsize>(dat.size()));
   const PixelMap pixels = ParseMetroProDat(dat, "map.dat");
-  PolishJob job = ReadJob(dir, R"({"file": "map.dat", "rotation_deg": 90, "scale": -1, "centre_mm": [1, 2]})");
-  const ErrorMap expected = PlaceInPartFrame(pixels, {.centre_x_mm = 1, .centre_y_mm = 2, .rotation_deg = 90, .scale = -1}, "map.dat");
+  PolishJob job =
+      ReadJob(dir, R"({"file": "map.dat", "rotation_deg": 90, "scale": -1, "centre_mm": [1, 2]})");
+  const ErrorMap expected = PlaceInPartFrame(
+      pixels, {.centre_x_mm = 1, .centre_y_mm = 2, .rotation_deg = 90, .scale = -1}, "map.dat");
   EXPECT_EQ(job.error_map.nx, 5);
   EXPECT_EQ(job.error_map.ny, 7);
   EXPECT_EQ(job.error_map.x0_mm, expected.x0_mm);
@@ -679,7 +714,13 @@ TEST(PolishJobErrorMap, ReadsEachFormatByItsExtensionAndAppliesThePlacementKeys)
   EXPECT_EQ(job.error_map.dx_mm, 0.5);
   EXPECT_NEAR(job.error_map.At(20, 20), 1.0, 1e-12);  // (0, 0) lies inside the triangle
 
-  ErrorMap grid{.x0_mm = -10, .y0_mm = -10, .dx_mm = 1, .dy_mm = 1, .nx = 21, .ny = 21, .error_um = std::vector<double>(441, 0.5)};
+  ErrorMap grid{.x0_mm = -10,
+                .y0_mm = -10,
+                .dx_mm = 1,
+                .dy_mm = 1,
+                .nx = 21,
+                .ny = 21,
+                .error_um = std::vector<double>(441, 0.5)};
   WriteErrorMapHdf5(grid, dir / "grid.h5");
   job = ReadJob(dir, R"({"file": "grid.h5", "scale": 2})");
   EXPECT_EQ(job.error_map.At(3, 4), 1.0);
@@ -688,10 +729,15 @@ TEST(PolishJobErrorMap, ReadsEachFormatByItsExtensionAndAppliesThePlacementKeys)
 TEST(PolishJobErrorMap, RefusesUnknownAndMisappliedKeysByDottedName) {
   arcwheel::testing::TempDir dir;
   std::ofstream(dir / "map.csv") << "x_mm,y_mm,error_um\n0,0,1\n1,0,1\n";
-  auto message = [&](const std::string& error_map) { return ErrorOf([&] { (void)ReadJob(dir, error_map); }); };
-  EXPECT_TRUE(Contains(message(R"({"file": "map.csv", "pixel_size": 1})"), "'error_map.pixel_size' is an unknown key"));
-  EXPECT_TRUE(Contains(message(R"({"file": "map.csv", "rotation_deg": 90})"), "'error_map.rotation_deg' applies only"));
-  EXPECT_TRUE(Contains(message(R"({"file": "map.csv", "grid_spacing_mm": 1})"), "'error_map.grid_spacing_mm' applies only"));
+  auto message = [&](const std::string& error_map) {
+    return ErrorOf([&] { (void)ReadJob(dir, error_map); });
+  };
+  EXPECT_TRUE(Contains(message(R"({"file": "map.csv", "pixel_size": 1})"),
+                       "'error_map.pixel_size' is an unknown key"));
+  EXPECT_TRUE(Contains(message(R"({"file": "map.csv", "rotation_deg": 90})"),
+                       "'error_map.rotation_deg' applies only"));
+  EXPECT_TRUE(Contains(message(R"({"file": "map.csv", "grid_spacing_mm": 1})"),
+                       "'error_map.grid_spacing_mm' applies only"));
   EXPECT_TRUE(Contains(message(R"({"file": "map.csv", "format": "zyg"})"), "'error_map.format' = \"zyg\""));
   EXPECT_TRUE(Contains(message(R"({"file": "map.txt"})"), "'error_map.format' is required"));
   EXPECT_TRUE(Contains(message(R"({"file": "map.csv", "scale": 0})"), "'error_map.scale' must be non-zero"));
@@ -705,7 +751,8 @@ TEST(ErrorMapSeeds, SmallSamplesOfEachFormatReadBack) {
   DatSpec spec;
   spec.height_m = TestHeightM;
   const std::vector<unsigned char> dat = MetroProImage(spec);
-  std::ofstream(dir / "map_small.dat", std::ios::binary).write(reinterpret_cast<const char*>(dat.data()), static_cast<std::streamsize>(dat.size()));
+  std::ofstream(dir / "map_small.dat", std::ios::binary)
+      .write(reinterpret_cast<const char*>(dat.data()), static_cast<std::streamsize>(dat.size()));
   WriteDatx(dir / "map_small.datx", DatxSpec{}, 6, 4, DatxHeightNm);
   ErrorMap grid{.x0_mm = -2, .y0_mm = -1, .dx_mm = 1, .dy_mm = 1, .nx = 5, .ny = 3, .error_um = {}};
   for (int k = 0; k < 15; ++k) grid.error_um.push_back(k == 4 ? kNaN : 0.05 * k);
@@ -713,14 +760,16 @@ TEST(ErrorMapSeeds, SmallSamplesOfEachFormatReadBack) {
   {
     std::ofstream csv(dir / "map_scattered.csv");
     csv << "x_mm,y_mm,error_um\n";
-    for (const ScatteredPoint& p : RandomPoints(12, [](double x, double y) { return 0.01 * x * y; }, 5)) {
+    for (const ScatteredPoint& p : RandomPoints(
+             12, [](double x, double y) { return 0.01 * x * y; }, 5)) {
       csv << p.x_mm << "," << p.y_mm << "," << p.error_um << "\n";
     }
   }
   EXPECT_EQ(ReadMetroProDat(dir / "map_small.dat").width, 7);
   EXPECT_EQ(ReadZygoDatx(dir / "map_small.datx").width, 6);
   EXPECT_EQ(ReadErrorMapHdf5(dir / "map_small_grid.h5").nx, 5);
-  EXPECT_GT(InterpolateScattered(ReadScatteredCsv(dir / "map_scattered.csv"), 0.0, "map_scattered.csv").nx, 1);
+  EXPECT_GT(InterpolateScattered(ReadScatteredCsv(dir / "map_scattered.csv"), 0.0, "map_scattered.csv").nx,
+            1);
   if (const char* folder = std::getenv("ARCWHEEL_WRITE_SEEDS")) {
     for (const char* name : {"map_small.dat", "map_small.datx", "map_small_grid.h5", "map_scattered.csv"}) {
       std::filesystem::copy_file(dir / name, std::filesystem::path(folder) / name,

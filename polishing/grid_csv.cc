@@ -67,11 +67,13 @@ std::vector<CsvTriple> ReadCsvTriples(const std::filesystem::path& path, std::st
       if (count == 3) LineFail(stage, path, line, "has more than 3 values");
       char* end = nullptr;
       v[count] = std::strtod(cell.c_str(), &end);
-      if (cell.empty() || *end != '\0') LineFail(stage, path, line, fmt::format("'{}' is not a number", cell));
+      if (cell.empty() || *end != '\0')
+        LineFail(stage, path, line, fmt::format("'{}' is not a number", cell));
       ++count;
     }
     if (count != 3) LineFail(stage, path, line, fmt::format("has {} values, needs {}", count, header));
-    if (!std::isfinite(v[0]) || !std::isfinite(v[1])) LineFail(stage, path, line, "x_mm and y_mm must be finite");
+    if (!std::isfinite(v[0]) || !std::isfinite(v[1]))
+      LineFail(stage, path, line, "x_mm and y_mm must be finite");
     rows.push_back({v[0], v[1], v[2], line});
   }
   if (in.bad()) throw Error(ErrorCode::kIo, stage, fmt::format("cannot read '{}'", path.string()));
@@ -79,7 +81,8 @@ std::vector<CsvTriple> ReadCsvTriples(const std::filesystem::path& path, std::st
   return rows;
 }
 
-CsvGrid ReadCsvGrid(const std::filesystem::path& path, std::string_view value_column, std::string_view stage) {
+CsvGrid ReadCsvGrid(const std::filesystem::path& path, std::string_view value_column,
+                    std::string_view stage) {
   const std::vector<CsvTriple> rows = ReadCsvTriples(path, value_column, stage);
   CsvGrid grid;
   grid.last_line = rows.empty() ? 1 : rows.back().line;
@@ -95,10 +98,11 @@ CsvGrid ReadCsvGrid(const std::filesystem::path& path, std::string_view value_co
   if (!(nx * ny <= kMaxNodes)) LineFail(stage, path, grid.last_line, "the grid would exceed 1e8 nodes");
   // A measured map fills most of its grid; a few rows spanning a vast grid are not a grid at all.
   if (nx * ny > 64.0 * static_cast<double>(rows.size()) + 4096.0) {
-    LineFail(stage, path, grid.last_line,
-             fmt::format("{} nodes spread over a grid of {} x {}: not the nodes of one regular grid (scattered "
-                         "points? set error_map.layout to scattered)",
-                         rows.size(), nx, ny));
+    LineFail(
+        stage, path, grid.last_line,
+        fmt::format("{} nodes spread over a grid of {} x {}: not the nodes of one regular grid (scattered "
+                    "points? set error_map.layout to scattered)",
+                    rows.size(), nx, ny));
   }
   grid.nx = static_cast<int>(nx);
   grid.ny = static_cast<int>(ny);
@@ -109,11 +113,13 @@ CsvGrid ReadCsvGrid(const std::filesystem::path& path, std::string_view value_co
     const int i = GridIndex(r.x_mm, grid.x0_mm, grid.dx_mm), j = GridIndex(r.y_mm, grid.y0_mm, grid.dy_mm);
     if (i < 0 || j < 0 || i >= grid.nx || j >= grid.ny) {
       LineFail(stage, path, r.line,
-               fmt::format("({}, {}) mm is not on the regular grid of spacing {} x {} mm", r.x_mm, r.y_mm, grid.dx_mm,
-                           grid.dy_mm));
+               fmt::format("({}, {}) mm is not on the regular grid of spacing {} x {} mm", r.x_mm, r.y_mm,
+                           grid.dx_mm, grid.dy_mm));
     }
-    const std::size_t index = static_cast<std::size_t>(j) * static_cast<std::size_t>(grid.nx) + static_cast<std::size_t>(i);
-    if (grid.lines[index] != 0) LineFail(stage, path, r.line, fmt::format("({}, {}) mm appears twice", r.x_mm, r.y_mm));
+    const std::size_t index =
+        static_cast<std::size_t>(j) * static_cast<std::size_t>(grid.nx) + static_cast<std::size_t>(i);
+    if (grid.lines[index] != 0)
+      LineFail(stage, path, r.line, fmt::format("({}, {}) mm appears twice", r.x_mm, r.y_mm));
     grid.lines[index] = r.line;
     grid.values[index] = r.value;
   }

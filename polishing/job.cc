@@ -5,13 +5,13 @@
 
 #include <algorithm>
 #include <cmath>
-#include <utility>
 #include <fstream>
 #include <iterator>
 #include <limits>
 #include <map>
 #include <set>
 #include <sstream>
+#include <utility>
 
 #include "core/atomic_file.h"
 #include "core/error.h"
@@ -32,14 +32,18 @@ class Section {
     if (object_ != nullptr && !object_->is_object()) Fail("", "must be an object");
   }
   [[noreturn]] void Fail(const std::string& key, const std::string& what) const {
-    throw Error(ErrorCode::kBadInput, kStage, fmt::format("'{}': '{}' {}", source_.string(), Dotted(key), what));
+    throw Error(ErrorCode::kBadInput, kStage,
+                fmt::format("'{}': '{}' {}", source_.string(), Dotted(key), what));
   }
-  [[nodiscard]] bool Has(const std::string& key) const { return object_ != nullptr && object_->contains(key); }
+  [[nodiscard]] bool Has(const std::string& key) const {
+    return object_ != nullptr && object_->contains(key);
+  }
   double Number(const std::string& key, double fallback) {
     used_.insert(key);
     double v = fallback;
     if (Has(key)) {
-      if (!object_->at(key).is_number() || !std::isfinite(object_->at(key).get<double>())) Fail(key, "must be a finite number");
+      if (!object_->at(key).is_number() || !std::isfinite(object_->at(key).get<double>()))
+        Fail(key, "must be a finite number");
       v = object_->at(key).get<double>();
     }
     resolved_[key] = v;
@@ -150,7 +154,8 @@ std::shared_ptr<const grinding::Surface> ReadSurface(Section& s) {
   if (s.Has("coefficients")) {
     // The same form as the grinding job: {"A4": ..., "A6": ..., ..., "A20": ...}.
     Section c = s.Child("coefficients");
-    for (int order = 4; order <= 20; order += 2) p.even_coefficients.push_back(c.Number(fmt::format("A{}", order), 0.0));
+    for (int order = 4; order <= 20; order += 2)
+      p.even_coefficients.push_back(c.Number(fmt::format("A{}", order), 0.0));
     while (!p.even_coefficients.empty() && p.even_coefficients.back() == 0.0) p.even_coefficients.pop_back();
     c.Finish();
     s.Adopt("coefficients", c);
@@ -184,7 +189,8 @@ grinding::Aperture ReadAperture(Section& s) {
 AbbQuaternion ReadQuaternion(Section& s, const std::string& key) {
   const std::vector<double> q = s.Numbers(key, {1.0, 0.0, 0.0, 0.0});
   const double norm = std::sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
-  if (std::abs(norm - 1.0) > 1e-6) s.Fail(key, fmt::format("must be a unit quaternion (q1 scalar first), has norm {}", norm));
+  if (std::abs(norm - 1.0) > 1e-6)
+    s.Fail(key, fmt::format("must be a unit quaternion (q1 scalar first), has norm {}", norm));
   return {q[0] / norm, q[1] / norm, q[2] / norm, q[3] / norm};
 }
 
@@ -202,7 +208,8 @@ void ReadMachine(Section& s, PolishJob& job) {
     s.Fail("min_dwell_s", "is unreachable together with min_speed_mm_s: give one of them");
   }
   job.dwell.max_acceleration_mm_s2 = s.Number("max_acceleration_mm_s2", 0.0);
-  if (!(job.dwell.max_acceleration_mm_s2 >= 0.0)) s.Fail("max_acceleration_mm_s2", "must be >= 0 (0 = no limit)");
+  if (!(job.dwell.max_acceleration_mm_s2 >= 0.0))
+    s.Fail("max_acceleration_mm_s2", "must be >= 0 (0 = no limit)");
   job.robot_side = s.Choice("robot_side", {"+x", "-x"}) == "+x" ? RobotSide::kPlusX : RobotSide::kMinusX;
 }
 
@@ -225,26 +232,34 @@ ErrorMap ReadErrorMapSection(Section& s, const std::filesystem::path& file) {
   if (!s.Has("format")) {
     try {
       const ErrorMapFormat implied = FormatFromExtension(file);
-      std::rotate(formats.begin(), formats.begin() + static_cast<int>(implied), formats.begin() + static_cast<int>(implied) + 1);
+      std::rotate(formats.begin(), formats.begin() + static_cast<int>(implied),
+                  formats.begin() + static_cast<int>(implied) + 1);
     } catch (const Error&) {
-      s.Fail("format", fmt::format("is required: the extension of '{}' names no format (csv, dat, datx, h5)", file.string()));
+      s.Fail("format", fmt::format("is required: the extension of '{}' names no format (csv, dat, datx, h5)",
+                                   file.string()));
     }
   }
   const std::string format = s.Choice("format", formats);
   ErrorMapOptions options;
-  options.format = format == "csv" ? ErrorMapFormat::kCsv : format == "dat" ? ErrorMapFormat::kDat
-                 : format == "datx" ? ErrorMapFormat::kDatx : ErrorMapFormat::kHdf5;
+  options.format = format == "csv"    ? ErrorMapFormat::kCsv
+                   : format == "dat"  ? ErrorMapFormat::kDat
+                   : format == "datx" ? ErrorMapFormat::kDatx
+                                      : ErrorMapFormat::kHdf5;
   options.placement.scale = s.Number("scale", 1.0);
-  if (options.placement.scale == 0.0) s.Fail("scale", "must be non-zero (+1: height = material to remove, -1: depth)");
+  if (options.placement.scale == 0.0)
+    s.Fail("scale", "must be non-zero (+1: height = material to remove, -1: depth)");
   const bool pixels = options.format == ErrorMapFormat::kDat || options.format == ErrorMapFormat::kDatx;
   for (const char* key : {"pixel_mm", "centre_px", "centre_mm", "rotation_deg", "flip"}) {
-    if (!pixels && s.Has(key)) s.Fail(key, "applies only to interferometer maps (format \"dat\" or \"datx\")");
+    if (!pixels && s.Has(key))
+      s.Fail(key, "applies only to interferometer maps (format \"dat\" or \"datx\")");
   }
-  if (options.format != ErrorMapFormat::kCsv && s.Has("layout")) s.Fail("layout", "applies only to format \"csv\"");
+  if (options.format != ErrorMapFormat::kCsv && s.Has("layout"))
+    s.Fail("layout", "applies only to format \"csv\"");
   if (options.format == ErrorMapFormat::kCsv) {
     const bool scattered = s.Choice("layout", {"grid", "scattered"}) == "scattered";
     options.layout = scattered ? ErrorMapLayout::kScattered : ErrorMapLayout::kGrid;
-    if (!scattered && s.Has("grid_spacing_mm")) s.Fail("grid_spacing_mm", "applies only to layout \"scattered\"");
+    if (!scattered && s.Has("grid_spacing_mm"))
+      s.Fail("grid_spacing_mm", "applies only to layout \"scattered\"");
     if (scattered && s.Has("grid_spacing_mm")) {
       options.grid_spacing_mm = s.Number("grid_spacing_mm", 0.0);
       if (!(options.grid_spacing_mm > 0.0)) s.Fail("grid_spacing_mm", "must be > 0");
@@ -278,7 +293,9 @@ ErrorMap ReadErrorMapSection(Section& s, const std::filesystem::path& file) {
   }
   p.rotation_deg = static_cast<int>(rotation);
   const std::string flip = s.Choice("flip", {"none", "x", "y"});
-  p.flip = flip == "x" ? MapPlacement::Flip::kX : flip == "y" ? MapPlacement::Flip::kY : MapPlacement::Flip::kNone;
+  p.flip = flip == "x"   ? MapPlacement::Flip::kX
+           : flip == "y" ? MapPlacement::Flip::kY
+                         : MapPlacement::Flip::kNone;
   return PlaceInPartFrame(raw, p, file.string());
 }
 
@@ -305,7 +322,8 @@ PolishJob ReadPolishJob(const std::filesystem::path& path) {
   section("error_map", [&](Section& c) {
     const std::string file = c.String("file", "");
     if (file.empty()) c.Fail("file", "is required: the error map (.csv, .dat, .datx or .h5)");
-    job.error_map_file = std::filesystem::path(file).is_absolute() ? std::filesystem::path(file) : path.parent_path() / file;
+    job.error_map_file =
+        std::filesystem::path(file).is_absolute() ? std::filesystem::path(file) : path.parent_path() / file;
     job.error_map = ReadErrorMapSection(c, job.error_map_file);
   });
   section("removal_target", [&](Section& c) {
@@ -329,7 +347,8 @@ PolishJob ReadPolishJob(const std::filesystem::path& path) {
     job.removal = gaussian;
   });
   section("path", [&](Section& c) {
-    job.path_pattern = c.Choice("type", {"raster", "spiral"}) == "spiral" ? PathPattern::kSpiral : PathPattern::kRaster;
+    job.path_pattern =
+        c.Choice("type", {"raster", "spiral"}) == "spiral" ? PathPattern::kSpiral : PathPattern::kRaster;
     // Defaults from the removal function's (equivalent) width: see removal_function.h.
     job.path.line_spacing_mm = c.Number("line_spacing_mm", job.removal.EquivalentFwhmMm() / 5.0);
     if (!(job.path.line_spacing_mm > 0.0)) c.Fail("line_spacing_mm", "must be > 0");
@@ -350,7 +369,8 @@ PolishJob ReadPolishJob(const std::filesystem::path& path) {
     section("precession", [&](Section& c) {
       job.precession.enabled = true;
       job.precession.tilt_deg = c.RequiredNumber("tilt_deg");
-      if (!(job.precession.tilt_deg >= 0.0 && job.precession.tilt_deg < 90.0)) c.Fail("tilt_deg", "must lie in [0, 90)");
+      if (!(job.precession.tilt_deg >= 0.0 && job.precession.tilt_deg < 90.0))
+        c.Fail("tilt_deg", "must lie in [0, 90)");
       job.precession.precession_rate_rpm = c.RequiredNumber("precession_rate_rpm");
       job.precession.bonnet_radius_mm = c.Number("bonnet_radius_mm", 0.0);
       if (!(job.precession.bonnet_radius_mm >= 0.0)) c.Fail("bonnet_radius_mm", "must be >= 0");
@@ -384,8 +404,9 @@ void CheckOnSurface(const PolishJob& job, std::span<const Eigen::Vector2d> path)
     if (!job.surface->InDomain(path[k].x(), path[k].y())) {
       throw Error(ErrorCode::kBadInput, kStage,
                   fmt::format("'{}': path point {} ({}, {}) mm (aperture grown by path.extension_mm = {}) "
-                              "is off the surface {}", job.source.string(), k, path[k].x(), path[k].y(),
-                              job.path.extension_mm, job.surface->Describe()));
+                              "is off the surface {}",
+                              job.source.string(), k, path[k].x(), path[k].y(), job.path.extension_mm,
+                              job.surface->Describe()));
     }
   }
 }
@@ -397,8 +418,8 @@ std::string ResidualCsv(const ErrorMap& target, const DwellSolution& d) {
     for (int i = 0; i < target.nx; ++i) {
       const std::size_t k = static_cast<std::size_t>(j) * target.nx + i;
       if (!std::isfinite(d.residual_um.error_um[k])) continue;
-      fmt::format_to(std::back_inserter(out), "{},{},{},{},{}\n", target.X(i), target.Y(j), target.error_um[k],
-                     d.predicted_removal_um.error_um[k], d.residual_um.error_um[k]);
+      fmt::format_to(std::back_inserter(out), "{},{},{},{},{}\n", target.X(i), target.Y(j),
+                     target.error_um[k], d.predicted_removal_um.error_um[k], d.residual_um.error_um[k]);
     }
   }
   return fmt::to_string(out);
@@ -407,34 +428,39 @@ std::string ResidualCsv(const ErrorMap& target, const DwellSolution& d) {
 }  // namespace
 
 PolishRunReport RunPolishJob(const PolishJob& job, const std::filesystem::path& output_folder) {
-  const std::vector<Eigen::Vector2d> path =
-      job.path_pattern == PathPattern::kSpiral ? SpiralPath(job.aperture, job.path) : RasterPath(job.aperture, job.path);
+  const std::vector<Eigen::Vector2d> path = job.path_pattern == PathPattern::kSpiral
+                                                ? SpiralPath(job.aperture, job.path)
+                                                : RasterPath(job.aperture, job.path);
   CheckOnSurface(job, path);
   const ErrorMap target = RemovalTarget(job.error_map, job.aperture, job.target);
   PolishRunReport report;
   report.dwell = SolveDwell(target, job.aperture, path, job.removal, job.dwell);
-  const std::vector<PolishingPoint> points = BuildPolishingPath(*job.surface, path, report.dwell, job.robot_side, job.precession);
+  const std::vector<PolishingPoint> points =
+      BuildPolishingPath(*job.surface, path, report.dwell, job.robot_side, job.precession);
   report.points = points.size();
-  report.max_speed_mm_s = *std::max_element(report.dwell.speed_mm_s.begin() + 1, report.dwell.speed_mm_s.end());
-  report.min_speed_mm_s = *std::min_element(report.dwell.speed_mm_s.begin() + 1, report.dwell.speed_mm_s.end());
+  report.max_speed_mm_s =
+      *std::max_element(report.dwell.speed_mm_s.begin() + 1, report.dwell.speed_mm_s.end());
+  report.min_speed_mm_s =
+      *std::min_element(report.dwell.speed_mm_s.begin() + 1, report.dwell.speed_mm_s.end());
 
-  const std::vector<std::string> comments = {
-      fmt::format("arcwheel {} polish, job '{}'", kVersion, job.name),
-      fmt::format("surface: {}", job.surface->Describe()),
-      fmt::format("aperture: {}", job.aperture.Describe()),
-      fmt::format("removal function: {}", job.removal.Describe())};
-  json summary = {
-      {"arcwheel_version", kVersion},
-      {"job", job.resolved},
-      {"points", report.points},
-      {"total_time_s", report.dwell.total_time_s},
-      {"before", {{"pv_um", report.dwell.before.pv_um}, {"rms_um", report.dwell.before.rms_um}}},
-      {"after", {{"pv_um", report.dwell.after.pv_um}, {"rms_um", report.dwell.after.rms_um}}},
-      {"aperture_nodes", report.dwell.before.nodes},
-      {"speed_mm_s", {{"min", report.min_speed_mm_s}, {"max", report.max_speed_mm_s}}},
-      {"max_acceleration_mm_s2", report.dwell.max_acceleration_mm_s2},
-      {"solver", {{"iterations", report.dwell.iterations}, {"converged", report.dwell.converged},
-                  {"nonzeros", report.dwell.nonzeros}, {"shaping_rounds", report.dwell.shaping_rounds}}}};
+  const std::vector<std::string> comments = {fmt::format("arcwheel {} polish, job '{}'", kVersion, job.name),
+                                             fmt::format("surface: {}", job.surface->Describe()),
+                                             fmt::format("aperture: {}", job.aperture.Describe()),
+                                             fmt::format("removal function: {}", job.removal.Describe())};
+  json summary = {{"arcwheel_version", kVersion},
+                  {"job", job.resolved},
+                  {"points", report.points},
+                  {"total_time_s", report.dwell.total_time_s},
+                  {"before", {{"pv_um", report.dwell.before.pv_um}, {"rms_um", report.dwell.before.rms_um}}},
+                  {"after", {{"pv_um", report.dwell.after.pv_um}, {"rms_um", report.dwell.after.rms_um}}},
+                  {"aperture_nodes", report.dwell.before.nodes},
+                  {"speed_mm_s", {{"min", report.min_speed_mm_s}, {"max", report.max_speed_mm_s}}},
+                  {"max_acceleration_mm_s2", report.dwell.max_acceleration_mm_s2},
+                  {"solver",
+                   {{"iterations", report.dwell.iterations},
+                    {"converged", report.dwell.converged},
+                    {"nonzeros", report.dwell.nonzeros},
+                    {"shaping_rounds", report.dwell.shaping_rounds}}}};
 
   EnsureDirectory(output_folder);
   OutputSet outputs;

@@ -24,7 +24,7 @@ struct PolishJob {
   std::filesystem::path error_map_file;
   ErrorMap error_map;
   RemovalTargetOptions target;
-  RemovalFunction removal;  // a Gaussian, or a measured table (removal_function.file)
+  RemovalFunction removal;                          // a Gaussian, or a measured table (removal_function.file)
   PathPattern path_pattern = PathPattern::kRaster;  // path.type
   RasterOptions path;
   DwellOptions dwell;

@@ -26,7 +26,8 @@ std::string ErrorOf(const std::string& text) {
 
 TEST(ReadErrorMapCsv, PlacesScatteredRowsOnTheirGridAndLeavesGapsWithoutData) {
   arcwheel::testing::TempDir dir;
-  std::ofstream(dir / "map.csv") << "# comment\nx_mm,y_mm,error_um\n2.5,-1,0.25\n-2.5,-1,1\n0,1,nan\n2.5,1,-3\n";
+  std::ofstream(dir / "map.csv")
+      << "# comment\nx_mm,y_mm,error_um\n2.5,-1,0.25\n-2.5,-1,1\n0,1,nan\n2.5,1,-3\n";
   const ErrorMap map = ReadErrorMapCsv(dir / "map.csv");
   EXPECT_EQ(map.nx, 3);
   EXPECT_EQ(map.ny, 2);
@@ -42,11 +43,14 @@ TEST(ReadErrorMapCsv, PlacesScatteredRowsOnTheirGridAndLeavesGapsWithoutData) {
 
 TEST(ReadErrorMapCsv, NamesTheFileAndLineOfMalformedInput) {
   EXPECT_NE(ErrorOf("x,y,z\n").find("map.csv' line 1: header 'x,y,z'"), std::string::npos);
-  EXPECT_NE(ErrorOf("x_mm,y_mm,error_um\n0,0,1\n1,0,abc\n").find("line 3: 'abc' is not a number"), std::string::npos);
-  EXPECT_NE(ErrorOf("x_mm,y_mm,error_um\n0,0,1\n1,0\n").find("line 3: has 2 values"), std::string::npos);
-  EXPECT_NE(ErrorOf("x_mm,y_mm,error_um\n0,0,1\n1,0,2\n2,0,2\n3,0,2\n3.4,0,3\n").find("line 6: (3.4, 0) mm is not on the regular grid"),
+  EXPECT_NE(ErrorOf("x_mm,y_mm,error_um\n0,0,1\n1,0,abc\n").find("line 3: 'abc' is not a number"),
             std::string::npos);
-  EXPECT_NE(ErrorOf("x_mm,y_mm,error_um\n0,0,1\n1,0,2\n1,0,3\n").find("line 4: (1, 0) mm appears twice"), std::string::npos);
+  EXPECT_NE(ErrorOf("x_mm,y_mm,error_um\n0,0,1\n1,0\n").find("line 3: has 2 values"), std::string::npos);
+  EXPECT_NE(ErrorOf("x_mm,y_mm,error_um\n0,0,1\n1,0,2\n2,0,2\n3,0,2\n3.4,0,3\n")
+                .find("line 6: (3.4, 0) mm is not on the regular grid"),
+            std::string::npos);
+  EXPECT_NE(ErrorOf("x_mm,y_mm,error_um\n0,0,1\n1,0,2\n1,0,3\n").find("line 4: (1, 0) mm appears twice"),
+            std::string::npos);
 }
 
 }  // namespace

@@ -24,8 +24,9 @@ void WriteMap(const std::filesystem::path& path, double x_offset_mm = 0.0) {
   for (int j = -32; j <= 32; ++j) {
     for (int i = -32; i <= 32; ++i) {
       const double x = i + x_offset_mm, y = j;
-      out << fmt::format("{},{},{}\n", x, y,
-                         0.3 * (x * x - y * y) / 900.0 + 0.4 * std::exp(-((x - 8) * (x - 8) + y * y) / 150.0));
+      out << fmt::format(
+          "{},{},{}\n", x, y,
+          0.3 * (x * x - y * y) / 900.0 + 0.4 * std::exp(-((x - 8) * (x - 8) + y * y) / 150.0));
     }
   }
 }
@@ -43,27 +44,29 @@ std::string Job(const std::string& extra_machine = "", const std::string& extra_
   "machine": {{"max_speed_mm_s": 150.0, "min_speed_mm_s": 0.5{}}},
   "solver": {{"max_iterations": 800}},
   "tool": {{"tcp_mm": [0, 0, 180], "removal_centre_offset_mm": [0.25, -0.1]}}{}
-}})", vertex_radius_mm, extra_machine, extra_root);
+}})",
+                     vertex_radius_mm, extra_machine, extra_root);
 }
 
-void WriteText(const std::filesystem::path& path, const std::string& text) {
-  std::ofstream(path) << text;
-}
+void WriteText(const std::filesystem::path& path, const std::string& text) { std::ofstream(path) << text; }
 
 TEST(PolishCommand, WritesPathRapidResidualAndSummaryWithATenfoldRmsDrop) {
   TempDir dir;
   WriteMap(dir / "map.csv");
   WriteText(dir / "job.json", Job());
-  const auto result = RunArcwheel(fmt::format("polish {} -o {}", (dir / "job.json").string(), (dir / "out").string()));
+  const auto result =
+      RunArcwheel(fmt::format("polish {} -o {}", (dir / "job.json").string(), (dir / "out").string()));
   ASSERT_EQ(result.exit_status, 0) << result.output;
   std::ifstream summary_file(dir / "out" / "polish_summary.json");
   const nlohmann::json summary = nlohmann::json::parse(summary_file);
-  EXPECT_LT(summary["after"]["rms_um"].get<double>(), summary["before"]["rms_um"].get<double>() / 10.0) << summary.dump(2);
+  EXPECT_LT(summary["after"]["rms_um"].get<double>(), summary["before"]["rms_um"].get<double>() / 10.0)
+      << summary.dump(2);
   EXPECT_LE(summary["speed_mm_s"]["max"].get<double>(), 150.0 * (1 + 1e-12));
   EXPECT_GE(summary["speed_mm_s"]["min"].get<double>(), 0.5 * (1 - 1e-12));
   std::ifstream csv(dir / "out" / "polishing_path.csv");
   std::string line;
-  while (std::getline(csv, line) && line.rfind("# ", 0) == 0) {}
+  while (std::getline(csv, line) && line.rfind("# ", 0) == 0) {
+  }
   EXPECT_EQ(line, "x,y,z,q1,q2,q3,q4,speed_mm_s,dwell_s");
   std::stringstream rapid;
   rapid << std::ifstream(dir / "out" / "polish.mod").rdbuf();
@@ -81,12 +84,12 @@ TEST(PolishCommand, RunsTheShippedExampleJob) {
   EXPECT_LT(summary["after"]["rms_um"].get<double>(), summary["before"]["rms_um"].get<double>() / 10.0);
 }
 
-
 void ExpectRefused(const std::string& job, const std::string& message, bool shifted_map = false) {
   TempDir dir;
   WriteMap(dir / "map.csv", shifted_map ? 1000.0 : 0.0);
   WriteText(dir / "job.json", job);
-  const auto result = RunArcwheel(fmt::format("polish {} -o {}", (dir / "job.json").string(), (dir / "out").string()));
+  const auto result =
+      RunArcwheel(fmt::format("polish {} -o {}", (dir / "job.json").string(), (dir / "out").string()));
   EXPECT_EQ(result.exit_status, 3) << result.output;
   EXPECT_NE(result.output.find(message), std::string::npos) << result.output;
   EXPECT_FALSE(std::filesystem::exists(dir / "out" / "polishing_path.csv"));
@@ -105,12 +108,14 @@ TEST(PolishCommand, ReadsFreeformAndAsphereSurfacesInTheGrindingJobsForm) {
   WriteMap(dir / "map.csv");
   WriteText(dir / "job.json", WithSurface(R"({"type": "xy_polynomial", "terms": [
       {"x_power": 2, "coefficient": -0.001}, {"y_power": 2, "coefficient": -0.0012}]})"));
-  const auto result = RunArcwheel(fmt::format("polish {} -o {}", (dir / "job.json").string(), (dir / "out").string()));
+  const auto result =
+      RunArcwheel(fmt::format("polish {} -o {}", (dir / "job.json").string(), (dir / "out").string()));
   ASSERT_EQ(result.exit_status, 0) << result.output;
   // z = -0.001 x^2 - 0.0012 y^2: the CSV's z follows the freeform.
   std::ifstream csv(dir / "out" / "polishing_path.csv");
   std::string line;
-  while (std::getline(csv, line) && line.rfind("# ", 0) == 0) {}
+  while (std::getline(csv, line) && line.rfind("# ", 0) == 0) {
+  }
   int rows = 0;
   while (std::getline(csv, line)) {
     double x, y, z;
@@ -127,10 +132,14 @@ TEST(PolishCommand, RefusesAPowerThatIsNotAWholeNumberInRangeNamingItsValue) {
   // 2.5 was computed as 2 while 2.5 went into the summary; 3e110 was cast to int (undefined).
   for (const std::string power : {"2.5", "3e110", "-1"}) {
     WriteText(dir / "job.json", WithSurface(R"({"type": "xy_polynomial", "terms": [
-        {"x_power": 2, "coefficient": -0.001}, {"y_power": )" + power + R"(, "coefficient": -0.0012}]})"));
-    const auto result = RunArcwheel(fmt::format("polish {} -o {}", (dir / "job.json").string(), (dir / "out").string()));
+        {"x_power": 2, "coefficient": -0.001}, {"y_power": )" +
+                                            power + R"(, "coefficient": -0.0012}]})"));
+    const auto result =
+        RunArcwheel(fmt::format("polish {} -o {}", (dir / "job.json").string(), (dir / "out").string()));
     EXPECT_EQ(result.exit_status, 3) << result.output;
-    EXPECT_NE(result.output.find("terms[1].y_power' must be a whole number within 0 .. 20, got"), std::string::npos) << result.output;
+    EXPECT_NE(result.output.find("terms[1].y_power' must be a whole number within 0 .. 20, got"),
+              std::string::npos)
+        << result.output;
     EXPECT_FALSE(std::filesystem::exists(dir / "out"));
   }
 }
@@ -143,9 +152,11 @@ TEST(PolishCommand, RefusesAnIterationCountThatIsNotAWholeNumberInRange) {
     const std::string given = R"("max_iterations": 800)";
     job.replace(job.find(given), given.size(), R"("max_iterations": )" + count);
     WriteText(dir / "job.json", job);
-    const auto result = RunArcwheel(fmt::format("polish {} -o {}", (dir / "job.json").string(), (dir / "out").string()));
+    const auto result =
+        RunArcwheel(fmt::format("polish {} -o {}", (dir / "job.json").string(), (dir / "out").string()));
     EXPECT_EQ(result.exit_status, 3) << result.output;
-    EXPECT_NE(result.output.find("'solver.max_iterations' must be a whole number within 1 .. 10000000, got"), std::string::npos)
+    EXPECT_NE(result.output.find("'solver.max_iterations' must be a whole number within 1 .. 10000000, got"),
+              std::string::npos)
         << result.output;
     EXPECT_FALSE(std::filesystem::exists(dir / "out"));
   }
@@ -156,15 +167,18 @@ TEST(PolishCommand, TiltsThePrecessingBonnetByTheJobsAngle) {
   WriteMap(dir / "map.csv");
   WriteText(dir / "job.json", Job("", R"(,
   "precession": {"tilt_deg": 20.0, "precession_rate_rpm": 5.0, "bonnet_radius_mm": 40.0})"));
-  const auto result = RunArcwheel(fmt::format("polish {} -o {}", (dir / "job.json").string(), (dir / "out").string()));
+  const auto result =
+      RunArcwheel(fmt::format("polish {} -o {}", (dir / "job.json").string(), (dir / "out").string()));
   ASSERT_EQ(result.exit_status, 0) << result.output;
   std::ifstream csv(dir / "out" / "polishing_path.csv");
   std::string line;
-  while (std::getline(csv, line) && line.rfind("# ", 0) == 0) {}
+  while (std::getline(csv, line) && line.rfind("# ", 0) == 0) {
+  }
   int rows = 0;
   while (std::getline(csv, line)) {
     double x, y, z, q1, q2, q3, q4;
-    ASSERT_EQ(std::sscanf(line.c_str(), "%lf,%lf,%lf,%lf,%lf,%lf,%lf", &x, &y, &z, &q1, &q2, &q3, &q4), 7) << line;
+    ASSERT_EQ(std::sscanf(line.c_str(), "%lf,%lf,%lf,%lf,%lf,%lf,%lf", &x, &y, &z, &q1, &q2, &q3, &q4), 7)
+        << line;
     // Tool z of the quaternion (third column of its rotation matrix) against the inward normal
     // of the convex conic (R0 = 400, k = -0.5) at the contact under the bonnet centre.
     const double zx = 2 * (q2 * q4 + q1 * q3), zy = 2 * (q3 * q4 - q1 * q2), zz = 1 - 2 * (q2 * q2 + q3 * q3);
@@ -188,8 +202,10 @@ TEST(PolishCommand, TiltsThePrecessingBonnetByTheJobsAngle) {
 }
 
 TEST(PolishCommand, RefusesAnUnknownAsphereCoefficientByItsDottedName) {
-  ExpectRefused(WithSurface(R"({"type": "even_asphere", "vertex_radius_mm": 400, "coefficients": {"A4": 1e-10, "A5": 1}})"),
-                "'surface.coefficients.A5' is an unknown key");
+  ExpectRefused(
+      WithSurface(
+          R"({"type": "even_asphere", "vertex_radius_mm": 400, "coefficients": {"A4": 1e-10, "A5": 1}})"),
+      "'surface.coefficients.A5' is an unknown key");
 }
 
 TEST(PolishCommand, RefusesAnUnknownKeyByItsDottedName) {
@@ -206,9 +222,7 @@ TEST(PolishCommand, RefusesAMapOffTheSurface) {
   ExpectRefused(Job("", "", 25.0), "off the surface");
 }
 
-TEST(PolishCommand, RefusesAnEmptyAperture) {
-  ExpectRefused(Job(), "empty aperture", /*shifted_map=*/true);
-}
+TEST(PolishCommand, RefusesAnEmptyAperture) { ExpectRefused(Job(), "empty aperture", /*shifted_map=*/true); }
 
 }  // namespace
 }  // namespace arcwheel::polishing

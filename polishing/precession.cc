@@ -79,8 +79,8 @@ std::vector<PrecessionSample> PrecessionTrajectory(const grinding::Surface& surf
     sample.local_frame.col(1) = c.cross(a);
     sample.local_frame.col(2) = c;
     const double alpha = w2_rad_per_s * t;
-    const Eigen::Vector3d p_a(std::sin(theta_rad) * std::cos(alpha),
-                              std::sin(theta_rad) * std::sin(alpha), std::cos(theta_rad));
+    const Eigen::Vector3d p_a(std::sin(theta_rad) * std::cos(alpha), std::sin(theta_rad) * std::sin(alpha),
+                              std::cos(theta_rad));
     sample.axis = sample.local_frame * p_a;
     sample.traced_mm = sample.centre_mm + options.arm_length_mm * sample.axis;
     samples.push_back(sample);

@@ -15,9 +15,12 @@ TEST(PrecessionTrajectory, StraightFeedOnAPlaneTracesTheProlateCycloidOfMethodC)
   // method.md C: theta = 20 deg, v = 5 mm/s, w2 = 5 r/min, the point 127 mm up the axis.
   const grinding::XyPolynomial plane({});
   const std::vector<Eigen::Vector2d> path = {{0.0, 0.0}, {60.0, 0.0}};
-  const PrecessionOptions options{.tilt_deg = 20.0, .precession_rate_rpm = 5.0,
-                                  .feed_mm_per_s = 5.0, .bonnet_radius_mm = 40.0,
-                                  .arm_length_mm = 127.0, .time_step_s = 0.1};
+  const PrecessionOptions options{.tilt_deg = 20.0,
+                                  .precession_rate_rpm = 5.0,
+                                  .feed_mm_per_s = 5.0,
+                                  .bonnet_radius_mm = 40.0,
+                                  .arm_length_mm = 127.0,
+                                  .time_step_s = 0.1};
   const auto samples = PrecessionTrajectory(plane, path, options);
   ASSERT_EQ(samples.size(), 121u);  // 12 s of feed at 0.1 s
   // Closed form: feed along x, normal +z, so a = x, b = y, c = z and the traced point is
@@ -43,8 +46,8 @@ TEST(PrecessionTrajectory, StraightFeedOnAPlaneTracesTheProlateCycloidOfMethodC)
 TEST(PrecessionTrajectory, AxisKeepsTheTiltFromTheNormalOnACurvedSurface) {
   const grinding::EvenAsphere sphere({.vertex_radius_mm = 300.0, .concave = false});
   const std::vector<Eigen::Vector2d> path = {{-80.0, -20.0}, {0.0, 10.0}, {70.0, 40.0}};
-  const PrecessionOptions options{.tilt_deg = 25.0, .precession_rate_rpm = 30.0,
-                                  .feed_mm_per_s = 10.0, .time_step_s = 0.05};
+  const PrecessionOptions options{
+      .tilt_deg = 25.0, .precession_rate_rpm = 30.0, .feed_mm_per_s = 10.0, .time_step_s = 0.05};
   const double theta = 25.0 * std::numbers::pi / 180.0;
   const double w2 = 30.0 * 2.0 * std::numbers::pi / 60.0;
   for (const PrecessionSample& s : PrecessionTrajectory(sphere, path, options)) {
@@ -68,8 +71,8 @@ TEST(PrecessionTrajectory, RefusesATiltOf90DegreesAndAPathOffTheSurface) {
     (void)PrecessionTrajectory(sphere, path, {});
     FAIL() << "a path beyond the sphere's rim was accepted";
   } catch (const Error& e) {
-    EXPECT_NE(std::string(e.what()).find("path point 1 (60, 0) mm is off the surface"),
-              std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("path point 1 (60, 0) mm is off the surface"), std::string::npos)
+        << e.what();
   }
 }
 

@@ -43,11 +43,13 @@ double SecondMomentSigmaMm(const TabulatedRemovalFunction& t) {
 
 void TabulatedRemovalFunction::Check() const {
   const std::string where = source.empty() ? std::string("the removal table") : fmt::format("'{}'", source);
-  if (nx < 2 || ny < 2) Bad(fmt::format("{}: the footprint grid has {} x {} nodes; it needs 2 x 2 or more", where, nx, ny));
+  if (nx < 2 || ny < 2)
+    Bad(fmt::format("{}: the footprint grid has {} x {} nodes; it needs 2 x 2 or more", where, nx, ny));
   if (!(dx_mm > 0.0) || !(dy_mm > 0.0) || !std::isfinite(dx_mm) || !std::isfinite(dy_mm)) {
     Bad(fmt::format("{}: the grid spacing {} x {} mm must be finite and > 0", where, dx_mm, dy_mm));
   }
-  if (!std::isfinite(x0_mm) || !std::isfinite(y0_mm)) Bad(fmt::format("{}: the grid origin must be finite", where));
+  if (!std::isfinite(x0_mm) || !std::isfinite(y0_mm))
+    Bad(fmt::format("{}: the grid origin must be finite", where));
   if (static_cast<double>(nx) * ny > kMaxNodes) Bad(fmt::format("{}: more than {} nodes", where, kMaxNodes));
   if (rate_um_per_s.size() != static_cast<std::size_t>(nx) * ny) {
     Bad(fmt::format("{}: {} rates for a {} x {} grid", where, rate_um_per_s.size(), nx, ny));
@@ -57,7 +59,8 @@ void TabulatedRemovalFunction::Check() const {
     const double r = rate_um_per_s[k];
     if (!std::isfinite(r) || r < 0.0) {
       Bad(fmt::format("{}: rate {} um/s at ({}, {}) mm must be finite and >= 0", where, r,
-                      x0_mm + static_cast<double>(k % nx) * dx_mm, y0_mm + static_cast<double>(k / nx) * dy_mm));
+                      x0_mm + static_cast<double>(k % nx) * dx_mm,
+                      y0_mm + static_cast<double>(k / nx) * dy_mm));
     }
     peak = std::max(peak, r);
   }
@@ -98,8 +101,8 @@ std::string RemovalFunction::Describe() const {
     return fmt::format("Gaussian, peak {} um/s, FWHM {} mm", g->peak_rate_um_per_s, g->fwhm_mm);
   }
   const auto& t = std::get<TabulatedRemovalFunction>(model_);
-  return fmt::format("measured '{}', {} x {} nodes of {} x {} mm, peak {} um/s, equivalent FWHM {:.4g} mm", t.source,
-                     t.nx, t.ny, t.dx_mm, t.dy_mm, PeakRateUmPerS(), EquivalentFwhmMm());
+  return fmt::format("measured '{}', {} x {} nodes of {} x {} mm, peak {} um/s, equivalent FWHM {:.4g} mm",
+                     t.source, t.nx, t.ny, t.dx_mm, t.dy_mm, PeakRateUmPerS(), EquivalentFwhmMm());
 }
 
 void RemovalFunction::Check() const {
@@ -109,7 +112,8 @@ void RemovalFunction::Check() const {
                   fmt::format("peak_rate_um_per_s = {} violates > 0", g->peak_rate_um_per_s));
     }
     if (!(g->fwhm_mm > 0.0) || !std::isfinite(g->fwhm_mm)) {
-      throw Error(ErrorCode::kInvalidOption, "polishing.dwell", fmt::format("fwhm_mm = {} violates > 0", g->fwhm_mm));
+      throw Error(ErrorCode::kInvalidOption, "polishing.dwell",
+                  fmt::format("fwhm_mm = {} violates > 0", g->fwhm_mm));
     }
     return;
   }
@@ -127,7 +131,8 @@ TabulatedRemovalFunction ReadRemovalFunctionCsv(const std::filesystem::path& pat
   for (std::size_t k = 0; k < grid.values.size(); ++k) {
     const double rate = grid.values[k];
     if (grid.lines[k] != 0 && (!std::isfinite(rate) || rate < 0.0)) {
-      Bad(fmt::format("'{}' line {}: rate_um_per_s = {} must be finite and >= 0", path.string(), grid.lines[k], rate));
+      Bad(fmt::format("'{}' line {}: rate_um_per_s = {} must be finite and >= 0", path.string(),
+                      grid.lines[k], rate));
     }
   }
   TabulatedRemovalFunction t;
@@ -141,7 +146,9 @@ TabulatedRemovalFunction ReadRemovalFunctionCsv(const std::filesystem::path& pat
   t.rate_um_per_s = std::move(grid.values);
   for (std::size_t k = 0; k < t.rate_um_per_s.size(); ++k) {
     if (std::isnan(t.rate_um_per_s[k])) {
-      Bad(fmt::format("'{}': node ({}, {}) mm of the {} x {} footprint grid is missing (write 0 where nothing is removed)",
+      Bad(
+          fmt::format("'{}': node ({}, {}) mm of the {} x {} footprint grid is missing (write 0 where "
+                      "nothing is removed)",
                       path.string(), t.x0_mm + static_cast<double>(k % t.nx) * t.dx_mm,
                       t.y0_mm + static_cast<double>(k / t.nx) * t.dy_mm, t.nx, t.ny));
     }
@@ -154,11 +161,14 @@ TabulatedRemovalFunction ReadRemovalFunctionHdf5(const std::filesystem::path& pa
   hdf5::ReadFirstInChildProcess(path, [&] { (void)ReadRemovalFunctionHdf5(path); });
   const hdf5::File file = hdf5::File::OpenReadOnly(path);
   const std::string dataset = "rate_um_per_s";
-  auto fail = [&](const std::string& what) { Bad(fmt::format("'{}' dataset '/{}': {}", path.string(), dataset, what)); };
+  auto fail = [&](const std::string& what) {
+    Bad(fmt::format("'{}' dataset '/{}': {}", path.string(), dataset, what));
+  };
   if (!file.HasObject(dataset)) fail("is missing");
   const std::vector<hsize_t> shape = file.Shape(dataset);
   if (shape.size() != 2) fail(fmt::format("has rank {}; it must be [ny][nx]", shape.size()));
-  if (static_cast<double>(shape[0]) * static_cast<double>(shape[1]) > kMaxNodes) fail(fmt::format("has more than {} nodes", kMaxNodes));
+  if (static_cast<double>(shape[0]) * static_cast<double>(shape[1]) > kMaxNodes)
+    fail(fmt::format("has more than {} nodes", kMaxNodes));
   TabulatedRemovalFunction t;
   t.source = path.string();
   t.ny = static_cast<int>(shape[0]);
@@ -173,8 +183,10 @@ TabulatedRemovalFunction ReadRemovalFunctionHdf5(const std::filesystem::path& pa
   t.y0_mm = attribute("y0_mm");
   t.dx_mm = attribute("dx_mm");
   t.dy_mm = attribute("dy_mm");
-  if (!(t.dx_mm > 0.0) || !(t.dy_mm > 0.0)) fail(fmt::format("dx_mm = {} and dy_mm = {} must be > 0", t.dx_mm, t.dy_mm));
-  if (t.nx < 2 || t.ny < 2) fail(fmt::format("is {} x {}; the footprint needs 2 x 2 nodes or more", t.ny, t.nx));
+  if (!(t.dx_mm > 0.0) || !(t.dy_mm > 0.0))
+    fail(fmt::format("dx_mm = {} and dy_mm = {} must be > 0", t.dx_mm, t.dy_mm));
+  if (t.nx < 2 || t.ny < 2)
+    fail(fmt::format("is {} x {}; the footprint needs 2 x 2 nodes or more", t.ny, t.nx));
   t.rate_um_per_s = file.ReadDoubles(dataset);
   for (std::size_t k = 0; k < t.rate_um_per_s.size(); ++k) {
     const double r = t.rate_um_per_s[k];

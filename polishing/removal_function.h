@@ -50,9 +50,9 @@ struct GaussianRemovalFunction {
 
 // A measured removal function: rate_um_per_s[j * nx + i] at the offset (x0 + i dx, y0 + j dy).
 struct TabulatedRemovalFunction {
-  double x0_mm = 0.0, y0_mm = 0.0;  // offset of node (0, 0) from the tool centre
-  double dx_mm = 1.0, dy_mm = 1.0;  // grid spacing, > 0
-  int nx = 0, ny = 0;               // nodes along x and y, >= 2 each
+  double x0_mm = 0.0, y0_mm = 0.0;         // offset of node (0, 0) from the tool centre
+  double dx_mm = 1.0, dy_mm = 1.0;         // grid spacing, > 0
+  int nx = 0, ny = 0;                      // nodes along x and y, >= 2 each
   std::vector<double> rate_um_per_s = {};  // nx * ny rates, finite, >= 0, positive peak
   std::string source = {};                 // the file it came from, for messages
   // Bilinear interpolation of the table; zero outside it.
@@ -72,8 +72,8 @@ struct TabulatedRemovalFunction {
 
 class RemovalFunction {
  public:
-  RemovalFunction() = default;  // the default Gaussian
-  RemovalFunction(GaussianRemovalFunction gaussian) : model_(gaussian) {}  // NOLINT: implicit by design
+  RemovalFunction() = default;                                                   // the default Gaussian
+  RemovalFunction(GaussianRemovalFunction gaussian) : model_(gaussian) {}        // NOLINT: implicit by design
   RemovalFunction(TabulatedRemovalFunction table) : model_(std::move(table)) {}  // NOLINT
 
   [[nodiscard]] double RateUmPerS(double dx_mm, double dy_mm) const;

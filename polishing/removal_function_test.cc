@@ -20,8 +20,8 @@ namespace arcwheel::polishing {
 namespace {
 
 // An axis-aligned elliptic Gaussian of known parameters sampled on a grid of offsets.
-TabulatedRemovalFunction EllipticTable(double peak, double cx, double cy, double sx, double sy, double x0, double y0,
-                                       double h, int nx, int ny) {
+TabulatedRemovalFunction EllipticTable(double peak, double cx, double cy, double sx, double sy, double x0,
+                                       double y0, double h, int nx, int ny) {
   TabulatedRemovalFunction t{.x0_mm = x0, .y0_mm = y0, .dx_mm = h, .dy_mm = h, .nx = nx, .ny = ny};
   for (int j = 0; j < ny; ++j) {
     for (int i = 0; i < nx; ++i) {
@@ -36,7 +36,8 @@ std::string Csv(const TabulatedRemovalFunction& t) {
   std::string out = "# measured footprint\nx_mm,y_mm,rate_um_per_s\n";
   for (int j = t.ny - 1; j >= 0; --j) {  // any order
     for (int i = 0; i < t.nx; ++i) {
-      out += fmt::format("{},{},{}\n", t.x0_mm + i * t.dx_mm, t.y0_mm + j * t.dy_mm, t.rate_um_per_s[j * t.nx + i]);
+      out += fmt::format("{},{},{}\n", t.x0_mm + i * t.dx_mm, t.y0_mm + j * t.dy_mm,
+                         t.rate_um_per_s[j * t.nx + i]);
     }
   }
   return out;
@@ -64,7 +65,8 @@ TEST(TabulatedRemovalFunction, InterpolatesAGaussianWithinTheBilinearBound) {
   const double peak = 2.0, sigma = 12.0 / (2.0 * std::sqrt(2.0 * std::numbers::ln2)), h = 0.1;
   const int n = 2 * static_cast<int>(std::ceil(4.5 * sigma / h)) + 1;
   const double half_width = (n - 1) / 2 * h;
-  const RemovalFunction table = EllipticTable(peak, 0.0, 0.0, sigma, sigma, -half_width, -half_width, h, n, n);
+  const RemovalFunction table =
+      EllipticTable(peak, 0.0, 0.0, sigma, sigma, -half_width, -half_width, h, n, n);
   const double inside_bound = peak * (h * h + h * h) / (8.0 * sigma * sigma);
   const double outside_bound = peak * std::exp(-half_width * half_width / (2.0 * sigma * sigma));
   std::mt19937 rng(7);
@@ -105,7 +107,8 @@ TEST(ReadRemovalFunction, ReadsTheCsvAndHdf5FormsToTheSameTable) {
   {
     hdf5::File file = hdf5::File::Create(dir / "footprint.h5");
     file.WriteDoubles("rate_um_per_s", table.rate_um_per_s, {21, 33});
-    for (const auto& [name, value] : {std::pair{"x0_mm", -6.0}, {"y0_mm", -6.0}, {"dx_mm", 0.5}, {"dy_mm", 0.5}}) {
+    for (const auto& [name, value] :
+         {std::pair{"x0_mm", -6.0}, {"y0_mm", -6.0}, {"dx_mm", 0.5}, {"dy_mm", 0.5}}) {
       file.WriteAttribute("rate_um_per_s", name, value);
     }
   }
@@ -126,17 +129,23 @@ TEST(ReadRemovalFunction, ReadsTheCsvAndHdf5FormsToTheSameTable) {
 TEST(ReadRemovalFunction, NamesTheFileAndLineOfAMalformedCsv) {
   const std::string head = "x_mm,y_mm,rate_um_per_s\n";
   EXPECT_NE(CsvError("x,y,r\n").find("footprint.csv' line 1: header 'x,y,r'"), std::string::npos);
-  EXPECT_NE(CsvError(head + "0,0,1\n1,0,-0.5\n0,1,1\n1,1,1\n").find("line 3: rate_um_per_s = -0.5 must be finite and >= 0"),
+  EXPECT_NE(CsvError(head + "0,0,1\n1,0,-0.5\n0,1,1\n1,1,1\n")
+                .find("line 3: rate_um_per_s = -0.5 must be finite and >= 0"),
             std::string::npos);
-  EXPECT_NE(CsvError(head + "0,0,1\n1,0,nan\n0,1,1\n1,1,1\n").find("line 3: rate_um_per_s = nan"), std::string::npos);
+  EXPECT_NE(CsvError(head + "0,0,1\n1,0,nan\n0,1,1\n1,1,1\n").find("line 3: rate_um_per_s = nan"),
+            std::string::npos);
   EXPECT_NE(CsvError(head + "0,0,1\n1,0,abc\n").find("line 3: 'abc' is not a number"), std::string::npos);
   std::string grid = head;
   for (int j = 0; j < 2; ++j) {
     for (int i = 0; i < 5; ++i) grid += fmt::format("{},{},1\n", i, j);
   }
-  EXPECT_NE(CsvError(grid + "1.4,1,1\n").find("line 12: (1.4, 1) mm is not on the regular grid"), std::string::npos);
-  EXPECT_NE(CsvError(head + "0,0,1\n1,0,1\n0,1,1\n0,1,1\n").find("line 5: (0, 1) mm appears twice"), std::string::npos);
-  EXPECT_NE(CsvError(head + "0,0,1\n1,0,1\n0,1,1\n").find("node (1, 1) mm of the 2 x 2 footprint grid is missing"), std::string::npos);
+  EXPECT_NE(CsvError(grid + "1.4,1,1\n").find("line 12: (1.4, 1) mm is not on the regular grid"),
+            std::string::npos);
+  EXPECT_NE(CsvError(head + "0,0,1\n1,0,1\n0,1,1\n0,1,1\n").find("line 5: (0, 1) mm appears twice"),
+            std::string::npos);
+  EXPECT_NE(
+      CsvError(head + "0,0,1\n1,0,1\n0,1,1\n").find("node (1, 1) mm of the 2 x 2 footprint grid is missing"),
+      std::string::npos);
   EXPECT_NE(CsvError(head + "0,0,0\n1,0,0\n0,1,0\n1,1,0\n").find("removes nothing"), std::string::npos);
   EXPECT_NE(CsvError(head + "0,0,1\n1,0,1\n").find("needs 2 x 2 or more"), std::string::npos);
 }
@@ -157,18 +166,23 @@ TEST(ReadRemovalFunction, NamesTheDatasetOfAMalformedHdf5Table) {
     return std::string("accepted");
   };
   auto attributes = [](hdf5::File& f) {
-    for (const auto& [name, value] : {std::pair{"x0_mm", 0.0}, {"y0_mm", 0.0}, {"dx_mm", 1.0}, {"dy_mm", 1.0}}) {
+    for (const auto& [name, value] :
+         {std::pair{"x0_mm", 0.0}, {"y0_mm", 0.0}, {"dx_mm", 1.0}, {"dy_mm", 1.0}}) {
       f.WriteAttribute("rate_um_per_s", name, value);
     }
   };
-  EXPECT_NE(error_of([](hdf5::File& f) { f.WriteDoubles("rate", {1, 2, 3, 4}, {2, 2}); }).find("dataset '/rate_um_per_s': is missing"),
+  EXPECT_NE(error_of([](hdf5::File& f) {
+              f.WriteDoubles("rate", {1, 2, 3, 4}, {2, 2});
+            }).find("dataset '/rate_um_per_s': is missing"),
             std::string::npos);
   EXPECT_NE(error_of([&](hdf5::File& f) {
               f.WriteDoubles("rate_um_per_s", {1, 2, 3, 4}, {4});
               attributes(f);
             }).find("has rank 1"),
             std::string::npos);
-  EXPECT_NE(error_of([](hdf5::File& f) { f.WriteDoubles("rate_um_per_s", {1, 2, 3, 4}, {2, 2}); }).find("attribute 'x0_mm' is missing"),
+  EXPECT_NE(error_of([](hdf5::File& f) {
+              f.WriteDoubles("rate_um_per_s", {1, 2, 3, 4}, {2, 2});
+            }).find("attribute 'x0_mm' is missing"),
             std::string::npos);
   EXPECT_NE(error_of([&](hdf5::File& f) {
               f.WriteDoubles("rate_um_per_s", {1, 2, 3, -4, 5, 6}, {2, 3});
@@ -177,7 +191,8 @@ TEST(ReadRemovalFunction, NamesTheDatasetOfAMalformedHdf5Table) {
             std::string::npos);
   EXPECT_NE(error_of([&](hdf5::File& f) {
               f.WriteDoubles("rate_um_per_s", {1, 2, 3, 4}, {2, 2});
-              for (const auto& [name, value] : {std::pair{"x0_mm", 0.0}, {"y0_mm", 0.0}, {"dx_mm", 1.0}, {"dy_mm", 0.0}}) {
+              for (const auto& [name, value] :
+                   {std::pair{"x0_mm", 0.0}, {"y0_mm", 0.0}, {"dx_mm", 1.0}, {"dy_mm", 0.0}}) {
                 f.WriteAttribute("rate_um_per_s", name, value);
               }
             }).find("must be > 0"),
@@ -185,7 +200,8 @@ TEST(ReadRemovalFunction, NamesTheDatasetOfAMalformedHdf5Table) {
 }
 
 // A job file as the example's, with `removal_function` replaced.
-std::filesystem::path WriteJob(const arcwheel::testing::TempDir& dir, const nlohmann::json& removal_function) {
+std::filesystem::path WriteJob(const arcwheel::testing::TempDir& dir,
+                               const nlohmann::json& removal_function) {
   const std::filesystem::path examples = arcwheel::testing::SourceDir() / "polishing" / "examples";
   std::ifstream in(examples / "disc_job.json");
   nlohmann::json job = nlohmann::json::parse(in);
@@ -199,7 +215,8 @@ std::filesystem::path WriteJob(const arcwheel::testing::TempDir& dir, const nloh
 TEST(ReadPolishJob, TakesAMeasuredRemovalFunctionAndDerivesThePathFromItsWidth) {
   const double sigma = 10.0 / (2.0 * std::sqrt(2.0 * std::numbers::ln2));
   arcwheel::testing::TempDir dir;
-  std::ofstream(dir / "footprint.csv") << Csv(EllipticTable(1.5, 0.0, 0.0, sigma, sigma, -20.0, -20.0, 0.25, 161, 161));
+  std::ofstream(dir / "footprint.csv")
+      << Csv(EllipticTable(1.5, 0.0, 0.0, sigma, sigma, -20.0, -20.0, 0.25, 161, 161));
   const PolishJob job = ReadPolishJob(WriteJob(dir, {{"file", "footprint.csv"}}));  // relative to the job
   ASSERT_TRUE(std::holds_alternative<TabulatedRemovalFunction>(job.removal.model()));
   // The equivalent sigma of a Gaussian table is the Gaussian's: the same defaults as fwhm_mm = 10.
@@ -215,16 +232,20 @@ TEST(ReadPolishJob, RefusesAMeasuredAndAGaussianRemovalFunctionTogetherOrABadTab
     (void)ReadPolishJob(WriteJob(dir, {{"file", "footprint.csv"}, {"fwhm_mm", 10.0}}));
     FAIL() << "accepted";
   } catch (const Error& e) {
-    EXPECT_NE(std::string(e.what()).find("'removal_function.file' is an alternative to peak_rate_um_per_s and fwhm_mm"),
-              std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find(
+                  "'removal_function.file' is an alternative to peak_rate_um_per_s and fwhm_mm"),
+              std::string::npos)
+        << e.what();
   }
   try {
     (void)ReadPolishJob(WriteJob(dir, {{"file", "footprint.csv"}}));
     FAIL() << "accepted";
   } catch (const Error& e) {
     EXPECT_EQ(e.code(), ErrorCode::kBadInput);
-    EXPECT_NE(std::string(e.what()).find("polishing.removal: '" + (dir / "footprint.csv").string() + "' line 5"),
-              std::string::npos) << e.what();
+    EXPECT_NE(
+        std::string(e.what()).find("polishing.removal: '" + (dir / "footprint.csv").string() + "' line 5"),
+        std::string::npos)
+        << e.what();
   }
 }
 
@@ -243,7 +264,8 @@ TEST(ReadPolishJob, TakesTheSpiralPathTypeAndRefusesAnUnknownOne) {
     (void)ReadPolishJob(dir / "helix.json");
     FAIL() << "accepted";
   } catch (const Error& e) {
-    EXPECT_NE(std::string(e.what()).find("'path.type' = \"helix\" is not one of \"raster\", \"spiral\""), std::string::npos)
+    EXPECT_NE(std::string(e.what()).find("'path.type' = \"helix\" is not one of \"raster\", \"spiral\""),
+              std::string::npos)
         << e.what();
   }
 }
@@ -253,9 +275,11 @@ TEST(RunPolishJob, SolvesWithAMeasuredRemovalFunctionUnderAnAccelerationLimit) {
   arcwheel::testing::TempDir dir;
   {
     hdf5::File file = hdf5::File::Create(dir / "footprint.h5");
-    const TabulatedRemovalFunction table = EllipticTable(1.5, 0.0, 0.0, sigma, sigma, -16.0, -16.0, 0.25, 129, 129);
+    const TabulatedRemovalFunction table =
+        EllipticTable(1.5, 0.0, 0.0, sigma, sigma, -16.0, -16.0, 0.25, 129, 129);
     file.WriteDoubles("rate_um_per_s", table.rate_um_per_s, {129, 129});
-    for (const auto& [name, value] : {std::pair{"x0_mm", -16.0}, {"y0_mm", -16.0}, {"dx_mm", 0.25}, {"dy_mm", 0.25}}) {
+    for (const auto& [name, value] :
+         {std::pair{"x0_mm", -16.0}, {"y0_mm", -16.0}, {"dx_mm", 0.25}, {"dy_mm", 0.25}}) {
       file.WriteAttribute("rate_um_per_s", name, value);
     }
   }
@@ -271,7 +295,8 @@ TEST(RunPolishJob, SolvesWithAMeasuredRemovalFunctionUnderAnAccelerationLimit) {
   EXPECT_LT(summary["after"]["rms_um"].get<double>(), summary["before"]["rms_um"].get<double>() / 10.0);
   std::ifstream path_csv(dir / "out" / "polishing_path.csv");
   const std::string text((std::istreambuf_iterator<char>(path_csv)), std::istreambuf_iterator<char>());
-  EXPECT_NE(text.find("removal function: measured '" + (dir / "footprint.h5").string() + "'"), std::string::npos);
+  EXPECT_NE(text.find("removal function: measured '" + (dir / "footprint.h5").string() + "'"),
+            std::string::npos);
 }
 
 }  // namespace

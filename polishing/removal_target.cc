@@ -18,7 +18,8 @@ void CheckGrid(const ErrorMap& map) {
       map.error_um.size() != static_cast<std::size_t>(map.nx) * map.ny) {
     throw Error(ErrorCode::kInvalidOption, kStage,
                 fmt::format("error map grid {} x {} nodes, spacing {} x {} mm with {} values is "
-                            "malformed", map.nx, map.ny, map.dx_mm, map.dy_mm, map.error_um.size()));
+                            "malformed",
+                            map.nx, map.ny, map.dx_mm, map.dy_mm, map.error_um.size()));
   }
 }
 
@@ -64,9 +65,9 @@ ErrorMap RemovalTarget(const ErrorMap& error, const grinding::Aperture& aperture
     }
   }
   if (!std::isfinite(minimum)) {
-    throw Error(ErrorCode::kBadInput, kStage,
-                fmt::format("empty aperture: no error-map node with data lies inside {}",
-                            aperture.Describe()));
+    throw Error(
+        ErrorCode::kBadInput, kStage,
+        fmt::format("empty aperture: no error-map node with data lies inside {}", aperture.Describe()));
   }
   ErrorMap target = error;
   for (int j = 0; j < error.ny; ++j) {

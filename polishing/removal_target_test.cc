@@ -13,8 +13,7 @@ namespace {
 
 // The 460 mm focusing lens of method.md B: y^2 = 3522.35573 x - 0.16398 x^2 + 1.97121e-4 x^3
 // - 6.87809e-6 x^4 + 2.37036e-7 x^5, x along the axis.
-constexpr std::array<double, 6> kLens = {0.0, 3522.35573, -0.16398, 1.97121e-4, -6.87809e-6,
-                                         2.37036e-7};
+constexpr std::array<double, 6> kLens = {0.0, 3522.35573, -0.16398, 1.97121e-4, -6.87809e-6, 2.37036e-7};
 
 // Independent sag: bisection on the polynomial over [0, 50] mm (the lens sag is below 16 mm).
 double BisectedSagMm(double y_mm) {
@@ -45,8 +44,9 @@ TEST(RemovalTarget, ClosestSphereOfTheLensNeeds14Point2Micrometres) {
   for (int j = 0; j < error.ny; ++j) {
     for (int i = 0; i < error.nx; ++i) {
       const double r = std::hypot(error.X(i), error.Y(j));
-      error.error_um.push_back(r <= 230.0 ? 1e3 * (SphereSagMm(1767.657, r) - PolynomialProfileSagMm(kLens, r))
-                                          : std::numeric_limits<double>::quiet_NaN());
+      error.error_um.push_back(r <= 230.0
+                                   ? 1e3 * (SphereSagMm(1767.657, r) - PolynomialProfileSagMm(kLens, r))
+                                   : std::numeric_limits<double>::quiet_NaN());
     }
   }
   const ErrorMap target = RemovalTarget(error, aperture, {});
@@ -60,14 +60,20 @@ TEST(RemovalTarget, ClosestSphereOfTheLensNeeds14Point2Micrometres) {
   EXPECT_NEAR(-deepest_um, 14.2, 0.1);
   EXPECT_NEAR(stats.pv_um, -deepest_um, 0.01);  // the 2.5 mm grid misses the deepest ring by < 10 nm
   double lowest = std::numeric_limits<double>::infinity();
-  for (const double v : target.error_um) if (std::isfinite(v)) lowest = std::min(lowest, v);
+  for (const double v : target.error_um)
+    if (std::isfinite(v)) lowest = std::min(lowest, v);
   EXPECT_EQ(lowest, 0.0);
 }
 
 TEST(RemovalTarget, AddsTheUniformLayerAndBlanksOutsideTheAperture) {
-  const grinding::Aperture aperture{.shape = grinding::Aperture::Shape::kRectangle,
-                                    .width_x_mm = 2.0, .width_y_mm = 2.0};
-  const ErrorMap error{.x0_mm = -2.0, .y0_mm = 0.0, .dx_mm = 1.0, .dy_mm = 1.0, .nx = 5, .ny = 1,
+  const grinding::Aperture aperture{
+      .shape = grinding::Aperture::Shape::kRectangle, .width_x_mm = 2.0, .width_y_mm = 2.0};
+  const ErrorMap error{.x0_mm = -2.0,
+                       .y0_mm = 0.0,
+                       .dx_mm = 1.0,
+                       .dy_mm = 1.0,
+                       .nx = 5,
+                       .ny = 1,
                        .error_um = {9.0, -1.0, 3.0, 2.0, -7.0}};
   const ErrorMap target = RemovalTarget(error, aperture, {.uniform_layer_um = 0.5});
   EXPECT_TRUE(std::isnan(target.error_um[0]));

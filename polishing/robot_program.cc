@@ -25,18 +25,19 @@ std::vector<PolishingPoint> BuildPolishingPath(const grinding::Surface& surface,
                                                const DwellSolution& dwell, RobotSide side,
                                                const PathPrecession& precession) {
   if (precession.enabled &&
-      (!(precession.tilt_deg >= 0.0 && precession.tilt_deg < 90.0) || !std::isfinite(precession.precession_rate_rpm) ||
-       !(precession.bonnet_radius_mm >= 0.0))) {
-    throw Error(ErrorCode::kInvalidOption, "polishing.path",
-                fmt::format("precession tilt_deg = {} (needs [0, 90)), precession_rate_rpm = {} (finite), "
-                            "bonnet_radius_mm = {} (>= 0)", precession.tilt_deg,
-                            precession.precession_rate_rpm, precession.bonnet_radius_mm));
+      (!(precession.tilt_deg >= 0.0 && precession.tilt_deg < 90.0) ||
+       !std::isfinite(precession.precession_rate_rpm) || !(precession.bonnet_radius_mm >= 0.0))) {
+    throw Error(
+        ErrorCode::kInvalidOption, "polishing.path",
+        fmt::format("precession tilt_deg = {} (needs [0, 90)), precession_rate_rpm = {} (finite), "
+                    "bonnet_radius_mm = {} (>= 0)",
+                    precession.tilt_deg, precession.precession_rate_rpm, precession.bonnet_radius_mm));
   }
   double elapsed_s = 0.0;
   if (dwell.dwell_s.size() != path_xy_mm.size() || dwell.speed_mm_s.size() != path_xy_mm.size()) {
-    throw Error(ErrorCode::kInvalidOption, "polishing.path",
-                fmt::format("{} path points but a dwell solution for {}", path_xy_mm.size(),
-                            dwell.dwell_s.size()));
+    throw Error(
+        ErrorCode::kInvalidOption, "polishing.path",
+        fmt::format("{} path points but a dwell solution for {}", path_xy_mm.size(), dwell.dwell_s.size()));
   }
   std::vector<PolishingPoint> points;
   points.reserve(path_xy_mm.size());
@@ -53,7 +54,8 @@ std::vector<PolishingPoint> BuildPolishingPath(const grinding::Surface& surface,
     elapsed_s += dwell.dwell_s[k];
     if (precession.enabled && path_xy_mm.size() > 1) {
       const Eigen::Vector3d c = -frame.col(2);
-      const Eigen::Vector2d d = k > 0 ? Eigen::Vector2d(p - path_xy_mm[k - 1]) : Eigen::Vector2d(path_xy_mm[1] - p);
+      const Eigen::Vector2d d =
+          k > 0 ? Eigen::Vector2d(p - path_xy_mm[k - 1]) : Eigen::Vector2d(path_xy_mm[1] - p);
       const grinding::SurfacePoint sp = surface.Evaluate(p.x(), p.y());
       const Eigen::Vector3d feed(d.x(), d.y(), sp.fx * d.x() + sp.fy * d.y());
       const Eigen::Vector3d a = (feed - feed.dot(c) * c).normalized();
@@ -74,7 +76,8 @@ std::vector<PolishingPoint> BuildPolishingPath(const grinding::Surface& surface,
 
 Eigen::Vector3d ToolData::CorrectedTcpMm() const {
   const Eigen::Matrix3d flange_R_tool = RotationFromAbbQuaternion(orientation);
-  return tcp_mm + flange_R_tool * Eigen::Vector3d(removal_centre_offset_mm.x(), removal_centre_offset_mm.y(), 0.0);
+  return tcp_mm +
+         flange_R_tool * Eigen::Vector3d(removal_centre_offset_mm.x(), removal_centre_offset_mm.y(), 0.0);
 }
 
 std::string PolishingPathCsv(std::span<const PolishingPoint> points, std::span<const std::string> comments) {
@@ -84,8 +87,8 @@ std::string PolishingPathCsv(std::span<const PolishingPoint> points, std::span<c
   for (const PolishingPoint& p : points) {
     // "{}" is the shortest representation that reads back to the same double.
     fmt::format_to(std::back_inserter(out), "{},{},{},{},{},{},{},{},{}\n", p.position_mm.x(),
-                   p.position_mm.y(), p.position_mm.z(), p.orientation.q1, p.orientation.q2,
-                   p.orientation.q3, p.orientation.q4, p.speed_mm_s, p.dwell_s);
+                   p.position_mm.y(), p.position_mm.z(), p.orientation.q1, p.orientation.q2, p.orientation.q3,
+                   p.orientation.q4, p.speed_mm_s, p.dwell_s);
   }
   return fmt::to_string(out);
 }
@@ -101,13 +104,17 @@ std::string RapidModule(std::span<const PolishingPoint> points, const ToolData& 
   line("  ! Positions rounded to 0.1 um, quaternions to 9 decimals (RAPID num precision).");
   const Eigen::Vector3d tcp = tool.CorrectedTcpMm();
   line(fmt::format("  ! TCP {:.4f},{:.4f},{:.4f} mm includes the removal-centre offset {:.4f},{:.4f} mm.",
-                   tcp.x(), tcp.y(), tcp.z(), tool.removal_centre_offset_mm.x(), tool.removal_centre_offset_mm.y()));
-  line(fmt::format("  PERS tooldata tPolish := [TRUE,[[{:.4f},{:.4f},{:.4f}],{}],[{:.4f},[{:.4f},{:.4f},{:.4f}],[1,0,0,0],0,0,0]];",
-                   tcp.x(), tcp.y(), tcp.z(), Quaternion9(tool.orientation), tool.mass_kg,
-                   tool.centre_of_gravity_mm.x(), tool.centre_of_gravity_mm.y(), tool.centre_of_gravity_mm.z()));
-  line(fmt::format("  PERS wobjdata wPart := [FALSE,TRUE,\"\",[[{:.4f},{:.4f},{:.4f}],{}],[[0,0,0],[1,0,0,0]]];",
-                   work_object.origin_mm.x(), work_object.origin_mm.y(), work_object.origin_mm.z(),
-                   Quaternion9(work_object.orientation)));
+                   tcp.x(), tcp.y(), tcp.z(), tool.removal_centre_offset_mm.x(),
+                   tool.removal_centre_offset_mm.y()));
+  line(fmt::format(
+      "  PERS tooldata tPolish := "
+      "[TRUE,[[{:.4f},{:.4f},{:.4f}],{}],[{:.4f},[{:.4f},{:.4f},{:.4f}],[1,0,0,0],0,0,0]];",
+      tcp.x(), tcp.y(), tcp.z(), Quaternion9(tool.orientation), tool.mass_kg, tool.centre_of_gravity_mm.x(),
+      tool.centre_of_gravity_mm.y(), tool.centre_of_gravity_mm.z()));
+  line(fmt::format(
+      "  PERS wobjdata wPart := [FALSE,TRUE,\"\",[[{:.4f},{:.4f},{:.4f}],{}],[[0,0,0],[1,0,0,0]]];",
+      work_object.origin_mm.x(), work_object.origin_mm.y(), work_object.origin_mm.z(),
+      Quaternion9(work_object.orientation)));
   line(fmt::format("  CONST num nPoints := {};", points.size()));
   line(fmt::format("  CONST robtarget pPath{{{}}} := [", points.size()));
   for (std::size_t k = 0; k < points.size(); ++k) {
@@ -119,7 +126,8 @@ std::string RapidModule(std::span<const PolishingPoint> points, const ToolData& 
   // speeddata: TCP speed (mm/s), reorientation (deg/s), linear and rotational external axes.
   line(fmt::format("  CONST speeddata vPath{{{}}} := [", points.size()));
   for (std::size_t k = 0; k < points.size(); ++k) {
-    line(fmt::format("    [{:.4f},500,5000,1000]{}", points[k].speed_mm_s, k + 1 < points.size() ? "," : "];"));
+    line(fmt::format("    [{:.4f},500,5000,1000]{}", points[k].speed_mm_s,
+                     k + 1 < points.size() ? "," : "];"));
   }
   line("  PROC main()");
   line("    ConfL \\Off;");

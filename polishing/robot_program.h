@@ -52,7 +52,7 @@ struct ToolData {
   // from the force-sensor calibration (method.md D, `arcwheel headcenter`). Added to the TCP so
   // that the robot brings the true removal centre onto the path.
   Eigen::Vector2d removal_centre_offset_mm = Eigen::Vector2d::Zero();
-  double mass_kg = 5.0;                                     // > 0
+  double mass_kg = 5.0;  // > 0
   Eigen::Vector3d centre_of_gravity_mm = Eigen::Vector3d(0.0, 0.0, 75.0);
   [[nodiscard]] Eigen::Vector3d CorrectedTcpMm() const;
 };

@@ -62,7 +62,8 @@ TEST(PolishingPathCsv, HoldsTheSection7ColumnsAtFullPrecision) {
     EXPECT_NEAR(r[2], -r2 / 1200.0, 1e-12);
     const AbbQuaternion q{r[3], r[4], r[5], r[6]};
     const Eigen::Matrix3d frame = RotationFromAbbQuaternion(q);
-    const Eigen::Vector3d inward = Eigen::Vector3d(-f.path[k].x() / 600.0, -f.path[k].y() / 600.0, -1.0).normalized();
+    const Eigen::Vector3d inward =
+        Eigen::Vector3d(-f.path[k].x() / 600.0, -f.path[k].y() / 600.0, -1.0).normalized();
     EXPECT_LT((frame.col(2) - inward).norm(), 1e-12);
     EXPECT_EQ(r[7], f.dwell.speed_mm_s[k]);
     EXPECT_EQ(r[8], f.dwell.dwell_s[k]);  // 1/3 reads back exactly: shortest round-trip digits
@@ -83,12 +84,15 @@ TEST(RapidModule, DeclaresTargetsSpeedsToolAndWorkObjectAndMovesThroughEveryPoin
   EXPECT_NE(text.find("ENDMODULE"), std::string::npos);
   // Offset (1.5, -2) in the tool frame is (1.5, +2, 0) in the flange frame after the half turn.
   EXPECT_NE(text.find("PERS tooldata tPolish := [TRUE,[[1.5000,2.0000,200.0000],[0.000000000,1.000000000,"),
-            std::string::npos) << text;
+            std::string::npos)
+      << text;
   EXPECT_NE(text.find("[[1000.0000,-250.0000,400.0000],[1.000000000,0.000000000,0.000000000,0.000000000]]"),
             std::string::npos);
-  const std::regex target(R"(\[\[(-?[0-9.]+),(-?[0-9.]+),(-?[0-9.]+)\],\[(-?[0-9.]+),(-?[0-9.]+),(-?[0-9.]+),(-?[0-9.]+)\],\[0,0,0,0\])");
+  const std::regex target(
+      R"(\[\[(-?[0-9.]+),(-?[0-9.]+),(-?[0-9.]+)\],\[(-?[0-9.]+),(-?[0-9.]+),(-?[0-9.]+),(-?[0-9.]+)\],\[0,0,0,0\])");
   std::size_t k = 0;
-  for (auto it = std::sregex_iterator(text.begin(), text.end(), target); it != std::sregex_iterator(); ++it, ++k) {
+  for (auto it = std::sregex_iterator(text.begin(), text.end(), target); it != std::sregex_iterator();
+       ++it, ++k) {
     ASSERT_LT(k, points.size());
     for (int c = 0; c < 3; ++c) EXPECT_NEAR(std::stod((*it)[c + 1]), points[k].position_mm[c], 0.5e-4);
     EXPECT_NEAR(std::stod((*it)[4]), points[k].orientation.q1, 0.5e-9);
@@ -101,8 +105,8 @@ TEST(RapidModule, DeclaresTargetsSpeedsToolAndWorkObjectAndMovesThroughEveryPoin
 
 TEST(BuildPolishingPath, PrecessesTheBonnetAxisAboutTheNormalAtTheTiltAndRate) {
   const Fixture f;
-  const PathPrecession precession{.enabled = true, .tilt_deg = 20.0, .precession_rate_rpm = 5.0,
-                                  .bonnet_radius_mm = 40.0};
+  const PathPrecession precession{
+      .enabled = true, .tilt_deg = 20.0, .precession_rate_rpm = 5.0, .bonnet_radius_mm = 40.0};
   const auto points = BuildPolishingPath(f.surface, f.path, f.dwell, RobotSide::kPlusX, precession);
   const double w2 = 5.0 * 2.0 * std::numbers::pi / 60.0;
   double elapsed = 0.0;
@@ -117,7 +121,8 @@ TEST(BuildPolishingPath, PrecessesTheBonnetAxisAboutTheNormalAtTheTiltAndRate) {
     const Eigen::Vector3d axis = -frame.col(2);
     EXPECT_NEAR(std::acos(axis.dot(up)), 20.0 * std::numbers::pi / 180.0, 1e-9);
     // Precession angle measured from the feed direction on the tangent plane.
-    const Eigen::Vector2d d = k > 0 ? Eigen::Vector2d(f.path[k] - f.path[k - 1]) : Eigen::Vector2d(f.path[1] - f.path[0]);
+    const Eigen::Vector2d d =
+        k > 0 ? Eigen::Vector2d(f.path[k] - f.path[k - 1]) : Eigen::Vector2d(f.path[1] - f.path[0]);
     Eigen::Vector3d a(d.x(), d.y(), -(p.x() * d.x() + p.y() * d.y()) / 600.0);
     a = (a - a.dot(up) * up).normalized();
     const Eigen::Vector3d tangential = axis - axis.dot(up) * up;
@@ -126,7 +131,8 @@ TEST(BuildPolishingPath, PrecessesTheBonnetAxisAboutTheNormalAtTheTiltAndRate) {
     EXPECT_LT((frame.transpose() * frame - Eigen::Matrix3d::Identity()).norm(), 1e-12);
   }
   EXPECT_THROW((void)BuildPolishingPath(f.surface, f.path, f.dwell, RobotSide::kPlusX,
-                                        {.enabled = true, .tilt_deg = 95.0}), Error);
+                                        {.enabled = true, .tilt_deg = 95.0}),
+               Error);
 }
 
 TEST(BuildPolishingPath, RefusesAPointOffTheSurface) {
@@ -136,7 +142,8 @@ TEST(BuildPolishingPath, RefusesAPointOffTheSurface) {
     (void)BuildPolishingPath(small, f.path, f.dwell, RobotSide::kPlusX);
     FAIL() << "accepted";
   } catch (const Error& e) {
-    EXPECT_NE(std::string(e.what()).find("path point 3 (40, 7) mm is off the surface"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("path point 3 (40, 7) mm is off the surface"), std::string::npos)
+        << e.what();
   }
 }
 

@@ -25,8 +25,8 @@ enum class RobotSide { kPlusX, kMinusX };
 [[nodiscard]] Eigen::Matrix3d ToolFrameFromSlopes(double fx, double fy, RobotSide side);
 
 // Tool frame at (x, y) of the surface. Precondition: surface.InDomain(x, y).
-[[nodiscard]] Eigen::Matrix3d ToolFrameAt(const grinding::Surface& surface, double x_mm,
-                                          double y_mm, RobotSide side);
+[[nodiscard]] Eigen::Matrix3d ToolFrameAt(const grinding::Surface& surface, double x_mm, double y_mm,
+                                          RobotSide side);
 
 // A unit quaternion in ABB order: q1 scalar, then q2, q3, q4 (i, j, k). Note that Eigen stores
 // (x, y, z, w); this type is never an Eigen::Quaterniond in disguise.

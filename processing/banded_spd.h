@@ -36,7 +36,9 @@ class BandedSpd {
     return i <= j ? z_[i][j - i] : z_[j][i - j];
   }
   // Inverse(i, i + d) for d = 0..3.
-  [[nodiscard]] double InverseInBand(std::size_t i, int d) const { return z_[i][static_cast<std::size_t>(d)]; }
+  [[nodiscard]] double InverseInBand(std::size_t i, int d) const {
+    return z_[i][static_cast<std::size_t>(d)];
+  }
 
  private:
   std::size_t n_;

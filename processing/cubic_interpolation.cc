@@ -42,7 +42,8 @@ double NaturalCubicSpline::operator()(double x) const {
   const double h = x_[i + 1] - x_[i];
   const double a = (x_[i + 1] - x) / h;
   const double b = (x - x_[i]) / h;
-  return a * y_[i] + b * y_[i + 1] + ((a * a * a - a) * second_[i] + (b * b * b - b) * second_[i + 1]) * h * h / 6.0;
+  return a * y_[i] + b * y_[i + 1] +
+         ((a * a * a - a) * second_[i] + (b * b * b - b) * second_[i + 1]) * h * h / 6.0;
 }
 
 }  // namespace arcwheel::processing

@@ -3,8 +3,8 @@
 #include <algorithm>
 #include <cmath>
 #include <deque>
-#include <thread>
 #include <limits>
+#include <thread>
 
 #include "core/error.h"
 
@@ -17,7 +17,9 @@ constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 // heap-based running median in practice.
 class SortedWindow {
  public:
-  void Insert(double value) { values_.insert(std::lower_bound(values_.begin(), values_.end(), value), value); }
+  void Insert(double value) {
+    values_.insert(std::lower_bound(values_.begin(), values_.end(), value), value);
+  }
   void Erase(double value) { values_.erase(std::lower_bound(values_.begin(), values_.end(), value)); }
   [[nodiscard]] double Median() const {
     const std::size_t n = values_.size();
@@ -87,7 +89,8 @@ struct WindowMeanOfOthers {
     --count;
   }
   [[nodiscard]] double Reference(double centre) const {
-    return count > 1 ? (sum - centre) / static_cast<double>(count - 1) : std::numeric_limits<double>::quiet_NaN();
+    return count > 1 ? (sum - centre) / static_cast<double>(count - 1)
+                     : std::numeric_limits<double>::quiet_NaN();
   }
 };
 
@@ -169,7 +172,8 @@ double MedianOf(std::vector<double> values) {
 }
 
 // The neighbours (as NeighbourIndices) of any of `removed`, sorted and unique.
-std::vector<std::size_t> SamplesNear(std::span<const double> z, const std::vector<std::size_t>& removed, int w) {
+std::vector<std::size_t> SamplesNear(std::span<const double> z, const std::vector<std::size_t>& removed,
+                                     int w) {
   std::vector<std::size_t> near;
   for (const std::size_t r : removed) {
     const std::vector<std::size_t> found = NeighbourIndices(z, r, w);
@@ -232,7 +236,8 @@ void DespikeByMovingMean(std::span<double> z, int w, double threshold_mm, Despik
 std::vector<std::string> DespikeOptions::Problems() const {
   std::vector<std::string> problems;
   if (window_half_width < 1 || window_half_width > 50) {
-    problems.push_back("despike window_half_width = " + std::to_string(window_half_width) + " violates 1..50");
+    problems.push_back("despike window_half_width = " + std::to_string(window_half_width) +
+                       " violates 1..50");
   }
   if (!(threshold_sigmas > 0)) problems.push_back("despike threshold_sigmas must be > 0");
   if (!(min_threshold_um >= 0)) problems.push_back("despike min_threshold_um must be >= 0");
@@ -250,9 +255,12 @@ DespikeMethod ParseDespikeMethod(const std::string& name) {
 
 std::string DespikeMethodName(DespikeMethod method) {
   switch (method) {
-    case DespikeMethod::kMedian: return "median";
-    case DespikeMethod::kMovingMean: return "moving-mean";
-    case DespikeMethod::kNone: return "none";
+    case DespikeMethod::kMedian:
+      return "median";
+    case DespikeMethod::kMovingMean:
+      return "moving-mean";
+    case DespikeMethod::kNone:
+      return "none";
   }
   return "none";
 }
@@ -262,9 +270,10 @@ DespikeResult Despike(std::span<double> z_mm, double noise_sigma_mm, const Despi
     throw Error(ErrorCode::kInvalidOption, "processing.despike", problems.front());
   }
   DespikeResult result;
-  result.threshold_um = options.threshold_um > 0
-                            ? options.threshold_um
-                            : std::max(options.min_threshold_um, options.threshold_sigmas * noise_sigma_mm * 1000.0);
+  result.threshold_um =
+      options.threshold_um > 0
+          ? options.threshold_um
+          : std::max(options.min_threshold_um, options.threshold_sigmas * noise_sigma_mm * 1000.0);
   if (options.method == DespikeMethod::kNone) return result;
   const double threshold_mm = result.threshold_um / 1000.0;
   if (options.method == DespikeMethod::kMedian) {

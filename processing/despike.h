@@ -35,9 +35,9 @@ struct DespikeOptions {
 [[nodiscard]] std::string DespikeMethodName(DespikeMethod method);
 
 struct DespikeResult {
-  std::size_t rejected = 0;             // samples replaced or dropped
-  double threshold_um = 0.0;            // the threshold used
-  std::vector<std::size_t> indices;     // which samples (ascending)
+  std::size_t rejected = 0;          // samples replaced or dropped
+  double threshold_um = 0.0;         // the threshold used
+  std::vector<std::size_t> indices;  // which samples (ascending)
 };
 
 // Despikes `z_mm` in place (NaN = invalid, left alone). `noise_sigma_mm` sets the automatic

@@ -66,12 +66,14 @@ HelixSpline::HelixSpline(std::span<const double> z, const HelixGeometry& geometr
   BandedSpd upper_normal(n);
   std::vector<double> upper_rhs(n, 0.0);
   std::vector<int> upper_counts(cells, 0);
-  std::thread upper([&, end = last] { Accumulate(z, geometry, middle, end, upper_normal, upper_rhs, upper_counts); });
+  std::thread upper(
+      [&, end = last] { Accumulate(z, geometry, middle, end, upper_normal, upper_rhs, upper_counts); });
   Accumulate(z, geometry, first, middle, normal_, rhs, cell_counts_);
   upper.join();
   for (std::size_t i = 0; i < n; ++i) {
     rhs[i] += upper_rhs[i];
-    for (std::size_t j = i; j <= std::min(n - 1, i + BandedSpd::kBand); ++j) normal_.Add(i, j, upper_normal.Get(i, j));
+    for (std::size_t j = i; j <= std::min(n - 1, i + BandedSpd::kBand); ++j)
+      normal_.Add(i, j, upper_normal.Get(i, j));
   }
   for (std::size_t c = 0; c < cells; ++c) cell_counts_[c] += upper_counts[c];
   ThrowIfInterrupted();
@@ -87,7 +89,8 @@ HelixSpline::HelixSpline(std::span<const double> z, const HelixGeometry& geometr
     }
   }
   if (!normal_.Factorize()) {
-    throw Error(ErrorCode::kFitFailed, "processing.spline", "the helix spline's normal matrix is not definite");
+    throw Error(ErrorCode::kFitFailed, "processing.spline",
+                "the helix spline's normal matrix is not definite");
   }
   normal_.Solve(rhs);
   coefficients_ = std::move(rhs);
@@ -134,7 +137,8 @@ int HelixSpline::Support(double u) const {
   const long other = f < 0.5 ? cell - 1 : cell + 1;
   int count = 0;
   for (const long c : {cell, other}) {
-    if (c >= 0 && c < static_cast<long>(cell_counts_.size())) count += cell_counts_[static_cast<std::size_t>(c)];
+    if (c >= 0 && c < static_cast<long>(cell_counts_.size()))
+      count += cell_counts_[static_cast<std::size_t>(c)];
   }
   return count;
 }

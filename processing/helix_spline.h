@@ -47,11 +47,12 @@ class HelixSpline {
   };
   [[nodiscard]] Basis BasisAt(double u_deg) const;
   // Adds samples [begin, end) to the normal equations, right-hand side and cell counts.
-  void Accumulate(std::span<const double> z, const HelixGeometry& geometry, std::size_t begin, std::size_t end,
-                  BandedSpd& normal, std::vector<double>& rhs, std::vector<int>& counts) const;
+  void Accumulate(std::span<const double> z, const HelixGeometry& geometry, std::size_t begin,
+                  std::size_t end, BandedSpd& normal, std::vector<double>& rhs,
+                  std::vector<int>& counts) const;
 
-  double u0_ = 0.0;     // first knot
-  double h_ = 1.0;      // knot spacing
+  double u0_ = 0.0;  // first knot
+  double h_ = 1.0;   // knot spacing
   double u_first_ = 0.0;
   double u_last_ = 0.0;
   std::vector<double> coefficients_;

@@ -1,8 +1,9 @@
 #include "processing/process_scan.h"
 
+#include <fmt/core.h>
+
 #include <algorithm>
 #include <cmath>
-#include <fmt/core.h>
 
 #include "core/error.h"
 #include "core/interrupt.h"
@@ -47,7 +48,8 @@ std::size_t StuckRunSamples(const acquisition::Scan& scan, double stuck_run_deg)
   const double turns = (geometry.PhaseAt(scan.size() - 1) - geometry.PhaseAt(0)) / 360.0;
   if (!(turns > 0.0)) return 0;
   const double samples_per_turn = static_cast<double>(scan.size()) / turns;
-  return std::max<std::size_t>(16, static_cast<std::size_t>(std::ceil(samples_per_turn * stuck_run_deg / 360.0)));
+  return std::max<std::size_t>(16,
+                               static_cast<std::size_t>(std::ceil(samples_per_turn * stuck_run_deg / 360.0)));
 }
 
 }  // namespace
@@ -57,7 +59,8 @@ std::vector<std::string> ProcessOptions::Problems() const {
   for (auto& p : map.Problems()) problems.push_back(std::move(p));
   if (!(stuck_run_deg >= 0.0 && stuck_run_deg <= 360.0)) problems.push_back("stuck_run_deg violates 0..360");
   if (!std::isfinite(beam_offset_mm)) problems.push_back("beam_offset_mm must be finite");
-  if (speed.max_harmonic < 1 || speed.max_harmonic > 60) problems.push_back("speed max_harmonic violates 1..60");
+  if (speed.max_harmonic < 1 || speed.max_harmonic > 60)
+    problems.push_back("speed max_harmonic violates 1..60");
   return problems;
 }
 
@@ -72,10 +75,14 @@ RpmSource ParseRpmSource(const std::string& name) {
 
 std::string RpmSourceName(RpmSource source) {
   switch (source) {
-    case RpmSource::kAuto: return "auto";
-    case RpmSource::kNominal: return "nominal";
-    case RpmSource::kEncoder: return "encoder";
-    case RpmSource::kEstimate: return "estimate";
+    case RpmSource::kAuto:
+      return "auto";
+    case RpmSource::kNominal:
+      return "nominal";
+    case RpmSource::kEncoder:
+      return "encoder";
+    case RpmSource::kEstimate:
+      return "estimate";
   }
   return "auto";
 }
@@ -85,14 +92,16 @@ ProcessedScan ProcessScan(acquisition::Scan scan, const ProcessOptions& options)
     throw Error(ErrorCode::kInvalidOption, kStage, problems.front());
   }
   if (options.rpm_source == RpmSource::kEncoder && !scan.has_encoder()) {
-    throw Error(ErrorCode::kInvalidOption, kStage, "'" + scan.path + "' has no angle column for --rpm-source encoder");
+    throw Error(ErrorCode::kInvalidOption, kStage,
+                "'" + scan.path + "' has no angle column for --rpm-source encoder");
   }
   ProcessedScan out;
   out.samples = scan.size();
   out.warnings = scan.metadata.notes;  // what the reader noticed comes first
   ToRadialCoordinate(scan);
   std::vector<double>& rho = scan.z_mm;
-  out.valid_samples = static_cast<std::size_t>(std::count_if(rho.begin(), rho.end(), [](double v) { return std::isfinite(v); }));
+  out.valid_samples = static_cast<std::size_t>(
+      std::count_if(rho.begin(), rho.end(), [](double v) { return std::isfinite(v); }));
   const auto first = std::find_if(rho.begin(), rho.end(), [](double v) { return std::isfinite(v); });
   const auto last = std::find_if(rho.rbegin(), rho.rend(), [](double v) { return std::isfinite(v); });
   out.first_valid = static_cast<std::size_t>(first - rho.begin());
@@ -101,23 +110,26 @@ ProcessedScan ProcessScan(acquisition::Scan scan, const ProcessOptions& options)
 
   out.stuck = DropStuckReadings(rho, StuckRunSamples(scan, options.stuck_run_deg));
   if (out.stuck.dropped > 0 && out.stuck.dropped == out.valid_samples) {
-    throw Error(ErrorCode::kBadInput, kStage,
-                fmt::format("'{}': every reading lies in a run of equal values (longest {} samples): the sensor is "
-                            "stuck or saturated",
-                            scan.path, out.stuck.longest_run));
+    throw Error(
+        ErrorCode::kBadInput, kStage,
+        fmt::format("'{}': every reading lies in a run of equal values (longest {} samples): the sensor is "
+                    "stuck or saturated",
+                    scan.path, out.stuck.longest_run));
   }
   if (out.stuck.dropped > 0) {
-    out.warnings.push_back(fmt::format("dropped {} samples in {} run(s) of equal readings (longest {} samples; a run of "
-                                       "{} or more is a stuck or saturated sensor): check the sensor",
-                                       out.stuck.dropped, out.stuck.runs, out.stuck.longest_run, out.stuck.min_run));
+    out.warnings.push_back(
+        fmt::format("dropped {} samples in {} run(s) of equal readings (longest {} samples; a run of "
+                    "{} or more is a stuck or saturated sensor): check the sensor",
+                    out.stuck.dropped, out.stuck.runs, out.stuck.longest_run, out.stuck.min_run));
   }
   out.noise_sigma_mm = EstimateNoiseSigmaMm(rho);
   out.despike = Despike(rho, out.noise_sigma_mm, options.despike);
   // The noise that matters for the sigmas is that of the samples the map is built from.
   out.noise_sigma_mm = EstimateNoiseSigmaMm(rho);
   if (out.despike.rejected > out.valid_samples / 10) {
-    out.warnings.push_back(fmt::format("despiking rejected {} of {} valid samples: check the threshold ({:.3g} um)",
-                                       out.despike.rejected, out.valid_samples, out.despike.threshold_um));
+    out.warnings.push_back(
+        fmt::format("despiking rejected {} of {} valid samples: check the threshold ({:.3g} um)",
+                    out.despike.rejected, out.valid_samples, out.despike.threshold_um));
   }
   ThrowIfInterrupted();
 
@@ -126,13 +138,14 @@ ProcessedScan ProcessScan(acquisition::Scan scan, const ProcessOptions& options)
     if (radius <= 0 && scan.metadata.wheel_diameter_mm) radius = *scan.metadata.wheel_diameter_mm / 2.0;
     if (radius <= 0) {
       throw Error(ErrorCode::kInvalidOption, kStage,
-                  "the beam-offset correction needs the wheel radius: give --wheel-radius-mm or a wheel_diameter_mm attribute");
+                  "the beam-offset correction needs the wheel radius: give --wheel-radius-mm or a "
+                  "wheel_diameter_mm attribute");
     }
     CorrectBeamOffset(rho, options.beam_offset_mm, radius);
   }
 
-  const bool use_encoder =
-      scan.has_encoder() && (options.rpm_source == RpmSource::kAuto || options.rpm_source == RpmSource::kEncoder);
+  const bool use_encoder = scan.has_encoder() && (options.rpm_source == RpmSource::kAuto ||
+                                                  options.rpm_source == RpmSource::kEncoder);
   if (use_encoder) {
     out.phase_source = PhaseSource::kEncoder;
     out.rpm_used = HelixGeometry(scan, 0.0).rpm();
@@ -148,8 +161,9 @@ ProcessedScan ProcessScan(acquisition::Scan scan, const ProcessOptions& options)
       if (out.speed.available && (out.speed.significant || forced)) {
         out.rpm_used = out.speed.fitted_rpm;
         out.phase_source = PhaseSource::kEstimated;
-        out.warnings.push_back(fmt::format("spindle speed estimated from the data: {:.6f} rpm (nominal {:.6f}, sigma {:.2g})",
-                                           out.speed.fitted_rpm, out.speed.nominal_rpm, out.speed.sigma_rpm));
+        out.warnings.push_back(
+            fmt::format("spindle speed estimated from the data: {:.6f} rpm (nominal {:.6f}, sigma {:.2g})",
+                        out.speed.fitted_rpm, out.speed.nominal_rpm, out.speed.sigma_rpm));
       }
       if (!out.speed.note.empty()) out.warnings.push_back(out.speed.note);
     }

@@ -11,9 +11,9 @@
 
 #include "acquisition/scan.h"
 #include "processing/despike.h"
-#include "processing/stuck_readings.h"
 #include "processing/helix_geometry.h"
 #include "processing/spindle_speed.h"
+#include "processing/stuck_readings.h"
 #include "processing/wheel_map.h"
 
 namespace arcwheel::processing {
@@ -42,13 +42,13 @@ struct ProcessOptions {
 
 struct ProcessedScan {
   std::size_t samples = 0;
-  std::size_t valid_samples = 0;       // before despiking
-  std::size_t first_valid = 0;         // the trimmed span [first_valid, last_valid]
+  std::size_t valid_samples = 0;  // before despiking
+  std::size_t first_valid = 0;    // the trimmed span [first_valid, last_valid]
   std::size_t last_valid = 0;
   StuckReadingsResult stuck;
   DespikeResult despike;
   double noise_sigma_mm = 0.0;
-  SpindleSpeedEstimate speed;          // filled when estimated
+  SpindleSpeedEstimate speed;  // filled when estimated
   PhaseSource phase_source = PhaseSource::kNominal;
   double rpm_used = 0.0;
   WheelMap map;

@@ -34,7 +34,8 @@ TEST(BandedSpd, SolveAndSelectedInverseMatchADenseInverse) {
   const Eigen::MatrixXd inverse = dense.inverse();
   for (std::size_t i = 0; i < n; ++i) {
     for (std::size_t j = i; j <= std::min(n - 1, i + 3); ++j) {
-      EXPECT_NEAR(banded.Inverse(i, j), inverse(static_cast<Eigen::Index>(i), static_cast<Eigen::Index>(j)), 1e-13);
+      EXPECT_NEAR(banded.Inverse(i, j), inverse(static_cast<Eigen::Index>(i), static_cast<Eigen::Index>(j)),
+                  1e-13);
     }
   }
   std::vector<double> b(n);
@@ -61,7 +62,8 @@ std::vector<double> NoisySine(std::size_t n, double noise_mm, std::uint32_t seed
   std::mt19937 rng(seed);
   std::normal_distribution<double> normal(0.0, noise_mm);
   std::vector<double> z(n);
-  for (std::size_t i = 0; i < n; ++i) z[i] = 0.005 * std::sin(2.0 * std::numbers::pi * static_cast<double>(i) / 1200.0) + normal(rng);
+  for (std::size_t i = 0; i < n; ++i)
+    z[i] = 0.005 * std::sin(2.0 * std::numbers::pi * static_cast<double>(i) / 1200.0) + normal(rng);
   return z;
 }
 

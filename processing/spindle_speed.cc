@@ -15,10 +15,10 @@ namespace {
 using Complex = std::complex<double>;
 
 struct TurnHarmonics {
-  double turn = 0.0;               // turn index of the window's middle
-  std::vector<Complex> amplitude;  // Q_h = A_h - i B_h, h = 1..H
+  double turn = 0.0;                    // turn index of the window's middle
+  std::vector<Complex> amplitude;       // Q_h = A_h - i B_h, h = 1..H
   std::vector<double> amplitude_sigma;  // 1 sigma of |Q_h| from the turn's residuals
-  double residual_sigma = 0.0;     // rms of the per-bin fit residual
+  double residual_sigma = 0.0;          // rms of the per-bin fit residual
 };
 
 // Over one turn a smooth trend and the lowest harmonics are nearly the same functions (a ramp's
@@ -43,7 +43,8 @@ std::vector<TurnHarmonics> FitTurns(const acquisition::Scan& scan, std::span<con
                                     int bins, int harmonics, std::size_t spacing) {
   const HelixGeometry geometry(scan, rpm);
   const double u0 = geometry.PhaseAt(0);
-  const auto turns = static_cast<std::size_t>(std::floor((geometry.PhaseAt(scan.size() - 1) - u0) / 360.0)) + 1;
+  const auto turns =
+      static_cast<std::size_t>(std::floor((geometry.PhaseAt(scan.size() - 1) - u0) / 360.0)) + 1;
   const auto nb = static_cast<std::size_t>(bins);
   std::vector<double> sum(turns * nb, 0.0);
   std::vector<double> position(turns * nb, 0.0);  // sum of the samples' fractional turn positions
@@ -109,7 +110,8 @@ std::vector<TurnHarmonics> FitTurns(const acquisition::Scan& scan, std::span<con
     for (int h = 1; h <= harmonics; ++h) {
       const int c = kTrendTerms - 2 + 2 * h;
       turn.amplitude.emplace_back(p(c), -p(c + 1));
-      turn.amplitude_sigma.push_back(turn.residual_sigma * std::sqrt(0.5 * (inverse(c, c) + inverse(c + 1, c + 1))));
+      turn.amplitude_sigma.push_back(turn.residual_sigma *
+                                     std::sqrt(0.5 * (inverse(c, c) + inverse(c + 1, c + 1))));
     }
     result.push_back(std::move(turn));
   }
@@ -168,7 +170,9 @@ SpindleSpeedEstimate EstimateSpindleSpeed(const acquisition::Scan& scan, std::sp
   estimate.fitted_rpm = estimate.used_rpm = estimate.nominal_rpm;
 
   const HelixGeometry nominal(scan, estimate.nominal_rpm);
-  const double samples_per_turn = static_cast<double>(scan.size()) / std::max(1.0, (nominal.PhaseAt(scan.size() - 1) - nominal.PhaseAt(0)) / 360.0);
+  const double samples_per_turn =
+      static_cast<double>(scan.size()) /
+      std::max(1.0, (nominal.PhaseAt(scan.size() - 1) - nominal.PhaseAt(0)) / 360.0);
   const int bins = static_cast<int>(std::clamp(samples_per_turn / 2.0, 16.0, 360.0));
   const int harmonics = std::clamp(options.max_harmonic, 1, std::max(1, bins / 2 - 3));
 
@@ -176,7 +180,8 @@ SpindleSpeedEstimate EstimateSpindleSpeed(const acquisition::Scan& scan, std::sp
   // slips 95 deg of the first harmonic in 132 turns), so the estimate starts on adjacent windows
   // and spreads them at most kSpreadGrowth times wider at each iteration, out to the whole scan.
   constexpr std::size_t kSpreadGrowth = 8;
-  const auto scan_turns = static_cast<std::size_t>(std::max(0.0, (nominal.PhaseAt(scan.size() - 1) - nominal.PhaseAt(0)) / 360.0));
+  const auto scan_turns = static_cast<std::size_t>(
+      std::max(0.0, (nominal.PhaseAt(scan.size() - 1) - nominal.PhaseAt(0)) / 360.0));
   const std::size_t widest = SpreadSpacing(scan_turns);
   std::size_t spacing = 1;
   double rpm = estimate.nominal_rpm;
@@ -224,7 +229,8 @@ SpindleSpeedEstimate EstimateSpindleSpeed(const acquisition::Scan& scan, std::sp
     // per-turn model does not describe): widen the sigma by the Birge ratio.
     if (drifts.size() > 1) {
       double chi2 = 0.0;
-      for (const Drift& d : drifts) chi2 += (d.delta - delta) * (d.delta - delta) / std::max(d.sigma * d.sigma, 1e-30);
+      for (const Drift& d : drifts)
+        chi2 += (d.delta - delta) * (d.delta - delta) / std::max(d.sigma * d.sigma, 1e-30);
       sigma_relative *= std::max(1.0, std::sqrt(chi2 / static_cast<double>(drifts.size() - 1)));
     }
     rpm *= 1.0 + delta;
@@ -234,7 +240,8 @@ SpindleSpeedEstimate EstimateSpindleSpeed(const acquisition::Scan& scan, std::sp
   estimate.available = true;
   estimate.fitted_rpm = rpm;
   estimate.sigma_rpm = sigma_relative * rpm;
-  estimate.significant = std::abs(rpm - estimate.nominal_rpm) > options.significance_sigmas * estimate.sigma_rpm;
+  estimate.significant =
+      std::abs(rpm - estimate.nominal_rpm) > options.significance_sigmas * estimate.sigma_rpm;
   estimate.used_rpm = estimate.significant ? rpm : estimate.nominal_rpm;
   if (estimate.used_first_harmonic) {
     estimate.note =

@@ -21,28 +21,29 @@
 namespace arcwheel::processing {
 
 struct SpindleSpeedOptions {
-  int max_harmonic = 12;            // H, 1..60
-  double min_harmonic_snr = 8.0;    // a harmonic is used when its mean amplitude is this many sigmas
+  int max_harmonic = 12;                    // H, 1..60
+  double min_harmonic_snr = 8.0;            // a harmonic is used when its mean amplitude is this many sigmas
   double min_harmonic_amplitude_um = 0.05;  // ... and at least this large (a phase needs an amplitude)
-  double significance_sigmas = 3.0; // the estimate replaces the nominal only beyond this many sigmas
-  int iterations = 3;               // re-binning at the improved speed
+  double significance_sigmas = 3.0;         // the estimate replaces the nominal only beyond this many sigmas
+  int iterations = 3;                       // re-binning at the improved speed
 };
 
 struct SpindleSpeedEstimate {
   double nominal_rpm = 0.0;
-  double fitted_rpm = 0.0;   // what the data say
-  double sigma_rpm = 0.0;    // 1 sigma of fitted_rpm
-  double used_rpm = 0.0;     // fitted_rpm if significant, else nominal_rpm
-  bool available = false;    // an estimate was made (enough turns, a usable harmonic)
+  double fitted_rpm = 0.0;  // what the data say
+  double sigma_rpm = 0.0;   // 1 sigma of fitted_rpm
+  double used_rpm = 0.0;    // fitted_rpm if significant, else nominal_rpm
+  bool available = false;   // an estimate was made (enough turns, a usable harmonic)
   bool significant = false;
   bool used_first_harmonic = false;
   int harmonics_used = 0;
   int turns_used = 0;
-  std::string note;          // why the estimate could not be made, or caveats
+  std::string note;  // why the estimate could not be made, or caveats
 };
 
 // `z_mm` already despiked (NaN = invalid). The scan must have no encoder column.
-[[nodiscard]] SpindleSpeedEstimate EstimateSpindleSpeed(const acquisition::Scan& scan, std::span<const double> z_mm,
+[[nodiscard]] SpindleSpeedEstimate EstimateSpindleSpeed(const acquisition::Scan& scan,
+                                                        std::span<const double> z_mm,
                                                         const SpindleSpeedOptions& options);
 
 }  // namespace arcwheel::processing

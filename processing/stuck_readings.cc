@@ -18,8 +18,8 @@ StuckReadingsResult DropStuckReadings(std::span<double> z_mm, std::size_t min_ru
     }
     const std::size_t length = end - begin;
     if (std::isfinite(z_mm[begin]) && length >= min_run) {
-      std::fill(z_mm.begin() + static_cast<std::ptrdiff_t>(begin), z_mm.begin() + static_cast<std::ptrdiff_t>(end),
-                std::numeric_limits<double>::quiet_NaN());
+      std::fill(z_mm.begin() + static_cast<std::ptrdiff_t>(begin),
+                z_mm.begin() + static_cast<std::ptrdiff_t>(end), std::numeric_limits<double>::quiet_NaN());
       result.dropped += length;
       ++result.runs;
       result.longest_run = std::max(result.longest_run, length);

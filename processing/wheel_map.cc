@@ -101,7 +101,8 @@ void InterpolateSection(const Section& section, std::span<const double> nodes, d
 
 std::vector<std::string> MapOptions::Problems() const {
   std::vector<std::string> problems;
-  if (phases < 4 || phases > 36000) problems.push_back("phases = " + std::to_string(phases) + " violates 4..36000");
+  if (phases < 4 || phases > 36000)
+    problems.push_back("phases = " + std::to_string(phases) + " violates 4..36000");
   if (!std::isfinite(knot_step_deg) || knot_step_deg > 90) problems.push_back("knot_step_deg must be <= 90");
   if (!std::isfinite(axial_step_mm)) problems.push_back("axial_step_mm must be finite");
   if (min_support < 1) problems.push_back("min_support must be >= 1");
@@ -114,7 +115,8 @@ WheelMap BuildWheelMap(std::span<const double> rho, const HelixGeometry& geometr
   if (const auto problems = options.Problems(); !problems.empty()) {
     throw Error(ErrorCode::kInvalidOption, "processing.map", problems.front());
   }
-  const auto valid = static_cast<std::size_t>(std::count_if(rho.begin(), rho.end(), [](double v) { return std::isfinite(v); }));
+  const auto valid = static_cast<std::size_t>(
+      std::count_if(rho.begin(), rho.end(), [](double v) { return std::isfinite(v); }));
   WheelMap map;
   map.noise_sigma_mm = noise_sigma_mm;
   map.knot_step_deg = ChooseKnotStep(options, geometry, valid);
@@ -137,7 +139,8 @@ WheelMap BuildWheelMap(std::span<const double> rho, const HelixGeometry& geometr
     y_high = std::min(y_high, s.y_mm.back());
   }
   if (!(y_high > y_low)) {
-    throw Error(ErrorCode::kBadInput, "processing.map", "the valid samples do not cover a common axial span at all phases");
+    throw Error(ErrorCode::kBadInput, "processing.map",
+                "the valid samples do not cover a common axial span at all phases");
   }
   ThrowIfInterrupted();
 

@@ -15,11 +15,11 @@
 namespace arcwheel::processing {
 
 struct MapOptions {
-  int phases = 360;             // phase nodes 0, 360/phases, ...; 4..36000
-  double knot_step_deg = 0.0;   // helix spline knot spacing; <= 0: 360/phases, widened to >= 2.5 samples
-  double axial_step_mm = 0.0;   // map node spacing; <= 0: one helix pitch
-  int min_support = 2;          // a section point needs this many valid samples within its two knot intervals
-  double max_sigma_ratio = 1.5; // ... and a sigma at most this many times the median point's; >= 1
+  int phases = 360;            // phase nodes 0, 360/phases, ...; 4..36000
+  double knot_step_deg = 0.0;  // helix spline knot spacing; <= 0: 360/phases, widened to >= 2.5 samples
+  double axial_step_mm = 0.0;  // map node spacing; <= 0: one helix pitch
+  int min_support = 2;         // a section point needs this many valid samples within its two knot intervals
+  double max_sigma_ratio = 1.5;  // ... and a sigma at most this many times the median point's; >= 1
   [[nodiscard]] std::vector<std::string> Problems() const;
 };
 
@@ -32,13 +32,13 @@ struct Section {
 };
 
 struct WheelMap {
-  std::vector<double> phase_deg;   // [n_phase]
-  std::vector<double> y_mm;        // [n_y]
-  std::vector<double> rho_mm;      // [n_phase * n_y], row-major by phase; NaN where not covered
-  std::vector<int> sample_count;   // valid samples per cell
-  std::vector<int> despiked_count; // despiked samples per cell
-  std::vector<Section> sections;   // [n_phase]
-  double noise_sigma_mm = 0.0;     // per-sample noise used for the sigmas
+  std::vector<double> phase_deg;    // [n_phase]
+  std::vector<double> y_mm;         // [n_y]
+  std::vector<double> rho_mm;       // [n_phase * n_y], row-major by phase; NaN where not covered
+  std::vector<int> sample_count;    // valid samples per cell
+  std::vector<int> despiked_count;  // despiked samples per cell
+  std::vector<Section> sections;    // [n_phase]
+  double noise_sigma_mm = 0.0;      // per-sample noise used for the sigmas
   double knot_step_deg = 0.0;
   double axial_step_mm = 0.0;
   double pitch_mm = 0.0;
@@ -46,7 +46,9 @@ struct WheelMap {
 
   [[nodiscard]] std::size_t n_phase() const { return phase_deg.size(); }
   [[nodiscard]] std::size_t n_y() const { return y_mm.size(); }
-  [[nodiscard]] double rho(std::size_t phase, std::size_t axial) const { return rho_mm[phase * n_y() + axial]; }
+  [[nodiscard]] double rho(std::size_t phase, std::size_t axial) const {
+    return rho_mm[phase * n_y() + axial];
+  }
 };
 
 // `rho_mm` per sample (NaN = invalid), already despiked. `despiked` lists rejected samples.

@@ -1,11 +1,11 @@
 #include "reports/browser_check.h"
 
 #include <cairo.h>
-#include <nlohmann/json.hpp>
 
 #include <cstdint>
 #include <cstdlib>
 #include <fstream>
+#include <nlohmann/json.hpp>
 #include <set>
 #include <sstream>
 
@@ -55,8 +55,8 @@ BrowserRun LoadInChromium(const fs::path& page, int width, int height) {
       "chromium --headless --no-sandbox --disable-gpu --disable-quic --no-first-run "
       "--disable-background-networking --disable-component-update --disable-sync --user-data-dir='" +
       (work / "profile").string() + "' --enable-logging=stderr --v=1 --log-net-log='" + net_log.string() +
-      "' --screenshot='" + shot.string() + "' --window-size=" + std::to_string(width) + "," + std::to_string(height) +
-      " 'file://" + page.string() + "' > /dev/null 2> '" + log.string() + "'";
+      "' --screenshot='" + shot.string() + "' --window-size=" + std::to_string(width) + "," +
+      std::to_string(height) + " 'file://" + page.string() + "' > /dev/null 2> '" + log.string() + "'";
   BrowserRun run;
   run.exit_status = Shell(command);
   std::istringstream lines(ReadText(log));
@@ -73,12 +73,12 @@ BrowserRun LoadInChromium(const fs::path& page, int width, int height) {
     for (const auto& event : net["events"]) {
       const auto params = event.find("params");
       if (params == event.end() || !params->contains("url") || !params->contains("initiator")) continue;
-      if ((*params)["initiator"] != "not an origin") run.page_requests.push_back((*params)["url"].get<std::string>());
+      if ((*params)["initiator"] != "not an origin")
+        run.page_requests.push_back((*params)["url"].get<std::string>());
     }
   }
   run.distinct_colours = DistinctColours(shot);
   return run;
 }
-
 
 }  // namespace arcwheel::reports::testing

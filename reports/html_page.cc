@@ -40,12 +40,23 @@ std::string Escape(const std::string& text) {
   out.reserve(text.size());
   for (char c : text) {
     switch (c) {
-      case '&': out += "&amp;"; break;
-      case '<': out += "&lt;"; break;
-      case '>': out += "&gt;"; break;
-      case '"': out += "&quot;"; break;
-      case '\'': out += "&#39;"; break;
-      default: out += c;
+      case '&':
+        out += "&amp;";
+        break;
+      case '<':
+        out += "&lt;";
+        break;
+      case '>':
+        out += "&gt;";
+        break;
+      case '"':
+        out += "&quot;";
+        break;
+      case '\'':
+        out += "&#39;";
+        break;
+      default:
+        out += c;
     }
   }
   return out;
@@ -63,7 +74,8 @@ std::string HtmlPageEnd() { return "</body>\n</html>\n"; }
 std::string KeyValueTable(const std::vector<KeyValue>& rows) {
   std::string html = "<div class=\"table-scroll\"><table>\n";
   for (const KeyValue& row : rows) {
-    html += "<tr><th scope=\"row\">" + Escape(row.key) + "</th><td class=\"value\">" + Escape(row.value) + "</td></tr>\n";
+    html += "<tr><th scope=\"row\">" + Escape(row.key) + "</th><td class=\"value\">" + Escape(row.value) +
+            "</td></tr>\n";
   }
   return html + "</table></div>\n";
 }
@@ -74,7 +86,8 @@ std::string Table(const std::vector<std::string>& header, const std::vector<std:
   html += "</tr>\n";
   for (const std::vector<std::string>& row : rows) {
     html += "<tr>";
-    for (std::size_t c = 0; c < row.size(); ++c) html += (c == 0 ? "<td>" : "<td class=\"number\">") + Escape(row[c]) + "</td>";
+    for (std::size_t c = 0; c < row.size(); ++c)
+      html += (c == 0 ? "<td>" : "<td class=\"number\">") + Escape(row[c]) + "</td>";
     html += "</tr>\n";
   }
   return html + "</table></div>\n";

@@ -20,14 +20,17 @@ namespace arcwheel::reports::internal {
 [[nodiscard]] std::string KeyValueTable(const std::vector<KeyValue>& rows);
 
 // A table with a header row; numeric columns (index >= 1) do not wrap.
-[[nodiscard]] std::string Table(const std::vector<std::string>& header, const std::vector<std::vector<std::string>>& rows);
+[[nodiscard]] std::string Table(const std::vector<std::string>& header,
+                                const std::vector<std::vector<std::string>>& rows);
 
 // One figure with its caption, drawn `width_pt` wide; ids in its SVG start with `id_prefix`.
-[[nodiscard]] std::string FigureHtml(const ReportFigure& figure, double width_pt, const std::string& id_prefix);
+[[nodiscard]] std::string FigureHtml(const ReportFigure& figure, double width_pt,
+                                     const std::string& id_prefix);
 
 // Figures side by side (stacked on a phone), each drawn at the PDF's width for that many
 // figures in a row so that both reports show the same drawing.
-[[nodiscard]] std::string FigureRowHtml(const std::vector<ReportFigure>& figures, const std::string& id_prefix);
+[[nodiscard]] std::string FigureRowHtml(const std::vector<ReportFigure>& figures,
+                                        const std::string& id_prefix);
 
 // Width (points) at which a full-width figure is drawn; CSS scales it to the screen.
 inline constexpr double kFigureWidth_pt = 640.0;

@@ -20,7 +20,7 @@ namespace arcwheel::reports::internal {
 
 inline constexpr const char* kPdfStage = "reports.pdf";
 inline constexpr const char* kFont = "DejaVu Sans";
-inline constexpr double kPageWidth_pt = 595.2756;  // A4, 210 mm
+inline constexpr double kPageWidth_pt = 595.2756;   // A4, 210 mm
 inline constexpr double kPageHeight_pt = 841.8898;  // A4, 297 mm
 inline constexpr double kMargin_pt = 40.0;
 inline constexpr double kContentWidth_pt = kPageWidth_pt - 2.0 * kMargin_pt;
@@ -30,7 +30,9 @@ inline constexpr double kRowGap_pt = 12.0;  // between figures side by side
 
 // Width of each of `count` figures laid side by side across the page.
 inline constexpr double RowFigureWidthPt(std::size_t count) {
-  return count <= 1 ? kContentWidth_pt : (kContentWidth_pt - kRowGap_pt * static_cast<double>(count - 1)) / static_cast<double>(count);
+  return count <= 1
+             ? kContentWidth_pt
+             : (kContentWidth_pt - kRowGap_pt * static_cast<double>(count - 1)) / static_cast<double>(count);
 }
 
 // A cell of a table row; `verdict` colours the cell's background when set.
@@ -44,7 +46,8 @@ struct Cell {
 class PdfFlow {
  public:
   PdfFlow(const std::filesystem::path& path, std::string footer)
-      : surface_(cairo_pdf_surface_create(path.c_str(), kPageWidth_pt, kPageHeight_pt), cairo_surface_destroy),
+      : surface_(cairo_pdf_surface_create(path.c_str(), kPageWidth_pt, kPageHeight_pt),
+                 cairo_surface_destroy),
         footer_(std::move(footer)) {
     CheckStatus("cannot create '" + path.string() + "'");
     cr_ = cairo_create(surface_.get());
@@ -101,7 +104,8 @@ class PdfFlow {
     double x = kMargin_pt;
     for (std::size_t c = 0; c < cells.size(); ++c) {
       if (cells[c].verdict) VerdictBackground(*cells[c].verdict, x, widths[c]);
-      for (std::size_t l = 0; l < lines[c].size(); ++l) Text(lines[c][l], x + 2.0, y_ + 9.0 + static_cast<double>(l) * kLine_pt);
+      for (std::size_t l = 0; l < lines[c].size(); ++l)
+        Text(lines[c][l], x + 2.0, y_ + 9.0 + static_cast<double>(l) * kLine_pt);
       x += widths[c];
     }
     cairo_set_source_rgb(cr_, 0.88, 0.88, 0.88);
@@ -157,7 +161,8 @@ class PdfFlow {
     cairo_set_source_rgb(cr_, 0.33, 0.33, 0.33);
     for (std::size_t i = 0; i < figures.size(); ++i) {
       for (std::size_t l = 0; l < captions[i].size(); ++l) {
-        Text(captions[i][l], kMargin_pt + static_cast<double>(i) * (width + kRowGap_pt), y_ + 8.0 + static_cast<double>(l) * kLine_pt);
+        Text(captions[i][l], kMargin_pt + static_cast<double>(i) * (width + kRowGap_pt),
+             y_ + 8.0 + static_cast<double>(l) * kLine_pt);
       }
     }
     y_ += static_cast<double>(caption_lines) * kLine_pt + 8.0;
@@ -177,11 +182,13 @@ class PdfFlow {
  private:
   void CheckStatus(const std::string& what) const {
     const cairo_status_t status = cairo_surface_status(surface_.get());
-    if (status != CAIRO_STATUS_SUCCESS) throw Error(ErrorCode::kIo, kPdfStage, what + ": " + cairo_status_to_string(status));
+    if (status != CAIRO_STATUS_SUCCESS)
+      throw Error(ErrorCode::kIo, kPdfStage, what + ": " + cairo_status_to_string(status));
   }
 
   void Font(double size_pt, bool bold) {
-    cairo_select_font_face(cr_, kFont, CAIRO_FONT_SLANT_NORMAL, bold ? CAIRO_FONT_WEIGHT_BOLD : CAIRO_FONT_WEIGHT_NORMAL);
+    cairo_select_font_face(cr_, kFont, CAIRO_FONT_SLANT_NORMAL,
+                           bold ? CAIRO_FONT_WEIGHT_BOLD : CAIRO_FONT_WEIGHT_NORMAL);
     cairo_set_font_size(cr_, size_pt);
     cairo_set_source_rgb(cr_, 0.13, 0.13, 0.13);
   }
@@ -203,7 +210,8 @@ class PdfFlow {
     std::size_t start = 0;
     while (start <= text.size()) {
       const std::size_t space = text.find(' ', start);
-      const std::string word = text.substr(start, space == std::string::npos ? std::string::npos : space - start);
+      const std::string word =
+          text.substr(start, space == std::string::npos ? std::string::npos : space - start);
       const std::string joined = lines.back().empty() ? word : lines.back() + " " + word;
       if (Width(joined) <= width) {
         lines.back() = joined;
@@ -213,7 +221,8 @@ class PdfFlow {
         for (std::size_t i = 0; i < word.size();) {
           std::size_t length = 1;
           while (i + length < word.size() && Width(word.substr(i, length + 1)) <= width) ++length;
-          while (i + length < word.size() && (static_cast<unsigned char>(word[i + length]) & 0xC0) == 0x80) ++length;
+          while (i + length < word.size() && (static_cast<unsigned char>(word[i + length]) & 0xC0) == 0x80)
+            ++length;
           if (!lines.back().empty()) lines.emplace_back();
           lines.back() = word.substr(i, length);
           i += length;

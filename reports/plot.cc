@@ -46,7 +46,9 @@ struct Frame {
   Rect area;
   Range x;
   Range y;
-  [[nodiscard]] double Px(double value) const { return area.x + (value - x.low) / (x.high - x.low) * area.width; }
+  [[nodiscard]] double Px(double value) const {
+    return area.x + (value - x.low) / (x.high - x.low) * area.width;
+  }
   [[nodiscard]] double Py(double value) const {
     return area.y + area.height - (value - y.low) / (y.high - y.low) * area.height;
   }
@@ -57,7 +59,8 @@ void SetColour(cairo_t* cr, const Rgb& colour, double alpha = 1.0) {
 }
 
 void SetFont(cairo_t* cr, double size_pt, bool bold = false) {
-  cairo_select_font_face(cr, kFont, CAIRO_FONT_SLANT_NORMAL, bold ? CAIRO_FONT_WEIGHT_BOLD : CAIRO_FONT_WEIGHT_NORMAL);
+  cairo_select_font_face(cr, kFont, CAIRO_FONT_SLANT_NORMAL,
+                         bold ? CAIRO_FONT_WEIGHT_BOLD : CAIRO_FONT_WEIGHT_NORMAL);
   cairo_set_font_size(cr, size_pt);
 }
 
@@ -69,7 +72,8 @@ double TextWidth(cairo_t* cr, const std::string& text) {
 
 // Writes `text` with its anchor at (x, y): align_x 0 left, 0.5 centre, 1 right; the baseline is
 // placed so that the text's middle is at y. `angle_rad` turns it about the anchor.
-void DrawText(cairo_t* cr, const std::string& text, double x, double y, double align_x, double angle_rad = 0.0) {
+void DrawText(cairo_t* cr, const std::string& text, double x, double y, double align_x,
+              double angle_rad = 0.0) {
   cairo_font_extents_t font;
   cairo_font_extents(cr, &font);
   cairo_save(cr);
@@ -124,7 +128,9 @@ void DrawTitle(cairo_t* cr, const std::string& title, double width) {
 
 // At least three ticks, so that a small plot (a map half a page wide) still shows a scale on
 // both sides of zero.
-int MaxTicks(double length_pt, double spacing_pt) { return std::max(3, static_cast<int>(length_pt / spacing_pt)); }
+int MaxTicks(double length_pt, double spacing_pt) {
+  return std::max(3, static_cast<int>(length_pt / spacing_pt));
+}
 
 void DrawAxes(cairo_t* cr, const Frame& frame, const Axis& x_axis, const Axis& y_axis, bool grid) {
   const Rect& a = frame.area;
@@ -204,7 +210,8 @@ void DrawLegend(cairo_t* cr, const std::vector<LegendEntry>& entries, double x, 
 }
 
 void CheckSeries(const Series& series) {
-  ARCWHEEL_CHECK(series.x.size() == series.y.size()) << "series '" << series.label << "' x and y differ in size";
+  ARCWHEEL_CHECK(series.x.size() == series.y.size())
+      << "series '" << series.label << "' x and y differ in size";
   ARCWHEEL_CHECK(series.band_low.size() == series.band_high.size() &&
                  (series.band_low.empty() || series.band_low.size() == series.x.size()))
       << "series '" << series.label << "' band does not match its points";
@@ -219,8 +226,10 @@ void DrawBand(cairo_t* cr, const Frame& frame, const Series& series) {
     std::size_t end = i;
     while (end < n && std::isfinite(series.band_low[end]) && std::isfinite(series.band_high[end])) ++end;
     if (end > i) {
-      for (std::size_t k = i; k < end; ++k) cairo_line_to(cr, frame.Px(series.x[k]), frame.Py(series.band_high[k]));
-      for (std::size_t k = end; k-- > i;) cairo_line_to(cr, frame.Px(series.x[k]), frame.Py(series.band_low[k]));
+      for (std::size_t k = i; k < end; ++k)
+        cairo_line_to(cr, frame.Px(series.x[k]), frame.Py(series.band_high[k]));
+      for (std::size_t k = end; k-- > i;)
+        cairo_line_to(cr, frame.Px(series.x[k]), frame.Py(series.band_low[k]));
       cairo_close_path(cr);
       SetColour(cr, series.colour, 0.25);
       cairo_fill(cr);
@@ -280,12 +289,14 @@ void DrawLinePlot(cairo_t* cr, const LinePlot& plot, double width, double height
   std::vector<LegendEntry> legend;
   if (plot.series.size() > 1) {
     for (const Series& s : plot.series) {
-      legend.push_back({s.label, s.colour, s.markers ? LegendEntry::Swatch::kDot
-                                           : s.dashed ? LegendEntry::Swatch::kDashed
-                                                      : LegendEntry::Swatch::kLine});
+      legend.push_back({s.label, s.colour,
+                        s.markers  ? LegendEntry::Swatch::kDot
+                        : s.dashed ? LegendEntry::Swatch::kDashed
+                                   : LegendEntry::Swatch::kLine});
     }
   }
-  for (const XSpan& span : plot.spans) legend.push_back({span.label, {0.55, 0.55, 0.55}, LegendEntry::Swatch::kBox});
+  for (const XSpan& span : plot.spans)
+    legend.push_back({span.label, {0.55, 0.55, 0.55}, LegendEntry::Swatch::kBox});
   const Frame frame{PlotArea(width, height, !legend.empty(), 0.0), ResolveRange(plot.x, x_low, x_high, true),
                     ResolveRange(plot.y, y_low, y_high, true)};
   DrawTitle(cr, plot.title, width);
@@ -296,7 +307,8 @@ void DrawLinePlot(cairo_t* cr, const LinePlot& plot, double width, double height
   cairo_clip(cr);
   for (const XSpan& span : plot.spans) {
     SetColour(cr, {0.55, 0.55, 0.55}, 0.15);
-    cairo_rectangle(cr, frame.Px(span.low), frame.area.y, frame.Px(span.high) - frame.Px(span.low), frame.area.height);
+    cairo_rectangle(cr, frame.Px(span.low), frame.area.y, frame.Px(span.high) - frame.Px(span.low),
+                    frame.area.height);
     cairo_fill(cr);
   }
   for (const Series& series : plot.series) DrawSeries(cr, frame, series);
@@ -304,18 +316,22 @@ void DrawLinePlot(cairo_t* cr, const LinePlot& plot, double width, double height
   if (plot.series.empty() || !std::isfinite(y_low)) {
     SetFont(cr, kLabelSize_pt);
     SetColour(cr, kInk);
-    DrawText(cr, "no data", frame.area.x + frame.area.width / 2.0, frame.area.y + frame.area.height / 2.0, 0.5);
+    DrawText(cr, "no data", frame.area.x + frame.area.width / 2.0, frame.area.y + frame.area.height / 2.0,
+             0.5);
   }
 }
 
 // Node extent of a regular grid: half a spacing beyond the first and last node.
 Range CellExtent(const std::vector<double>& nodes) {
-  const double half = nodes.size() > 1 ? 0.5 * (nodes.back() - nodes.front()) / static_cast<double>(nodes.size() - 1) : 0.5;
+  const double half =
+      nodes.size() > 1 ? 0.5 * (nodes.back() - nodes.front()) / static_cast<double>(nodes.size() - 1) : 0.5;
   return {nodes.front() - half, nodes.back() + half};
 }
 
 std::uint32_t PackArgb(const Rgb& c) {
-  auto byte = [](double v) { return static_cast<std::uint32_t>(std::lround(std::clamp(v, 0.0, 1.0) * 255.0)); };
+  auto byte = [](double v) {
+    return static_cast<std::uint32_t>(std::lround(std::clamp(v, 0.0, 1.0) * 255.0));
+  };
   return 0xFF000000u | (byte(c.r) << 16) | (byte(c.g) << 8) | byte(c.b);
 }
 
@@ -328,8 +344,9 @@ template <typename BlockColour>
 SurfacePtr GridImage(std::size_t n_x, std::size_t n_y, const BlockColour& colour_of_block) {
   const std::size_t columns = std::min(n_x, kMaxImageColumns);
   const std::size_t rows = std::min(n_y, kMaxImageRows);
-  SurfacePtr image(cairo_image_surface_create(CAIRO_FORMAT_ARGB32, static_cast<int>(columns), static_cast<int>(rows)),
-                   cairo_surface_destroy);
+  SurfacePtr image(
+      cairo_image_surface_create(CAIRO_FORMAT_ARGB32, static_cast<int>(columns), static_cast<int>(rows)),
+      cairo_surface_destroy);
   cairo_surface_flush(image.get());
   unsigned char* data = cairo_image_surface_get_data(image.get());
   const int stride = cairo_image_surface_get_stride(image.get());
@@ -450,20 +467,22 @@ void DrawHeatMap(cairo_t* cr, const HeatMap& map, double width, double height) {
               ResolveRange(map.y, y_extent.low, y_extent.high, false)};
   if (map.equal_aspect) frame = EqualAspect(frame);
   const Range colours = ColourRange(map.values, map.colour_min, map.colour_max);
-  SurfacePtr image = GridImage(map.n_x, map.n_y, [&](std::size_t i0, std::size_t i1, std::size_t j0, std::size_t j1) {
-    double sum = 0.0;
-    int count = 0;
-    for (std::size_t i = i0; i < i1; ++i) {
-      for (std::size_t j = j0; j < j1; ++j) {
-        const double v = map.values[i * map.n_y + j];
-        if (std::isfinite(v)) {
-          sum += v;
-          ++count;
+  SurfacePtr image =
+      GridImage(map.n_x, map.n_y, [&](std::size_t i0, std::size_t i1, std::size_t j0, std::size_t j1) {
+        double sum = 0.0;
+        int count = 0;
+        for (std::size_t i = i0; i < i1; ++i) {
+          for (std::size_t j = j0; j < j1; ++j) {
+            const double v = map.values[i * map.n_y + j];
+            if (std::isfinite(v)) {
+              sum += v;
+              ++count;
+            }
+          }
         }
-      }
-    }
-    return count == 0 ? kMissingColour : Viridis((sum / count - colours.low) / (colours.high - colours.low));
-  });
+        return count == 0 ? kMissingColour
+                          : Viridis((sum / count - colours.low) / (colours.high - colours.low));
+      });
   DrawTitle(cr, map.title, width);
   PaintGridImage(cr, frame, image.get(), x_extent, y_extent);
   DrawAxes(cr, frame, map.x, map.y, false);
@@ -485,8 +504,8 @@ void DrawPathMap(cairo_t* cr, const PathMap& map, double width, double height) {
       Extend(overlay.y[i], y_low, y_high);
     }
   }
-  Frame frame{PlotArea(width, height, false, kColourBarWidth_pt + 62.0), ResolveRange(map.x, x_low, x_high, true),
-              ResolveRange(map.y, y_low, y_high, true)};
+  Frame frame{PlotArea(width, height, false, kColourBarWidth_pt + 62.0),
+              ResolveRange(map.x, x_low, x_high, true), ResolveRange(map.y, y_low, y_high, true)};
   if (map.equal_aspect) frame = EqualAspect(frame);
   const Range colours = ColourRange(map.values, map.colour_min, map.colour_max);
   DrawTitle(cr, map.title, width);
@@ -497,7 +516,8 @@ void DrawPathMap(cairo_t* cr, const PathMap& map, double width, double height) {
   cairo_set_line_width(cr, 1.2);
   cairo_set_line_cap(cr, CAIRO_LINE_CAP_ROUND);
   for (std::size_t k = 1; k < map.x_points.size(); ++k) {
-    const double x0 = map.x_points[k - 1], y0 = map.y_points[k - 1], x1 = map.x_points[k], y1 = map.y_points[k];
+    const double x0 = map.x_points[k - 1], y0 = map.y_points[k - 1], x1 = map.x_points[k],
+                 y1 = map.y_points[k];
     if (!std::isfinite(x0) || !std::isfinite(y0) || !std::isfinite(x1) || !std::isfinite(y1)) continue;
     SetColour(cr, Viridis((map.values[k] - colours.low) / (colours.high - colours.low)));
     cairo_move_to(cr, frame.Px(x0), frame.Py(y0));
@@ -511,21 +531,25 @@ void DrawPathMap(cairo_t* cr, const PathMap& map, double width, double height) {
 
 void DrawCategoryMap(cairo_t* cr, const CategoryMap& map, double width, double height) {
   CheckGrid(map.n_x, map.n_y, map.codes.size(), map.x_nodes, map.y_nodes, map.title);
-  for (std::uint8_t code : map.codes) ARCWHEEL_CHECK(code < map.categories.size()) << "category " << int{code};
+  for (std::uint8_t code : map.codes)
+    ARCWHEEL_CHECK(code < map.categories.size()) << "category " << int{code};
   const Range x_extent = CellExtent(map.x_nodes);
   const Range y_extent = CellExtent(map.y_nodes);
-  const Frame frame{PlotArea(width, height, true, 0.0), ResolveRange(map.x, x_extent.low, x_extent.high, false),
+  const Frame frame{PlotArea(width, height, true, 0.0),
+                    ResolveRange(map.x, x_extent.low, x_extent.high, false),
                     ResolveRange(map.y, y_extent.low, y_extent.high, false)};
   // When cells are merged for display the highest code wins, so a lone missing cell still shows.
-  SurfacePtr image = GridImage(map.n_x, map.n_y, [&](std::size_t i0, std::size_t i1, std::size_t j0, std::size_t j1) {
-    std::uint8_t worst = 0;
-    for (std::size_t i = i0; i < i1; ++i) {
-      for (std::size_t j = j0; j < j1; ++j) worst = std::max(worst, map.codes[i * map.n_y + j]);
-    }
-    return map.categories[worst].colour;
-  });
+  SurfacePtr image =
+      GridImage(map.n_x, map.n_y, [&](std::size_t i0, std::size_t i1, std::size_t j0, std::size_t j1) {
+        std::uint8_t worst = 0;
+        for (std::size_t i = i0; i < i1; ++i) {
+          for (std::size_t j = j0; j < j1; ++j) worst = std::max(worst, map.codes[i * map.n_y + j]);
+        }
+        return map.categories[worst].colour;
+      });
   std::vector<LegendEntry> legend;
-  for (const Category& category : map.categories) legend.push_back({category.label, category.colour, LegendEntry::Swatch::kBox});
+  for (const Category& category : map.categories)
+    legend.push_back({category.label, category.colour, LegendEntry::Swatch::kBox});
   DrawTitle(cr, map.title, width);
   DrawLegend(cr, legend, frame.area.x, 18.0 + kLegendRow_pt / 2.0);
   PaintGridImage(cr, frame, image.get(), x_extent, y_extent);
@@ -667,7 +691,8 @@ std::string RenderSvg(const Figure& figure, double width_pt, double height_pt, c
 std::string RenderPng(const Figure& figure, double width_pt, double height_pt, double pixels_per_pt) {
   const int width_px = static_cast<int>(std::ceil(width_pt * pixels_per_pt));
   const int height_px = static_cast<int>(std::ceil(height_pt * pixels_per_pt));
-  SurfacePtr surface(cairo_image_surface_create(CAIRO_FORMAT_ARGB32, width_px, height_px), cairo_surface_destroy);
+  SurfacePtr surface(cairo_image_surface_create(CAIRO_FORMAT_ARGB32, width_px, height_px),
+                     cairo_surface_destroy);
   CheckSurface(surface.get(), "cannot create a PNG image");
   {
     const ContextPtr cr(cairo_create(surface.get()), cairo_destroy);

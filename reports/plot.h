@@ -1,7 +1,7 @@
 #pragma once
 // The project's one plotting layer. A figure is a plain description (line plot, heat map,
-// category map or coloured path); Draw() paints it with cairo, so the same drawing code makes the inline SVG of
-// the HTML report, the vector plots of the PDF report and PNG images.
+// category map or coloured path); Draw() paints it with cairo, so the same drawing code makes the inline SVG
+// of the HTML report, the vector plots of the PDF report and PNG images.
 //
 // Lengths are in points (1/72 inch); colours are sRGB in [0, 1]. Axis labels carry their unit,
 // e.g. "phase (deg)". Ticks fall on round numbers: steps of 1, 2 or 5 times a power of ten.
@@ -81,8 +81,8 @@ struct HeatMap {
   // Row-major [n_x, n_y]: value (i, j) at index i * n_y + j, at x_nodes[i], y_nodes[j]. NaN cells
   // are drawn grey.
   std::vector<double> values;
-  std::vector<double> x_nodes;  // strictly increasing, size n_x
-  std::vector<double> y_nodes;  // strictly increasing, size n_y
+  std::vector<double> x_nodes;   // strictly increasing, size n_x
+  std::vector<double> y_nodes;   // strictly increasing, size n_y
   std::string colour_bar_label;  // with the unit, e.g. "form error (um)"
   // Colour range; when absent, the 0.5 and 99.5 percentiles of the finite values (so that a few
   // extreme cells do not wash out the rest; cells beyond the range take the end colours).

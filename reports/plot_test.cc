@@ -67,7 +67,8 @@ TEST(NiceTicks, StepIsOneTwoOrFiveTimesAPowerOfTenAndTicksFitTheRange) {
         const double high = low + span;
         const double step = NiceStep(low, high, max_ticks);
         const double mantissa = step / std::pow(10.0, std::floor(std::log10(step) + 1e-12));
-        EXPECT_TRUE(std::abs(mantissa - 1) < 1e-9 || std::abs(mantissa - 2) < 1e-9 || std::abs(mantissa - 5) < 1e-9)
+        EXPECT_TRUE(std::abs(mantissa - 1) < 1e-9 || std::abs(mantissa - 2) < 1e-9 ||
+                    std::abs(mantissa - 5) < 1e-9)
             << "step " << step;
         const std::vector<double> ticks = NiceTicks(low, high, max_ticks);
         EXPECT_LE(static_cast<int>(ticks.size()), max_ticks);
@@ -212,12 +213,14 @@ TEST(RenderSvg, PrefixesEveryIdAndReferenceSoFiguresCanShareAPage) {
   EXPECT_EQ(svg.rfind("<svg", 0), 0u) << "no XML prolog";
   const std::regex id(R"re(id="([^"]*)")re");
   int ids = 0;
-  for (auto it = std::sregex_iterator(svg.begin(), svg.end(), id); it != std::sregex_iterator(); ++it, ++ids) {
+  for (auto it = std::sregex_iterator(svg.begin(), svg.end(), id); it != std::sregex_iterator();
+       ++it, ++ids) {
     EXPECT_EQ((*it)[1].str().rfind("f7-", 0), 0u) << (*it)[1].str();
   }
   EXPECT_GT(ids, 0) << "cairo draws text as glyph symbols referenced by id";
   const std::regex reference(R"re((?:href="#|url\(#)([^")]*))re");
-  for (auto it = std::sregex_iterator(svg.begin(), svg.end(), reference); it != std::sregex_iterator(); ++it) {
+  for (auto it = std::sregex_iterator(svg.begin(), svg.end(), reference); it != std::sregex_iterator();
+       ++it) {
     EXPECT_EQ((*it)[1].str().rfind("f7-", 0), 0u) << (*it)[1].str();
   }
 }

@@ -35,17 +35,21 @@ std::vector<KeyValue> Provenance(const PolishReportInputs& in) {
       {"Error map", s.error_map_file.empty() ? "not recorded" : s.error_map_file},
       {"Output folder", in.sources.front().path.parent_path().string()},
   };
-  for (const SourceFile& file : in.sources) rows.push_back({file.path.filename().string() + " SHA-256", file.sha256});
+  for (const SourceFile& file : in.sources)
+    rows.push_back({file.path.filename().string() + " SHA-256", file.sha256});
   rows.push_back({"Polished by", "arcwheel " + s.arcwheel_version});
   rows.push_back({"Report by", std::string("arcwheel ") + kVersion});
   return rows;
 }
 
 // A machine limit as the job gives it (shortest form), or "none" for 0 (not limited).
-std::string Limit(double value, const char* unit) { return value > 0.0 ? fmt::format("{} {}", value, unit) : "none"; }
+std::string Limit(double value, const char* unit) {
+  return value > 0.0 ? fmt::format("{} {}", value, unit) : "none";
+}
 
 std::string SpeedLimits(const PolishSummary& s) {
-  if (s.limit_min_speed_mm_s > 0.0) return fmt::format("limits {} … {} mm/s", s.limit_min_speed_mm_s, s.limit_max_speed_mm_s);
+  if (s.limit_min_speed_mm_s > 0.0)
+    return fmt::format("limits {} … {} mm/s", s.limit_min_speed_mm_s, s.limit_max_speed_mm_s);
   return "limit " + Limit(s.limit_max_speed_mm_s, "mm/s");
 }
 
@@ -54,8 +58,8 @@ std::vector<KeyValue> PathRows(const PolishSummary& s) {
       {"Total dwell time", s.total_time_text + " s"},
       {"Path points", fmt::format("{} (rows of polishing_path.csv)", s.points)},
       {"Aperture nodes", fmt::format("{} (rows of residual_map.csv)", s.aperture_nodes)},
-      {"TCP speed range", FormatNumber(s.min_speed_mm_s, 3) + " … " + FormatNumber(s.max_speed_mm_s, 3) + " mm/s (" +
-                              SpeedLimits(s) + ")"},
+      {"TCP speed range", FormatNumber(s.min_speed_mm_s, 3) + " … " + FormatNumber(s.max_speed_mm_s, 3) +
+                              " mm/s (" + SpeedLimits(s) + ")"},
       {"Largest acceleration", FormatNumber(s.max_acceleration_mm_s2, 1) + " mm/s² (limit " +
                                    Limit(s.limit_max_acceleration_mm_s2, "mm/s²") + ")"},
       {"Solver iterations", fmt::format("{} ({})", s.solver_iterations,
@@ -71,8 +75,8 @@ double MapRatio(double width_pt, double x_span, double y_span) {
   return std::clamp((area_width * y_span / x_span + 48.0) / width_pt, 0.4, 1.3);
 }
 
-plot::HeatMap ResidualHeatMap(const ResidualMap& map, const std::string& title, const std::vector<double>& values,
-                              const std::string& colour_label) {
+plot::HeatMap ResidualHeatMap(const ResidualMap& map, const std::string& title,
+                              const std::vector<double>& values, const std::string& colour_label) {
   plot::HeatMap heat;
   heat.title = title;
   heat.x.label = "x (mm)";
@@ -89,7 +93,8 @@ plot::HeatMap ResidualHeatMap(const ResidualMap& map, const std::string& title, 
 
 // Grid extent of the residual map's cells, for the figure's aspect ratio.
 double Span(const std::vector<double>& nodes) {
-  return nodes.size() > 1 ? (nodes.back() - nodes.front()) * static_cast<double>(nodes.size()) / static_cast<double>(nodes.size() - 1)
+  return nodes.size() > 1 ? (nodes.back() - nodes.front()) * static_cast<double>(nodes.size()) /
+                                static_cast<double>(nodes.size() - 1)
                           : 1.0;
 }
 
@@ -110,16 +115,17 @@ std::vector<std::vector<ReportFigure>> MapRows(const ResidualMap& map) {
     if (std::isfinite(low)) heat.colour_min = low, heat.colour_max = high;
     return heat;
   };
-  return {{{fmt::format("Removal target: the error minus its minimum plus the uniform layer. Target, removal and "
-                        "residual share one colour scale, {} … {} µm, the range of all three.",
-                        FormatNumber(low, 3), FormatNumber(high, 3)),
-            shared("Removal target (before)", map.target_um), ratio},
-           {"Removal the dwell times are predicted to make, on the target's colour scale.",
-            shared("Predicted removal", map.removal_um), ratio}},
-          {{"Predicted residual (target minus removal) on the target's colour scale: what is left of it.",
-            shared("Predicted residual (after)", map.residual_um), ratio},
-           {"The same residual on its own scale (0.5 to 99.5 percentile) to show its shape; grey: no node.",
-            ResidualHeatMap(map, "Predicted residual, own scale", map.residual_um, "residual (µm)"), ratio}}};
+  return {
+      {{fmt::format("Removal target: the error minus its minimum plus the uniform layer. Target, removal and "
+                    "residual share one colour scale, {} … {} µm, the range of all three.",
+                    FormatNumber(low, 3), FormatNumber(high, 3)),
+        shared("Removal target (before)", map.target_um), ratio},
+       {"Removal the dwell times are predicted to make, on the target's colour scale.",
+        shared("Predicted removal", map.removal_um), ratio}},
+      {{"Predicted residual (target minus removal) on the target's colour scale: what is left of it.",
+        shared("Predicted residual (after)", map.residual_um), ratio},
+       {"The same residual on its own scale (0.5 to 99.5 percentile) to show its shape; grey: no node.",
+        ResidualHeatMap(map, "Predicted residual, own scale", map.residual_um, "residual (µm)"), ratio}}};
 }
 
 // The clear aperture's outline (centred on the part origin) when the job records it.
@@ -136,7 +142,8 @@ std::vector<plot::Series> ApertureOutline(const nlohmann::json& job) {
       outline.x.push_back(r * std::cos(2.0 * M_PI * k / 180.0));
       outline.y.push_back(r * std::sin(2.0 * M_PI * k / 180.0));
     }
-  } else if (size != aperture->end() && size->is_array() && size->size() == 2 && (*size)[0].is_number() && (*size)[1].is_number()) {
+  } else if (size != aperture->end() && size->is_array() && size->size() == 2 && (*size)[0].is_number() &&
+             (*size)[1].is_number()) {
     const double hx = (*size)[0].get<double>() / 2.0, hy = (*size)[1].get<double>() / 2.0;
     outline.x = {-hx, hx, hx, -hx, -hx};
     outline.y = {-hy, -hy, hy, hy, -hy};
@@ -164,12 +171,13 @@ std::vector<ReportFigure> PathMaps(const PolishReportInputs& in) {
   const auto [y_low, y_high] = std::minmax_element(p.y_mm.begin(), p.y_mm.end());
   const double x_span = std::max(*x_high - *x_low, 1e-9), y_span = std::max(*y_high - *y_low, 1e-9);
   const double ratio = MapRatio(RowFigureWidthPt(2), x_span, y_span);
-  return {{"Tool path, each segment coloured by the TCP speed into its end point (colour range: 0.5 to 99.5 "
-           "percentile); dashed: the clear aperture.",
-           map("Path, coloured by speed", p.speed_mm_s, "speed (mm/s)"), ratio},
-          {"The same path coloured by the dwell of each segment's end point, the time the tool takes over that "
-           "segment (0.5 to 99.5 percentile).",
-           map("Path, coloured by dwell", p.dwell_s, "dwell per point (s)"), ratio}};
+  return {
+      {"Tool path, each segment coloured by the TCP speed into its end point (colour range: 0.5 to 99.5 "
+       "percentile); dashed: the clear aperture.",
+       map("Path, coloured by speed", p.speed_mm_s, "speed (mm/s)"), ratio},
+      {"The same path coloured by the dwell of each segment's end point, the time the tool takes over that "
+       "segment (0.5 to 99.5 percentile).",
+       map("Path, coloured by dwell", p.dwell_s, "dwell per point (s)"), ratio}};
 }
 
 ReportFigure SpeedPlot(const PolishReportInputs& in) {
@@ -187,8 +195,10 @@ ReportFigure SpeedPlot(const PolishReportInputs& in) {
     plot.series.push_back(line);
   };
   std::string caption = "TCP speed into each point against the length of the path up to it";
-  if (s.limit_max_speed_mm_s > 0.0) limit(fmt::format("max speed {} mm/s", s.limit_max_speed_mm_s), s.limit_max_speed_mm_s, 1);
-  if (s.limit_min_speed_mm_s > 0.0) limit(fmt::format("min speed {} mm/s", s.limit_min_speed_mm_s), s.limit_min_speed_mm_s, 2);
+  if (s.limit_max_speed_mm_s > 0.0)
+    limit(fmt::format("max speed {} mm/s", s.limit_max_speed_mm_s), s.limit_max_speed_mm_s, 1);
+  if (s.limit_min_speed_mm_s > 0.0)
+    limit(fmt::format("min speed {} mm/s", s.limit_min_speed_mm_s), s.limit_min_speed_mm_s, 2);
   caption += s.limit_max_speed_mm_s > 0.0 ? "; dashed: the machine's speed limits from the job." : ".";
   return {caption, plot, 0.42};
 }
@@ -218,7 +228,8 @@ std::string RenderPolishHtml(const PolishReportContent& content) {
           Table({"Quantity", "Before (error)", "After (predicted residual)"}, content.form);
   html += "<h2>Path and dwell</h2>\n" + KeyValueTable(content.path);
   html += "<h2>Plots</h2>\n";
-  for (std::size_t r = 0; r < content.figure_rows.size(); ++r) html += FigureRowHtml(content.figure_rows[r], fmt::format("r{}-", r));
+  for (std::size_t r = 0; r < content.figure_rows.size(); ++r)
+    html += FigureRowHtml(content.figure_rows[r], fmt::format("r{}-", r));
   html += "<h2>Job as used</h2>\n" + KeyValueTable(content.job);
   return html + HtmlPageEnd();
 }
@@ -231,15 +242,18 @@ void RenderPolishPdf(const PolishReportContent& content, const std::filesystem::
   pdf.Heading("Job and sources", 3 * kLine_pt);
   for (const KeyValue& row : content.provenance) pdf.Row({{row.key, {}}, {row.value, {}}}, key_value, false);
   pdf.Heading("Form error over the aperture", 3 * kLine_pt);
-  const std::vector<double> form = {0.32 * kContentWidth_pt, 0.34 * kContentWidth_pt, 0.34 * kContentWidth_pt};
+  const std::vector<double> form = {0.32 * kContentWidth_pt, 0.34 * kContentWidth_pt,
+                                    0.34 * kContentWidth_pt};
   pdf.Row({{"Quantity", {}}, {"Before (error)", {}}, {"After (predicted residual)", {}}}, form, true);
-  for (const std::vector<std::string>& row : content.form) pdf.Row({{row[0], {}}, {row[1], {}}, {row[2], {}}}, form, false);
+  for (const std::vector<std::string>& row : content.form)
+    pdf.Row({{row[0], {}}, {row[1], {}}, {row[2], {}}}, form, false);
   pdf.Heading("Path and dwell", 3 * kLine_pt);
   for (const KeyValue& row : content.path) pdf.Row({{row.key, {}}, {row.value, {}}}, key_value, false);
-  const double first_row_pt = content.figure_rows.empty() ? 0.0
-                                                          : RowFigureWidthPt(content.figure_rows.front().size()) *
-                                                                    content.figure_rows.front().front().height_over_width +
-                                                                3.0 * kLine_pt;
+  const double first_row_pt = content.figure_rows.empty()
+                                  ? 0.0
+                                  : RowFigureWidthPt(content.figure_rows.front().size()) *
+                                            content.figure_rows.front().front().height_over_width +
+                                        3.0 * kLine_pt;
   pdf.Heading("Plots", first_row_pt);
   for (const std::vector<ReportFigure>& row : content.figure_rows) pdf.FigureRow(row);
   pdf.Heading("Job as used", kLine_pt);

@@ -24,9 +24,9 @@ struct PolishReportContent {
   std::vector<KeyValue> provenance;  // job, surface, aperture, removal function, files, versions
   // Rows of {quantity, before, after}: PV and RMS over the aperture.
   std::vector<std::vector<std::string>> form;
-  std::vector<KeyValue> path;  // dwell time, points, speeds, acceleration, solver
+  std::vector<KeyValue> path;                          // dwell time, points, speeds, acceleration, solver
   std::vector<std::vector<ReportFigure>> figure_rows;  // figures laid side by side per row
-  std::vector<KeyValue> job;   // job as used, dotted keys
+  std::vector<KeyValue> job;                           // job as used, dotted keys
 };
 
 // Builds the report from its inputs. Pure: no I/O.

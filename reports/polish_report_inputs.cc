@@ -56,7 +56,8 @@ std::vector<std::string_view> SplitCells(std::string_view line) {
   std::size_t start = 0;
   for (;;) {
     const std::size_t comma = line.find(',', start);
-    cells.push_back(line.substr(start, comma == std::string_view::npos ? std::string_view::npos : comma - start));
+    cells.push_back(
+        line.substr(start, comma == std::string_view::npos ? std::string_view::npos : comma - start));
     if (comma == std::string_view::npos) return cells;
     start = comma + 1;
   }
@@ -78,7 +79,9 @@ std::vector<std::size_t> Columns(std::string_view header, const std::vector<std:
   for (const std::string& name : required) {
     const auto it = index.find(name);
     if (it == index.end()) {
-      BadLine(source, line, fmt::format("header '{}' has no column '{}' (needs {})", header, name, fmt::join(required, ",")));
+      BadLine(
+          source, line,
+          fmt::format("header '{}' has no column '{}' (needs {})", header, name, fmt::join(required, ",")));
     }
     columns.push_back(it->second);
   }
@@ -107,15 +110,18 @@ void ReadCsv(std::string_view text, const std::string& source, const std::vector
       continue;
     }
     const std::vector<std::string_view> cells = SplitCells(line);
-    if (cells.size() != width) BadLine(source, lines.number(), fmt::format("has {} values, the header names {}", cells.size(), width));
+    if (cells.size() != width)
+      BadLine(source, lines.number(), fmt::format("has {} values, the header names {}", cells.size(), width));
     for (std::size_t k = 0; k < required.size(); ++k) {
       if (!ParseDouble(cells[columns[k]], values[k])) {
-        BadLine(source, lines.number(), fmt::format("{} '{}' is not a number", required[k], cells[columns[k]]));
+        BadLine(source, lines.number(),
+                fmt::format("{} '{}' is not a number", required[k], cells[columns[k]]));
       }
     }
     row(values, lines.number());
   }
-  if (columns.empty()) BadLine(source, lines.number(), fmt::format("has no header line ({})", fmt::join(required, ",")));
+  if (columns.empty())
+    BadLine(source, lines.number(), fmt::format("has no header line ({})", fmt::join(required, ",")));
 }
 
 // Grid nodes of one axis from the distinct coordinates: spacing = the median gap (a stray value
@@ -127,7 +133,8 @@ std::vector<double> GridNodes(const std::set<double>& values, const std::string&
   std::nth_element(gaps.begin(), gaps.begin() + static_cast<std::ptrdiff_t>(gaps.size() / 2), gaps.end());
   const double step = gaps[gaps.size() / 2];
   const double count = std::round((*values.rbegin() - *values.begin()) / step) + 1.0;
-  if (!(count <= kMaxGridNodes)) Bad(fmt::format("'{}': the {} nodes would need a grid of {} nodes", source, axis, count));
+  if (!(count <= kMaxGridNodes))
+    Bad(fmt::format("'{}': the {} nodes would need a grid of {} nodes", source, axis, count));
   std::vector<double> nodes(static_cast<std::size_t>(count));
   for (std::size_t i = 0; i < nodes.size(); ++i) nodes[i] = *values.begin() + static_cast<double>(i) * step;
   return nodes;
@@ -138,7 +145,9 @@ std::ptrdiff_t NodeIndex(const std::vector<double>& nodes, double v) {
   if (nodes.size() == 1) return v == nodes.front() ? 0 : -1;
   const double u = (v - nodes.front()) / (nodes[1] - nodes[0]);
   const double r = std::round(u);
-  return std::abs(u - r) <= 1e-6 && r >= 0.0 && r < static_cast<double>(nodes.size()) ? static_cast<std::ptrdiff_t>(r) : -1;
+  return std::abs(u - r) <= 1e-6 && r >= 0.0 && r < static_cast<double>(nodes.size())
+             ? static_cast<std::ptrdiff_t>(r)
+             : -1;
 }
 
 // Locates a value in the summary for messages: "'OUTDIR/polish_summary.json' key 'before.pv_um'".
@@ -171,7 +180,8 @@ class JsonReader {
   }
   [[nodiscard]] double Number(const std::string& key) const {
     const json& value = Require(key);
-    if (!value.is_number() || !std::isfinite(value.get<double>())) Fail(key, "is not a finite number (found " + value.dump() + ")");
+    if (!value.is_number() || !std::isfinite(value.get<double>()))
+      Fail(key, "is not a finite number (found " + value.dump() + ")");
     return value.get<double>();
   }
   [[nodiscard]] double OptionalNumber(const std::string& key, double fallback) const {
@@ -209,7 +219,8 @@ std::string ReadWhole(const std::filesystem::path& path) {
   std::ifstream in(path, std::ios::binary);
   if (!in) {
     const std::string why = std::filesystem::exists(path) ? "cannot be read" : "does not exist";
-    throw Error(ErrorCode::kIo, kStage, fmt::format("'{}' {} (is this a folder written by `arcwheel polish`?)", path.string(), why));
+    throw Error(ErrorCode::kIo, kStage,
+                fmt::format("'{}' {} (is this a folder written by `arcwheel polish`?)", path.string(), why));
   }
   std::ostringstream text;
   text << in.rdbuf();
@@ -227,7 +238,8 @@ ResidualMap ParseResidualMapCsv(std::string_view text, const std::string& source
   ReadCsv(
       text, source_name, {"x_mm", "y_mm", "target_um", "removal_um", "residual_um"},
       [&](const std::vector<double>& v, std::size_t line) {
-        if (!std::isfinite(v[0]) || !std::isfinite(v[1])) BadLine(source_name, line, "x_mm and y_mm must be finite");
+        if (!std::isfinite(v[0]) || !std::isfinite(v[1]))
+          BadLine(source_name, line, "x_mm and y_mm must be finite");
         nodes.push_back({v[0], v[1], v[2], v[3], v[4], line});
       },
       [](std::string_view) {});
@@ -239,12 +251,13 @@ ResidualMap ParseResidualMapCsv(std::string_view text, const std::string& source
   map.y_mm = GridNodes(ys, source_name, "y_mm");
   const double grid_nodes = static_cast<double>(map.n_x()) * static_cast<double>(map.n_y());
   if (grid_nodes > kMaxGridNodes) {
-    Bad(fmt::format("'{}': a grid of {} x {} nodes is too large for a residual map", source_name, map.n_x(), map.n_y()));
+    Bad(fmt::format("'{}': a grid of {} x {} nodes is too large for a residual map", source_name, map.n_x(),
+                    map.n_y()));
   }
   // Aperture nodes fill most of their grid; a few nodes spanning a vast grid are not a map.
   if (grid_nodes > 64.0 * static_cast<double>(nodes.size()) + 4096.0) {
-    Bad(fmt::format("'{}': {} nodes spread over a grid of {} x {}: not the nodes of one regular grid", source_name,
-                    nodes.size(), map.n_x(), map.n_y()));
+    Bad(fmt::format("'{}': {} nodes spread over a grid of {} x {}: not the nodes of one regular grid",
+                    source_name, nodes.size(), map.n_x(), map.n_y()));
   }
   const std::size_t cells = map.n_x() * map.n_y();
   map.target_um.assign(cells, kNaN);
@@ -253,7 +266,9 @@ ResidualMap ParseResidualMapCsv(std::string_view text, const std::string& source
   std::vector<bool> seen(cells, false);
   for (const Node& n : nodes) {
     const std::ptrdiff_t i = NodeIndex(map.x_mm, n.x), j = NodeIndex(map.y_mm, n.y);
-    if (i < 0 || j < 0) BadLine(source_name, n.line, fmt::format("node ({}, {}) mm is not on the grid of the other nodes", n.x, n.y));
+    if (i < 0 || j < 0)
+      BadLine(source_name, n.line,
+              fmt::format("node ({}, {}) mm is not on the grid of the other nodes", n.x, n.y));
     const std::size_t k = static_cast<std::size_t>(i) * map.n_y() + static_cast<std::size_t>(j);
     if (seen[k]) BadLine(source_name, n.line, fmt::format("node ({}, {}) mm appears twice", n.x, n.y));
     seen[k] = true;
@@ -277,7 +292,8 @@ PolishingPathTable ParsePolishingPathCsv(std::string_view text, const std::strin
         if (!(v[8] >= 0.0)) BadLine(source_name, line, fmt::format("dwell_s = {} is negative", v[8]));
         double length = 0.0;
         if (!path.x_mm.empty()) {
-          length = path.path_length_mm.back() + std::hypot(v[0] - path.x_mm.back(), v[1] - path.y_mm.back(), v[2] - path.z_mm.back());
+          length = path.path_length_mm.back() +
+                   std::hypot(v[0] - path.x_mm.back(), v[1] - path.y_mm.back(), v[2] - path.z_mm.back());
         }
         path.x_mm.push_back(v[0]);
         path.y_mm.push_back(v[1]);
@@ -337,14 +353,15 @@ PolishReportInputs ReadPolishReportInputs(const std::filesystem::path& outdir) {
   inputs.residual = ParseResidualMapCsv(ReadWhole(residual_path), residual_path.string());
   inputs.path = ParsePolishingPathCsv(ReadWhole(path_path), path_path.string());
   if (inputs.path.size() != static_cast<std::size_t>(inputs.summary.points)) {
-    Bad(fmt::format("'{}' has {} points but '{}' key 'points' says {}", path_path.string(), inputs.path.size(),
-                    summary_path.string(), inputs.summary.points));
+    Bad(fmt::format("'{}' has {} points but '{}' key 'points' says {}", path_path.string(),
+                    inputs.path.size(), summary_path.string(), inputs.summary.points));
   }
   if (inputs.residual.nodes != static_cast<std::size_t>(inputs.summary.aperture_nodes)) {
-    Bad(fmt::format("'{}' has {} nodes but '{}' key 'aperture_nodes' says {}", residual_path.string(), inputs.residual.nodes,
-                    summary_path.string(), inputs.summary.aperture_nodes));
+    Bad(fmt::format("'{}' has {} nodes but '{}' key 'aperture_nodes' says {}", residual_path.string(),
+                    inputs.residual.nodes, summary_path.string(), inputs.summary.aperture_nodes));
   }
-  for (const auto& file : {summary_path, residual_path, path_path}) inputs.sources.push_back({file, Sha256OfFile(file)});
+  for (const auto& file : {summary_path, residual_path, path_path})
+    inputs.sources.push_back({file, Sha256OfFile(file)});
   return inputs;
 }
 

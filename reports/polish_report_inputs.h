@@ -7,10 +7,9 @@
 // (invalid JSON, a missing key, a wrong type, a bad CSV line, files that disagree) throws
 // Error{kBadInput, "reports.polish"} naming the file and the key or line.
 
-#include <nlohmann/json.hpp>
-
 #include <cstdint>
 #include <filesystem>
+#include <nlohmann/json.hpp>
 #include <string>
 #include <string_view>
 #include <vector>

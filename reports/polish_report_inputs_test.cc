@@ -12,8 +12,8 @@
 namespace arcwheel::reports {
 namespace {
 
-using ::testing::HasSubstr;
 using arcwheel::testing::TempDir;
+using ::testing::HasSubstr;
 
 template <typename Read>
 Error ErrorOf(const Read& read) {
@@ -54,13 +54,18 @@ TEST(ParseResidualMapCsv, RefusesMalformedLinesNamingSourceAndLine) {
     std::string message;
   };
   const std::vector<Case> cases = {
-      {"x_mm,y_mm,target_um,removal_um\n0,0,1,1\n", "'res.csv' line 1: header 'x_mm,y_mm,target_um,removal_um' has no column 'residual_um'"},
-      {"x_mm,y_mm,target_um,removal_um,residual_um\n0,0,1,1,0\n2,0,1,x1,0\n", "'res.csv' line 3: removal_um 'x1' is not a number"},
-      {"x_mm,y_mm,target_um,removal_um,residual_um\n0,0,1,1,0\n2,0,1,1\n", "'res.csv' line 3: has 4 values, the header names 5"},
-      {"x_mm,y_mm,target_um,removal_um,residual_um\n0,0,1,1,0\n0,0,1,1,0\n", "'res.csv' line 3: node (0, 0) mm appears twice"},
+      {"x_mm,y_mm,target_um,removal_um\n0,0,1,1\n",
+       "'res.csv' line 1: header 'x_mm,y_mm,target_um,removal_um' has no column 'residual_um'"},
+      {"x_mm,y_mm,target_um,removal_um,residual_um\n0,0,1,1,0\n2,0,1,x1,0\n",
+       "'res.csv' line 3: removal_um 'x1' is not a number"},
+      {"x_mm,y_mm,target_um,removal_um,residual_um\n0,0,1,1,0\n2,0,1,1\n",
+       "'res.csv' line 3: has 4 values, the header names 5"},
+      {"x_mm,y_mm,target_um,removal_um,residual_um\n0,0,1,1,0\n0,0,1,1,0\n",
+       "'res.csv' line 3: node (0, 0) mm appears twice"},
       {"x_mm,y_mm,target_um,removal_um,residual_um\n0,0,1,1,0\n2,0,1,1,0\n4,0,1,1,0\n4.5,0,1,1,0\n",
        "'res.csv' line 5: node (4.5, 0) mm is not on the grid"},
-      {"x_mm,y_mm,target_um,removal_um,residual_um\nnan,0,1,1,0\n", "'res.csv' line 2: x_mm and y_mm must be finite"},
+      {"x_mm,y_mm,target_um,removal_um,residual_um\nnan,0,1,1,0\n",
+       "'res.csv' line 2: x_mm and y_mm must be finite"},
       {"# only a comment\n", "'res.csv' line 1: has no header line"},
       {"x_mm,y_mm,target_um,removal_um,residual_um\n", "'res.csv' has no aperture node"},
       {"x_mm,y_mm,target_um,removal_um,residual_um\n0,0,1,1,0\n1e-9,0,1,1,0\n2e-9,0,1,1,0\n1000,0,1,1,0\n",
@@ -97,7 +102,8 @@ TEST(ParsePolishingPathCsv, RefusesBadRowsNamingSourceAndLine) {
       {header + "0,0,0,1,0,0,0,0,1\n", "'path.csv' line 2: speed_mm_s = 0 is not > 0"},
       {header + "0,0,0,1,0,0,0,5,1\n0,0,0,1,0,0,0,5,-1\n", "'path.csv' line 3: dwell_s = -1 is negative"},
       {header + "0,0,inf,1,0,0,0,5,1\n", "'path.csv' line 2: every value must be finite"},
-      {"x,y,z,q1,q2,q3,q4,speed_mm_s\n", "'path.csv' line 1: header 'x,y,z,q1,q2,q3,q4,speed_mm_s' has no column 'dwell_s'"},
+      {"x,y,z,q1,q2,q3,q4,speed_mm_s\n",
+       "'path.csv' line 1: header 'x,y,z,q1,q2,q3,q4,speed_mm_s' has no column 'dwell_s'"},
       {header, "'path.csv' has no path point"},
       {header + "0, 0,0,1,0,0,0,5,1\n", "'path.csv' line 2: y ' 0' is not a number"},
   };
@@ -141,7 +147,10 @@ TEST(ParsePolishSummary, RefusesMissingOrMistypedKeysByDottedName) {
   nlohmann::json base = nlohmann::json::parse(kSummary);
   auto without = [&](const std::string& a, const std::string& b) {
     nlohmann::json j = base;
-    if (b.empty()) j.erase(a); else j[a].erase(b);
+    if (b.empty())
+      j.erase(a);
+    else
+      j[a].erase(b);
     return j.dump();
   };
   nlohmann::json typed = base;
@@ -163,7 +172,8 @@ TEST(ReadPolishReportInputs, RefusesFilesThatDisagreeAndNamesMissingFiles) {
   TempDir dir;
   std::ofstream(dir / "polish_summary.json") << kSummary;
   std::ofstream(dir / "residual_map.csv") << kResidual;
-  std::ofstream(dir / "polishing_path.csv") << "x,y,z,q1,q2,q3,q4,speed_mm_s,dwell_s\n0,0,0,1,0,0,0,5,0\n1,0,0,1,0,0,0,5,0.2\n";
+  std::ofstream(dir / "polishing_path.csv")
+      << "x,y,z,q1,q2,q3,q4,speed_mm_s,dwell_s\n0,0,0,1,0,0,0,5,0\n1,0,0,1,0,0,0,5,0.2\n";
   const Error count = ErrorOf([&] { (void)ReadPolishReportInputs(dir.path()); });
   EXPECT_EQ(count.code(), ErrorCode::kBadInput);
   EXPECT_THAT(count.what(), HasSubstr("polishing_path.csv' has 2 points but"));

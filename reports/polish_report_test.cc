@@ -6,13 +6,13 @@
 #include <fmt/format.h>
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
-#include <nlohmann/json.hpp>
 
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
+#include <nlohmann/json.hpp>
 #include <sstream>
 
 #include "core/testing/testing.h"
@@ -22,12 +22,12 @@ namespace arcwheel::reports {
 namespace {
 
 namespace fs = std::filesystem;
-using ::testing::HasSubstr;
-using ::testing::Not;
 using arcwheel::testing::ListFolder;
 using arcwheel::testing::RunArcwheel;
 using arcwheel::testing::SourceDir;
 using arcwheel::testing::TempDir;
+using ::testing::HasSubstr;
+using ::testing::Not;
 
 std::string ReadText(const fs::path& path) {
   std::ifstream stream(path, std::ios::binary);
@@ -55,7 +55,8 @@ void Polish(const fs::path& out, const std::string& extra = "") {
 
 // The number at `pointer` in the summary as JSON writes it; checked to be literally in the file,
 // so that the report is compared with the file's own text.
-std::string AsWritten(const std::string& file_text, const nlohmann::json& summary, const std::string& pointer) {
+std::string AsWritten(const std::string& file_text, const nlohmann::json& summary,
+                      const std::string& pointer) {
   const nlohmann::json::json_pointer at(pointer);
   const std::string key = at.back();
   const std::string token = summary.at(at).dump();
@@ -67,7 +68,8 @@ TEST(PolishReport, PdfCarriesPvRmsBeforeAfterAndTotalTimeAsInTheSummary) {
   TempDir dir;
   Polish(dir / "out", "--report pdf,html");
   EXPECT_EQ(ListFolder(dir / "out"),
-            "polish.mod\npolish_report.html\npolish_report.pdf\npolish_summary.json\npolishing_path.csv\nresidual_map.csv\n");
+            "polish.mod\npolish_report.html\npolish_report.pdf\npolish_summary.json\npolishing_path."
+            "csv\nresidual_map.csv\n");
   const std::string summary_text = ReadText(dir / "out" / "polish_summary.json");
   const nlohmann::json summary = nlohmann::json::parse(summary_text);
   const std::string text = PdfText(dir / "out" / "polish_report.pdf", dir / "pdf.txt");
@@ -81,17 +83,20 @@ TEST(PolishReport, PdfCarriesPvRmsBeforeAfterAndTotalTimeAsInTheSummary) {
   EXPECT_THAT(text, HasSubstr(fmt::format("{:.3f} … {:.3f} mm/s", summary["speed_mm_s"]["min"].get<double>(),
                                           summary["speed_mm_s"]["max"].get<double>())));
   EXPECT_THAT(text, HasSubstr(fmt::format("{:.1f} mm/s²", summary["max_acceleration_mm_s2"].get<double>())));
-  EXPECT_THAT(text, HasSubstr(fmt::format("{} ({})", summary["solver"]["iterations"].get<int>(),
-                                          summary["solver"]["converged"].get<bool>() ? "converged" : "iteration limit reached")));
+  EXPECT_THAT(text,
+              HasSubstr(fmt::format(
+                  "{} ({})", summary["solver"]["iterations"].get<int>(),
+                  summary["solver"]["converged"].get<bool>() ? "converged" : "iteration limit reached")));
   // Each source file with its SHA-256, as coreutils computes it.
   for (const char* file : {"polish_summary.json", "residual_map.csv", "polishing_path.csv"}) {
-    const std::string sha = Capture("sha256sum '" + (dir / "out" / file).string() + "' | cut -c1-64", dir / "sha.txt");
+    const std::string sha =
+        Capture("sha256sum '" + (dir / "out" / file).string() + "' | cut -c1-64", dir / "sha.txt");
     ASSERT_EQ(sha.size(), 65u) << file;
     EXPECT_THAT(text, HasSubstr(sha.substr(0, 64))) << file;
   }
   // Plots are vector drawings: their labels are text, including the speed limits of the job.
-  for (const char* label : {"Removal target (before)", "Predicted residual (after)", "depth (µm)", "speed (mm/s)",
-                            "path length (mm)", "max speed 150 mm/s", "min speed 0.5 mm/s"}) {
+  for (const char* label : {"Removal target (before)", "Predicted residual (after)", "depth (µm)",
+                            "speed (mm/s)", "path length (mm)", "max speed 150 mm/s", "min speed 0.5 mm/s"}) {
     EXPECT_THAT(text, HasSubstr(label));
   }
   EXPECT_THAT(Capture("pdfinfo '" + (dir / "out" / "polish_report.pdf").string() + "'", dir / "info.txt"),
@@ -111,7 +116,8 @@ TEST(PolishReport, MapsShareOneColourScaleSpanningTargetRemovalAndResidual) {
   int rows = 0;
   while (std::getline(csv, line)) {
     double x, y, target, removal, residual;
-    ASSERT_EQ(std::sscanf(line.c_str(), "%lf,%lf,%lf,%lf,%lf", &x, &y, &target, &removal, &residual), 5) << line;
+    ASSERT_EQ(std::sscanf(line.c_str(), "%lf,%lf,%lf,%lf,%lf", &x, &y, &target, &removal, &residual), 5)
+        << line;
     low = std::min({low, target, removal, residual});
     high = std::max({high, target, removal, residual});
     ++rows;
@@ -119,7 +125,8 @@ TEST(PolishReport, MapsShareOneColourScaleSpanningTargetRemovalAndResidual) {
   const PolishReportContent content = ComposePolishReport(ReadPolishReportInputs(dir / "out"));
   ASSERT_GE(content.figure_rows.size(), 2u);
   int shared = 0;
-  for (const auto* figure : {&content.figure_rows[0][0], &content.figure_rows[0][1], &content.figure_rows[1][0]}) {
+  for (const auto* figure :
+       {&content.figure_rows[0][0], &content.figure_rows[0][1], &content.figure_rows[1][0]}) {
     const auto& map = std::get<plot::HeatMap>(figure->figure);
     EXPECT_EQ(map.colour_min, low) << map.title;
     EXPECT_EQ(map.colour_max, high) << map.title;
@@ -160,7 +167,8 @@ TEST(ReportCommand, MakesThePolishReportForAPolishFolder) {
   ASSERT_EQ(result.exit_status, 0) << result.output;
   EXPECT_THAT(result.output, HasSubstr((dir / "out" / "polish_report.pdf").string()));
   EXPECT_EQ(ListFolder(dir / "out"),
-            "polish.mod\npolish_report.html\npolish_report.pdf\npolish_summary.json\npolishing_path.csv\nresidual_map.csv\n");
+            "polish.mod\npolish_report.html\npolish_report.pdf\npolish_summary.json\npolishing_path."
+            "csv\nresidual_map.csv\n");
 }
 
 TEST(ReportCommand, RefusesACorruptResidualLineNamingFileAndLineAndKeepsTheEarlierReport) {
@@ -181,7 +189,8 @@ TEST(ReportCommand, RefusesACorruptResidualLineNamingFileAndLineAndKeepsTheEarli
   std::ofstream(residual, std::ios::trunc) << corrupted;
   const auto result = RunArcwheel("report '" + (dir / "out").string() + "'");
   EXPECT_EQ(result.exit_status, 3) << result.output;
-  EXPECT_THAT(result.output, HasSubstr(fmt::format("'{}' line 7: residual_um '0.1.2' is not a number", residual.string())));
+  EXPECT_THAT(result.output,
+              HasSubstr(fmt::format("'{}' line 7: residual_um '0.1.2' is not a number", residual.string())));
   EXPECT_EQ(ListFolder(dir / "out"), listing) << "no temporary or new file left";
   EXPECT_EQ(ReadText(dir / "out" / "polish_report.pdf"), pdf_before);
   EXPECT_EQ(ReadText(dir / "out" / "polish_report.html"), html_before);

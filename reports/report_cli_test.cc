@@ -4,9 +4,9 @@
 #include <fmt/format.h>
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
-#include <nlohmann/json.hpp>
 
 #include <fstream>
+#include <nlohmann/json.hpp>
 #include <sstream>
 
 #include "core/testing/testing.h"
@@ -16,10 +16,10 @@ namespace arcwheel::reports {
 namespace {
 
 namespace fs = std::filesystem;
-using ::testing::HasSubstr;
 using arcwheel::testing::ListFolder;
 using arcwheel::testing::RunArcwheel;
 using arcwheel::testing::TempDir;
+using ::testing::HasSubstr;
 
 std::string ReadText(const fs::path& path) {
   std::ifstream stream(path, std::ios::binary);
@@ -41,7 +41,8 @@ TEST(ReportCommand, WritesBothReportsAndJudgesAToleranceFile) {
   TempDir dir;
   testing::WriteFixture(dir / "out", {.n_phase = 36, .n_y = 81});
   std::ofstream(dir / "tol.json") << R"({"max_runout_um": 7.5, "max_roundness_um": {"max": 3.0}})";
-  const auto result = RunArcwheel("report '" + (dir / "out").string() + "' --tolerances '" + (dir / "tol.json").string() + "'");
+  const auto result = RunArcwheel("report '" + (dir / "out").string() + "' --tolerances '" +
+                                  (dir / "tol.json").string() + "'");
   ASSERT_EQ(result.exit_status, 0) << result.output;
   EXPECT_THAT(result.output, HasSubstr("overall: FAIL")) << "roundness 3.47 um > 3.0 um";
   EXPECT_EQ(ListFolder(dir / "out"), "report.html\nreport.pdf\nsummary.json\nwheel_map.h5\n");
@@ -54,8 +55,8 @@ TEST(ReportCommand, FlagsOverrideTheToleranceFile) {
   TempDir dir;
   testing::WriteFixture(dir / "out", {.n_phase = 36, .n_y = 81});
   std::ofstream(dir / "tol.json") << R"({"max_roundness_um": 3.0})";
-  const auto result = RunArcwheel("report '" + (dir / "out").string() + "' --tolerances '" + (dir / "tol.json").string() +
-                                  "' --tolerance max_roundness_um=3.5");
+  const auto result = RunArcwheel("report '" + (dir / "out").string() + "' --tolerances '" +
+                                  (dir / "tol.json").string() + "' --tolerance max_roundness_um=3.5");
   ASSERT_EQ(result.exit_status, 0) << result.output;
   EXPECT_THAT(result.output, HasSubstr("overall: PASS"));
 }
@@ -90,9 +91,11 @@ TEST(ReportCommand, RefusesAMalformedToleranceFlag) {
 
 TEST(ReportCommand, ReportsASimulatedAndProcessedScanWithTheSummaryNumbers) {
   TempDir dir;
-  const auto simulated = RunArcwheel("simulate '" + (dir / "scan.h5").string() + "' --noise-um 0.5 --spike-rate 0.0005");
+  const auto simulated =
+      RunArcwheel("simulate '" + (dir / "scan.h5").string() + "' --noise-um 0.5 --spike-rate 0.0005");
   ASSERT_EQ(simulated.exit_status, 0) << simulated.output;
-  const auto processed = RunArcwheel("process '" + (dir / "scan.h5").string() + "' -o '" + (dir / "out").string() + "' -q");
+  const auto processed =
+      RunArcwheel("process '" + (dir / "scan.h5").string() + "' -o '" + (dir / "out").string() + "' -q");
   ASSERT_EQ(processed.exit_status, 0) << processed.output;
   const auto reported = RunArcwheel("report '" + (dir / "out").string() + "' --tolerance max_runout_um=1000");
   ASSERT_EQ(reported.exit_status, 0) << reported.output;

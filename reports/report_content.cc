@@ -63,7 +63,8 @@ std::vector<HeadlineRow> HeadlineRows(const Summary& summary, const Tolerances& 
     const double value = HeadlineValue(summary, spec.key);
     row.value = WithUnit(FormatNumber(value, spec.decimals), spec.unit);
     if (row.key == "mean_arc_radius_mm" && std::isfinite(value)) {
-      row.value = FormatNumber(value, spec.decimals) + " ± " + FormatNumber(summary.mean_arc_radius_sigma_mm, spec.decimals) + " mm";
+      row.value = FormatNumber(value, spec.decimals) + " ± " +
+                  FormatNumber(summary.mean_arc_radius_sigma_mm, spec.decimals) + " mm";
     }
     std::optional<Limit> limit;
     if (const auto it = tolerances.limits.find(row.key); it != tolerances.limits.end()) limit = it->second;
@@ -99,7 +100,8 @@ std::string ScanNumber(const json& scan, const char* key, int decimals, const ch
 std::vector<KeyValue> Provenance(const ReportInputs& inputs) {
   const Summary& s = inputs.summary;
   const InputProvenance& in = s.input;
-  const double valid_pct = in.samples > 0 ? 100.0 * static_cast<double>(in.valid_samples) / static_cast<double>(in.samples) : kNaN;
+  const double valid_pct =
+      in.samples > 0 ? 100.0 * static_cast<double>(in.valid_samples) / static_cast<double>(in.samples) : kNaN;
   std::string estimated = FormatNumber(s.spindle_rpm_estimated, 2) + " rpm";
   if (!s.spindle_rpm_source.empty()) estimated += " (used: " + s.spindle_rpm_source + ")";
   std::vector<KeyValue> rows = {
@@ -118,8 +120,10 @@ std::vector<KeyValue> Provenance(const ReportInputs& inputs) {
                                 " mm (half width " + FormatNumber(s.band_half_width_mm, 3) + " mm)"},
       {"Map", fmt::format("{} phases × {} axial nodes", inputs.map.n_phase(), inputs.map.n_y())},
   };
-  if (std::isfinite(s.noise_sigma_um)) rows.push_back({"Measurement noise (1σ)", FormatNumber(s.noise_sigma_um, 3) + " µm"});
-  if (std::isfinite(s.map_sigma_um)) rows.push_back({"Map value noise (median 1σ)", FormatNumber(s.map_sigma_um, 3) + " µm"});
+  if (std::isfinite(s.noise_sigma_um))
+    rows.push_back({"Measurement noise (1σ)", FormatNumber(s.noise_sigma_um, 3) + " µm"});
+  if (std::isfinite(s.map_sigma_um))
+    rows.push_back({"Map value noise (median 1σ)", FormatNumber(s.map_sigma_um, 3) + " µm"});
   rows.push_back({"Input file", in.path + (in.format.empty() ? "" : " (" + in.format + ")")});
   rows.push_back({"Input SHA-256", in.sha256});
   rows.push_back({"Processed by", "arcwheel " + s.arcwheel_version});
@@ -129,7 +133,8 @@ std::vector<KeyValue> Provenance(const ReportInputs& inputs) {
 
 void Flatten(const json& value, const std::string& prefix, std::vector<KeyValue>& out) {
   if (value.is_object() && !value.empty()) {
-    for (const auto& [key, child] : value.items()) Flatten(child, prefix.empty() ? key : prefix + "." + key, out);
+    for (const auto& [key, child] : value.items())
+      Flatten(child, prefix.empty() ? key : prefix + "." + key, out);
     return;
   }
   out.push_back({prefix, value.is_string() ? value.get<std::string>() : value.dump()});
@@ -176,18 +181,21 @@ ReportFigure FormErrorMap(const ReportInputs& inputs) {
   map.x_nodes = inputs.map.phase_deg;
   map.y_nodes = inputs.map.y_mm;
   map.colour_bar_label = "form error (µm)";
-  return {"Unwrapped form-error map: radial deviation of the wheel from the circle of mean radius and mean "
-          "centre, by phase and axial position (colour range: 0.5 to 99.5 percentile; grey: no value).",
-          map, 0.5};
+  return {
+      "Unwrapped form-error map: radial deviation of the wheel from the circle of mean radius and mean "
+      "centre, by phase and axial position (colour range: 0.5 to 99.5 percentile; grey: no value).",
+      map, 0.5};
 }
 
 ReportFigure RadiusPlot(const PhaseSeries& p) {
-  plot::Series series{"arc radius Ra", p.phase_deg, UsableOnly(p.arc_radius_mm, p.usable), {}, {}, plot::SeriesColour(0)};
+  plot::Series series{"arc radius Ra",      p.phase_deg, UsableOnly(p.arc_radius_mm, p.usable), {}, {},
+                      plot::SeriesColour(0)};
   for (std::size_t i = 0; i < p.phase_deg.size(); ++i) {
     series.band_low.push_back(series.y[i] - p.arc_radius_sigma_mm[i]);
     series.band_high.push_back(series.y[i] + p.arc_radius_sigma_mm[i]);
   }
-  plot::LinePlot plot{"Arc radius vs phase (shaded: ± 1σ)", kPhaseAxis, FreeAxis("arc radius Ra (mm)"), {series}, {}};
+  plot::LinePlot plot{
+      "Arc radius vs phase (shaded: ± 1σ)", kPhaseAxis, FreeAxis("arc radius Ra (mm)"), {series}, {}};
   return {"Arc radius of each axial section, with its 1-sigma band.", plot, 0.42};
 }
 
@@ -212,24 +220,28 @@ ReportFigure CentrePlot(const PhaseSeries& p) {
 }
 
 ReportFigure ArcErrorPlot(const PhaseSeries& p) {
-  plot::LinePlot plot{"Arc error vs phase",
-                      kPhaseAxis,
-                      FreeAxis("arc error, peak-to-valley (µm)"),
-                      {{"arc error", p.phase_deg, UsableOnly(p.arc_error_um, p.usable), {}, {}, plot::SeriesColour(2)}},
-                      {}};
-  return {"Peak-to-valley of each section's residuals against its own fitted circle, inside the band.", plot, 0.42};
+  plot::LinePlot plot{
+      "Arc error vs phase",
+      kPhaseAxis,
+      FreeAxis("arc error, peak-to-valley (µm)"),
+      {{"arc error", p.phase_deg, UsableOnly(p.arc_error_um, p.usable), {}, {}, plot::SeriesColour(2)}},
+      {}};
+  return {"Peak-to-valley of each section's residuals against its own fitted circle, inside the band.", plot,
+          0.42};
 }
 
 ReportFigure RunoutPlot(const Summary& s) {
-  plot::LinePlot plot{"Runout and roundness vs axial position",
-                      kAxialAxis,
-                      FreeAxis("runout, roundness (µm)"),
-                      {{"runout", s.axial.y_mm, s.axial.runout_um, {}, {}, plot::SeriesColour(0)},
-                       {"roundness", s.axial.y_mm, s.axial.roundness_um, {}, {}, plot::SeriesColour(1), false, true}},
-                      {{s.band_low_mm, s.band_high_mm, "band"}}};
-  return {"Total indicated runout (max − min over a turn) and roundness (after removing the least-squares "
-          "circle) at each axial node of the band.",
-          plot, 0.42};
+  plot::LinePlot plot{
+      "Runout and roundness vs axial position",
+      kAxialAxis,
+      FreeAxis("runout, roundness (µm)"),
+      {{"runout", s.axial.y_mm, s.axial.runout_um, {}, {}, plot::SeriesColour(0)},
+       {"roundness", s.axial.y_mm, s.axial.roundness_um, {}, {}, plot::SeriesColour(1), false, true}},
+      {{s.band_low_mm, s.band_high_mm, "band"}}};
+  return {
+      "Total indicated runout (max − min over a turn) and roundness (after removing the least-squares "
+      "circle) at each axial node of the band.",
+      plot, 0.42};
 }
 
 // Usable phases of largest and smallest arc radius; npos if none is usable.
@@ -246,7 +258,8 @@ std::pair<std::size_t, std::size_t> ExtremePhases(const PhaseSeries& p) {
 
 // The fitted arc of phase `k` over the band, on the branch (above or below the centre) on which
 // the measured section lies.
-plot::Series FittedArc(const ReportInputs& inputs, std::size_t k, const std::string& label, plot::Rgb colour) {
+plot::Series FittedArc(const ReportInputs& inputs, std::size_t k, const std::string& label,
+                       plot::Rgb colour) {
   const PhaseSeries& p = inputs.summary.phases;
   const double a = p.center_axial_mm[k], b = p.center_radial_mm[k], radius = p.arc_radius_mm[k];
   double side = 0.0;
@@ -266,7 +279,8 @@ plot::Series FittedArc(const ReportInputs& inputs, std::size_t k, const std::str
   return arc;
 }
 
-plot::Series MeasuredSection(const ReportInputs& inputs, std::size_t k, const std::string& label, plot::Rgb colour) {
+plot::Series MeasuredSection(const ReportInputs& inputs, std::size_t k, const std::string& label,
+                             plot::Rgb colour) {
   plot::Series section{label, inputs.map.y_mm, {}, {}, {}, colour, true};
   section.y.assign(inputs.map.rho_mm.begin() + static_cast<std::ptrdiff_t>(k * inputs.map.n_y()),
                    inputs.map.rho_mm.begin() + static_cast<std::ptrdiff_t>((k + 1) * inputs.map.n_y()));
@@ -292,16 +306,18 @@ std::vector<ReportFigure> SectionFigures(const ReportInputs& inputs) {
                           {band}};
   const SectionResidual r_large = SectionResiduals(inputs, largest);
   const SectionResidual r_small = SectionResiduals(inputs, smallest);
-  plot::LinePlot residuals{"Section residuals against the fitted arc (magnified)",
-                           kAxialAxis,
-                           FreeAxis("residual |p − centre| − Ra (µm)"),
-                           {{large, r_large.y_mm, r_large.residual_um, {}, {}, plot::SeriesColour(0)},
-                            {small, r_small.y_mm, r_small.residual_um, {}, {}, plot::SeriesColour(1), false, true}},
-                           {}};
-  return {{"Axial sections (map nodes, dots) at the phases of largest and smallest arc radius, with their fitted "
-           "arcs over the band.",
-           sections, 0.5},
-          {"Geometric residuals of the same two sections inside the band, in micrometres.", residuals, 0.42}};
+  plot::LinePlot residuals{
+      "Section residuals against the fitted arc (magnified)",
+      kAxialAxis,
+      FreeAxis("residual |p − centre| − Ra (µm)"),
+      {{large, r_large.y_mm, r_large.residual_um, {}, {}, plot::SeriesColour(0)},
+       {small, r_small.y_mm, r_small.residual_um, {}, {}, plot::SeriesColour(1), false, true}},
+      {}};
+  return {
+      {"Axial sections (map nodes, dots) at the phases of largest and smallest arc radius, with their fitted "
+       "arcs over the band.",
+       sections, 0.5},
+      {"Geometric residuals of the same two sections inside the band, in micrometres.", residuals, 0.42}};
 }
 
 ReportFigure CoverageMap(const WheelMapData& map) {
@@ -321,9 +337,10 @@ ReportFigure CoverageMap(const WheelMapData& map) {
     const bool missing = !(map.sample_count[i] > 0.0) || !std::isfinite(map.rho_mm[i]);
     coverage.codes[i] = missing ? 2 : (map.despiked_count[i] > 0.0 ? 1 : 0);
   }
-  return {"Map cells by their raw samples: where samples were missing or replaced by despiking (a merged "
-          "display pixel shows its worst cell).",
-          coverage, 0.5};
+  return {
+      "Map cells by their raw samples: where samples were missing or replaced by despiking (a merged "
+      "display pixel shows its worst cell).",
+      coverage, 0.5};
 }
 
 }  // namespace
@@ -371,7 +388,8 @@ ReportContent ComposeReport(const ReportInputs& inputs, const Tolerances& tolera
   const Summary& s = inputs.summary;
   ReportContent content;
   const std::string wheel = ScanText(s.scan, "wheel_id");
-  content.title = "Wheel inspection report: " + (wheel == "not recorded" ? std::string("wheel id not recorded") : wheel);
+  content.title =
+      "Wheel inspection report: " + (wheel == "not recorded" ? std::string("wheel id not recorded") : wheel);
   content.provenance = Provenance(inputs);
   content.headline = HeadlineRows(s, tolerances);
   content.overall = Overall(content.headline);

@@ -34,9 +34,9 @@ struct ReportFigure {
 };
 
 struct ReportContent {
-  std::string title;                  // "Wheel inspection report: WHEEL-ID"
-  std::vector<KeyValue> provenance;   // wheel, scan settings, input file and SHA-256, versions
-  std::vector<HeadlineRow> headline;  // in kHeadlineKeys order
+  std::string title;                        // "Wheel inspection report: WHEEL-ID"
+  std::vector<KeyValue> provenance;         // wheel, scan settings, input file and SHA-256, versions
+  std::vector<HeadlineRow> headline;        // in kHeadlineKeys order
   Verdict overall = Verdict::kNoTolerance;  // kFail if any row fails, kPass if some pass and none fail
   std::vector<ReportFigure> figures;
   std::vector<KeyValue> processing;  // summary.json "processing", flattened to dotted keys

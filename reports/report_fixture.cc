@@ -17,13 +17,15 @@ constexpr const char* kSha = "3b1f5e0c9a7d4e2b8c6f1a0d9e8b7c6a5f4e3d2c1b0a998877
 
 std::vector<double> PhaseNodes(const FixtureOptions& o) {
   std::vector<double> phases(o.n_phase);
-  for (std::size_t i = 0; i < o.n_phase; ++i) phases[i] = 360.0 * static_cast<double>(i) / static_cast<double>(o.n_phase);
+  for (std::size_t i = 0; i < o.n_phase; ++i)
+    phases[i] = 360.0 * static_cast<double>(i) / static_cast<double>(o.n_phase);
   return phases;
 }
 
 std::vector<double> AxialNodes(const FixtureOptions& o) {
   std::vector<double> y(o.n_y);
-  for (std::size_t j = 0; j < o.n_y; ++j) y[j] = 20.0 * static_cast<double>(j) / static_cast<double>(o.n_y - 1);
+  for (std::size_t j = 0; j < o.n_y; ++j)
+    y[j] = 20.0 * static_cast<double>(j) / static_cast<double>(o.n_y - 1);
   return y;
 }
 
@@ -48,9 +50,9 @@ nlohmann::json FixtureSummary(const FixtureOptions& options) {
   using nlohmann::json;
   const std::vector<double> phases = PhaseNodes(options);
   json p = {{"phase_deg", phases}};
-  for (const char* key : {"arc_radius_mm", "arc_radius_sigma_mm", "center_axial_mm", "center_axial_sigma_mm",
-                          "center_radial_mm", "center_radial_sigma_mm", "arc_error_um", "points_in_band", "usable",
-                          "flag"}) {
+  for (const char* key :
+       {"arc_radius_mm", "arc_radius_sigma_mm", "center_axial_mm", "center_axial_sigma_mm",
+        "center_radial_mm", "center_radial_sigma_mm", "arc_error_um", "points_in_band", "usable", "flag"}) {
     p[key] = json::array();
   }
   for (double c : phases) {
@@ -125,7 +127,8 @@ nlohmann::json FixtureSummary(const FixtureOptions& options) {
   };
 }
 
-void WriteFixture(const std::filesystem::path& outdir, const FixtureOptions& options, const nlohmann::json& summary) {
+void WriteFixture(const std::filesystem::path& outdir, const FixtureOptions& options,
+                  const nlohmann::json& summary) {
   std::filesystem::create_directories(outdir);
   std::ofstream(outdir / "summary.json") << summary.dump(2);
   const std::vector<double> phases = PhaseNodes(options);
@@ -156,7 +159,8 @@ void WriteFixture(const std::filesystem::path& outdir, const FixtureOptions& opt
   file.WriteInts("/map/despiked_count", despiked, grid);
   file.CreateGroup("/fit");
   const nlohmann::json& p = summary.at("phases");
-  for (const char* key : {"arc_radius_mm", "arc_radius_sigma_mm", "center_axial_mm", "center_radial_mm", "arc_error_um"}) {
+  for (const char* key :
+       {"arc_radius_mm", "arc_radius_sigma_mm", "center_axial_mm", "center_radial_mm", "arc_error_um"}) {
     if (p.contains(key) && p.at(key).size() == options.n_phase) {
       std::vector<double> values;
       for (const auto& v : p.at(key)) values.push_back(v.is_number() ? v.get<double>() : kNaN);

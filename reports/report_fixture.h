@@ -9,10 +9,9 @@
 // with cells of no valid sample (rho NaN, sample_count 0) where 90 <= c < 100 and y < 1, and
 // despiked samples in the cells where 180 <= c < 190 and 5 <= y < 6.
 
-#include <nlohmann/json.hpp>
-
 #include <cstddef>
 #include <filesystem>
+#include <nlohmann/json.hpp>
 
 namespace arcwheel::reports::testing {
 
@@ -33,7 +32,8 @@ double FixtureCenterRadial_mm(double phase_deg);
 [[nodiscard]] nlohmann::json FixtureSummary(const FixtureOptions& options);
 
 // Writes OUTDIR/summary.json (from `summary`) and OUTDIR/wheel_map.h5.
-void WriteFixture(const std::filesystem::path& outdir, const FixtureOptions& options, const nlohmann::json& summary);
+void WriteFixture(const std::filesystem::path& outdir, const FixtureOptions& options,
+                  const nlohmann::json& summary);
 void WriteFixture(const std::filesystem::path& outdir, const FixtureOptions& options = {});
 
 }  // namespace arcwheel::reports::testing

@@ -10,8 +10,8 @@ using internal::Escape;
 using internal::FigureHtml;
 using internal::HtmlPageEnd;
 using internal::HtmlPageStart;
-using internal::kFigureWidth_pt;
 using internal::KeyValueTable;
+using internal::kFigureWidth_pt;
 
 std::string VerdictClass(Verdict verdict) {
   return verdict == Verdict::kPass ? "pass" : verdict == Verdict::kFail ? "fail" : "none";
@@ -23,10 +23,14 @@ std::string VerdictBadge(Verdict verdict) {
 
 std::string HeadlineTable(const ReportContent& content) {
   std::string html = "<p>Overall: " + VerdictBadge(content.overall) + "</p>\n";
-  html += "<div class=\"table-scroll\"><table>\n<tr><th>Quantity</th><th>Value</th><th>Tolerance</th><th>Result</th></tr>\n";
+  html +=
+      "<div "
+      "class=\"table-scroll\"><table>\n<tr><th>Quantity</th><th>Value</th><th>Tolerance</th><th>Result</th></"
+      "tr>\n";
   for (const HeadlineRow& row : content.headline) {
-    html += "<tr><td>" + Escape(row.label) + "</td><td class=\"number\">" + Escape(row.value) + "</td><td class=\"number\">" +
-            Escape(row.tolerance) + "</td><td>" + VerdictBadge(row.verdict) + "</td></tr>\n";
+    html += "<tr><td>" + Escape(row.label) + "</td><td class=\"number\">" + Escape(row.value) +
+            "</td><td class=\"number\">" + Escape(row.tolerance) + "</td><td>" + VerdictBadge(row.verdict) +
+            "</td></tr>\n";
   }
   return html + "</table></div>\n";
 }

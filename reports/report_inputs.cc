@@ -8,8 +8,8 @@
 #include <sstream>
 
 #include "core/error.h"
-#include "core/json_text.h"
 #include "core/hdf5.h"
+#include "core/json_text.h"
 
 namespace arcwheel::reports {
 namespace {
@@ -82,8 +82,8 @@ std::string OptionalString(const json& object, const JsonWhere& parent, const st
   return it->get<std::string>();
 }
 
-std::vector<double> RequireNumberArray(const json& object, const JsonWhere& parent,
-                                       const std::string& name, std::size_t expected_size) {
+std::vector<double> RequireNumberArray(const json& object, const JsonWhere& parent, const std::string& name,
+                                       std::size_t expected_size) {
   const json& value = RequireKey(object, parent, name);
   const JsonWhere where = parent.Child(name);
   if (!value.is_array()) BadSummary(where, "is not an array");
@@ -127,7 +127,8 @@ PhaseSeries ParsePhases(const json& root, const JsonWhere& top) {
   series.usable.assign(n, true);
   if (const auto it = phases.find("usable"); it != phases.end()) {
     const JsonWhere usable_where = where.Child("usable");
-    if (!it->is_array() || it->size() != n) BadSummary(usable_where, fmt::format("is not an array of {} booleans", n));
+    if (!it->is_array() || it->size() != n)
+      BadSummary(usable_where, fmt::format("is not an array of {} booleans", n));
     for (std::size_t i = 0; i < n; ++i) {
       if (!(*it)[i].is_boolean()) BadSummary(usable_where.Child(std::to_string(i)), "is not a boolean");
       series.usable[i] = (*it)[i].get<bool>();
@@ -196,8 +197,10 @@ std::string ReadWholeFile(const std::filesystem::path& path, const char* stage) 
   return contents.str();
 }
 
-[[noreturn]] void BadMap(const std::filesystem::path& path, const std::string& dataset, const std::string& problem) {
-  throw Error(ErrorCode::kBadInput, kMapStage, "'" + path.string() + "' dataset '" + dataset + "' " + problem);
+[[noreturn]] void BadMap(const std::filesystem::path& path, const std::string& dataset,
+                         const std::string& problem) {
+  throw Error(ErrorCode::kBadInput, kMapStage,
+              "'" + path.string() + "' dataset '" + dataset + "' " + problem);
 }
 
 std::vector<double> ReadDataset(const hdf5::File& file, const std::string& dataset,
@@ -214,11 +217,13 @@ std::vector<double> ReadDataset(const hdf5::File& file, const std::string& datas
 std::vector<double> ReadAxisDataset(const hdf5::File& file, const std::string& dataset) {
   if (!file.HasObject(dataset)) BadMap(file.path(), dataset, "is missing");
   const std::vector<hsize_t> shape = file.Shape(dataset);
-  if (shape.size() != 1 || shape[0] < 2) BadMap(file.path(), dataset, "is not a 1-D array of at least 2 nodes");
+  if (shape.size() != 1 || shape[0] < 2)
+    BadMap(file.path(), dataset, "is not a 1-D array of at least 2 nodes");
   std::vector<double> nodes = file.ReadDoubles(dataset);
   for (std::size_t i = 1; i < nodes.size(); ++i) {
     if (!(nodes[i] > nodes[i - 1])) {
-      BadMap(file.path(), dataset, fmt::format("is not strictly increasing at index {} ({} after {})", i, nodes[i], nodes[i - 1]));
+      BadMap(file.path(), dataset,
+             fmt::format("is not strictly increasing at index {} ({} after {})", i, nodes[i], nodes[i - 1]));
     }
   }
   return nodes;
@@ -229,7 +234,8 @@ std::vector<double> ReadAxisDataset(const hdf5::File& file, const std::string& d
 Summary ParseSummary(const std::string& text, const std::string& name) {
   const json root = ParseJsonText(text, name, kSummaryStage);
   const JsonWhere top{name, ""};
-  if (!root.is_object()) throw Error(ErrorCode::kBadInput, kSummaryStage, "'" + name + "' is not a JSON object");
+  if (!root.is_object())
+    throw Error(ErrorCode::kBadInput, kSummaryStage, "'" + name + "' is not a JSON object");
   Summary summary;
   summary.arcwheel_version = RequireString(root, top, "arcwheel_version");
   summary.input = ParseInput(root, top);
@@ -248,14 +254,16 @@ Summary ParseSummary(const std::string& text, const std::string& name) {
 
 Summary ReadSummary(const std::filesystem::path& path) {
   if (!std::filesystem::exists(path)) {
-    throw Error(ErrorCode::kIo, kSummaryStage, "'" + path.string() + "' does not exist (run `arcwheel process` first)");
+    throw Error(ErrorCode::kIo, kSummaryStage,
+                "'" + path.string() + "' does not exist (run `arcwheel process` first)");
   }
   return ParseSummary(ReadWholeFile(path, kSummaryStage), path.string());
 }
 
 WheelMapData ReadWheelMap(const std::filesystem::path& path) {
   if (!std::filesystem::exists(path)) {
-    throw Error(ErrorCode::kIo, kMapStage, "'" + path.string() + "' does not exist (run `arcwheel process` first)");
+    throw Error(ErrorCode::kIo, kMapStage,
+                "'" + path.string() + "' does not exist (run `arcwheel process` first)");
   }
   hdf5::ReadFirstInChildProcess(path, [&] { (void)ReadWheelMap(path); });
   const hdf5::File file = hdf5::File::OpenReadOnly(path);
@@ -286,17 +294,20 @@ ReportInputs ReadReportInputs(const std::filesystem::path& outdir) {
                     summary.input.sha256 + "): the two files describe different scans");
   }
   if (inputs.map.n_phase() != summary.phases.phase_deg.size()) {
-    throw Error(ErrorCode::kBadInput, kMapStage,
-                fmt::format("'{}' dataset '/map/phase_deg' has {} phases but '{}' key 'phases.phase_deg' has {}",
-                            inputs.map_path.string(), inputs.map.n_phase(), inputs.summary_path.string(),
-                            summary.phases.phase_deg.size()));
+    throw Error(
+        ErrorCode::kBadInput, kMapStage,
+        fmt::format("'{}' dataset '/map/phase_deg' has {} phases but '{}' key 'phases.phase_deg' has {}",
+                    inputs.map_path.string(), inputs.map.n_phase(), inputs.summary_path.string(),
+                    summary.phases.phase_deg.size()));
   }
   for (std::size_t i = 0; i < inputs.map.n_phase(); ++i) {
     if (std::abs(inputs.map.phase_deg[i] - summary.phases.phase_deg[i]) > 1e-6) {
-      throw Error(ErrorCode::kBadInput, kMapStage,
-                  fmt::format("'{}' dataset '/map/phase_deg' [{}] = {} differs from '{}' key 'phases.phase_deg.{}' = {}",
-                              inputs.map_path.string(), i, inputs.map.phase_deg[i], inputs.summary_path.string(), i,
-                              summary.phases.phase_deg[i]));
+      throw Error(
+          ErrorCode::kBadInput, kMapStage,
+          fmt::format(
+              "'{}' dataset '/map/phase_deg' [{}] = {} differs from '{}' key 'phases.phase_deg.{}' = {}",
+              inputs.map_path.string(), i, inputs.map.phase_deg[i], inputs.summary_path.string(), i,
+              summary.phases.phase_deg[i]));
     }
   }
   return inputs;

@@ -8,10 +8,9 @@
 // names the file and the key or dataset. Numbers that `process` could not compute are `null` in
 // JSON and NaN in HDF5; both are read as NaN.
 
-#include <nlohmann/json.hpp>
-
 #include <cstdint>
 #include <filesystem>
+#include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
 #include <vector>

@@ -14,11 +14,11 @@
 namespace arcwheel::reports {
 namespace {
 
-using ::testing::HasSubstr;
+using arcwheel::testing::TempDir;
 using testing::FixtureOptions;
 using testing::FixtureSummary;
+using ::testing::HasSubstr;
 using testing::WriteFixture;
-using arcwheel::testing::TempDir;
 
 // Runs `read` and returns the Error it throws; fails the test if it throws nothing.
 template <typename Read>
@@ -60,7 +60,8 @@ TEST(ReadReportInputs, ReadsBackTheFixtureValues) {
   // rho at (c = 0, y = 10) from the fixture's closed form.
   const double a = testing::FixtureCenterAxial_mm(0.0);
   const double ra = testing::FixtureArcRadius_mm(0.0);
-  EXPECT_NEAR(map.rho_mm[20], testing::FixtureCenterRadial_mm(0.0) + std::sqrt(ra * ra - (10.0 - a) * (10.0 - a)), 1e-12);
+  EXPECT_NEAR(map.rho_mm[20],
+              testing::FixtureCenterRadial_mm(0.0) + std::sqrt(ra * ra - (10.0 - a) * (10.0 - a)), 1e-12);
   EXPECT_TRUE(std::isnan(map.rho_mm[9 * 41 + 0])) << "missing cell at c = 90, y = 0";
   EXPECT_EQ(map.sample_count[9 * 41 + 0], 0.0);
   EXPECT_EQ(map.despiked_count[18 * 41 + 11], 1.0) << "despiked cell at c = 180, y = 5.5";
@@ -119,7 +120,8 @@ INSTANTIATE_TEST_SUITE_P(
                           "key 'phases.arc_error_um' has 11 entries, expected 12"},
         BrokenSummaryCase{"TextInArray", [](nlohmann::json& s) { s["axial"]["runout_um"][2] = "x"; },
                           "key 'axial.runout_um.2' is not a number"},
-        BrokenSummaryCase{"MissingPhases", [](nlohmann::json& s) { s.erase("phases"); }, "key 'phases' is missing"},
+        BrokenSummaryCase{"MissingPhases", [](nlohmann::json& s) { s.erase("phases"); },
+                          "key 'phases' is missing"},
         BrokenSummaryCase{"MissingProcessing", [](nlohmann::json& s) { s.erase("processing"); },
                           "key 'processing' is missing"},
         BrokenSummaryCase{"NegativeCount", [](nlohmann::json& s) { s["input"]["samples"] = -4; },
@@ -128,7 +130,9 @@ INSTANTIATE_TEST_SUITE_P(
                           "key 'phases.usable.1' is not a boolean"},
         BrokenSummaryCase{"NotAnObject", [](nlohmann::json& s) { s = nlohmann::json::array(); },
                           "'out/summary.json' is not a JSON object"}),
-    [](const ::testing::TestParamInfo<BrokenSummaryCase>& param_info) { return std::string(param_info.param.name); });
+    [](const ::testing::TestParamInfo<BrokenSummaryCase>& param_info) {
+      return std::string(param_info.param.name);
+    });
 
 TEST(ReadWheelMap, RefusesAMissingFileNamingIt) {
   TempDir dir;

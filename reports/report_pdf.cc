@@ -18,15 +18,16 @@ void RenderPdf(const ReportContent& content, const std::filesystem::path& path) 
   pdf.Heading("Headline numbers", 10 * kLine_pt);
   pdf.Paragraph("Overall: " + VerdictText(content.overall), content.overall);
   pdf.Space(3.0);
-  const std::vector<double> headline = {0.40 * kContentWidth_pt, 0.25 * kContentWidth_pt, 0.20 * kContentWidth_pt,
-                                        0.15 * kContentWidth_pt};
+  const std::vector<double> headline = {0.40 * kContentWidth_pt, 0.25 * kContentWidth_pt,
+                                        0.20 * kContentWidth_pt, 0.15 * kContentWidth_pt};
   pdf.Row({{"Quantity", {}}, {"Value", {}}, {"Tolerance", {}}, {"Result", {}}}, headline, true);
   for (const HeadlineRow& row : content.headline) {
-    pdf.Row({{row.label, {}}, {row.value, {}}, {row.tolerance, {}}, {VerdictText(row.verdict), row.verdict}}, headline,
-            false);
+    pdf.Row({{row.label, {}}, {row.value, {}}, {row.tolerance, {}}, {VerdictText(row.verdict), row.verdict}},
+            headline, false);
   }
   const double first_figure_pt =
-      content.figures.empty() ? 0.0 : kContentWidth_pt * content.figures.front().height_over_width + 3.0 * kLine_pt;
+      content.figures.empty() ? 0.0
+                              : kContentWidth_pt * content.figures.front().height_over_width + 3.0 * kLine_pt;
   pdf.Heading("Plots", first_figure_pt);
   for (const ReportFigure& figure : content.figures) pdf.Figure(figure);
   pdf.Heading("Warnings", kLine_pt);

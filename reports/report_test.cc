@@ -3,11 +3,11 @@
 #include <cairo.h>
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
-#include <nlohmann/json.hpp>
 
 #include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <nlohmann/json.hpp>
 #include <regex>
 #include <set>
 #include <sstream>
@@ -21,18 +21,18 @@ namespace arcwheel::reports {
 namespace {
 
 namespace fs = std::filesystem;
-using ::testing::HasSubstr;
-using ::testing::Not;
 using arcwheel::testing::TempDir;
-using testing::FixtureOptions;
-using testing::WriteFixture;
 using testing::BrowserRun;
+using testing::FixtureOptions;
+using ::testing::HasSubstr;
 using testing::LoadInChromium;
+using ::testing::Not;
+using testing::WriteFixture;
 
 // The fixture's headline literals (reports/report_fixture.cc) as the report must print them:
 // mm with 4 decimals (mean radius and sigma with 5), um with 2, percent with 3.
-const std::vector<std::string> kFixtureHeadline = {"75.01234 ± 0.00021 mm", "0.0061 mm", "0.008 %", "0.0043 mm",
-                                                   "1.58 µm",               "7.13 µm",   "3.47 µm"};
+const std::vector<std::string> kFixtureHeadline = {
+    "75.01234 ± 0.00021 mm", "0.0061 mm", "0.008 %", "0.0043 mm", "1.58 µm", "7.13 µm", "3.47 µm"};
 
 std::string ReadText(const fs::path& path) {
   std::ifstream stream(path, std::ios::binary);
@@ -50,8 +50,8 @@ int Shell(const std::string& command) {
 Tolerances FixtureTolerances() {
   Tolerances t;
   t.limits["mean_arc_radius_mm"] = {.min = 74.9, .max = 75.1};  // 75.01234: pass
-  t.limits["max_runout_um"] = {.max = 7.0};                      // 7.13: fail
-  t.limits["max_arc_error_um"] = {.max = 2.0};                   // 1.58: pass
+  t.limits["max_runout_um"] = {.max = 7.0};                     // 7.13: fail
+  t.limits["max_arc_error_um"] = {.max = 2.0};                  // 1.58: pass
   return t;
 }
 
@@ -130,7 +130,8 @@ TEST(WriteReports, PdfTextCarriesTheHeadlineNumbersAsInTheSummary) {
   WriteFixture(dir.path());
   const WrittenReports written = WriteReports(dir.path(), FixtureTolerances());
   EXPECT_EQ(written.overall, Verdict::kFail);
-  ASSERT_EQ(Shell("pdftotext -enc UTF-8 '" + written.pdf.string() + "' '" + (dir / "report.txt").string() + "'"), 0)
+  ASSERT_EQ(
+      Shell("pdftotext -enc UTF-8 '" + written.pdf.string() + "' '" + (dir / "report.txt").string() + "'"), 0)
       << "poppler-utils' pdftotext is installed by scripts/install_deps.sh";
   const std::string text = ReadText(dir / "report.txt");
   for (const std::string& number : kFixtureHeadline) EXPECT_THAT(text, HasSubstr(number));
@@ -159,7 +160,8 @@ TEST(WriteReports, HtmlCarriesTheHeadlineNumbersAndReferencesNothingOutside) {
   // Every reference is in-document (#id) or inline data.
   const std::regex reference(R"re((?:href|url)\s*[=(]\s*"?([^")\s]*))re");
   int references = 0;
-  for (auto it = std::sregex_iterator(html.begin(), html.end(), reference); it != std::sregex_iterator(); ++it) {
+  for (auto it = std::sregex_iterator(html.begin(), html.end(), reference); it != std::sregex_iterator();
+       ++it) {
     const std::string target = (*it)[1].str();
     EXPECT_TRUE(target.rfind("#", 0) == 0 || target.rfind("data:", 0) == 0) << target;
     ++references;
@@ -221,7 +223,8 @@ TEST(Chromium, LoadsTheHtmlReportCleanlyOnADesktopAndAPhoneScreen) {
     const BrowserRun run = LoadInChromium(written.html, width, height);
     ASSERT_EQ(run.exit_status, 0);
     EXPECT_THAT(run.console, ::testing::IsEmpty()) << "no console errors or warnings";
-    EXPECT_THAT(run.files_loaded, ::testing::ElementsAre("file://" + written.html.string())) << "nothing but itself";
+    EXPECT_THAT(run.files_loaded, ::testing::ElementsAre("file://" + written.html.string()))
+        << "nothing but itself";
     EXPECT_THAT(run.page_requests, ::testing::IsEmpty()) << "no network";
     // Text, tables and the viridis map give hundreds of colours; a blank page gives one.
     EXPECT_GT(run.distinct_colours, 100u);

@@ -1,10 +1,9 @@
 #include "reports/tolerances.h"
 
-#include <nlohmann/json.hpp>
-
 #include <algorithm>
 #include <cmath>
 #include <fstream>
+#include <nlohmann/json.hpp>
 #include <sstream>
 
 #include "core/error.h"
@@ -31,7 +30,8 @@ std::string KnownKeys() {
 
 void CheckOrder(const Limit& limit, ErrorCode code, const std::string& where) {
   if (limit.min && limit.max && *limit.min > *limit.max) {
-    BadTolerance(code, where, "has min " + std::to_string(*limit.min) + " > max " + std::to_string(*limit.max));
+    BadTolerance(code, where,
+                 "has min " + std::to_string(*limit.min) + " > max " + std::to_string(*limit.max));
   }
 }
 
@@ -48,7 +48,8 @@ Limit ParseLimit(const nlohmann::json& value, const std::string& where) {
     limit.max = FiniteNumber(value, where);
     return limit;
   }
-  if (!value.is_object()) BadTolerance(ErrorCode::kBadInput, where, "is neither a number nor {\"min\":..,\"max\":..}");
+  if (!value.is_object())
+    BadTolerance(ErrorCode::kBadInput, where, "is neither a number nor {\"min\":..,\"max\":..}");
   for (const auto& [name, bound] : value.items()) {
     if (name == "min") {
       limit.min = FiniteNumber(bound, where + ".min");
@@ -73,7 +74,8 @@ std::optional<double> ParseBound(const std::string& text, const std::string& fla
     used = 0;
   }
   if (used != text.size() || !std::isfinite(value)) {
-    BadTolerance(ErrorCode::kInvalidOption, "tolerance '" + flag + "'", "has '" + text + "', which is not a number");
+    BadTolerance(ErrorCode::kInvalidOption, "tolerance '" + flag + "'",
+                 "has '" + text + "', which is not a number");
   }
   return value;
 }
@@ -94,7 +96,8 @@ Tolerances ParseTolerances(const std::string& text, const std::string& name) {
   Tolerances tolerances;
   for (const auto& [key, value] : root.items()) {
     const std::string where = "'" + name + "' key '" + key + "'";
-    if (!IsHeadlineKey(key)) BadTolerance(ErrorCode::kBadInput, where, "is not a headline quantity (" + KnownKeys() + ")");
+    if (!IsHeadlineKey(key))
+      BadTolerance(ErrorCode::kBadInput, where, "is not a headline quantity (" + KnownKeys() + ")");
     tolerances.limits[key] = ParseLimit(value, where);
   }
   return tolerances;
@@ -115,7 +118,8 @@ void AddToleranceFlag(Tolerances& tolerances, const std::string& flag) {
   }
   const std::string key = flag.substr(0, equals);
   if (!IsHeadlineKey(key)) {
-    BadTolerance(ErrorCode::kInvalidOption, "tolerance '" + flag + "'", "names no headline quantity (" + KnownKeys() + ")");
+    BadTolerance(ErrorCode::kInvalidOption, "tolerance '" + flag + "'",
+                 "names no headline quantity (" + KnownKeys() + ")");
   }
   const std::string bounds = flag.substr(equals + 1);
   const std::size_t colon = bounds.find(':');
@@ -126,7 +130,8 @@ void AddToleranceFlag(Tolerances& tolerances, const std::string& flag) {
     limit.min = ParseBound(bounds.substr(0, colon), flag);
     limit.max = ParseBound(bounds.substr(colon + 1), flag);
   }
-  if (!limit.min && !limit.max) BadTolerance(ErrorCode::kInvalidOption, "tolerance '" + flag + "'", "gives no limit");
+  if (!limit.min && !limit.max)
+    BadTolerance(ErrorCode::kInvalidOption, "tolerance '" + flag + "'", "gives no limit");
   CheckOrder(limit, ErrorCode::kInvalidOption, "tolerance '" + flag + "'");
   tolerances.limits[key] = limit;
 }

@@ -49,7 +49,8 @@ TEST(ParseTolerances, RefusesUnknownKeysBadNumbersAndInvertedRanges) {
     }
     return std::string("no error");
   };
-  EXPECT_THAT(message(R"({"max_runnout_um": 3})"), HasSubstr("'tol.json' key 'max_runnout_um' is not a headline quantity"));
+  EXPECT_THAT(message(R"({"max_runnout_um": 3})"),
+              HasSubstr("'tol.json' key 'max_runnout_um' is not a headline quantity"));
   EXPECT_THAT(message(R"({"max_runout_um": "3"})"), HasSubstr("key 'max_runout_um' is neither a number"));
   EXPECT_THAT(message(R"({"max_runout_um": {"maximum": 3}})"), HasSubstr("key 'max_runout_um'.maximum"));
   EXPECT_THAT(message(R"({"mean_arc_radius_mm": {"min": 76, "max": 75}})"), HasSubstr("has min"));

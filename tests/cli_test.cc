@@ -24,23 +24,25 @@ void WriteText(const std::filesystem::path& path, const std::string& text) { std
 
 TEST(Cli, SimulateThenProcessWritesTheContractKeys) {
   TempDir dir;
-  const auto sim = RunArcwheel("simulate " + (dir / "scan.h5").string() + " --noise-um 0.3 --radial-harmonic 1:4");
+  const auto sim =
+      RunArcwheel("simulate " + (dir / "scan.h5").string() + " --noise-um 0.3 --radial-harmonic 1:4");
   ASSERT_EQ(sim.exit_status, 0) << sim.output;
   const auto run = RunArcwheel("process " + (dir / "scan.h5").string() + " -o " + (dir / "out").string());
   ASSERT_EQ(run.exit_status, 0) << run.output;
   EXPECT_NE(run.output.find("mean arc radius"), std::string::npos);
   EXPECT_EQ(testing::ListFolder(dir / "out"), "summary.json\nwheel_map.h5\n");
   const auto s = ReadJson(dir / "out" / "summary.json");
-  for (const char* key : {"arcwheel_version", "input", "spindle_rpm_nominal", "spindle_rpm_estimated",
-                          "mean_arc_radius_mm", "mean_arc_radius_sigma_mm", "arc_radius_range_mm",
-                          "arc_radius_fluctuation_pct", "mean_center_axial_mm", "center_axial_deviation_mm",
-                          "band_half_width_mm", "max_arc_error_um", "max_runout_um", "max_roundness_um", "phases",
-                          "axial"}) {
+  for (const char* key :
+       {"arcwheel_version", "input", "spindle_rpm_nominal", "spindle_rpm_estimated", "mean_arc_radius_mm",
+        "mean_arc_radius_sigma_mm", "arc_radius_range_mm", "arc_radius_fluctuation_pct",
+        "mean_center_axial_mm", "center_axial_deviation_mm", "band_half_width_mm", "max_arc_error_um",
+        "max_runout_um", "max_roundness_um", "phases", "axial"}) {
     EXPECT_TRUE(s.contains(key)) << key;
   }
   EXPECT_EQ(s["input"]["sha256"].get<std::string>().size(), 64u);
   EXPECT_EQ(s["phases"]["phase_deg"].size(), 360u);
-  EXPECT_NEAR(s["mean_arc_radius_mm"].get<double>(), 55.4423, 4 * s["mean_arc_radius_sigma_mm"].get<double>());
+  EXPECT_NEAR(s["mean_arc_radius_mm"].get<double>(), 55.4423,
+              4 * s["mean_arc_radius_sigma_mm"].get<double>());
   // Runout of a pure 4 um eccentricity is 8 um, plus the noise's peak-to-valley.
   EXPECT_NEAR(s["max_runout_um"].get<double>(), 8.0, 1.5);
 }
@@ -53,15 +55,21 @@ TEST(Cli, ProcessWithReportWritesBothReportsBesideTheOutputs) {
   ASSERT_EQ(run.exit_status, 0) << run.output;
   EXPECT_EQ(testing::ListFolder(dir / "out"), "report.html\nreport.pdf\nsummary.json\nwheel_map.h5\n");
   EXPECT_NE(RunArcwheel("process -q " + (dir / "scan.h5").string() + " -o " + (dir / "x").string() +
-                        " --report docx").exit_status, 0);
+                        " --report docx")
+                .exit_status,
+            0);
 }
 
 TEST(Cli, CsvAndHdf5OfTheSameScanGiveTheSameNumbers) {
   TempDir dir;
-  ASSERT_EQ(RunArcwheel("simulate " + (dir / "a.h5").string() + " --float64 --seed 3 --noise-um 0.2").exit_status, 0);
+  ASSERT_EQ(
+      RunArcwheel("simulate " + (dir / "a.h5").string() + " --float64 --seed 3 --noise-um 0.2").exit_status,
+      0);
   ASSERT_EQ(RunArcwheel("simulate " + (dir / "a.csv").string() + " --seed 3 --noise-um 0.2").exit_status, 0);
-  ASSERT_EQ(RunArcwheel("process -q " + (dir / "a.h5").string() + " -o " + (dir / "h").string()).exit_status, 0);
-  ASSERT_EQ(RunArcwheel("process -q " + (dir / "a.csv").string() + " -o " + (dir / "c").string()).exit_status, 0);
+  ASSERT_EQ(RunArcwheel("process -q " + (dir / "a.h5").string() + " -o " + (dir / "h").string()).exit_status,
+            0);
+  ASSERT_EQ(RunArcwheel("process -q " + (dir / "a.csv").string() + " -o " + (dir / "c").string()).exit_status,
+            0);
   const auto h = ReadJson(dir / "h" / "summary.json");
   const auto c = ReadJson(dir / "c" / "summary.json");
   // The CSV keeps 1e-9 mm: the fits agree far below their sigmas.
@@ -88,7 +96,8 @@ TEST_P(RefusedInput, GivesOneClearMessageAndWritesNothing) {
   const auto run = RunArcwheel("process " + input.string() + " -o " + (dir / "out").string());
   EXPECT_NE(run.exit_status, 0);
   EXPECT_NE(run.output.find(bad.expected_message), std::string::npos) << run.output;
-  EXPECT_NE(run.output.find(input.string()), std::string::npos) << "the message names the file: " << run.output;
+  EXPECT_NE(run.output.find(input.string()), std::string::npos)
+      << "the message names the file: " << run.output;
   EXPECT_EQ(testing::ListFolder(dir / "out"), "summary.json\n");
   EXPECT_TRUE(ReadJson(dir / "out" / "summary.json")["earlier"].get<bool>());
 }
@@ -99,25 +108,51 @@ INSTANTIATE_TEST_SUITE_P(
     Section2p3, RefusedInput,
     ::testing::Values(
         BadInput{"NotHdf5", "scan.h5", "this is not HDF5", "not an HDF5 file"},
-        BadInput{"NoValidSamples", "scan.csv", "# spindle_rpm: 500\n# feed_mm_per_min: 100\n# sample_period_s: 0.0001\nz_mm\nnan\n-FFFFFFF\nALARM\n", "no valid samples"},
-        BadInput{"MissingRpm", "scan.csv", "# feed_mm_per_min: 100\n# sample_period_s: 0.0001\nz_mm\n0.1\n0.2\n", "lacks spindle_rpm"},
-        BadInput{"MissingPeriod", "scan.csv", "# spindle_rpm: 500\n# feed_mm_per_min: 100\nz_mm\n0.1\n0.2\n", "lacks sample_period_s"},
-        BadInput{"NegativeRpm", "scan.csv", "# spindle_rpm: -500\n# feed_mm_per_min: 100\n# sample_period_s: 0.0001\nz_mm\n0.1\n", "spindle_rpm must be positive"},
-        BadInput{"ZeroPeriod", "scan.csv", "# spindle_rpm: 500\n# feed_mm_per_min: 100\n# sample_period_s: 0\nz_mm\n0.1\n", "sample_period_s must be positive"},
-        BadInput{"TooShort", "scan.csv", "# spindle_rpm: 500\n# feed_mm_per_min: 100\n# sample_period_s: 0.0001\nz_mm\n0.1\n0.2\n0.3\n", "at least 2 are needed"},
-        BadInput{"Unparsable", "scan.csv", "# spindle_rpm: 500\n# feed_mm_per_min: 100\n# sample_period_s: 0.0001\nz_mm,t_s\n0.1,0\n0.2,abc\n", "line 6"},
-        BadInput{"DecimalComma", "scan.csv", "# spindle_rpm: 500\n# feed_mm_per_min: 100\n# sample_period_s: 0.0001\nz_mm;t_s\n0,1;0\n", "decimal comma"},
-        BadInput{"EmptyTimeCell", "scan.csv", "# spindle_rpm: 500\n# feed_mm_per_min: 100\n# sample_period_s: 0.0001\nz_mm,t_s\n0.1,\n", "empty t_s cell"},
-        BadInput{"RaggedRow", "scan.csv", "# spindle_rpm: 500\n# feed_mm_per_min: 100\n# sample_period_s: 0.0001\nz_mm,t_s\n0.1,0,7\n", "has 3 cells"},
-        BadInput{"UnknownColumn", "scan.csv", "# spindle_rpm: 500\nz_mm,speed\n0.1,0\n", "unknown column 'speed'"},
-        BadInput{"TimeNotIncreasing", "scan.csv", "# spindle_rpm: 500\n# feed_mm_per_min: 100\nz_mm,t_s\n0.1,0\n0.1,0.1\n0.1,0.05\n", "does not increase"},
+        BadInput{"NoValidSamples", "scan.csv",
+                 "# spindle_rpm: 500\n# feed_mm_per_min: 100\n# sample_period_s: "
+                 "0.0001\nz_mm\nnan\n-FFFFFFF\nALARM\n",
+                 "no valid samples"},
+        BadInput{"MissingRpm", "scan.csv",
+                 "# feed_mm_per_min: 100\n# sample_period_s: 0.0001\nz_mm\n0.1\n0.2\n", "lacks spindle_rpm"},
+        BadInput{"MissingPeriod", "scan.csv", "# spindle_rpm: 500\n# feed_mm_per_min: 100\nz_mm\n0.1\n0.2\n",
+                 "lacks sample_period_s"},
+        BadInput{"NegativeRpm", "scan.csv",
+                 "# spindle_rpm: -500\n# feed_mm_per_min: 100\n# sample_period_s: 0.0001\nz_mm\n0.1\n",
+                 "spindle_rpm must be positive"},
+        BadInput{"ZeroPeriod", "scan.csv",
+                 "# spindle_rpm: 500\n# feed_mm_per_min: 100\n# sample_period_s: 0\nz_mm\n0.1\n",
+                 "sample_period_s must be positive"},
+        BadInput{
+            "TooShort", "scan.csv",
+            "# spindle_rpm: 500\n# feed_mm_per_min: 100\n# sample_period_s: 0.0001\nz_mm\n0.1\n0.2\n0.3\n",
+            "at least 2 are needed"},
+        BadInput{"Unparsable", "scan.csv",
+                 "# spindle_rpm: 500\n# feed_mm_per_min: 100\n# sample_period_s: "
+                 "0.0001\nz_mm,t_s\n0.1,0\n0.2,abc\n",
+                 "line 6"},
+        BadInput{"DecimalComma", "scan.csv",
+                 "# spindle_rpm: 500\n# feed_mm_per_min: 100\n# sample_period_s: 0.0001\nz_mm;t_s\n0,1;0\n",
+                 "decimal comma"},
+        BadInput{"EmptyTimeCell", "scan.csv",
+                 "# spindle_rpm: 500\n# feed_mm_per_min: 100\n# sample_period_s: 0.0001\nz_mm,t_s\n0.1,\n",
+                 "empty t_s cell"},
+        BadInput{"RaggedRow", "scan.csv",
+                 "# spindle_rpm: 500\n# feed_mm_per_min: 100\n# sample_period_s: 0.0001\nz_mm,t_s\n0.1,0,7\n",
+                 "has 3 cells"},
+        BadInput{"UnknownColumn", "scan.csv", "# spindle_rpm: 500\nz_mm,speed\n0.1,0\n",
+                 "unknown column 'speed'"},
+        BadInput{"TimeNotIncreasing", "scan.csv",
+                 "# spindle_rpm: 500\n# feed_mm_per_min: 100\nz_mm,t_s\n0.1,0\n0.1,0.1\n0.1,0.05\n",
+                 "does not increase"},
         BadInput{"UnknownType", "scan.dat", "1 2 3", "unknown scan file type"}),
     [](const ::testing::TestParamInfo<BadInput>& param_info) { return std::string(param_info.param.name); });
 
 TEST(Cli, TruncatedHdf5IsRefusedAndEarlierOutputsSurvive) {
   TempDir dir;
   ASSERT_EQ(RunArcwheel("simulate " + (dir / "scan.h5").string()).exit_status, 0);
-  ASSERT_EQ(RunArcwheel("process -q " + (dir / "scan.h5").string() + " -o " + (dir / "out").string()).exit_status, 0);
+  ASSERT_EQ(
+      RunArcwheel("process -q " + (dir / "scan.h5").string() + " -o " + (dir / "out").string()).exit_status,
+      0);
   const auto before = ReadJson(dir / "out" / "summary.json");
   std::filesystem::resize_file(dir / "scan.h5", std::filesystem::file_size(dir / "scan.h5") / 2);
   const auto run = RunArcwheel("process " + (dir / "scan.h5").string() + " -o " + (dir / "out").string());
@@ -178,7 +213,8 @@ TEST(Cli, TheSameInputGivesByteIdenticalFiles) {
     ASSERT_EQ(RunArcwheel("simulate " + (dir / name).string() + " --noise-um 0.2 --seed 5").exit_status, 0);
   }
   std::ifstream a(dir / "a.h5", std::ios::binary), b(dir / "b.h5", std::ios::binary);
-  const std::string bytes_a((std::istreambuf_iterator<char>(a)), {}), bytes_b((std::istreambuf_iterator<char>(b)), {});
+  const std::string bytes_a((std::istreambuf_iterator<char>(a)), {}),
+      bytes_b((std::istreambuf_iterator<char>(b)), {});
   EXPECT_EQ(bytes_a, bytes_b) << "a scan's SHA-256 must not depend on when it was written";
 }
 

@@ -36,14 +36,17 @@ std::string Slurp(const std::filesystem::path& path) {
 // A scan of the paper's settings and a finished run of it in `out`.
 void PrepareEarlierOutputs(const TempDir& dir) {
   ASSERT_EQ(RunArcwheel("simulate " + (dir / "short.h5").string() + " --noise-um 0.3").exit_status, 0);
-  ASSERT_EQ(RunArcwheel("process -q " + (dir / "short.h5").string() + " -o " + (dir / "out").string()).exit_status, 0);
+  ASSERT_EQ(
+      RunArcwheel("process -q " + (dir / "short.h5").string() + " -o " + (dir / "out").string()).exit_status,
+      0);
 }
 
 // Runs arcwheel with `arguments` under a file-size limit of `limit_kib`, with SIGXFSZ ignored so
 // that a write beyond it fails with EFBIG, as on a full disk.
 testing::CommandResult RunWithFileSizeLimit(const std::string& arguments, int limit_kib) {
-  const std::string command = "bash -c 'trap \"\" XFSZ; ulimit -f " + std::to_string(limit_kib) + "; exec \"" +
-                              std::string(std::getenv("ARCWHEEL_BINARY")) + "\" " + arguments + "' 2>&1";
+  const std::string command = "bash -c 'trap \"\" XFSZ; ulimit -f " + std::to_string(limit_kib) +
+                              "; exec \"" + std::string(std::getenv("ARCWHEEL_BINARY")) + "\" " + arguments +
+                              "' 2>&1";
   testing::CommandResult result;
   FILE* pipe = ::popen(command.c_str(), "r");
   if (pipe == nullptr) return result;
@@ -79,7 +82,8 @@ TEST(Faults, InterruptDuringProcessingLeavesEarlierOutputsIntact) {
   posix_spawnattr_setsigmask(&attributes, &blocked);
   posix_spawnattr_setflags(&attributes, POSIX_SPAWN_SETSIGMASK);
   pid_t pid = 0;
-  ASSERT_EQ(posix_spawn(&pid, binary.c_str(), nullptr, &attributes, const_cast<char* const*>(argv), environ), 0);
+  ASSERT_EQ(posix_spawn(&pid, binary.c_str(), nullptr, &attributes, const_cast<char* const*>(argv), environ),
+            0);
   posix_spawnattr_destroy(&attributes);
   std::this_thread::sleep_for(std::chrono::milliseconds(250));
   ::kill(pid, SIGINT);
@@ -97,7 +101,8 @@ TEST(Faults, WriteFailingPartWayLeavesEarlierOutputsIntact) {
   PrepareEarlierOutputs(dir);
   const std::string summary_before = Slurp(dir / "out" / "summary.json");
   // A 512 KiB limit: the summary fits, the new map (~0.9 MB) does not.
-  const auto run = RunWithFileSizeLimit("process -q " + (dir / "short.h5").string() + " -o " + (dir / "out").string(), 512);
+  const auto run = RunWithFileSizeLimit(
+      "process -q " + (dir / "short.h5").string() + " -o " + (dir / "out").string(), 512);
   EXPECT_EQ(run.exit_status, 4) << run.output;
   EXPECT_NE(run.output.find("wheel_map.h5"), std::string::npos) << run.output;
   EXPECT_EQ(testing::ListFolder(dir / "out"), "summary.json\nwheel_map.h5\n");
@@ -108,7 +113,7 @@ TEST(Faults, WriteFailingPartWayLeavesEarlierOutputsIntact) {
 // second run leaves the first run's files exactly as they were, and no new file.
 struct StageRun {
   const char* name;
-  const char* arguments;  // with {src} for the source folder and {out} for the output folder
+  const char* arguments;    // with {src} for the source folder and {out} for the output folder
   int file_size_limit_kib;  // above the smallest output, below the largest
 };
 
@@ -145,9 +150,9 @@ TEST_P(StageOutputs, AFullDiskLeavesTheEarlierRunIntact) {
 
 INSTANTIATE_TEST_SUITE_P(
     EveryWritingStage, StageOutputs,
-    ::testing::Values(
-        StageRun{"Toolpath", "toolpath {src}/grinding/examples/trial_part.json -o {out}", 1024},
-        StageRun{"Polish", "polish {src}/polishing/examples/disc_job.json -o {out} --report pdf", 100}),
+    ::testing::Values(StageRun{"Toolpath", "toolpath {src}/grinding/examples/trial_part.json -o {out}", 1024},
+                      StageRun{"Polish",
+                               "polish {src}/polishing/examples/disc_job.json -o {out} --report pdf", 100}),
     [](const ::testing::TestParamInfo<StageRun>& test) { return std::string(test.param.name); });
 
 }  // namespace

@@ -35,11 +35,13 @@ class ForeignFiles : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
     dir_ = std::make_unique<TempDir>();
-    const auto sim = RunArcwheel("simulate " + Base().string() + " --seed 11 --noise-um 0.3 --dropout-rate 0.001 "
+    const auto sim = RunArcwheel("simulate " + Base().string() +
+                                 " --seed 11 --noise-um 0.3 --dropout-rate 0.001 "
                                  "--radial-harmonic 1:3 --encoder");
     ASSERT_EQ(sim.exit_status, 0) << sim.output;
-    const std::string command = "/usr/bin/python3 " + (testing::SourceDir() / "tests/foreign/write_scans.py").string() +
-                                " " + Base().string() + " " + (*dir_ / "foreign").string() + " > " +
+    const std::string command = "/usr/bin/python3 " +
+                                (testing::SourceDir() / "tests/foreign/write_scans.py").string() + " " +
+                                Base().string() + " " + (*dir_ / "foreign").string() + " > " +
                                 (*dir_ / "writer.log").string() + " 2>&1";
     const int status = std::system(command.c_str());
     std::ifstream log(*dir_ / "writer.log");
@@ -62,14 +64,16 @@ json ForeignFiles::expected_;
 
 bool SameSample(double a, double b) { return (std::isnan(a) && std::isnan(b)) || a == b; }
 
-void ExpectSameColumn(const std::vector<double>& got, const std::vector<double>& want, const std::string& what) {
+void ExpectSameColumn(const std::vector<double>& got, const std::vector<double>& want,
+                      const std::string& what) {
   ASSERT_EQ(got.size(), want.size()) << what;
   std::size_t differ = 0;
   for (std::size_t i = 0; i < got.size(); ++i) differ += SameSample(got[i], want[i]) ? 0 : 1;
   EXPECT_EQ(differ, 0u) << what << ": samples that differ";
 }
 
-void ExpectSameNumbers(const acquisition::ScanMetadata& got, const acquisition::ScanMetadata& want, const std::string& name) {
+void ExpectSameNumbers(const acquisition::ScanMetadata& got, const acquisition::ScanMetadata& want,
+                       const std::string& name) {
   EXPECT_EQ(got.spindle_rpm, want.spindle_rpm) << name;
   EXPECT_EQ(got.feed_mm_per_min, want.feed_mm_per_min) << name;
   EXPECT_EQ(got.sample_period_s, want.sample_period_s) << name;
@@ -104,7 +108,10 @@ TEST_F(ForeignFiles, EveryVariantReadsToTheSamplesNumbersAndTextOfThePlainFile) 
       ASSERT_EQ(scan.size(), plain.size());
       std::size_t off = 0;
       for (std::size_t i = 0; i < scan.size(); ++i) {
-        off += (std::isnan(plain.z_mm[i]) ? std::isnan(scan.z_mm[i]) : std::abs(scan.z_mm[i] - plain.z_mm[i]) <= half) ? 0 : 1;
+        off += (std::isnan(plain.z_mm[i]) ? std::isnan(scan.z_mm[i])
+                                          : std::abs(scan.z_mm[i] - plain.z_mm[i]) <= half)
+                   ? 0
+                   : 1;
       }
       EXPECT_EQ(off, 0u);
     } else {
@@ -153,13 +160,15 @@ TEST_F(ForeignFiles, H5pyDefaultsAndPandasProcessToExactlyTheNumbersOfThePlainFi
     EXPECT_EQ(Numbers(out / name / "summary.json"), plain);
     const json summary = ReadJson(out / name / "summary.json");
     for (const char* key : {"wheel_id", "sensor", "operator", "timestamp"}) {
-      EXPECT_EQ(summary["scan"][key].get<std::string>(), expected_[name]["text"][key].get<std::string>()) << key;
+      EXPECT_EQ(summary["scan"][key].get<std::string>(), expected_[name]["text"][key].get<std::string>())
+          << key;
     }
   }
   // The key arcwheel does not use is in the summary's warnings, not dropped unseen.
   const json mixed = ReadJson(out / "mixed_case_keys.h5" / "summary.json");
   ASSERT_FALSE(mixed["warnings"].empty());
-  EXPECT_NE(mixed["warnings"][0].get<std::string>().find("'Comment'"), std::string::npos) << mixed["warnings"];
+  EXPECT_NE(mixed["warnings"][0].get<std::string>().find("'Comment'"), std::string::npos)
+      << mixed["warnings"];
 }
 
 TEST_F(ForeignFiles, Latin1MetadataBecomesValidUtf8AndTheSummarySaysSo) {
@@ -206,7 +215,8 @@ TEST_F(ForeignFiles, AFilterThisHdf5CannotDecodeIsNamed) {
   ::unsetenv("HDF5_PLUGIN_PATH");
   EXPECT_EQ(run.exit_status, 3) << run.output;
   EXPECT_NE(run.output.find(Good("lzf.h5").string() + "' /scan/z is compressed with HDF5 filter 32000 'lzf'"),
-            std::string::npos) << run.output;
+            std::string::npos)
+      << run.output;
   EXPECT_NE(run.output.find("hdf5-plugin-lzf"), std::string::npos) << run.output;
   EXPECT_FALSE(std::filesystem::exists(out / "x"));
 }

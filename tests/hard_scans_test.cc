@@ -89,8 +89,10 @@ TEST(HardScans, SpikesBurstsAndDropoutsLeaveEveryMetricWithinTheNoiseOnlySpread)
 
     const auto& f = dirty.fit;
     EXPECT_EQ(f.usable_phases, 360) << "seed " << seed;
-    EXPECT_LT(std::abs(f.mean_arc_radius_mm - TrueMeanRadiusMm(wheel)), 3.0 * f.mean_arc_radius_sigma_mm) << "seed " << seed;
-    EXPECT_LT(std::abs(f.mean_center_axial_mm - TrueMeanCenterAxialMm(wheel)), 3.0 * f.mean_center_axial_sigma_mm)
+    EXPECT_LT(std::abs(f.mean_arc_radius_mm - TrueMeanRadiusMm(wheel)), 3.0 * f.mean_arc_radius_sigma_mm)
+        << "seed " << seed;
+    EXPECT_LT(std::abs(f.mean_center_axial_mm - TrueMeanCenterAxialMm(wheel)),
+              3.0 * f.mean_center_axial_sigma_mm)
         << "seed " << seed;
     dirty_fits.push_back(std::move(dirty.fit));
   }
@@ -106,7 +108,8 @@ TEST(HardScans, SpikesBurstsAndDropoutsLeaveEveryMetricWithinTheNoiseOnlySpread)
     EXPECT_LT(std::abs(f.max_roundness_um - roundness.mean), 3.0 * roundness.sd) << "seed " << k + 1;
     // Ranges over the 360 per-phase fits: set by the per-phase noise (~11 um of radius at 1e5 samples).
     EXPECT_LT(std::abs(f.arc_radius_range_mm * 1000.0 - range.mean), 3.0 * range.sd) << "seed " << k + 1;
-    EXPECT_LT(std::abs(f.center_axial_deviation_mm * 1000.0 - deviation.mean), 3.0 * deviation.sd) << "seed " << k + 1;
+    EXPECT_LT(std::abs(f.center_axial_deviation_mm * 1000.0 - deviation.mean), 3.0 * deviation.sd)
+        << "seed " << k + 1;
   }
   // The spread is noise, not a tolerance wide enough to hide anything: a few tenths of a micrometre.
   EXPECT_LT(arc_error.sd, 0.3);
@@ -185,8 +188,8 @@ std::string CaseName(const ::testing::TestParamInfo<SizeCase>& info) {
   const char* timing = info.param.timing == Timing::kNominal           ? "Nominal"
                        : info.param.timing == Timing::kEncoderSpeedOff ? "EncoderSpeedOff"
                                                                        : "EstimatedSpeedOff";
-  return "N1e" + std::to_string(static_cast<int>(std::lround(std::log10(info.param.samples)))) + timing + "Seed" +
-         std::to_string(info.param.seed);
+  return "N1e" + std::to_string(static_cast<int>(std::lround(std::log10(info.param.samples)))) + timing +
+         "Seed" + std::to_string(info.param.seed);
 }
 
 INSTANTIATE_TEST_SUITE_P(UpTo1e7Samples, MeanRadius, ::testing::ValuesIn(SizeCases()), CaseName);

@@ -86,13 +86,15 @@ TEST(NumericHazards, InfinityInTheReadingsIsAnInvalidSampleInCsvAndHdf5Alike) {
 TEST(NumericHazards, NonFiniteTimeAngleOrAxialValuesAreRefusedNamingTheLine) {
   ExpectRefused([] { (void)acquisition::ParseCsvScan(kCsvHeader + "z_mm,t_s\n0.1,0\n0.2,inf\n", "t.csv"); },
                 ErrorCode::kBadInput, "line 6");
-  ExpectRefused([] { (void)acquisition::ParseCsvScan(kCsvHeader + "z_mm,angle_deg\n0.1,0\n0.2,nan\n", "a.csv"); },
-                ErrorCode::kBadInput, "line 6");
+  ExpectRefused(
+      [] { (void)acquisition::ParseCsvScan(kCsvHeader + "z_mm,angle_deg\n0.1,0\n0.2,nan\n", "a.csv"); },
+      ErrorCode::kBadInput, "line 6");
   ExpectRefused([] { (void)acquisition::ParseCsvScan(kCsvHeader + "z_mm,y_mm\n0.1,-inf\n0.2,0\n", "y.csv"); },
                 ErrorCode::kBadInput, "line 5");
 
   testing::TempDir dir;
-  acquisition::Scan scan = acquisition::ParseCsvScan(kCsvHeader + "z_mm,t_s\n0.1,0\n0.2,0.1\n0.3,0.2\n0.4,0.3\n0.5,0.4\n", "t.csv");
+  acquisition::Scan scan = acquisition::ParseCsvScan(
+      kCsvHeader + "z_mm,t_s\n0.1,0\n0.2,0.1\n0.3,0.2\n0.4,0.3\n0.5,0.4\n", "t.csv");
   scan.t_s[1] = std::nan("");
   acquisition::WriteHdf5Scan(scan, /*float32=*/false, (dir / "t.h5").string());
   ExpectRefused([&] { (void)acquisition::ReadHdf5Scan(dir / "t.h5"); }, ErrorCode::kBadInput,
@@ -101,11 +103,13 @@ TEST(NumericHazards, NonFiniteTimeAngleOrAxialValuesAreRefusedNamingTheLine) {
 
 TEST(NumericHazards, NonFiniteOrNonPositiveSettingsAreRefused) {
   for (const char* line : {"# spindle_rpm: inf\n", "# spindle_rpm: nan\n", "# spindle_rpm: 0\n"}) {
-    const std::string csv = std::string(line) + "# feed_mm_per_min: 100\n# sample_period_s: 0.0001\nz_mm\n0.1\n0.2\n0.3\n";
+    const std::string csv =
+        std::string(line) + "# feed_mm_per_min: 100\n# sample_period_s: 0.0001\nz_mm\n0.1\n0.2\n0.3\n";
     ExpectRefused([&] { (void)acquisition::ParseCsvScan(csv, "rpm.csv"); }, ErrorCode::kBadInput,
                   "spindle_rpm must be positive and finite");
   }
-  const std::string csv = "# spindle_rpm: 500\n# feed_mm_per_min: 100\n# sample_period_s: -inf\nz_mm\n0.1\n0.2\n";
+  const std::string csv =
+      "# spindle_rpm: 500\n# feed_mm_per_min: 100\n# sample_period_s: -inf\nz_mm\n0.1\n0.2\n";
   ExpectRefused([&] { (void)acquisition::ParseCsvScan(csv, "period.csv"); }, ErrorCode::kBadInput,
                 "sample_period_s must be positive and finite");
 }
@@ -113,10 +117,12 @@ TEST(NumericHazards, NonFiniteOrNonPositiveSettingsAreRefused) {
 // --- time and encoder order ------------------------------------------------------------------------
 
 TEST(NumericHazards, DuplicatedOrBackwardTimeIsRefusedNamingTheSample) {
-  ExpectRefused([] { (void)acquisition::ParseCsvScan(kCsvHeader + "z_mm,t_s\n0.1,0\n0.2,0.1\n0.3,0.1\n", "d.csv"); },
-                ErrorCode::kBadInput, "column 't' does not increase at sample 2");
-  ExpectRefused([] { (void)acquisition::ParseCsvScan(kCsvHeader + "z_mm,t_s\n0.1,0\n0.2,0.2\n0.3,0.1\n", "b.csv"); },
-                ErrorCode::kBadInput, "column 't' does not increase at sample 2");
+  ExpectRefused(
+      [] { (void)acquisition::ParseCsvScan(kCsvHeader + "z_mm,t_s\n0.1,0\n0.2,0.1\n0.3,0.1\n", "d.csv"); },
+      ErrorCode::kBadInput, "column 't' does not increase at sample 2");
+  ExpectRefused(
+      [] { (void)acquisition::ParseCsvScan(kCsvHeader + "z_mm,t_s\n0.1,0\n0.2,0.2\n0.3,0.1\n", "b.csv"); },
+      ErrorCode::kBadInput, "column 't' does not increase at sample 2");
 }
 
 TEST(NumericHazards, DuplicatedOrBackwardEncoderIsRefusedButAWrappedEncoderIsNot) {
@@ -138,10 +144,12 @@ TEST(NumericHazards, DuplicatedOrBackwardEncoderIsRefusedButAWrappedEncoderIsNot
 
   acquisition::Scan duplicated = unwrapped;
   duplicated.angle_deg[5000] = duplicated.angle_deg[4999];
-  ExpectRefused([&] { (void)processing::ProcessScan(duplicated, {}); }, ErrorCode::kBadInput, "does not increase");
+  ExpectRefused([&] { (void)processing::ProcessScan(duplicated, {}); }, ErrorCode::kBadInput,
+                "does not increase");
   acquisition::Scan backward = unwrapped;
   backward.angle_deg[5000] -= 30.0;  // a jump back that is not a wrap
-  ExpectRefused([&] { (void)processing::ProcessScan(backward, {}); }, ErrorCode::kBadInput, "does not increase");
+  ExpectRefused([&] { (void)processing::ProcessScan(backward, {}); }, ErrorCode::kBadInput,
+                "does not increase");
 }
 
 // --- a stuck sensor and sections without variance ------------------------------------------------
@@ -191,7 +199,8 @@ TEST(NumericHazards, AScanWithoutVarianceIsRefusedClearly) {
   processing::ProcessOptions keep;
   keep.stuck_run_deg = 0.0;
   const processing::ProcessedScan processed = processing::ProcessScan(flat, keep);
-  ExpectRefused([&] { (void)fitting::FitWheel(processed.map, NarrowBand()); }, ErrorCode::kFitFailed, "collinear");
+  ExpectRefused([&] { (void)fitting::FitWheel(processed.map, NarrowBand()); }, ErrorCode::kFitFailed,
+                "collinear");
 }
 
 // --- fits that do not converge ----------------------------------------------------------------

@@ -39,7 +39,8 @@ struct Result {
   fitting::WheelFit fit;
 };
 
-Result RunPipeline(const WheelModel& wheel, const ScanSettings& settings, const processing::ProcessOptions& options = {}) {
+Result RunPipeline(const WheelModel& wheel, const ScanSettings& settings,
+                   const processing::ProcessOptions& options = {}) {
   const auto simulated = acquisition::SimulateScan(wheel, settings);
   Result r{processing::ProcessScan(simulated.scan, options), {}};
   r.fit = fitting::FitWheel(r.processed.map, {});
@@ -47,7 +48,8 @@ Result RunPipeline(const WheelModel& wheel, const ScanSettings& settings, const 
 }
 
 // Independent geometric circle fit (Gauss-Newton on (a, b, r)), for expected values.
-Eigen::Vector3d ReferenceCircle(const std::vector<double>& y, const std::vector<double>& rho, Eigen::Vector3d p) {
+Eigen::Vector3d ReferenceCircle(const std::vector<double>& y, const std::vector<double>& rho,
+                                Eigen::Vector3d p) {
   for (int iteration = 0; iteration < 50; ++iteration) {
     Eigen::MatrixXd J(static_cast<Eigen::Index>(y.size()), 3);
     Eigen::VectorXd r(static_cast<Eigen::Index>(y.size()));
@@ -106,7 +108,8 @@ TEST(ScanPipeline, NoiseFreeScanRecoversTheWheelWithin50Nanometres) {
   EXPECT_NEAR(r.fit.mean_arc_radius_mm, truth_mean_radius, 50e-6);
   EXPECT_NEAR(r.fit.mean_center_axial_mm, truth_mean_axial, 50e-6);
   EXPECT_NEAR(r.fit.max_arc_error_um, truth_max_arc_error_um, 0.05);
-  EXPECT_GT(truth_max_arc_error_um, 0.5) << "the profile error must be visible for this test to mean anything";
+  EXPECT_GT(truth_max_arc_error_um, 0.5)
+      << "the profile error must be visible for this test to mean anything";
 
   // Runout truth: max - min over the 360 phases of the true rim at each band node.
   double truth_max_runout_um = 0.0;
@@ -177,7 +180,8 @@ TEST_P(SpeedError, IsRecoveredWithin0p01PercentWithoutAnEncoder) {
   EXPECT_NEAR(r.fit.mean_arc_radius_mm, wheel.arc_radius_mm, 4 * r.fit.mean_arc_radius_sigma_mm);
 }
 
-INSTANTIATE_TEST_SUITE_P(UpToHalfAPercent, SpeedError, ::testing::Values(-0.005, -0.001, 0.0003, 0.002, 0.005));
+INSTANTIATE_TEST_SUITE_P(UpToHalfAPercent, SpeedError,
+                         ::testing::Values(-0.005, -0.001, 0.0003, 0.002, 0.005));
 
 TEST(ScanPipeline, NominalSpeedIsKeptWhenTheDataAgreeWithIt) {
   ScanSettings s = PaperScan();
@@ -201,8 +205,8 @@ TEST(ScanPipeline, EncoderRadiusSignAndTimeColumnGiveTheSameWheel) {
   EXPECT_NEAR(r.processed.rpm_used, 503.0, 1e-6);
   for (std::size_t j = 0; j < r.fit.phases.size(); j += 17) {
     const double c = r.processed.map.phase_deg[j];
-    EXPECT_NEAR(r.fit.phases[j].center_radial_mm,
-                wheel.CenterDistanceMm(c) - s.sensor_zero_radius_mm, 2e-4) << c;
+    EXPECT_NEAR(r.fit.phases[j].center_radial_mm, wheel.CenterDistanceMm(c) - s.sensor_zero_radius_mm, 2e-4)
+        << c;
   }
 }
 
@@ -238,8 +242,8 @@ TEST(ScanPipeline, SectionsTooShortOrTooSparseAreFlaggedAndLeftOutOfTheMeans) {
     }
     section = kept;
   };
-  for (std::size_t j = 10; j < 20; ++j) keep_below(sections[j], -3.0);   // covers 5 of the 16 mm band
-  for (std::size_t j = 30; j < 35; ++j) keep_below(sections[j], -7.5);   // three points or so
+  for (std::size_t j = 10; j < 20; ++j) keep_below(sections[j], -3.0);  // covers 5 of the 16 mm band
+  for (std::size_t j = 30; j < 35; ++j) keep_below(sections[j], -7.5);  // three points or so
   const fitting::WheelFit fit = fitting::FitWheel(processed.map, {});
   EXPECT_EQ(fit.usable_phases, 345);
   double truth_mean = 0.0;

@@ -5,13 +5,12 @@
 #include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
-#include <exception>
 #include <limits>
 #include <numbers>
-#include <thread>
 
 #include "core/error.h"
 #include "core/hdf5.h"
+#include "core/parallel.h"
 #include "core/version.h"
 #include "grinding/toolpath.h"
 
@@ -228,33 +227,19 @@ FormPrediction PredictFormError(const Surface& surface, const Aperture& aperture
   p.low_order_um.assign(nx * ny, nan);
   std::vector<double> ripple_um(nx * ny, nan);
   const NodePredictor predictor(surface, wheel, options);
-  const int threads = options.threads > 0
-                          ? options.threads
-                          : std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
-  std::vector<std::exception_ptr> errors(static_cast<size_t>(threads));
-  const auto work = [&](int worker) {
-    try {
-      for (size_t j = static_cast<size_t>(worker); j < ny; j += static_cast<size_t>(threads)) {
-        for (size_t i = 0; i < nx; ++i) {
-          if (!aperture.Contains(p.x_mm[i], p.y_mm[j])) continue;
-          const NodeError e = predictor.Predict(p.x_mm[i], p.y_mm[j]);
-          const size_t k = j * nx + i;
-          p.low_order_um[k] = 1e3 * e.low_order_mm;
-          ripple_um[k] = 1e3 * e.ripple_mm;
-          p.error_um[k] = 1e3 * (e.low_order_mm + e.ripple_mm);
-        }
+  const int workers = WorkerCount(options.threads);
+  RunOnWorkers(workers, [&](int worker) {
+    for (size_t j = static_cast<size_t>(worker); j < ny; j += static_cast<size_t>(workers)) {
+      for (size_t i = 0; i < nx; ++i) {
+        if (!aperture.Contains(p.x_mm[i], p.y_mm[j])) continue;
+        const NodeError e = predictor.Predict(p.x_mm[i], p.y_mm[j]);
+        const size_t k = j * nx + i;
+        p.low_order_um[k] = 1e3 * e.low_order_mm;
+        ripple_um[k] = 1e3 * e.ripple_mm;
+        p.error_um[k] = 1e3 * (e.low_order_mm + e.ripple_mm);
       }
-    } catch (...) {
-      errors[static_cast<size_t>(worker)] = std::current_exception();
     }
-  };
-  std::vector<std::thread> pool;
-  for (int t = 1; t < threads; ++t) pool.emplace_back(work, t);
-  work(0);
-  for (std::thread& t : pool) t.join();
-  for (const std::exception_ptr& e : errors) {
-    if (e) std::rethrow_exception(e);
-  }
+  });
   const Statistics all = PvRms(p.error_um);
   const Statistics flat = PvRms(WithoutPlane(p));
   p.pv_um = all.pv_um;

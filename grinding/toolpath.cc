@@ -8,10 +8,10 @@
 #include <exception>
 #include <limits>
 #include <mutex>
-#include <thread>
 
 #include "core/error.h"
 #include "core/interrupt.h"
+#include "core/parallel.h"
 
 namespace arcwheel::grinding {
 namespace {
@@ -408,9 +408,7 @@ ToolpathSummary GenerateToolpath(const Surface& surface, const Aperture& apertur
   }
   const std::vector<double> rows = PlanRows(surface, aperture, wheel, options.step_over_mm);
   const RowBuilder builder(surface, aperture, wheel, options, static_cast<int>(rows.size()));
-  const int threads = options.threads > 0
-                          ? options.threads
-                          : std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
+  const int threads = WorkerCount(options.threads);
   const int block = 8 * threads;
   ToolpathSummary summary;
   summary.passes = options.passes;
@@ -428,7 +426,8 @@ ToolpathSummary GenerateToolpath(const Surface& surface, const Aperture& apertur
       batch.resize(count);
       std::vector<std::exception_ptr> errors(count);
       std::vector<RowStats> stats(static_cast<size_t>(threads));
-      const auto work = [&](int worker) {
+      // Each row keeps its own error, so that the first failing row is the one reported.
+      RunOnWorkers(threads, [&](int worker) {
         for (size_t k = static_cast<size_t>(worker); k < count; k += static_cast<size_t>(threads)) {
           try {
             ToolpathRow& row = batch[k];
@@ -449,11 +448,7 @@ ToolpathSummary GenerateToolpath(const Surface& surface, const Aperture& apertur
             errors[k] = std::current_exception();
           }
         }
-      };
-      std::vector<std::thread> pool;
-      for (int t = 1; t < threads; ++t) pool.emplace_back(work, t);
-      work(0);
-      for (std::thread& t : pool) t.join();
+      });
       for (const std::exception_ptr& e : errors) {
         if (e) std::rethrow_exception(e);
       }

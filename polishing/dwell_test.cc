@@ -8,9 +8,12 @@
 #include <random>
 
 #include "core/error.h"
+#include "polishing/testing.h"
 
 namespace arcwheel::polishing {
 namespace {
+
+using testing::SampledGaussian;
 
 const grinding::Aperture kDisc{.shape = grinding::Aperture::Shape::kCircle, .diameter_mm = 100.0};
 
@@ -42,29 +45,44 @@ ErrorMap SimulatedErrorMap(unsigned seed, double step_mm = 1.0) {
   return map;
 }
 
-// Independent prediction: the untruncated Gaussian summed over every dwell point.
-double FullGaussianRemovalUm(double x, double y, const std::vector<Eigen::Vector2d>& path,
-                             const std::vector<double>& dwell_s, double peak, double fwhm) {
-  const double sigma = fwhm / std::sqrt(8.0 * std::log(2.0));
-  double sum = 0.0;
-  for (std::size_t k = 0; k < path.size(); ++k) {
-    const double r2 = (x - path[k].x()) * (x - path[k].x()) + (y - path[k].y()) * (y - path[k].y());
-    sum += peak * std::exp(-r2 / (2.0 * sigma * sigma)) * dwell_s[k];
+// exp(-(node - point)^2 / (2 sigma^2)) for every node of one grid axis (rows) and every path point
+// (columns), along x or y.
+Eigen::MatrixXd AxisGaussian(int nodes, double first_mm, double step_mm,
+                             const std::vector<Eigen::Vector2d>& path, int axis, double sigma_mm) {
+  Eigen::MatrixXd g(nodes, static_cast<Eigen::Index>(path.size()));
+  for (int i = 0; i < nodes; ++i) {
+    for (std::size_t k = 0; k < path.size(); ++k) {
+      const double d = first_mm + i * step_mm - path[k][axis];
+      g(i, static_cast<Eigen::Index>(k)) = std::exp(-d * d / (2.0 * sigma_mm * sigma_mm));
+    }
   }
-  return sum;
+  return g;
+}
+
+// Independent prediction: the untruncated Gaussian summed over every dwell point, at every node of
+// `grid` (row j, column i). The Gaussian is separable, so the sum over points k of
+// exp(-dx^2 / 2s^2) exp(-dy^2 / 2s^2) dwell_k is the product Gy diag(dwell) Gx^T.
+Eigen::MatrixXd FullGaussianRemovalUm(const ErrorMap& grid, const std::vector<Eigen::Vector2d>& path,
+                                      const std::vector<double>& dwell_s, double peak, double fwhm) {
+  const double sigma = fwhm / std::sqrt(8.0 * std::log(2.0));
+  const Eigen::Map<const Eigen::VectorXd> dwell(dwell_s.data(), static_cast<Eigen::Index>(dwell_s.size()));
+  const Eigen::MatrixXd gx = AxisGaussian(grid.nx, grid.x0_mm, grid.dx_mm, path, 0, sigma);
+  const Eigen::MatrixXd gy = AxisGaussian(grid.ny, grid.y0_mm, grid.dy_mm, path, 1, sigma);
+  return peak * (gy * dwell.asDiagonal() * gx.transpose());
 }
 
 // RMS (about the mean) of target - removal over the disc, the removal recomputed with the whole
 // Gaussian from the solution's dwell.
 double ResidualRmsUm(const ErrorMap& target, const std::vector<Eigen::Vector2d>& path,
                      const std::vector<double>& dwell_s, double peak, double fwhm) {
+  const Eigen::MatrixXd removal = FullGaussianRemovalUm(target, path, dwell_s, peak, fwhm);
   double sum = 0.0, sum2 = 0.0;
   int n = 0;
   for (int j = 0; j < target.ny; ++j) {
     for (int i = 0; i < target.nx; ++i) {
       const double x = target.X(i), y = target.Y(j);
       if (x * x + y * y > 50.0 * 50.0) continue;
-      const double r = target.At(i, j) - FullGaussianRemovalUm(x, y, path, dwell_s, peak, fwhm);
+      const double r = target.At(i, j) - removal(j, i);
       sum += r, sum2 += r * r, ++n;
     }
   }
@@ -90,18 +108,16 @@ TEST(SolveDwell, CutsTheResidualRmsTenfoldWithNonNegativeDwellWithinSpeedLimits)
       }
     }
     // Residual recomputed independently, with the whole Gaussian, over the aperture.
-    double sum = 0.0, sum2 = 0.0, before_sum = 0.0, before_sum2 = 0.0;
+    double before_sum = 0.0, before_sum2 = 0.0;
     int n = 0;
-    for (int j = 0; j < target.ny; ++j) {
-      for (int i = 0; i < target.nx; ++i) {
-        const double x = target.X(i), y = target.Y(j);
+    for (int j = 0; j < error.ny; ++j) {
+      for (int i = 0; i < error.nx; ++i) {
+        const double x = error.X(i), y = error.Y(j), e = error.At(i, j);
         if (x * x + y * y > 50.0 * 50.0) continue;
-        const double e = error.At(i, j);
-        const double r = target.At(i, j) - FullGaussianRemovalUm(x, y, path, solution.dwell_s, 2.0, 12.0);
-        sum += r, sum2 += r * r, before_sum += e, before_sum2 += e * e, ++n;
+        before_sum += e, before_sum2 += e * e, ++n;
       }
     }
-    const double rms_after = std::sqrt(sum2 / n - (sum / n) * (sum / n));
+    const double rms_after = ResidualRmsUm(target, path, solution.dwell_s, 2.0, 12.0);
     const double rms_before = std::sqrt(before_sum2 / n - (before_sum / n) * (before_sum / n));
     EXPECT_NEAR(solution.before.rms_um, rms_before, 1e-9);
     EXPECT_LT(rms_after, rms_before / 10.0) << "seed " << seed << ": " << rms_before << " -> " << rms_after;
@@ -109,19 +125,6 @@ TEST(SolveDwell, CutsTheResidualRmsTenfoldWithNonNegativeDwellWithinSpeedLimits)
     EXPECT_NEAR(solution.after.rms_um, rms_after, 2e-3 * rms_before);
     EXPECT_GT(solution.total_time_s, 0.0);
   }
-}
-
-// An axis-aligned elliptic Gaussian (peak, centre, sigmas) sampled on a grid of tool offsets.
-TabulatedRemovalFunction SampledGaussian(double peak, double cx, double cy, double sx, double sy, double x0,
-                                         double y0, double h, int nx, int ny) {
-  TabulatedRemovalFunction t{.x0_mm = x0, .y0_mm = y0, .dx_mm = h, .dy_mm = h, .nx = nx, .ny = ny};
-  for (int j = 0; j < ny; ++j) {
-    for (int i = 0; i < nx; ++i) {
-      const double x = x0 + i * h - cx, y = y0 + j * h - cy;
-      t.rate_um_per_s.push_back(peak * std::exp(-0.5 * (x * x / (sx * sx) + y * y / (sy * sy))));
-    }
-  }
-  return t;
 }
 
 TEST(SolveDwell, AMeasuredGaussianRemovesAsTheAnalyticOneWithinTheInterpolationBoundAndCutsTheRmsTenfold) {
@@ -139,22 +142,35 @@ TEST(SolveDwell, AMeasuredGaussianRemovesAsTheAnalyticOneWithinTheInterpolationB
   const ErrorMap target = RemovalTarget(SimulatedErrorMap(1), kDisc, {.uniform_layer_um = 1.5});
   const DwellSolution solution = SolveDwell(target, kDisc, path, table, options);
   // Same dwell through the analytic, untruncated Gaussian: inside the table each point's rate is
-  // within the interpolation bound; outside it the table gives 0 for the Gaussian's value.
+  // within the interpolation bound; outside it the table gives 0 for the Gaussian's value. So the
+  // bound at a node is the sum over points of dwell * (inside ? interpolation bound : Gaussian),
+  // and "inside" (|dx|, |dy| <= half width) is separable like the Gaussian.
+  const Eigen::MatrixXd analytic = FullGaussianRemovalUm(target, path, solution.dwell_s, peak, fwhm);
+  const auto inside_along = [&](int nodes, double first_mm, double step_mm, int axis) {
+    Eigen::MatrixXd in(nodes, static_cast<Eigen::Index>(path.size()));
+    for (int i = 0; i < nodes; ++i) {
+      for (std::size_t k = 0; k < path.size(); ++k) {
+        in(i, static_cast<Eigen::Index>(k)) = std::abs(first_mm + i * step_mm - path[k][axis]) <= half_width;
+      }
+    }
+    return in;
+  };
+  const Eigen::MatrixXd in_x = inside_along(target.nx, target.x0_mm, target.dx_mm, 0);
+  const Eigen::MatrixXd in_y = inside_along(target.ny, target.y0_mm, target.dy_mm, 1);
+  const Eigen::MatrixXd gx = AxisGaussian(target.nx, target.x0_mm, target.dx_mm, path, 0, sigma);
+  const Eigen::MatrixXd gy = AxisGaussian(target.ny, target.y0_mm, target.dy_mm, path, 1, sigma);
+  const Eigen::Map<const Eigen::VectorXd> dwell(solution.dwell_s.data(),
+                                                static_cast<Eigen::Index>(solution.dwell_s.size()));
+  const Eigen::MatrixXd inside_dwell = in_y * dwell.asDiagonal() * in_x.transpose();
+  const Eigen::MatrixXd inside_gaussian =
+      peak * (in_y.cwiseProduct(gy) * dwell.asDiagonal() * in_x.cwiseProduct(gx).transpose());
+  const Eigen::MatrixXd bound = interpolation_bound * inside_dwell + (analytic - inside_gaussian);
   for (int j = 0; j < target.ny; ++j) {
     for (int i = 0; i < target.nx; ++i) {
       const double removal = solution.predicted_removal_um.At(i, j);
       if (std::isnan(removal)) continue;
-      double bound = 0.0;
-      for (std::size_t k = 0; k < path.size(); ++k) {
-        const double dx = target.X(i) - path[k].x(), dy = target.Y(j) - path[k].y();
-        const bool inside = std::abs(dx) <= half_width && std::abs(dy) <= half_width;
-        bound +=
-            solution.dwell_s[k] *
-            (inside ? interpolation_bound : peak * std::exp(-(dx * dx + dy * dy) / (2.0 * sigma * sigma)));
-      }
-      const double analytic =
-          FullGaussianRemovalUm(target.X(i), target.Y(j), path, solution.dwell_s, peak, fwhm);
-      EXPECT_LE(std::abs(removal - analytic), bound + 1e-12) << target.X(i) << ", " << target.Y(j);
+      EXPECT_LE(std::abs(removal - analytic(j, i)), bound(j, i) + 1e-12)
+          << target.X(i) << ", " << target.Y(j);
     }
   }
   const double rms_after = ResidualRmsUm(target, path, solution.dwell_s, peak, fwhm);

@@ -15,22 +15,12 @@
 #include "core/hdf5.h"
 #include "core/testing/testing.h"
 #include "polishing/job.h"
+#include "polishing/testing.h"
 
 namespace arcwheel::polishing {
 namespace {
 
-// An axis-aligned elliptic Gaussian of known parameters sampled on a grid of offsets.
-TabulatedRemovalFunction EllipticTable(double peak, double cx, double cy, double sx, double sy, double x0,
-                                       double y0, double h, int nx, int ny) {
-  TabulatedRemovalFunction t{.x0_mm = x0, .y0_mm = y0, .dx_mm = h, .dy_mm = h, .nx = nx, .ny = ny};
-  for (int j = 0; j < ny; ++j) {
-    for (int i = 0; i < nx; ++i) {
-      const double x = x0 + i * h - cx, y = y0 + j * h - cy;
-      t.rate_um_per_s.push_back(peak * std::exp(-0.5 * (x * x / (sx * sx) + y * y / (sy * sy))));
-    }
-  }
-  return t;
-}
+using testing::SampledGaussian;
 
 std::string Csv(const TabulatedRemovalFunction& t) {
   std::string out = "# measured footprint\nx_mm,y_mm,rate_um_per_s\n";
@@ -66,7 +56,7 @@ TEST(TabulatedRemovalFunction, InterpolatesAGaussianWithinTheBilinearBound) {
   const int n = 2 * static_cast<int>(std::ceil(4.5 * sigma / h)) + 1;
   const double half_width = (n - 1) / 2 * h;
   const RemovalFunction table =
-      EllipticTable(peak, 0.0, 0.0, sigma, sigma, -half_width, -half_width, h, n, n);
+      SampledGaussian(peak, 0.0, 0.0, sigma, sigma, -half_width, -half_width, h, n, n);
   const double inside_bound = peak * (h * h + h * h) / (8.0 * sigma * sigma);
   const double outside_bound = peak * std::exp(-half_width * half_width / (2.0 * sigma * sigma));
   std::mt19937 rng(7);
@@ -89,7 +79,7 @@ TEST(TabulatedRemovalFunction, InterpolatesAGaussianWithinTheBilinearBound) {
 
 TEST(TabulatedRemovalFunction, PutsAnOffsetFootprintWhereTheTableSays) {
   // Footprint centred 2 mm in +x and 1 mm in -y of the tool centre: the rate peaks there.
-  const RemovalFunction table = EllipticTable(3.0, 2.0, -1.0, 3.0, 1.5, -6.0, -6.0, 0.5, 33, 21);
+  const RemovalFunction table = SampledGaussian(3.0, 2.0, -1.0, 3.0, 1.5, -6.0, -6.0, 0.5, 33, 21);
   EXPECT_DOUBLE_EQ(table.RateUmPerS(2.0, -1.0), 3.0);
   EXPECT_NEAR(table.RateUmPerS(2.0 + 3.0, -1.0), 3.0 * std::exp(-0.5), 1e-12);  // on nodes: exact
   EXPECT_EQ(table.RateUmPerS(-6.01, 0.0), 0.0);
@@ -101,7 +91,7 @@ TEST(TabulatedRemovalFunction, PutsAnOffsetFootprintWhereTheTableSays) {
 }
 
 TEST(ReadRemovalFunction, ReadsTheCsvAndHdf5FormsToTheSameTable) {
-  const TabulatedRemovalFunction table = EllipticTable(3.0, 2.0, -1.0, 3.0, 1.5, -6.0, -6.0, 0.5, 33, 21);
+  const TabulatedRemovalFunction table = SampledGaussian(3.0, 2.0, -1.0, 3.0, 1.5, -6.0, -6.0, 0.5, 33, 21);
   arcwheel::testing::TempDir dir;
   std::ofstream(dir / "footprint.csv") << Csv(table);
   {
@@ -216,7 +206,7 @@ TEST(ReadPolishJob, TakesAMeasuredRemovalFunctionAndDerivesThePathFromItsWidth) 
   const double sigma = 10.0 / (2.0 * std::sqrt(2.0 * std::numbers::ln2));
   arcwheel::testing::TempDir dir;
   std::ofstream(dir / "footprint.csv")
-      << Csv(EllipticTable(1.5, 0.0, 0.0, sigma, sigma, -20.0, -20.0, 0.25, 161, 161));
+      << Csv(SampledGaussian(1.5, 0.0, 0.0, sigma, sigma, -20.0, -20.0, 0.25, 161, 161));
   const PolishJob job = ReadPolishJob(WriteJob(dir, {{"file", "footprint.csv"}}));  // relative to the job
   ASSERT_TRUE(std::holds_alternative<TabulatedRemovalFunction>(job.removal.model()));
   // The equivalent sigma of a Gaussian table is the Gaussian's: the same defaults as fwhm_mm = 10.
@@ -276,7 +266,7 @@ TEST(RunPolishJob, SolvesWithAMeasuredRemovalFunctionUnderAnAccelerationLimit) {
   {
     hdf5::File file = hdf5::File::Create(dir / "footprint.h5");
     const TabulatedRemovalFunction table =
-        EllipticTable(1.5, 0.0, 0.0, sigma, sigma, -16.0, -16.0, 0.25, 129, 129);
+        SampledGaussian(1.5, 0.0, 0.0, sigma, sigma, -16.0, -16.0, 0.25, 129, 129);
     file.WriteDoubles("rate_um_per_s", table.rate_um_per_s, {129, 129});
     for (const auto& [name, value] :
          {std::pair{"x0_mm", -16.0}, {"y0_mm", -16.0}, {"dx_mm", 0.25}, {"dy_mm", 0.25}}) {

@@ -1,0 +1,24 @@
+#pragma once
+// Helpers shared by polishing's tests.
+
+#include <cmath>
+
+#include "polishing/removal_function.h"
+
+namespace arcwheel::polishing::testing {
+
+// An axis-aligned elliptic Gaussian of known parameters (peak rate, centre cx, cy and sigmas sx, sy
+// in mm) sampled on an nx x ny grid of tool offsets from (x0, y0) in steps of h mm.
+inline TabulatedRemovalFunction SampledGaussian(double peak, double cx, double cy, double sx, double sy,
+                                                double x0, double y0, double h, int nx, int ny) {
+  TabulatedRemovalFunction t{.x0_mm = x0, .y0_mm = y0, .dx_mm = h, .dy_mm = h, .nx = nx, .ny = ny};
+  for (int j = 0; j < ny; ++j) {
+    for (int i = 0; i < nx; ++i) {
+      const double x = x0 + i * h - cx, y = y0 + j * h - cy;
+      t.rate_um_per_s.push_back(peak * std::exp(-0.5 * (x * x / (sx * sx) + y * y / (sy * sy))));
+    }
+  }
+  return t;
+}
+
+}  // namespace arcwheel::polishing::testing

@@ -190,6 +190,71 @@ Drift PhaseDrift(const std::vector<TurnHarmonics>& turns, int h) {
   return {slope / scale, slope_sigma / scale};
 }
 
+// The harmonics whose mean amplitude over the windows stands clear of both its own noise and the
+// amplitude floor.
+std::vector<int> HarmonicsClearOfTheNoise(const std::vector<TurnHarmonics>& turns, int harmonics,
+                                          const SpindleSpeedOptions& options) {
+  std::vector<int> usable;
+  for (int h = 1; h <= harmonics; ++h) {
+    const auto index = static_cast<std::size_t>(h - 1);
+    double mean_amplitude = 0.0;
+    double mean_sigma = 0.0;
+    for (const auto& t : turns) {
+      mean_amplitude += std::abs(t.amplitude[index]);
+      mean_sigma += t.amplitude_sigma[index];
+    }
+    mean_amplitude /= static_cast<double>(turns.size());
+    mean_sigma /= static_cast<double>(turns.size());
+    const double floor_mm = options.min_harmonic_amplitude_um / 1000.0;
+    if (mean_amplitude > std::max(options.min_harmonic_snr * mean_sigma, floor_mm)) usable.push_back(h);
+  }
+  return usable;
+}
+
+// The drifts of the usable harmonics combined: their weighted mean and its sigma.
+Drift CombineDrifts(const std::vector<TurnHarmonics>& turns, const std::vector<int>& usable) {
+  std::vector<Drift> drifts;
+  double weight_sum = 0.0;
+  double weighted = 0.0;
+  for (const int h : usable) {
+    drifts.push_back(PhaseDrift(turns, h));
+    const double w = 1.0 / std::max(drifts.back().sigma * drifts.back().sigma, 1e-30);
+    weight_sum += w;
+    weighted += w * drifts.back().delta;
+  }
+  const double delta = weighted / weight_sum;
+  double sigma_relative = std::sqrt(1.0 / weight_sum);
+  // Harmonics that disagree beyond their sigmas reveal model error (what the wheel does that the
+  // per-turn model does not describe): widen the sigma by the Birge ratio.
+  if (drifts.size() > 1) {
+    double chi2 = 0.0;
+    for (const Drift& d : drifts)
+      chi2 += (d.delta - delta) * (d.delta - delta) / std::max(d.sigma * d.sigma, 1e-30);
+    sigma_relative *= std::max(1.0, std::sqrt(chi2 / static_cast<double>(drifts.size() - 1)));
+  }
+  return {delta, sigma_relative};
+}
+
+// Turns of the scan at the nominal speed.
+double NominalTurns(const HelixGeometry& nominal, std::size_t samples) {
+  return (nominal.PhaseAt(samples - 1) - nominal.PhaseAt(0)) / 360.0;
+}
+
+void SetResult(double rpm, double sigma_relative, const SpindleSpeedOptions& options,
+               SpindleSpeedEstimate& estimate) {
+  estimate.available = true;
+  estimate.fitted_rpm = rpm;
+  estimate.sigma_rpm = sigma_relative * rpm;
+  estimate.significant =
+      std::abs(rpm - estimate.nominal_rpm) > options.significance_sigmas * estimate.sigma_rpm;
+  estimate.used_rpm = estimate.significant ? rpm : estimate.nominal_rpm;
+  if (estimate.used_first_harmonic) {
+    estimate.note =
+        "only the first harmonic (eccentricity) was usable: an axial wobble of the arc centre cannot be told "
+        "from a speed error with it";
+  }
+}
+
 }  // namespace
 
 SpindleSpeedEstimate EstimateSpindleSpeed(const acquisition::Scan& scan, std::span<const double> z,
@@ -201,8 +266,7 @@ SpindleSpeedEstimate EstimateSpindleSpeed(const acquisition::Scan& scan, std::sp
 
   const HelixGeometry nominal(scan, estimate.nominal_rpm);
   const double samples_per_turn =
-      static_cast<double>(scan.size()) /
-      std::max(1.0, (nominal.PhaseAt(scan.size() - 1) - nominal.PhaseAt(0)) / 360.0);
+      static_cast<double>(scan.size()) / std::max(1.0, NominalTurns(nominal, scan.size()));
   const int bins = static_cast<int>(std::clamp(samples_per_turn / 2.0, 16.0, 360.0));
   const int harmonics = std::clamp(options.max_harmonic, 1, std::max(1, bins / 2 - 3));
 
@@ -210,8 +274,7 @@ SpindleSpeedEstimate EstimateSpindleSpeed(const acquisition::Scan& scan, std::sp
   // slips 95 deg of the first harmonic in 132 turns), so the estimate starts on adjacent windows
   // and spreads them at most kSpreadGrowth times wider at each iteration, out to the whole scan.
   constexpr std::size_t kSpreadGrowth = 8;
-  const auto scan_turns = static_cast<std::size_t>(
-      std::max(0.0, (nominal.PhaseAt(scan.size() - 1) - nominal.PhaseAt(0)) / 360.0));
+  const auto scan_turns = static_cast<std::size_t>(std::max(0.0, NominalTurns(nominal, scan.size())));
   const std::size_t widest = SpreadSpacing(scan_turns);
   std::size_t spacing = 1;
   double rpm = estimate.nominal_rpm;
@@ -224,60 +287,20 @@ SpindleSpeedEstimate EstimateSpindleSpeed(const acquisition::Scan& scan, std::sp
       return estimate;
     }
     estimate.turns_used = static_cast<int>(turns.size());
-    std::vector<int> usable;
-    for (int h = 1; h <= harmonics; ++h) {
-      const auto index = static_cast<std::size_t>(h - 1);
-      double mean_amplitude = 0.0;
-      double mean_sigma = 0.0;
-      for (const auto& t : turns) {
-        mean_amplitude += std::abs(t.amplitude[index]);
-        mean_sigma += t.amplitude_sigma[index];
-      }
-      mean_amplitude /= static_cast<double>(turns.size());
-      mean_sigma /= static_cast<double>(turns.size());
-      const double floor_mm = options.min_harmonic_amplitude_um / 1000.0;
-      if (mean_amplitude > std::max(options.min_harmonic_snr * mean_sigma, floor_mm)) usable.push_back(h);
-    }
+    std::vector<int> usable = HarmonicsClearOfTheNoise(turns, harmonics, options);
     const bool only_first = usable.size() == 1 && usable.front() == 1;
     if (!only_first) std::erase(usable, 1);
     if (usable.empty()) {
       estimate.note = "the wheel shows no harmonic clear of the noise; the nominal speed is used";
       return estimate;
     }
-    std::vector<Drift> drifts;
-    double weight_sum = 0.0;
-    double weighted = 0.0;
-    for (const int h : usable) {
-      drifts.push_back(PhaseDrift(turns, h));
-      const double w = 1.0 / std::max(drifts.back().sigma * drifts.back().sigma, 1e-30);
-      weight_sum += w;
-      weighted += w * drifts.back().delta;
-    }
-    const double delta = weighted / weight_sum;
-    sigma_relative = std::sqrt(1.0 / weight_sum);
-    // Harmonics that disagree beyond their sigmas reveal model error (what the wheel does that the
-    // per-turn model does not describe): widen the sigma by the Birge ratio.
-    if (drifts.size() > 1) {
-      double chi2 = 0.0;
-      for (const Drift& d : drifts)
-        chi2 += (d.delta - delta) * (d.delta - delta) / std::max(d.sigma * d.sigma, 1e-30);
-      sigma_relative *= std::max(1.0, std::sqrt(chi2 / static_cast<double>(drifts.size() - 1)));
-    }
-    rpm *= 1.0 + delta;
+    const Drift drift = CombineDrifts(turns, usable);
+    sigma_relative = drift.sigma;
+    rpm *= 1.0 + drift.delta;
     estimate.harmonics_used = static_cast<int>(usable.size());
     estimate.used_first_harmonic = only_first;
   }
-  estimate.available = true;
-  estimate.fitted_rpm = rpm;
-  estimate.sigma_rpm = sigma_relative * rpm;
-  estimate.significant =
-      std::abs(rpm - estimate.nominal_rpm) > options.significance_sigmas * estimate.sigma_rpm;
-  estimate.used_rpm = estimate.significant ? rpm : estimate.nominal_rpm;
-  if (estimate.used_first_harmonic) {
-    estimate.note =
-        "only the first harmonic (eccentricity) was usable: an axial wobble of the arc centre cannot be told "
-        "from a speed error with it";
-  }
+  SetResult(rpm, sigma_relative, options, estimate);
   return estimate;
 }
 

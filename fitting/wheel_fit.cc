@@ -8,6 +8,7 @@
 #include <limits>
 #include <numbers>
 #include <numeric>
+#include <span>
 #include <thread>
 #include <utility>
 
@@ -26,6 +27,41 @@ struct PhaseSolution {
   CircleFit circle;
   std::vector<double> u_deg;  // helix points used, for propagation
 };
+
+// The section's covariance from the points' own sigmas (noise along rho, independent between
+// turns) through the fit's first-order sensitivity: C = S diag(sigma^2) S^T; chi2 with the same
+// sigmas. Left as FitCircle gave it when a sigma is not positive.
+void PropagatePointSigmas(std::span<const double> y, std::span<const double> rho,
+                          std::span<const double> sigma, CircleFit& circle) {
+  if (!std::all_of(sigma.begin(), sigma.end(), [](double s) { return s > 0; })) return;
+  Eigen::VectorXd variance(static_cast<Eigen::Index>(sigma.size()));
+  for (std::size_t k = 0; k < sigma.size(); ++k) variance(static_cast<Eigen::Index>(k)) = sigma[k] * sigma[k];
+  circle.covariance = circle.sensitivity_to_y * variance.asDiagonal() * circle.sensitivity_to_y.transpose();
+  double chi2 = 0.0;
+  for (std::size_t k = 0; k < y.size(); ++k) {
+    const double e =
+        std::hypot(y[k] - circle.center_mm.x(), rho[k] - circle.center_mm.y()) - circle.radius_mm;
+    chi2 += e * e / variance(static_cast<Eigen::Index>(k));
+  }
+  circle.chi2 = chi2;
+}
+
+// Copies a usable circle into the phase fit; flags it when the radius is not determined.
+void SetPhaseFit(const CircleFit& c, PhaseFit& fit) {
+  fit.center_axial_mm = c.center_mm.x();
+  fit.center_radial_mm = c.center_mm.y();
+  fit.arc_radius_mm = c.radius_mm;
+  fit.center_axial_sigma_mm = std::sqrt(c.covariance(0, 0));
+  fit.center_radial_sigma_mm = std::sqrt(c.covariance(1, 1));
+  fit.arc_radius_sigma_mm = std::sqrt(c.covariance(2, 2));
+  fit.arc_error_um = c.pv_residual_mm * 1000.0;
+  fit.chi2_per_dof = fit.points > 3 ? c.chi2 / (fit.points - 3) : 0.0;
+  if (!std::isfinite(fit.arc_radius_sigma_mm) || fit.arc_radius_sigma_mm > 0.1 * fit.arc_radius_mm) {
+    fit.flag = "ill-conditioned: the radius is not determined";
+    return;
+  }
+  fit.usable = true;
+}
 
 // Fits the section's points with |y - center| <= half (all points for FitSpan::kFull).
 PhaseSolution FitSection(const processing::Section& section, double center_mm, double half_mm, bool full,
@@ -50,42 +86,14 @@ PhaseSolution FitSection(const processing::Section& section, double center_mm, d
     fit.flag = fmt::format("the section covers {:.3g} mm of the {:.3g} mm band", extent, 2.0 * half_mm);
     return out;
   }
-  // The section's circle is the unweighted geometric least-squares circle (formats.md 3.1). Its
-  // covariance follows from the points' own sigmas (noise along rho, independent between turns)
-  // through the fit's first-order sensitivity: C = S diag(sigma^2) S^T.
+  // The section's circle is the unweighted geometric least-squares circle (formats.md 3.1).
   out.circle = FitCircle(y, rho, {}, options.circle);
-  if (out.circle.IsUsable() && std::all_of(sigma.begin(), sigma.end(), [](double s) { return s > 0; })) {
-    Eigen::VectorXd variance(static_cast<Eigen::Index>(sigma.size()));
-    for (std::size_t k = 0; k < sigma.size(); ++k)
-      variance(static_cast<Eigen::Index>(k)) = sigma[k] * sigma[k];
-    out.circle.covariance =
-        out.circle.sensitivity_to_y * variance.asDiagonal() * out.circle.sensitivity_to_y.transpose();
-    double chi2 = 0.0;
-    for (std::size_t k = 0; k < y.size(); ++k) {
-      const double e = std::hypot(y[k] - out.circle.center_mm.x(), rho[k] - out.circle.center_mm.y()) -
-                       out.circle.radius_mm;
-      chi2 += e * e / variance(static_cast<Eigen::Index>(k));
-    }
-    out.circle.chi2 = chi2;
-  }
-  const CircleFit& c = out.circle;
-  if (!c.IsUsable()) {
-    fit.flag = c.message;
+  if (!out.circle.IsUsable()) {
+    fit.flag = out.circle.message;
     return out;
   }
-  fit.center_axial_mm = c.center_mm.x();
-  fit.center_radial_mm = c.center_mm.y();
-  fit.arc_radius_mm = c.radius_mm;
-  fit.center_axial_sigma_mm = std::sqrt(c.covariance(0, 0));
-  fit.center_radial_sigma_mm = std::sqrt(c.covariance(1, 1));
-  fit.arc_radius_sigma_mm = std::sqrt(c.covariance(2, 2));
-  fit.arc_error_um = c.pv_residual_mm * 1000.0;
-  fit.chi2_per_dof = fit.points > 3 ? c.chi2 / (fit.points - 3) : 0.0;
-  if (!std::isfinite(fit.arc_radius_sigma_mm) || fit.arc_radius_sigma_mm > 0.1 * fit.arc_radius_mm) {
-    fit.flag = "ill-conditioned: the radius is not determined";
-    return out;
-  }
-  fit.usable = true;
+  PropagatePointSigmas(y, rho, sigma, out.circle);
+  SetPhaseFit(out.circle, fit);
   return out;
 }
 

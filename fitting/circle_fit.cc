@@ -5,6 +5,9 @@
 #include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
+#include <span>
+#include <string>
+#include <utility>
 #include <vector>
 
 namespace arcwheel::fitting {
@@ -108,64 +111,59 @@ void PolishByGaussNewton(const std::vector<double>& x, const std::vector<double>
   }
 }
 
-}  // namespace
+// The points centred on their centroid and scaled to unit rms spread, so that the fit works on
+// O(1) numbers.
+struct ScaledPoints {
+  std::vector<double> x, y, w;
+  double cx = 0.0, cy = 0.0, scale = 0.0;
+};
 
-CircleFit FitCircle(std::span<const double> x_in, std::span<const double> y_in,
-                    std::span<const double> weights, const CircleFitOptions& options) {
-  CircleFit fit;
+ScaledPoints ScalePoints(std::span<const double> x_in, std::span<const double> y_in,
+                         std::span<const double> weights) {
   const std::size_t n = x_in.size();
-  fit.n = static_cast<int>(n);
-  if (n < 3 || y_in.size() != n || (!weights.empty() && weights.size() != n)) {
-    fit.status = FitStatus::kDegenerate;
-    fit.message = "a circle needs at least 3 points (and as many weights)";
-    return fit;
-  }
-  // Centre on the centroid and scale to unit rms spread: the fit then works on O(1) numbers.
-  double cx = 0, cy = 0;
+  ScaledPoints out;
   for (std::size_t i = 0; i < n; ++i) {
-    cx += x_in[i];
-    cy += y_in[i];
+    out.cx += x_in[i];
+    out.cy += y_in[i];
   }
-  cx /= static_cast<double>(n);
-  cy /= static_cast<double>(n);
+  out.cx /= static_cast<double>(n);
+  out.cy /= static_cast<double>(n);
   double spread = 0;
   for (std::size_t i = 0; i < n; ++i)
-    spread += (x_in[i] - cx) * (x_in[i] - cx) + (y_in[i] - cy) * (y_in[i] - cy);
-  const double scale = std::sqrt(spread / static_cast<double>(n));
-  if (!(scale > 0)) {
-    fit.status = FitStatus::kDegenerate;
-    fit.message = "all points coincide";
-    return fit;
-  }
-  std::vector<double> x(n), y(n), w(n, 1.0);
+    spread += (x_in[i] - out.cx) * (x_in[i] - out.cx) + (y_in[i] - out.cy) * (y_in[i] - out.cy);
+  out.scale = std::sqrt(spread / static_cast<double>(n));
+  if (!(out.scale > 0)) return out;
+  out.x.resize(n);
+  out.y.resize(n);
+  out.w.assign(n, 1.0);
   for (std::size_t i = 0; i < n; ++i) {
-    x[i] = (x_in[i] - cx) / scale;
-    y[i] = (y_in[i] - cy) / scale;
-    if (!weights.empty()) w[i] = weights[i];
+    out.x[i] = (x_in[i] - out.cx) / out.scale;
+    out.y[i] = (y_in[i] - out.cy) / out.scale;
+    if (!weights.empty()) out.w[i] = weights[i];
   }
-  double p[3];
-  if (!AlgebraicCircle(x, y, w, p)) {
-    fit.status = FitStatus::kDegenerate;
-    fit.message = "the points are collinear: no circle is determined";
-    return fit;
-  }
+  return out;
+}
 
-  ceres::Problem::Options problem_options;
-  problem_options.cost_function_ownership = ceres::TAKE_OWNERSHIP;
-  ceres::Problem problem(problem_options);
-  problem.AddResidualBlock(new CircleResiduals(x, y, w), nullptr, p);
+ceres::Solver::Summary SolveWithCeres(ceres::Problem& problem, int max_iterations) {
   ceres::Solver::Options solver_options;
   solver_options.linear_solver_type = ceres::DENSE_QR;
-  solver_options.max_num_iterations = options.max_iterations;
+  solver_options.max_num_iterations = max_iterations;
   solver_options.function_tolerance = 1e-16;
   solver_options.gradient_tolerance = 1e-16;
   solver_options.parameter_tolerance = 1e-15;
   solver_options.logging_type = ceres::SILENT;
   ceres::Solver::Summary summary;
   ceres::Solve(solver_options, &problem, &summary);
-  fit.iterations = static_cast<int>(summary.iterations.size());
-  PolishByGaussNewton(x, y, w, p);
+  return summary;
+}
 
+// Sets the circle, the residual statistics and the sensitivity to y from the solution p of the
+// scaled problem.
+void SetSolution(const ScaledPoints& s, const double p[3], CircleFit& fit) {
+  const std::size_t n = s.x.size();
+  const auto& x = s.x;
+  const auto& y = s.y;
+  const auto& w = s.w;
   // Jacobian at the solution (unscaled units follow from the chain rule: a, b, r scale with `scale`).
   Eigen::MatrixXd jacobian(static_cast<Eigen::Index>(n), 3);
   double rss_weighted = 0.0, rss = 0.0, low = 0.0, high = 0.0;
@@ -173,7 +171,7 @@ CircleFit FitCircle(std::span<const double> x_in, std::span<const double> y_in,
     const double dx = x[i] - p[0];
     const double dy = y[i] - p[1];
     const double d = std::hypot(dx, dy);
-    const double residual_mm = (d - p[2]) * scale;
+    const double residual_mm = (d - p[2]) * s.scale;
     const auto row = static_cast<Eigen::Index>(i);
     jacobian(row, 0) = -w[i] * dx / d;
     jacobian(row, 1) = -w[i] * dy / d;
@@ -191,12 +189,16 @@ CircleFit FitCircle(std::span<const double> x_in, std::span<const double> y_in,
   }
   const Eigen::Matrix3d normal = jacobian.transpose() * jacobian;
   fit.sensitivity_to_y = -normal.ldlt().solve(jacobian.transpose() * along_y.asDiagonal());
-  fit.center_mm = {cx + p[0] * scale, cy + p[1] * scale};
-  fit.radius_mm = p[2] * scale;
+  fit.center_mm = {s.cx + p[0] * s.scale, s.cy + p[1] * s.scale};
+  fit.radius_mm = p[2] * s.scale;
   fit.rms_residual_mm = std::sqrt(rss / static_cast<double>(n));
   fit.pv_residual_mm = high - low;
   fit.chi2 = rss_weighted;
+}
 
+// Sets fit.covariance from Ceres' (J^T J)^-1 at p. Returns false if it cannot be computed.
+bool SetCovariance(ceres::Problem& problem, const double* p, const CircleFitOptions& options,
+                   CircleFit& fit) {
   ceres::Covariance::Options covariance_options;
   covariance_options.algorithm_type = ceres::DENSE_SVD;
   covariance_options.min_reciprocal_condition_number = 1e-14;
@@ -204,17 +206,51 @@ CircleFit FitCircle(std::span<const double> x_in, std::span<const double> y_in,
   ceres::Covariance covariance(covariance_options);
   const std::vector<std::pair<const double*, const double*>> blocks = {{p, p}};
   double scaled[9];
-  if (!covariance.Compute(blocks, &problem) || !covariance.GetCovarianceBlock(p, p, scaled)) {
-    fit.status = FitStatus::kDegenerate;
-    fit.message = "the points do not determine the circle (ill-conditioned)";
-    return fit;
-  }
+  if (!covariance.Compute(blocks, &problem) || !covariance.GetCovarianceBlock(p, p, scaled)) return false;
   // Scaling by `scale` leaves the Jacobian unchanged (d(r/scale)/d(p/scale) = dr/dp), so Ceres'
   // (J^T J)^-1 is already the covariance in mm^2 for residuals of unit variance: exact when the
   // weights are 1/sigma, else scaled by the residual variance.
   fit.covariance = Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(scaled);
   if (!options.weights_are_inverse_sigmas) {
-    fit.covariance *= n > 3 ? rss_weighted / static_cast<double>(n - 3) : 0.0;
+    const auto n = static_cast<std::size_t>(fit.n);
+    fit.covariance *= n > 3 ? fit.chi2 / static_cast<double>(n - 3) : 0.0;
+  }
+  return true;
+}
+
+CircleFit Degenerate(CircleFit fit, const std::string& message) {
+  fit.status = FitStatus::kDegenerate;
+  fit.message = message;
+  return fit;
+}
+
+}  // namespace
+
+CircleFit FitCircle(std::span<const double> x_in, std::span<const double> y_in,
+                    std::span<const double> weights, const CircleFitOptions& options) {
+  CircleFit fit;
+  const std::size_t n = x_in.size();
+  fit.n = static_cast<int>(n);
+  if (n < 3 || y_in.size() != n || (!weights.empty() && weights.size() != n)) {
+    return Degenerate(fit, "a circle needs at least 3 points (and as many weights)");
+  }
+  const ScaledPoints points = ScalePoints(x_in, y_in, weights);
+  if (!(points.scale > 0)) return Degenerate(fit, "all points coincide");
+  double p[3];
+  if (!AlgebraicCircle(points.x, points.y, points.w, p)) {
+    return Degenerate(fit, "the points are collinear: no circle is determined");
+  }
+
+  ceres::Problem::Options problem_options;
+  problem_options.cost_function_ownership = ceres::TAKE_OWNERSHIP;
+  ceres::Problem problem(problem_options);
+  problem.AddResidualBlock(new CircleResiduals(points.x, points.y, points.w), nullptr, p);
+  const ceres::Solver::Summary summary = SolveWithCeres(problem, options.max_iterations);
+  fit.iterations = static_cast<int>(summary.iterations.size());
+  PolishByGaussNewton(points.x, points.y, points.w, p);
+  SetSolution(points, p, fit);
+  if (!SetCovariance(problem, p, options, fit)) {
+    return Degenerate(fit, "the points do not determine the circle (ill-conditioned)");
   }
   if (summary.termination_type == ceres::CONVERGENCE || summary.termination_type == ceres::USER_SUCCESS) {
     fit.status = FitStatus::kConverged;

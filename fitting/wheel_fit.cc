@@ -8,6 +8,7 @@
 #include <limits>
 #include <numbers>
 #include <numeric>
+#include <span>
 #include <thread>
 #include <utility>
 
@@ -26,6 +27,41 @@ struct PhaseSolution {
   CircleFit circle;
   std::vector<double> u_deg;  // helix points used, for propagation
 };
+
+// The section's covariance from the points' own sigmas (noise along rho, independent between
+// turns) through the fit's first-order sensitivity: C = S diag(sigma^2) S^T; chi2 with the same
+// sigmas. Left as FitCircle gave it when a sigma is not positive.
+void PropagatePointSigmas(std::span<const double> y, std::span<const double> rho,
+                          std::span<const double> sigma, CircleFit& circle) {
+  if (!std::all_of(sigma.begin(), sigma.end(), [](double s) { return s > 0; })) return;
+  Eigen::VectorXd variance(static_cast<Eigen::Index>(sigma.size()));
+  for (std::size_t k = 0; k < sigma.size(); ++k) variance(static_cast<Eigen::Index>(k)) = sigma[k] * sigma[k];
+  circle.covariance = circle.sensitivity_to_y * variance.asDiagonal() * circle.sensitivity_to_y.transpose();
+  double chi2 = 0.0;
+  for (std::size_t k = 0; k < y.size(); ++k) {
+    const double e =
+        std::hypot(y[k] - circle.center_mm.x(), rho[k] - circle.center_mm.y()) - circle.radius_mm;
+    chi2 += e * e / variance(static_cast<Eigen::Index>(k));
+  }
+  circle.chi2 = chi2;
+}
+
+// Copies a usable circle into the phase fit; flags it when the radius is not determined.
+void SetPhaseFit(const CircleFit& c, PhaseFit& fit) {
+  fit.center_axial_mm = c.center_mm.x();
+  fit.center_radial_mm = c.center_mm.y();
+  fit.arc_radius_mm = c.radius_mm;
+  fit.center_axial_sigma_mm = std::sqrt(c.covariance(0, 0));
+  fit.center_radial_sigma_mm = std::sqrt(c.covariance(1, 1));
+  fit.arc_radius_sigma_mm = std::sqrt(c.covariance(2, 2));
+  fit.arc_error_um = c.pv_residual_mm * 1000.0;
+  fit.chi2_per_dof = fit.points > 3 ? c.chi2 / (fit.points - 3) : 0.0;
+  if (!std::isfinite(fit.arc_radius_sigma_mm) || fit.arc_radius_sigma_mm > 0.1 * fit.arc_radius_mm) {
+    fit.flag = "ill-conditioned: the radius is not determined";
+    return;
+  }
+  fit.usable = true;
+}
 
 // Fits the section's points with |y - center| <= half (all points for FitSpan::kFull).
 PhaseSolution FitSection(const processing::Section& section, double center_mm, double half_mm, bool full,
@@ -50,42 +86,14 @@ PhaseSolution FitSection(const processing::Section& section, double center_mm, d
     fit.flag = fmt::format("the section covers {:.3g} mm of the {:.3g} mm band", extent, 2.0 * half_mm);
     return out;
   }
-  // The section's circle is the unweighted geometric least-squares circle (formats.md 3.1). Its
-  // covariance follows from the points' own sigmas (noise along rho, independent between turns)
-  // through the fit's first-order sensitivity: C = S diag(sigma^2) S^T.
+  // The section's circle is the unweighted geometric least-squares circle (formats.md 3.1).
   out.circle = FitCircle(y, rho, {}, options.circle);
-  if (out.circle.IsUsable() && std::all_of(sigma.begin(), sigma.end(), [](double s) { return s > 0; })) {
-    Eigen::VectorXd variance(static_cast<Eigen::Index>(sigma.size()));
-    for (std::size_t k = 0; k < sigma.size(); ++k)
-      variance(static_cast<Eigen::Index>(k)) = sigma[k] * sigma[k];
-    out.circle.covariance =
-        out.circle.sensitivity_to_y * variance.asDiagonal() * out.circle.sensitivity_to_y.transpose();
-    double chi2 = 0.0;
-    for (std::size_t k = 0; k < y.size(); ++k) {
-      const double e = std::hypot(y[k] - out.circle.center_mm.x(), rho[k] - out.circle.center_mm.y()) -
-                       out.circle.radius_mm;
-      chi2 += e * e / variance(static_cast<Eigen::Index>(k));
-    }
-    out.circle.chi2 = chi2;
-  }
-  const CircleFit& c = out.circle;
-  if (!c.IsUsable()) {
-    fit.flag = c.message;
+  if (!out.circle.IsUsable()) {
+    fit.flag = out.circle.message;
     return out;
   }
-  fit.center_axial_mm = c.center_mm.x();
-  fit.center_radial_mm = c.center_mm.y();
-  fit.arc_radius_mm = c.radius_mm;
-  fit.center_axial_sigma_mm = std::sqrt(c.covariance(0, 0));
-  fit.center_radial_sigma_mm = std::sqrt(c.covariance(1, 1));
-  fit.arc_radius_sigma_mm = std::sqrt(c.covariance(2, 2));
-  fit.arc_error_um = c.pv_residual_mm * 1000.0;
-  fit.chi2_per_dof = fit.points > 3 ? c.chi2 / (fit.points - 3) : 0.0;
-  if (!std::isfinite(fit.arc_radius_sigma_mm) || fit.arc_radius_sigma_mm > 0.1 * fit.arc_radius_mm) {
-    fit.flag = "ill-conditioned: the radius is not determined";
-    return out;
-  }
-  fit.usable = true;
+  PropagatePointSigmas(y, rho, sigma, out.circle);
+  SetPhaseFit(out.circle, fit);
   return out;
 }
 
@@ -128,6 +136,201 @@ double Roundness(const std::vector<double>& phase_deg, const std::vector<double>
   return residual.maxCoeff() - residual.minCoeff();
 }
 
+// Fits every phase whose index is j = k * step (k = 0, 1, ...) with the band centred on
+// band_center_mm; the others are left unfitted. The phases are independent: half of them run on a
+// second thread.
+void FitPhases(const processing::WheelMap& map, double band_center_mm, std::size_t step,
+               const WheelFitOptions& options, std::vector<PhaseSolution>& solutions) {
+  const bool full = options.fit_span == FitSpan::kFull;
+  const std::size_t n_phase = map.n_phase();
+  const auto fit_phases = [&](std::size_t first) {
+    for (std::size_t j = first * step; j < n_phase; j += 2 * step) {
+      solutions[j] = FitSection(map.sections[j], band_center_mm, options.band_half_width_mm, full, options);
+    }
+  };
+  std::thread odd(fit_phases, 1);
+  fit_phases(0);
+  odd.join();
+}
+
+// Mean arc-centre axial position over the usable phases. Throws Error{kFitFailed} if none is usable.
+double MeanCenterAxialOfUsable(const std::vector<PhaseSolution>& solutions) {
+  double sum_a = 0.0;
+  int usable = 0;
+  for (const PhaseSolution& solution : solutions) {
+    if (solution.fit.usable) {
+      sum_a += solution.fit.center_axial_mm;
+      ++usable;
+    }
+  }
+  if (usable == 0) {
+    const std::string why = !solutions.empty() ? solutions[0].fit.flag : "no phases";
+    throw Error(ErrorCode::kFitFailed, kStage, "no phase gave a usable arc fit (phase 0: " + why + ")");
+  }
+  return sum_a / usable;
+}
+
+struct CenteredFits {
+  std::vector<PhaseSolution> solutions;
+  double used_center_mm = 0.0;  // the centre of the band the final fits used
+  double mean_center_mm = 0.0;  // the mean arc centre those fits found
+};
+
+// Pass 1 centres the band on the middle of the scanned span; pass 2 on the mean arc centre.
+CenteredFits FitPhasesInCenteredBand(const processing::WheelMap& map, const WheelFitOptions& options) {
+  const std::size_t n_phase = map.n_phase();
+  CenteredFits out;
+  out.solutions.resize(n_phase);
+  double band_center = 0.5 * (map.y_mm.front() + map.y_mm.back());
+  for (int pass = 0; pass < 2; ++pass) {
+    out.used_center_mm = band_center;
+    ThrowIfInterrupted();
+    // Pass 1 only centres the band, for which every 8th phase is plenty.
+    const std::size_t step = pass == 0 && n_phase >= 64 ? 8 : 1;
+    if (pass == 1 || step > 1) {
+      for (auto& solution : out.solutions) solution = PhaseSolution{};
+    }
+    FitPhases(map, band_center, step, options, out.solutions);
+    band_center = MeanCenterAxialOfUsable(out.solutions);
+  }
+  out.mean_center_mm = band_center;
+  return out;
+}
+
+// The band the fits used, clipped to the scanned span. Throws Error{kBadInput} if nothing is left.
+void SetBand(const processing::WheelMap& map, const CenteredFits& fits, const WheelFitOptions& options,
+             WheelFit& out) {
+  const double y_min = map.y_mm.front();
+  const double y_max = map.y_mm.back();
+  const double half = options.band_half_width_mm;
+  out.band_low_mm = std::max(fits.used_center_mm - half, y_min);
+  out.band_high_mm = std::min(fits.used_center_mm + half, y_max);
+  if (!(out.band_high_mm > out.band_low_mm)) {
+    throw Error(ErrorCode::kBadInput, kStage,
+                fmt::format("the band {:.4g} +- {:.4g} mm lies outside the scanned span [{:.4g}, {:.4g}] mm",
+                            fits.mean_center_mm, half, y_min, y_max));
+  }
+  if (out.band_high_mm - out.band_low_mm < 2.0 * half - 1e-9 && options.fit_span != FitSpan::kFull) {
+    out.warnings.push_back(fmt::format("the band was clipped to [{:.4f}, {:.4f}] mm by the scanned span",
+                                       out.band_low_mm, out.band_high_mm));
+  }
+}
+
+double Mean(const std::vector<double>& v) {
+  return std::accumulate(v.begin(), v.end(), 0.0) / static_cast<double>(v.size());
+}
+
+// Copies the phase fits into `out` and sets the means, spreads and sigmas over the usable ones.
+void SummarisePhases(const std::vector<PhaseSolution>& solutions, const processing::WheelMap& map,
+                     WheelFit& out) {
+  std::vector<double> radii, axial, radial, sigmas, chi2;
+  for (const auto& s : solutions) {
+    out.phases.push_back(s.fit);
+    if (!s.fit.usable) continue;
+    radii.push_back(s.fit.arc_radius_mm);
+    axial.push_back(s.fit.center_axial_mm);
+    radial.push_back(s.fit.center_radial_mm);
+    sigmas.push_back(s.fit.arc_radius_sigma_mm);
+    chi2.push_back(s.fit.chi2_per_dof);
+    out.max_arc_error_um = std::max(out.max_arc_error_um, s.fit.arc_error_um);
+  }
+  const auto n = static_cast<double>(radii.size());
+  out.usable_phases = static_cast<int>(radii.size());
+  out.mean_arc_radius_mm = Mean(radii);
+  out.mean_center_axial_mm = Mean(axial);
+  out.mean_center_radial_mm = Mean(radial);
+  const auto [r_min, r_max] = std::minmax_element(radii.begin(), radii.end());
+  out.arc_radius_range_mm = *r_max - *r_min;
+  out.arc_radius_fluctuation_pct = out.arc_radius_range_mm / out.mean_arc_radius_mm * 100.0;
+  const auto [a_min, a_max] = std::minmax_element(axial.begin(), axial.end());
+  out.center_axial_deviation_mm = *a_max - *a_min;
+  double var = 0.0, noise = 0.0;
+  for (std::size_t k = 0; k < radii.size(); ++k) {
+    var += (radii[k] - out.mean_arc_radius_mm) * (radii[k] - out.mean_arc_radius_mm);
+    noise += sigmas[k] * sigmas[k];
+  }
+  out.arc_radius_std_mm = std::sqrt(var / std::max(1.0, n - 1.0));
+  out.arc_radius_noise_std_mm = std::sqrt(noise / n);
+  out.arc_radius_excess_std_mm =
+      std::sqrt(std::max(0.0, out.arc_radius_std_mm * out.arc_radius_std_mm -
+                                  out.arc_radius_noise_std_mm * out.arc_radius_noise_std_mm));
+  out.median_chi2_per_dof = Median(chi2);
+  out.mean_arc_radius_sigma_mm = SigmaOfMean(solutions, 2, map);
+  out.mean_center_axial_sigma_mm = SigmaOfMean(solutions, 0, map);
+  const std::size_t n_phase = map.n_phase();
+  if (out.usable_phases < static_cast<int>(n_phase)) {
+    out.warnings.push_back(fmt::format("{} of {} phases were not usable and are left out of the means",
+                                       n_phase - static_cast<std::size_t>(out.usable_phases), n_phase));
+  }
+}
+
+bool InBand(double y_mm, const WheelFit& fit) {
+  return y_mm >= fit.band_low_mm - 1e-9 && y_mm <= fit.band_high_mm + 1e-9;
+}
+
+// Runout and roundness over the map's axial nodes in the band.
+void SetRunoutAndRoundness(const processing::WheelMap& map, const WheelFitOptions& options, WheelFit& out) {
+  const std::size_t n_phase = map.n_phase();
+  for (std::size_t m = 0; m < map.n_y(); ++m) {
+    const double y = map.y_mm[m];
+    if (!InBand(y, out)) continue;
+    std::vector<double> phase, rho;
+    for (std::size_t j = 0; j < n_phase; ++j) {
+      if (std::isfinite(map.rho(j, m))) {
+        phase.push_back(map.phase_deg[j]);
+        rho.push_back(map.rho(j, m));
+      }
+    }
+    out.axial_y_mm.push_back(y);
+    if (static_cast<double>(rho.size()) < options.min_phase_coverage * static_cast<double>(n_phase) ||
+        rho.size() < 4) {
+      out.runout_um.push_back(kNaN);
+      out.roundness_um.push_back(kNaN);
+      continue;
+    }
+    const auto [lo, hi] = std::minmax_element(rho.begin(), rho.end());
+    out.runout_um.push_back((*hi - *lo) * 1000.0);
+    out.roundness_um.push_back(Roundness(phase, rho) * 1000.0);
+    out.max_runout_um = std::max(out.max_runout_um, out.runout_um.back());
+    out.max_roundness_um = std::max(out.max_roundness_um, out.roundness_um.back());
+  }
+}
+
+// Mean deviation of the sections from their own circles at each axial node in the band.
+void SetProfileError(const processing::WheelMap& map, WheelFit& out) {
+  for (std::size_t m = 0; m < map.n_y(); ++m) {
+    const double y = map.y_mm[m];
+    if (!InBand(y, out)) continue;
+    double sum = 0.0;
+    int count = 0;
+    for (std::size_t j = 0; j < map.n_phase(); ++j) {
+      const PhaseFit& f = out.phases[j];
+      const double u = y - f.center_axial_mm;
+      if (!f.usable || !std::isfinite(map.rho(j, m)) || std::abs(u) >= f.arc_radius_mm) continue;
+      sum += map.rho(j, m) - (f.center_radial_mm + std::sqrt(f.arc_radius_mm * f.arc_radius_mm - u * u));
+      ++count;
+    }
+    out.profile_u_mm.push_back(y - out.mean_center_axial_mm);
+    out.profile_error_um.push_back(count > 0 ? sum / count * 1000.0 : kNaN);
+  }
+}
+
+// The map minus the mean wheel (the circle of mean radius and centre), over the whole map.
+void SetFormError(const processing::WheelMap& map, WheelFit& out) {
+  const std::size_t n_phase = map.n_phase();
+  const std::size_t n_y = map.n_y();
+  out.form_error_um.assign(n_phase * n_y, kNaN);
+  const double R = out.mean_arc_radius_mm;
+  for (std::size_t m = 0; m < n_y; ++m) {
+    const double u = map.y_mm[m] - out.mean_center_axial_mm;
+    if (std::abs(u) >= R) continue;
+    const double mean_wheel = out.mean_center_radial_mm + std::sqrt(R * R - u * u);
+    for (std::size_t j = 0; j < n_phase; ++j) {
+      out.form_error_um[j * n_y + m] = (map.rho(j, m) - mean_wheel) * 1000.0;
+    }
+  }
+}
+
 }  // namespace
 
 std::vector<std::string> WheelFitOptions::Problems() const {
@@ -152,155 +355,13 @@ WheelFit FitWheel(const processing::WheelMap& map, const WheelFitOptions& option
   if (const auto problems = options.Problems(); !problems.empty()) {
     throw Error(ErrorCode::kInvalidOption, kStage, problems.front());
   }
-  const std::size_t n_phase = map.n_phase();
-  const std::size_t n_y = map.n_y();
-  const double y_min = map.y_mm.front();
-  const double y_max = map.y_mm.back();
-  const double half = options.band_half_width_mm;
-  const bool full = options.fit_span == FitSpan::kFull;
-
-  // Pass 1 centres the band on the middle of the scanned span; pass 2 on the mean arc centre.
-  double band_center = 0.5 * (y_min + y_max);
-  double used_center = band_center;  // the centre of the band the final fits used
-  std::vector<PhaseSolution> solutions(n_phase);
-  for (int pass = 0; pass < 2; ++pass) {
-    used_center = band_center;
-    ThrowIfInterrupted();
-    // The phases are independent: half of them on a second thread. Pass 1 only centres the band,
-    // for which every 8th phase is plenty.
-    const std::size_t step = pass == 0 && n_phase >= 64 ? 8 : 1;
-    const auto fit_phases = [&](std::size_t first) {
-      for (std::size_t j = first * step; j < n_phase; j += 2 * step) {
-        solutions[j] = FitSection(map.sections[j], band_center, half, full, options);
-      }
-    };
-    if (pass == 1 || step > 1) {
-      for (auto& solution : solutions) solution = PhaseSolution{};
-    }
-    std::thread odd(fit_phases, 1);
-    fit_phases(0);
-    odd.join();
-    double sum_a = 0.0;
-    int usable = 0;
-    for (const PhaseSolution& solution : solutions) {
-      if (solution.fit.usable) {
-        sum_a += solution.fit.center_axial_mm;
-        ++usable;
-      }
-    }
-    if (usable == 0) {
-      const std::string why = n_phase > 0 ? solutions[0].fit.flag : "no phases";
-      throw Error(ErrorCode::kFitFailed, kStage, "no phase gave a usable arc fit (phase 0: " + why + ")");
-    }
-    band_center = sum_a / usable;
-  }
-
+  const CenteredFits fits = FitPhasesInCenteredBand(map, options);
   WheelFit out;
-  out.band_low_mm = std::max(used_center - half, y_min);
-  out.band_high_mm = std::min(used_center + half, y_max);
-  if (!(out.band_high_mm > out.band_low_mm)) {
-    throw Error(ErrorCode::kBadInput, kStage,
-                fmt::format("the band {:.4g} +- {:.4g} mm lies outside the scanned span [{:.4g}, {:.4g}] mm",
-                            band_center, half, y_min, y_max));
-  }
-  if (out.band_high_mm - out.band_low_mm < 2.0 * half - 1e-9 && !full) {
-    out.warnings.push_back(fmt::format("the band was clipped to [{:.4f}, {:.4f}] mm by the scanned span",
-                                       out.band_low_mm, out.band_high_mm));
-  }
-
-  std::vector<double> radii, axial, radial, sigmas, chi2;
-  for (const auto& s : solutions) {
-    out.phases.push_back(s.fit);
-    if (!s.fit.usable) continue;
-    radii.push_back(s.fit.arc_radius_mm);
-    axial.push_back(s.fit.center_axial_mm);
-    radial.push_back(s.fit.center_radial_mm);
-    sigmas.push_back(s.fit.arc_radius_sigma_mm);
-    chi2.push_back(s.fit.chi2_per_dof);
-    out.max_arc_error_um = std::max(out.max_arc_error_um, s.fit.arc_error_um);
-  }
-  const auto n = static_cast<double>(radii.size());
-  out.usable_phases = static_cast<int>(radii.size());
-  const auto mean = [](const std::vector<double>& v) {
-    return std::accumulate(v.begin(), v.end(), 0.0) / static_cast<double>(v.size());
-  };
-  out.mean_arc_radius_mm = mean(radii);
-  out.mean_center_axial_mm = mean(axial);
-  out.mean_center_radial_mm = mean(radial);
-  const auto [r_min, r_max] = std::minmax_element(radii.begin(), radii.end());
-  out.arc_radius_range_mm = *r_max - *r_min;
-  out.arc_radius_fluctuation_pct = out.arc_radius_range_mm / out.mean_arc_radius_mm * 100.0;
-  const auto [a_min, a_max] = std::minmax_element(axial.begin(), axial.end());
-  out.center_axial_deviation_mm = *a_max - *a_min;
-  double var = 0.0, noise = 0.0;
-  for (std::size_t k = 0; k < radii.size(); ++k) {
-    var += (radii[k] - out.mean_arc_radius_mm) * (radii[k] - out.mean_arc_radius_mm);
-    noise += sigmas[k] * sigmas[k];
-  }
-  out.arc_radius_std_mm = std::sqrt(var / std::max(1.0, n - 1.0));
-  out.arc_radius_noise_std_mm = std::sqrt(noise / n);
-  out.arc_radius_excess_std_mm =
-      std::sqrt(std::max(0.0, out.arc_radius_std_mm * out.arc_radius_std_mm -
-                                  out.arc_radius_noise_std_mm * out.arc_radius_noise_std_mm));
-  out.median_chi2_per_dof = Median(chi2);
-  out.mean_arc_radius_sigma_mm = SigmaOfMean(solutions, 2, map);
-  out.mean_center_axial_sigma_mm = SigmaOfMean(solutions, 0, map);
-  if (out.usable_phases < static_cast<int>(n_phase)) {
-    out.warnings.push_back(fmt::format("{} of {} phases were not usable and are left out of the means",
-                                       n_phase - static_cast<std::size_t>(out.usable_phases), n_phase));
-  }
-
-  // Runout and roundness over the map's axial nodes in the band.
-  for (std::size_t m = 0; m < n_y; ++m) {
-    const double y = map.y_mm[m];
-    if (y < out.band_low_mm - 1e-9 || y > out.band_high_mm + 1e-9) continue;
-    std::vector<double> phase, rho;
-    for (std::size_t j = 0; j < n_phase; ++j) {
-      if (std::isfinite(map.rho(j, m))) {
-        phase.push_back(map.phase_deg[j]);
-        rho.push_back(map.rho(j, m));
-      }
-    }
-    out.axial_y_mm.push_back(y);
-    if (static_cast<double>(rho.size()) < options.min_phase_coverage * static_cast<double>(n_phase) ||
-        rho.size() < 4) {
-      out.runout_um.push_back(kNaN);
-      out.roundness_um.push_back(kNaN);
-      continue;
-    }
-    const auto [lo, hi] = std::minmax_element(rho.begin(), rho.end());
-    out.runout_um.push_back((*hi - *lo) * 1000.0);
-    out.roundness_um.push_back(Roundness(phase, rho) * 1000.0);
-    out.max_runout_um = std::max(out.max_runout_um, out.runout_um.back());
-    out.max_roundness_um = std::max(out.max_roundness_um, out.roundness_um.back());
-  }
-
-  // Mean profile deviation and the form-error map.
-  for (std::size_t m = 0; m < n_y; ++m) {
-    const double y = map.y_mm[m];
-    if (y < out.band_low_mm - 1e-9 || y > out.band_high_mm + 1e-9) continue;
-    double sum = 0.0;
-    int count = 0;
-    for (std::size_t j = 0; j < n_phase; ++j) {
-      const PhaseFit& f = out.phases[j];
-      const double u = y - f.center_axial_mm;
-      if (!f.usable || !std::isfinite(map.rho(j, m)) || std::abs(u) >= f.arc_radius_mm) continue;
-      sum += map.rho(j, m) - (f.center_radial_mm + std::sqrt(f.arc_radius_mm * f.arc_radius_mm - u * u));
-      ++count;
-    }
-    out.profile_u_mm.push_back(y - out.mean_center_axial_mm);
-    out.profile_error_um.push_back(count > 0 ? sum / count * 1000.0 : kNaN);
-  }
-  out.form_error_um.assign(n_phase * n_y, kNaN);
-  const double R = out.mean_arc_radius_mm;
-  for (std::size_t m = 0; m < n_y; ++m) {
-    const double u = map.y_mm[m] - out.mean_center_axial_mm;
-    if (std::abs(u) >= R) continue;
-    const double mean_wheel = out.mean_center_radial_mm + std::sqrt(R * R - u * u);
-    for (std::size_t j = 0; j < n_phase; ++j) {
-      out.form_error_um[j * n_y + m] = (map.rho(j, m) - mean_wheel) * 1000.0;
-    }
-  }
+  SetBand(map, fits, options, out);
+  SummarisePhases(fits.solutions, map, out);
+  SetRunoutAndRoundness(map, options, out);
+  SetProfileError(map, out);
+  SetFormError(map, out);
   return out;
 }
 

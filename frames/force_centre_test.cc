@@ -276,10 +276,11 @@ TEST(ReadForceRecord, RefusesHdf5ChannelsOfDifferentLengthsOrWithNan) {
   ForceRecord short_channel = record;
   short_channel.my_Nmm.pop_back();
   WriteForceRecordHdf5(dir / "short.h5", short_channel);
-  EXPECT_THROW((void)ReadForceRecord(dir / "short.h5"), Error);
   try {
     (void)ReadForceRecord(dir / "short.h5");
+    ADD_FAILURE() << "a record with a short channel was accepted";
   } catch (const Error& error) {
+    EXPECT_EQ(error.code(), ErrorCode::kBadInput);
     EXPECT_NE(std::string(error.what()).find("channel My_Nmm has 4 samples but t_s has 5"), std::string::npos)
         << error.what();
   }

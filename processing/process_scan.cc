@@ -4,6 +4,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <span>
+#include <vector>
 
 #include "core/error.h"
 #include "core/interrupt.h"
@@ -52,6 +54,106 @@ std::size_t StuckRunSamples(const acquisition::Scan& scan, double stuck_run_deg)
                                static_cast<std::size_t>(std::ceil(samples_per_turn * stuck_run_deg / 360.0)));
 }
 
+void CheckOptions(const acquisition::Scan& scan, const ProcessOptions& options) {
+  if (const auto problems = options.Problems(); !problems.empty()) {
+    throw Error(ErrorCode::kInvalidOption, kStage, problems.front());
+  }
+  if (options.rpm_source == RpmSource::kEncoder && !scan.has_encoder()) {
+    throw Error(ErrorCode::kInvalidOption, kStage,
+                "'" + scan.path + "' has no angle column for --rpm-source encoder");
+  }
+}
+
+// Step 1: the valid samples and the span from the first to the last of them.
+void FindValidSpan(const std::vector<double>& rho, ProcessedScan& out) {
+  out.valid_samples = static_cast<std::size_t>(
+      std::count_if(rho.begin(), rho.end(), [](double v) { return std::isfinite(v); }));
+  const auto first = std::find_if(rho.begin(), rho.end(), [](double v) { return std::isfinite(v); });
+  const auto last = std::find_if(rho.rbegin(), rho.rend(), [](double v) { return std::isfinite(v); });
+  out.first_valid = static_cast<std::size_t>(first - rho.begin());
+  out.last_valid = rho.size() - 1 - static_cast<std::size_t>(last - rho.rbegin());
+}
+
+// Drops runs of equal readings (a stuck sensor); refuses a scan that is nothing else.
+void DropStuckSensorRuns(const acquisition::Scan& scan, std::vector<double>& rho, double stuck_run_deg,
+                         ProcessedScan& out) {
+  out.stuck = DropStuckReadings(rho, StuckRunSamples(scan, stuck_run_deg));
+  if (out.stuck.dropped > 0 && out.stuck.dropped == out.valid_samples) {
+    throw Error(
+        ErrorCode::kBadInput, kStage,
+        fmt::format("'{}': every reading lies in a run of equal values (longest {} samples): the sensor is "
+                    "stuck or saturated",
+                    scan.path, out.stuck.longest_run));
+  }
+  if (out.stuck.dropped > 0) {
+    out.warnings.push_back(
+        fmt::format("dropped {} samples in {} run(s) of equal readings (longest {} samples; a run of "
+                    "{} or more is a stuck or saturated sensor): check the sensor",
+                    out.stuck.dropped, out.stuck.runs, out.stuck.longest_run, out.stuck.min_run));
+  }
+}
+
+// Steps 2-3: noise, despiking, and the noise again of what is left.
+void DespikeAndEstimateNoise(std::vector<double>& rho, const DespikeOptions& options, ProcessedScan& out) {
+  out.noise_sigma_mm = EstimateNoiseSigmaMm(rho);
+  out.despike = Despike(rho, out.noise_sigma_mm, options);
+  // The noise that matters for the sigmas is that of the samples the map is built from.
+  out.noise_sigma_mm = EstimateNoiseSigmaMm(rho);
+  if (out.despike.rejected > out.valid_samples / 10) {
+    out.warnings.push_back(
+        fmt::format("despiking rejected {} of {} valid samples: check the threshold ({:.3g} um)",
+                    out.despike.rejected, out.valid_samples, out.despike.threshold_um));
+  }
+}
+
+// Step 4, when a beam offset is given.
+void CorrectBeamOffsetIfAsked(const acquisition::Scan& scan, std::vector<double>& rho,
+                              const ProcessOptions& options) {
+  if (options.beam_offset_mm == 0.0) return;
+  double radius = options.wheel_radius_mm;
+  if (radius <= 0 && scan.metadata.wheel_diameter_mm) radius = *scan.metadata.wheel_diameter_mm / 2.0;
+  if (radius <= 0) {
+    throw Error(ErrorCode::kInvalidOption, kStage,
+                "the beam-offset correction needs the wheel radius: give --wheel-radius-mm or a "
+                "wheel_diameter_mm attribute");
+  }
+  CorrectBeamOffset(rho, options.beam_offset_mm, radius);
+}
+
+// Step 5 without an encoder: the nominal speed, or the estimate when it is significant or asked for.
+void ChooseSpeedWithoutEncoder(const acquisition::Scan& scan, std::span<const double> rho,
+                               const ProcessOptions& options, ProcessedScan& out) {
+  if (!scan.metadata.spindle_rpm) {
+    throw Error(ErrorCode::kBadInput, kStage, "'" + scan.path + "' lacks spindle_rpm");
+  }
+  out.rpm_used = *scan.metadata.spindle_rpm;
+  out.phase_source = PhaseSource::kNominal;
+  if (options.rpm_source == RpmSource::kNominal || scan.has_encoder()) return;
+  out.speed = EstimateSpindleSpeed(scan, rho, options.speed);
+  const bool forced = options.rpm_source == RpmSource::kEstimate;
+  if (out.speed.available && (out.speed.significant || forced)) {
+    out.rpm_used = out.speed.fitted_rpm;
+    out.phase_source = PhaseSource::kEstimated;
+    out.warnings.push_back(
+        fmt::format("spindle speed estimated from the data: {:.6f} rpm (nominal {:.6f}, sigma {:.2g})",
+                    out.speed.fitted_rpm, out.speed.nominal_rpm, out.speed.sigma_rpm));
+  }
+  if (!out.speed.note.empty()) out.warnings.push_back(out.speed.note);
+}
+
+// Step 5: the encoder when there is one and it is allowed, else ChooseSpeedWithoutEncoder.
+void ChooseSpeed(const acquisition::Scan& scan, std::span<const double> rho, const ProcessOptions& options,
+                 ProcessedScan& out) {
+  const bool use_encoder = scan.has_encoder() && (options.rpm_source == RpmSource::kAuto ||
+                                                  options.rpm_source == RpmSource::kEncoder);
+  if (use_encoder) {
+    out.phase_source = PhaseSource::kEncoder;
+    out.rpm_used = HelixGeometry(scan, 0.0).rpm();
+  } else {
+    ChooseSpeedWithoutEncoder(scan, rho, options, out);
+  }
+}
+
 }  // namespace
 
 std::vector<std::string> ProcessOptions::Problems() const {
@@ -88,86 +190,21 @@ std::string RpmSourceName(RpmSource source) {
 }
 
 ProcessedScan ProcessScan(acquisition::Scan scan, const ProcessOptions& options) {
-  if (const auto problems = options.Problems(); !problems.empty()) {
-    throw Error(ErrorCode::kInvalidOption, kStage, problems.front());
-  }
-  if (options.rpm_source == RpmSource::kEncoder && !scan.has_encoder()) {
-    throw Error(ErrorCode::kInvalidOption, kStage,
-                "'" + scan.path + "' has no angle column for --rpm-source encoder");
-  }
+  CheckOptions(scan, options);
   ProcessedScan out;
   out.samples = scan.size();
   out.warnings = scan.metadata.notes;  // what the reader noticed comes first
   ToRadialCoordinate(scan);
   std::vector<double>& rho = scan.z_mm;
-  out.valid_samples = static_cast<std::size_t>(
-      std::count_if(rho.begin(), rho.end(), [](double v) { return std::isfinite(v); }));
-  const auto first = std::find_if(rho.begin(), rho.end(), [](double v) { return std::isfinite(v); });
-  const auto last = std::find_if(rho.rbegin(), rho.rend(), [](double v) { return std::isfinite(v); });
-  out.first_valid = static_cast<std::size_t>(first - rho.begin());
-  out.last_valid = rho.size() - 1 - static_cast<std::size_t>(last - rho.rbegin());
+  FindValidSpan(rho, out);
   ThrowIfInterrupted();
 
-  out.stuck = DropStuckReadings(rho, StuckRunSamples(scan, options.stuck_run_deg));
-  if (out.stuck.dropped > 0 && out.stuck.dropped == out.valid_samples) {
-    throw Error(
-        ErrorCode::kBadInput, kStage,
-        fmt::format("'{}': every reading lies in a run of equal values (longest {} samples): the sensor is "
-                    "stuck or saturated",
-                    scan.path, out.stuck.longest_run));
-  }
-  if (out.stuck.dropped > 0) {
-    out.warnings.push_back(
-        fmt::format("dropped {} samples in {} run(s) of equal readings (longest {} samples; a run of "
-                    "{} or more is a stuck or saturated sensor): check the sensor",
-                    out.stuck.dropped, out.stuck.runs, out.stuck.longest_run, out.stuck.min_run));
-  }
-  out.noise_sigma_mm = EstimateNoiseSigmaMm(rho);
-  out.despike = Despike(rho, out.noise_sigma_mm, options.despike);
-  // The noise that matters for the sigmas is that of the samples the map is built from.
-  out.noise_sigma_mm = EstimateNoiseSigmaMm(rho);
-  if (out.despike.rejected > out.valid_samples / 10) {
-    out.warnings.push_back(
-        fmt::format("despiking rejected {} of {} valid samples: check the threshold ({:.3g} um)",
-                    out.despike.rejected, out.valid_samples, out.despike.threshold_um));
-  }
+  DropStuckSensorRuns(scan, rho, options.stuck_run_deg, out);
+  DespikeAndEstimateNoise(rho, options.despike, out);
   ThrowIfInterrupted();
 
-  if (options.beam_offset_mm != 0.0) {
-    double radius = options.wheel_radius_mm;
-    if (radius <= 0 && scan.metadata.wheel_diameter_mm) radius = *scan.metadata.wheel_diameter_mm / 2.0;
-    if (radius <= 0) {
-      throw Error(ErrorCode::kInvalidOption, kStage,
-                  "the beam-offset correction needs the wheel radius: give --wheel-radius-mm or a "
-                  "wheel_diameter_mm attribute");
-    }
-    CorrectBeamOffset(rho, options.beam_offset_mm, radius);
-  }
-
-  const bool use_encoder = scan.has_encoder() && (options.rpm_source == RpmSource::kAuto ||
-                                                  options.rpm_source == RpmSource::kEncoder);
-  if (use_encoder) {
-    out.phase_source = PhaseSource::kEncoder;
-    out.rpm_used = HelixGeometry(scan, 0.0).rpm();
-  } else {
-    if (!scan.metadata.spindle_rpm) {
-      throw Error(ErrorCode::kBadInput, kStage, "'" + scan.path + "' lacks spindle_rpm");
-    }
-    out.rpm_used = *scan.metadata.spindle_rpm;
-    out.phase_source = PhaseSource::kNominal;
-    if (options.rpm_source != RpmSource::kNominal && !scan.has_encoder()) {
-      out.speed = EstimateSpindleSpeed(scan, rho, options.speed);
-      const bool forced = options.rpm_source == RpmSource::kEstimate;
-      if (out.speed.available && (out.speed.significant || forced)) {
-        out.rpm_used = out.speed.fitted_rpm;
-        out.phase_source = PhaseSource::kEstimated;
-        out.warnings.push_back(
-            fmt::format("spindle speed estimated from the data: {:.6f} rpm (nominal {:.6f}, sigma {:.2g})",
-                        out.speed.fitted_rpm, out.speed.nominal_rpm, out.speed.sigma_rpm));
-      }
-      if (!out.speed.note.empty()) out.warnings.push_back(out.speed.note);
-    }
-  }
+  CorrectBeamOffsetIfAsked(scan, rho, options);
+  ChooseSpeed(scan, rho, options, out);
   ThrowIfInterrupted();
 
   const HelixGeometry geometry(scan, out.rpm_used);

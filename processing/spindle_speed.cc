@@ -35,85 +35,115 @@ std::size_t SpreadSpacing(std::size_t turns) {
   return std::max<std::size_t>(1, (available + kMaxWindows - 1) / kMaxWindows);
 }
 
-// Bins the scan by phase at `rpm` and fits each window whose turns are 90 % covered with
-// sum_j p_j tau^j + sum_h (A_h cos(h theta) + B_h sin(h theta)); `turn` is the window's middle.
-// Windows start every `spacing` windows, at most kMaxWindows of them; `spacing` 0 spreads them
-// over the whole scan.
-std::vector<TurnHarmonics> FitTurns(const acquisition::Scan& scan, std::span<const double> z, double rpm,
-                                    int bins, int harmonics, std::size_t spacing) {
+// The scan's valid samples binned by turn and by phase within the turn: cell k * bins + b holds
+// bin b of turn k.
+struct PhaseBins {
+  std::size_t turns = 0;
+  std::size_t bins = 0;
+  std::vector<double> sum;
+  std::vector<double> position;  // sum of the samples' fractional turn positions
+  std::vector<int> count;
+};
+
+PhaseBins BinByPhase(const acquisition::Scan& scan, std::span<const double> z, double rpm, int bins) {
   const HelixGeometry geometry(scan, rpm);
   const double u0 = geometry.PhaseAt(0);
-  const auto turns =
-      static_cast<std::size_t>(std::floor((geometry.PhaseAt(scan.size() - 1) - u0) / 360.0)) + 1;
-  const auto nb = static_cast<std::size_t>(bins);
-  std::vector<double> sum(turns * nb, 0.0);
-  std::vector<double> position(turns * nb, 0.0);  // sum of the samples' fractional turn positions
-  std::vector<int> count(turns * nb, 0);
+  PhaseBins out;
+  out.turns = static_cast<std::size_t>(std::floor((geometry.PhaseAt(scan.size() - 1) - u0) / 360.0)) + 1;
+  out.bins = static_cast<std::size_t>(bins);
+  const std::size_t nb = out.bins;
+  out.sum.assign(out.turns * nb, 0.0);
+  out.position.assign(out.turns * nb, 0.0);
+  out.count.assign(out.turns * nb, 0);
   // Bins need a few samples each, not thirty: long scans are read with a stride.
-  const std::size_t sample_stride = std::max<std::size_t>(1, z.size() / (turns * nb * 4));
+  const std::size_t sample_stride = std::max<std::size_t>(1, z.size() / (out.turns * nb * 4));
   for (std::size_t i = 0; i < z.size(); i += sample_stride) {
     if (!std::isfinite(z[i])) continue;
     const double turn_position = (geometry.PhaseAt(i) - u0) / 360.0;
     const auto k = static_cast<std::size_t>(turn_position);
     const double fraction = turn_position - static_cast<double>(k);
     const auto b = std::min(nb - 1, static_cast<std::size_t>(fraction * bins));
-    sum[k * nb + b] += z[i];
-    position[k * nb + b] += fraction;
-    ++count[k * nb + b];
+    out.sum[k * nb + b] += z[i];
+    out.position[k * nb + b] += fraction;
+    ++out.count[k * nb + b];
   }
-  // Each bin enters at the mean position of its own samples, not at its centre: with a
-  // non-integer number of samples per bin the two differ, and the arc's slope through a turn
-  // would turn that difference into a phase that drifts along the axis.
+  return out;
+}
+
+// The filled cells of the window of turns starting at `first`; empty unless every turn of it has
+// at least 90 % of its bins filled.
+std::vector<std::size_t> CoveredWindowCells(const PhaseBins& bins, std::size_t first) {
+  const std::size_t nb = bins.bins;
+  std::vector<std::size_t> cells;
+  for (std::size_t k = first; k < first + static_cast<std::size_t>(kTurnsPerWindow); ++k) {
+    std::size_t filled = 0;
+    for (std::size_t b = 0; b < nb; ++b) {
+      if (bins.count[k * nb + b] > 0) {
+        cells.push_back(k * nb + b);
+        ++filled;
+      }
+    }
+    if (static_cast<double>(filled) < 0.9 * static_cast<double>(nb)) return {};
+  }
+  return cells;
+}
+
+// Fits one window's cells with sum_j p_j tau^j + sum_h (A_h cos(h theta) + B_h sin(h theta)).
+// Each bin enters at the mean position of its own samples, not at its centre: with a non-integer
+// number of samples per bin the two differ, and the arc's slope through a turn would turn that
+// difference into a phase that drifts along the axis.
+TurnHarmonics FitWindow(const PhaseBins& bins, const std::vector<std::size_t>& cells, std::size_t first,
+                        int harmonics) {
+  const std::size_t nb = bins.bins;
   const int parameters = kTrendTerms + 2 * harmonics;
-  const auto window = static_cast<std::size_t>(kTurnsPerWindow);
-  const std::size_t stride = window * (spacing > 0 ? spacing : SpreadSpacing(turns));
-  std::vector<TurnHarmonics> result;
-  for (std::size_t first = 0; first + window <= turns && result.size() < kMaxWindows; first += stride) {
-    std::vector<std::size_t> cells;
-    bool covered = true;
-    for (std::size_t k = first; k < first + window && covered; ++k) {
-      std::size_t filled = 0;
-      for (std::size_t b = 0; b < nb; ++b) {
-        if (count[k * nb + b] > 0) {
-          cells.push_back(k * nb + b);
-          ++filled;
-        }
-      }
-      covered = static_cast<double>(filled) >= 0.9 * static_cast<double>(nb);
-    }
-    if (!covered) continue;
-    const auto rows = static_cast<Eigen::Index>(cells.size());
-    Eigen::MatrixXd design(rows, parameters);
-    Eigen::VectorXd values(rows);
-    for (Eigen::Index r = 0; r < rows; ++r) {
-      const std::size_t cell = cells[static_cast<std::size_t>(r)];
-      const double fraction = position[cell] / count[cell];
-      const double in_window = static_cast<double>(cell / nb - first) + fraction;
-      const double tau = (in_window - 0.5 * kTurnsPerWindow) / kTurnsPerWindow;
-      const double theta = 2.0 * std::numbers::pi * fraction;
-      double power = 1.0;
-      for (int j = 0; j < kTrendTerms; ++j, power *= tau) design(r, j) = power;
-      for (int h = 1; h <= harmonics; ++h) {
-        design(r, kTrendTerms - 2 + 2 * h) = std::cos(h * theta);
-        design(r, kTrendTerms - 1 + 2 * h) = std::sin(h * theta);
-      }
-      values(r) = sum[cell] / count[cell];
-    }
-    const Eigen::MatrixXd normal = design.transpose() * design;
-    const Eigen::LDLT<Eigen::MatrixXd> solver(normal);
-    const Eigen::VectorXd p = solver.solve(design.transpose() * values);
-    const Eigen::MatrixXd inverse = solver.solve(Eigen::MatrixXd::Identity(parameters, parameters));
-    const double rss = (design * p - values).squaredNorm();
-    TurnHarmonics turn;
-    turn.turn = static_cast<double>(first) + 0.5 * kTurnsPerWindow;
-    turn.residual_sigma = std::sqrt(rss / std::max<double>(1.0, static_cast<double>(rows - parameters)));
+  const auto rows = static_cast<Eigen::Index>(cells.size());
+  Eigen::MatrixXd design(rows, parameters);
+  Eigen::VectorXd values(rows);
+  for (Eigen::Index r = 0; r < rows; ++r) {
+    const std::size_t cell = cells[static_cast<std::size_t>(r)];
+    const double fraction = bins.position[cell] / bins.count[cell];
+    const double in_window = static_cast<double>(cell / nb - first) + fraction;
+    const double tau = (in_window - 0.5 * kTurnsPerWindow) / kTurnsPerWindow;
+    const double theta = 2.0 * std::numbers::pi * fraction;
+    double power = 1.0;
+    for (int j = 0; j < kTrendTerms; ++j, power *= tau) design(r, j) = power;
     for (int h = 1; h <= harmonics; ++h) {
-      const int c = kTrendTerms - 2 + 2 * h;
-      turn.amplitude.emplace_back(p(c), -p(c + 1));
-      turn.amplitude_sigma.push_back(turn.residual_sigma *
-                                     std::sqrt(0.5 * (inverse(c, c) + inverse(c + 1, c + 1))));
+      design(r, kTrendTerms - 2 + 2 * h) = std::cos(h * theta);
+      design(r, kTrendTerms - 1 + 2 * h) = std::sin(h * theta);
     }
-    result.push_back(std::move(turn));
+    values(r) = bins.sum[cell] / bins.count[cell];
+  }
+  const Eigen::MatrixXd normal = design.transpose() * design;
+  const Eigen::LDLT<Eigen::MatrixXd> solver(normal);
+  const Eigen::VectorXd p = solver.solve(design.transpose() * values);
+  const Eigen::MatrixXd inverse = solver.solve(Eigen::MatrixXd::Identity(parameters, parameters));
+  const double rss = (design * p - values).squaredNorm();
+  TurnHarmonics turn;
+  turn.turn = static_cast<double>(first) + 0.5 * kTurnsPerWindow;
+  turn.residual_sigma = std::sqrt(rss / std::max<double>(1.0, static_cast<double>(rows - parameters)));
+  for (int h = 1; h <= harmonics; ++h) {
+    const int c = kTrendTerms - 2 + 2 * h;
+    turn.amplitude.emplace_back(p(c), -p(c + 1));
+    turn.amplitude_sigma.push_back(turn.residual_sigma *
+                                   std::sqrt(0.5 * (inverse(c, c) + inverse(c + 1, c + 1))));
+  }
+  return turn;
+}
+
+// Bins the scan by phase at `rpm` and fits each window whose turns are 90 % covered (FitWindow);
+// `turn` is the window's middle. Windows start every `spacing` windows, at most kMaxWindows of
+// them; `spacing` 0 spreads them over the whole scan.
+std::vector<TurnHarmonics> FitTurns(const acquisition::Scan& scan, std::span<const double> z, double rpm,
+                                    int bins, int harmonics, std::size_t spacing) {
+  const PhaseBins binned = BinByPhase(scan, z, rpm, bins);
+  const auto window = static_cast<std::size_t>(kTurnsPerWindow);
+  const std::size_t stride = window * (spacing > 0 ? spacing : SpreadSpacing(binned.turns));
+  std::vector<TurnHarmonics> result;
+  for (std::size_t first = 0; first + window <= binned.turns && result.size() < kMaxWindows;
+       first += stride) {
+    const std::vector<std::size_t> cells = CoveredWindowCells(binned, first);
+    if (cells.empty()) continue;
+    result.push_back(FitWindow(binned, cells, first, harmonics));
   }
   return result;
 }
@@ -160,6 +190,71 @@ Drift PhaseDrift(const std::vector<TurnHarmonics>& turns, int h) {
   return {slope / scale, slope_sigma / scale};
 }
 
+// The harmonics whose mean amplitude over the windows stands clear of both its own noise and the
+// amplitude floor.
+std::vector<int> HarmonicsClearOfTheNoise(const std::vector<TurnHarmonics>& turns, int harmonics,
+                                          const SpindleSpeedOptions& options) {
+  std::vector<int> usable;
+  for (int h = 1; h <= harmonics; ++h) {
+    const auto index = static_cast<std::size_t>(h - 1);
+    double mean_amplitude = 0.0;
+    double mean_sigma = 0.0;
+    for (const auto& t : turns) {
+      mean_amplitude += std::abs(t.amplitude[index]);
+      mean_sigma += t.amplitude_sigma[index];
+    }
+    mean_amplitude /= static_cast<double>(turns.size());
+    mean_sigma /= static_cast<double>(turns.size());
+    const double floor_mm = options.min_harmonic_amplitude_um / 1000.0;
+    if (mean_amplitude > std::max(options.min_harmonic_snr * mean_sigma, floor_mm)) usable.push_back(h);
+  }
+  return usable;
+}
+
+// The drifts of the usable harmonics combined: their weighted mean and its sigma.
+Drift CombineDrifts(const std::vector<TurnHarmonics>& turns, const std::vector<int>& usable) {
+  std::vector<Drift> drifts;
+  double weight_sum = 0.0;
+  double weighted = 0.0;
+  for (const int h : usable) {
+    drifts.push_back(PhaseDrift(turns, h));
+    const double w = 1.0 / std::max(drifts.back().sigma * drifts.back().sigma, 1e-30);
+    weight_sum += w;
+    weighted += w * drifts.back().delta;
+  }
+  const double delta = weighted / weight_sum;
+  double sigma_relative = std::sqrt(1.0 / weight_sum);
+  // Harmonics that disagree beyond their sigmas reveal model error (what the wheel does that the
+  // per-turn model does not describe): widen the sigma by the Birge ratio.
+  if (drifts.size() > 1) {
+    double chi2 = 0.0;
+    for (const Drift& d : drifts)
+      chi2 += (d.delta - delta) * (d.delta - delta) / std::max(d.sigma * d.sigma, 1e-30);
+    sigma_relative *= std::max(1.0, std::sqrt(chi2 / static_cast<double>(drifts.size() - 1)));
+  }
+  return {delta, sigma_relative};
+}
+
+// Turns of the scan at the nominal speed.
+double NominalTurns(const HelixGeometry& nominal, std::size_t samples) {
+  return (nominal.PhaseAt(samples - 1) - nominal.PhaseAt(0)) / 360.0;
+}
+
+void SetResult(double rpm, double sigma_relative, const SpindleSpeedOptions& options,
+               SpindleSpeedEstimate& estimate) {
+  estimate.available = true;
+  estimate.fitted_rpm = rpm;
+  estimate.sigma_rpm = sigma_relative * rpm;
+  estimate.significant =
+      std::abs(rpm - estimate.nominal_rpm) > options.significance_sigmas * estimate.sigma_rpm;
+  estimate.used_rpm = estimate.significant ? rpm : estimate.nominal_rpm;
+  if (estimate.used_first_harmonic) {
+    estimate.note =
+        "only the first harmonic (eccentricity) was usable: an axial wobble of the arc centre cannot be told "
+        "from a speed error with it";
+  }
+}
+
 }  // namespace
 
 SpindleSpeedEstimate EstimateSpindleSpeed(const acquisition::Scan& scan, std::span<const double> z,
@@ -171,8 +266,7 @@ SpindleSpeedEstimate EstimateSpindleSpeed(const acquisition::Scan& scan, std::sp
 
   const HelixGeometry nominal(scan, estimate.nominal_rpm);
   const double samples_per_turn =
-      static_cast<double>(scan.size()) /
-      std::max(1.0, (nominal.PhaseAt(scan.size() - 1) - nominal.PhaseAt(0)) / 360.0);
+      static_cast<double>(scan.size()) / std::max(1.0, NominalTurns(nominal, scan.size()));
   const int bins = static_cast<int>(std::clamp(samples_per_turn / 2.0, 16.0, 360.0));
   const int harmonics = std::clamp(options.max_harmonic, 1, std::max(1, bins / 2 - 3));
 
@@ -180,8 +274,7 @@ SpindleSpeedEstimate EstimateSpindleSpeed(const acquisition::Scan& scan, std::sp
   // slips 95 deg of the first harmonic in 132 turns), so the estimate starts on adjacent windows
   // and spreads them at most kSpreadGrowth times wider at each iteration, out to the whole scan.
   constexpr std::size_t kSpreadGrowth = 8;
-  const auto scan_turns = static_cast<std::size_t>(
-      std::max(0.0, (nominal.PhaseAt(scan.size() - 1) - nominal.PhaseAt(0)) / 360.0));
+  const auto scan_turns = static_cast<std::size_t>(std::max(0.0, NominalTurns(nominal, scan.size())));
   const std::size_t widest = SpreadSpacing(scan_turns);
   std::size_t spacing = 1;
   double rpm = estimate.nominal_rpm;
@@ -194,60 +287,20 @@ SpindleSpeedEstimate EstimateSpindleSpeed(const acquisition::Scan& scan, std::sp
       return estimate;
     }
     estimate.turns_used = static_cast<int>(turns.size());
-    std::vector<int> usable;
-    for (int h = 1; h <= harmonics; ++h) {
-      const auto index = static_cast<std::size_t>(h - 1);
-      double mean_amplitude = 0.0;
-      double mean_sigma = 0.0;
-      for (const auto& t : turns) {
-        mean_amplitude += std::abs(t.amplitude[index]);
-        mean_sigma += t.amplitude_sigma[index];
-      }
-      mean_amplitude /= static_cast<double>(turns.size());
-      mean_sigma /= static_cast<double>(turns.size());
-      const double floor_mm = options.min_harmonic_amplitude_um / 1000.0;
-      if (mean_amplitude > std::max(options.min_harmonic_snr * mean_sigma, floor_mm)) usable.push_back(h);
-    }
+    std::vector<int> usable = HarmonicsClearOfTheNoise(turns, harmonics, options);
     const bool only_first = usable.size() == 1 && usable.front() == 1;
     if (!only_first) std::erase(usable, 1);
     if (usable.empty()) {
       estimate.note = "the wheel shows no harmonic clear of the noise; the nominal speed is used";
       return estimate;
     }
-    std::vector<Drift> drifts;
-    double weight_sum = 0.0;
-    double weighted = 0.0;
-    for (const int h : usable) {
-      drifts.push_back(PhaseDrift(turns, h));
-      const double w = 1.0 / std::max(drifts.back().sigma * drifts.back().sigma, 1e-30);
-      weight_sum += w;
-      weighted += w * drifts.back().delta;
-    }
-    const double delta = weighted / weight_sum;
-    sigma_relative = std::sqrt(1.0 / weight_sum);
-    // Harmonics that disagree beyond their sigmas reveal model error (what the wheel does that the
-    // per-turn model does not describe): widen the sigma by the Birge ratio.
-    if (drifts.size() > 1) {
-      double chi2 = 0.0;
-      for (const Drift& d : drifts)
-        chi2 += (d.delta - delta) * (d.delta - delta) / std::max(d.sigma * d.sigma, 1e-30);
-      sigma_relative *= std::max(1.0, std::sqrt(chi2 / static_cast<double>(drifts.size() - 1)));
-    }
-    rpm *= 1.0 + delta;
+    const Drift drift = CombineDrifts(turns, usable);
+    sigma_relative = drift.sigma;
+    rpm *= 1.0 + drift.delta;
     estimate.harmonics_used = static_cast<int>(usable.size());
     estimate.used_first_harmonic = only_first;
   }
-  estimate.available = true;
-  estimate.fitted_rpm = rpm;
-  estimate.sigma_rpm = sigma_relative * rpm;
-  estimate.significant =
-      std::abs(rpm - estimate.nominal_rpm) > options.significance_sigmas * estimate.sigma_rpm;
-  estimate.used_rpm = estimate.significant ? rpm : estimate.nominal_rpm;
-  if (estimate.used_first_harmonic) {
-    estimate.note =
-        "only the first harmonic (eccentricity) was usable: an axial wobble of the arc centre cannot be told "
-        "from a speed error with it";
-  }
+  SetResult(rpm, sigma_relative, options, estimate);
   return estimate;
 }
 

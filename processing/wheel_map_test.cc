@@ -1,0 +1,153 @@
+#include "processing/wheel_map.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <numeric>
+#include <vector>
+
+#include "acquisition/simulate.h"
+#include "core/error.h"
+#include "processing/helix_geometry.h"
+
+namespace arcwheel::processing {
+namespace {
+
+// A small scan of the lobed test wheel without noise: 500 rpm, 3 deg a sample (starting off the
+// 10 deg phase nodes, so no sample sits on a cell boundary), a 0.5 mm pitch, 24 turns.
+acquisition::ScanSettings SmallScan() {
+  acquisition::ScanSettings s;
+  s.sample_period_s = 1e-3;
+  s.feed_mm_per_min = 250.0;
+  s.start_phase_deg = 0.7;
+  s.start_y_mm = -6.0;
+  s.end_y_mm = 6.0;
+  return s;
+}
+
+// Where sample i lies, from the simulator's settings (no encoder, no time or axial column).
+double PhaseOfSample(const acquisition::ScanSettings& s, std::size_t i) {
+  return s.start_phase_deg + 6.0 * s.spindle_rpm_true * s.sample_period_s * static_cast<double>(i);
+}
+double AxialOfSample(const acquisition::ScanSettings& s, std::size_t i) {
+  return s.start_y_mm + s.feed_mm_per_min / 60.0 * s.sample_period_s * static_cast<double>(i);
+}
+
+// The true reading at (phase, y): the rim's radius less the sensor's zero.
+double TrueRhoMm(const acquisition::WheelModel& wheel, const acquisition::ScanSettings& s, double phase_deg,
+                 double y_mm) {
+  return wheel.SmoothRadiusMm(phase_deg, y_mm) - s.sensor_zero_radius_mm;
+}
+
+// The map cell (phase node, axial node) nearest to sample i, or -1 outside the axial nodes.
+long NearestCell(const acquisition::ScanSettings& s, const WheelMap& map, std::size_t i) {
+  const double phase_step = 360.0 / static_cast<double>(map.n_phase());
+  const double c = std::fmod(PhaseOfSample(s, i), 360.0);
+  const auto j = static_cast<std::size_t>(std::round(c / phase_step)) % map.n_phase();
+  const double m = std::round((AxialOfSample(s, i) - map.y_mm.front()) / map.axial_step_mm);
+  if (m < 0 || m >= static_cast<double>(map.n_y())) return -1;
+  return static_cast<long>(j * map.n_y() + static_cast<std::size_t>(m));
+}
+
+// How far a map node may lie from the true rim. Inside, the tolerance covers the helix spline's
+// approximation of the lobes at 10 deg knots and its penalty (a few nm) with a wide margin. At
+// the two outermost nodes at each end the axial interpolation's natural end condition (zero
+// curvature where the arc has curvature kappa ~ 1 / 55 mm) costs up to about what linear
+// interpolation over a pitch h would, kappa h^2 / 8 = 0.58 um at h = 0.5 mm.
+double MapToleranceMm(const WheelMap& map, std::size_t m) {
+  const bool outermost = m < 2 || m + 2 >= map.n_y();
+  return outermost ? 0.5 * 0.5 / 55.0 / 8.0 : 2e-5;
+}
+
+TEST(BuildWheelMap, MapsASimulatedWheelOntoItsTrueRadiiAndCountsTheSamplesPerCell) {
+  const acquisition::WheelModel wheel = acquisition::LobedTestWheel();
+  const acquisition::ScanSettings settings = SmallScan();
+  const acquisition::Scan scan = acquisition::SimulateScan(wheel, settings).scan;
+  const std::vector<std::size_t> despiked = {10, 500, 501, 2000};
+  const WheelMap map = BuildWheelMap(scan.z_mm, HelixGeometry(scan, settings.spindle_rpm_nominal), 1e-3,
+                                     despiked, {.phases = 36});
+
+  ASSERT_EQ(map.n_phase(), 36u);
+  EXPECT_DOUBLE_EQ(map.pitch_mm, 0.5);
+  EXPECT_DOUBLE_EQ(map.axial_step_mm, 0.5);
+  EXPECT_DOUBLE_EQ(map.knot_step_deg, 10.0);  // 360 / 36, already >= 2.5 samples of 3 deg
+  ASSERT_GE(map.n_y(), 20u);
+  for (std::size_t m = 1; m < map.n_y(); ++m) EXPECT_NEAR(map.y_mm[m] - map.y_mm[m - 1], 0.5, 1e-12);
+
+  // Every section point lies on the true rim (the helix spline alone, as MapToleranceMm inside).
+  for (std::size_t j = 0; j < map.n_phase(); ++j) {
+    const Section& section = map.sections[j];
+    ASSERT_GE(section.y_mm.size(), 20u) << "phase " << map.phase_deg[j];
+    for (std::size_t k = 0; k < section.y_mm.size(); ++k) {
+      EXPECT_NEAR(section.rho_mm[k], TrueRhoMm(wheel, settings, map.phase_deg[j], section.y_mm[k]), 2e-5)
+          << "phase " << map.phase_deg[j] << ", y " << section.y_mm[k];
+    }
+  }
+  for (std::size_t j = 0; j < map.n_phase(); ++j) {
+    for (std::size_t m = 0; m < map.n_y(); ++m) {
+      EXPECT_NEAR(map.rho(j, m), TrueRhoMm(wheel, settings, map.phase_deg[j], map.y_mm[m]),
+                  MapToleranceMm(map, m))
+          << "phase " << map.phase_deg[j] << ", y " << map.y_mm[m];
+    }
+  }
+
+  // Counts of the samples nearest each cell, from the simulator's own timing.
+  std::vector<int> expected(map.n_phase() * map.n_y(), 0), expected_despiked(expected.size(), 0);
+  for (std::size_t i = 0; i < scan.size(); ++i) {
+    const long cell = NearestCell(settings, map, i);
+    if (cell >= 0 && std::isfinite(scan.z_mm[i])) ++expected[static_cast<std::size_t>(cell)];
+  }
+  for (const std::size_t i : despiked) {
+    const long cell = NearestCell(settings, map, i);
+    if (cell >= 0) ++expected_despiked[static_cast<std::size_t>(cell)];
+  }
+  EXPECT_EQ(map.sample_count, expected);
+  EXPECT_EQ(map.despiked_count, expected_despiked);
+  // About 120 samples a turn over 36 cells: 3 or 4 each inside the nodes' span.
+  EXPECT_GT(std::accumulate(expected.begin(), expected.end(), 0), 3 * static_cast<int>(expected.size()));
+}
+
+TEST(BuildWheelMap, LeavesCellsWithoutSamplesEmptyAndKeepsTheRest) {
+  const acquisition::WheelModel wheel = acquisition::LobedTestWheel();
+  const acquisition::ScanSettings settings = SmallScan();
+  acquisition::Scan scan = acquisition::SimulateScan(wheel, settings).scan;
+  // No valid sample over 3.4 pitches of the axis, at every phase.
+  constexpr double kGapLowMm = -0.9, kGapHighMm = 0.8;
+  for (std::size_t i = 0; i < scan.size(); ++i) {
+    const double y = AxialOfSample(settings, i);
+    if (y >= kGapLowMm && y <= kGapHighMm) scan.z_mm[i] = std::nan("");
+  }
+  const WheelMap map =
+      BuildWheelMap(scan.z_mm, HelixGeometry(scan, settings.spindle_rpm_nominal), 1e-3, {}, {.phases = 36});
+
+  int empty_in_gap = 0;
+  for (std::size_t j = 0; j < map.n_phase(); ++j) {
+    for (std::size_t m = 0; m < map.n_y(); ++m) {
+      const double y = map.y_mm[m];
+      const auto cell = j * map.n_y() + m;
+      if (y > kGapLowMm + 0.25 && y < kGapHighMm - 0.25) {
+        // No sample is nearest this node, and no section point lies within a pitch of it.
+        EXPECT_EQ(map.sample_count[cell], 0) << "y " << y;
+        EXPECT_TRUE(std::isnan(map.rho(j, m))) << "phase " << map.phase_deg[j] << ", y " << y;
+        empty_in_gap += std::isnan(map.rho(j, m)) ? 1 : 0;
+      } else if (y < kGapLowMm - 1.0 || y > kGapHighMm + 1.0) {
+        // More than two pitches from the gap the sections are whole and the map is the wheel.
+        EXPECT_NEAR(map.rho(j, m), TrueRhoMm(wheel, settings, map.phase_deg[j], y), MapToleranceMm(map, m))
+            << "phase " << map.phase_deg[j] << ", y " << y;
+      }
+    }
+  }
+  EXPECT_GE(empty_in_gap, 36 * 2);
+  // No section point rests on the gap.
+  for (const Section& section : map.sections) {
+    for (const double y : section.y_mm) EXPECT_FALSE(y > kGapLowMm + 0.05 && y < kGapHighMm - 0.05) << y;
+  }
+}
+
+TEST(BuildWheelMap, RefusesOptionsOutOfRange) {
+  const acquisition::Scan scan = acquisition::SimulateScan(acquisition::LobedTestWheel(), SmallScan()).scan;
+  EXPECT_THROW((void)BuildWheelMap(scan.z_mm, HelixGeometry(scan, 500.0), 1e-3, {}, {.phases = 3}), Error);
+}
+
+}  // namespace
+}  // namespace arcwheel::processing

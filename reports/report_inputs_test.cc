@@ -50,7 +50,8 @@ TEST(ReadReportInputs, ReadsBackTheFixtureValues) {
   EXPECT_DOUBLE_EQ(s.phases.phase_deg[9], 90.0);
   EXPECT_DOUBLE_EQ(s.phases.arc_radius_mm[9], testing::FixtureArcRadius_mm(90.0));
   EXPECT_EQ(s.scan.at("wheel_id"), "W17-arc75");
-  EXPECT_EQ(s.processing.at("despike").at("threshold_um"), 5.0);
+  EXPECT_EQ(s.processing.at("despike_threshold_um"), 5.0);
+  EXPECT_EQ(s.processing.at("fit_span"), "band");
   ASSERT_EQ(s.warnings.size(), 1u);
 
   const WheelMapData& map = inputs.map;

@@ -168,6 +168,18 @@ TEST(ParsePolishSummary, RefusesMissingOrMistypedKeysByDottedName) {
   }
 }
 
+// kSummary records no schema_version, as files written before 1.0: it is read (test above).
+TEST(ParsePolishSummary, ReadsTheSameMajorVersionAndRefusesANewerOne) {
+  nlohmann::json summary = nlohmann::json::parse(kSummary);
+  summary["schema_version"] = "1.2";
+  EXPECT_EQ(ParsePolishSummary(summary.dump(), "sum.json").points, 3);
+  summary["schema_version"] = "2.0";
+  const Error error = ErrorOf([&] { (void)ParsePolishSummary(summary.dump(), "out/polish_summary.json"); });
+  EXPECT_EQ(error.code(), ErrorCode::kBadInput);
+  EXPECT_THAT(error.what(), HasSubstr("'out/polish_summary.json' key 'schema_version' = '2.0'"));
+  EXPECT_THAT(error.what(), HasSubstr("reads schema version 1.x only"));
+}
+
 TEST(ReadPolishReportInputs, RefusesFilesThatDisagreeAndNamesMissingFiles) {
   TempDir dir;
   std::ofstream(dir / "polish_summary.json") << kSummary;

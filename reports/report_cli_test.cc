@@ -80,6 +80,17 @@ TEST(ReportCommand, RefusesASummaryMissingAKeyAndWritesNothing) {
   EXPECT_EQ(ListFolder(dir.path()), "summary.json\nwheel_map.h5\n");
 }
 
+TEST(ReportCommand, RefusesASummaryOfANewerSchemaMajorVersionAsBadInput) {
+  TempDir dir;
+  nlohmann::json summary = testing::FixtureSummary({.n_phase = 12, .n_y = 21});
+  summary["schema_version"] = "3.1";
+  testing::WriteFixture(dir.path(), {.n_phase = 12, .n_y = 21}, summary);
+  const auto result = RunArcwheel("report '" + dir.path().string() + "'");
+  EXPECT_EQ(result.exit_status, 3) << result.output;
+  EXPECT_THAT(result.output, HasSubstr("summary.json' key 'schema_version' = '3.1'"));
+  EXPECT_EQ(ListFolder(dir.path()), "summary.json\nwheel_map.h5\n");
+}
+
 TEST(ReportCommand, RefusesAMalformedToleranceFlag) {
   TempDir dir;
   testing::WriteFixture(dir.path(), {.n_phase = 12, .n_y = 21});

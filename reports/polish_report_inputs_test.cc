@@ -12,19 +12,9 @@
 namespace arcwheel::reports {
 namespace {
 
+using arcwheel::testing::ErrorOf;
 using arcwheel::testing::TempDir;
 using ::testing::HasSubstr;
-
-template <typename Read>
-Error ErrorOf(const Read& read) {
-  try {
-    read();
-  } catch (const Error& error) {
-    return error;
-  }
-  ADD_FAILURE() << "no Error thrown";
-  return Error(ErrorCode::kInternal, "test", "no error");
-}
 
 // A 3 x 2 grid (x = -2, 0, 2 mm; y = 5, 6 mm) with the node (2, 6) missing, rows in any order.
 constexpr const char* kResidual =

@@ -15,27 +15,12 @@
 namespace arcwheel::reports {
 namespace {
 
-namespace fs = std::filesystem;
 using arcwheel::testing::ListFolder;
+using arcwheel::testing::PdfText;
+using arcwheel::testing::ReadText;
 using arcwheel::testing::RunArcwheel;
 using arcwheel::testing::TempDir;
 using ::testing::HasSubstr;
-
-std::string ReadText(const fs::path& path) {
-  std::ifstream stream(path, std::ios::binary);
-  std::ostringstream text;
-  text << stream.rdbuf();
-  return text.str();
-}
-
-std::string PdfText(const fs::path& pdf) {
-  const fs::path text = fs::path(pdf).replace_extension(".txt");
-  const std::string command = "pdftotext -enc UTF-8 '" + pdf.string() + "' '" + text.string() + "'";
-  EXPECT_EQ(std::system(command.c_str()), 0) << command;
-  std::string contents = ReadText(text);
-  fs::remove(text);
-  return contents;
-}
 
 TEST(ReportCommand, WritesBothReportsAndJudgesAToleranceFile) {
   TempDir dir;

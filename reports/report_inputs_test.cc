@@ -14,23 +14,12 @@
 namespace arcwheel::reports {
 namespace {
 
+using arcwheel::testing::ErrorOf;
 using arcwheel::testing::TempDir;
 using testing::FixtureOptions;
 using testing::FixtureSummary;
 using ::testing::HasSubstr;
 using testing::WriteFixture;
-
-// Runs `read` and returns the Error it throws; fails the test if it throws nothing.
-template <typename Read>
-Error ErrorOf(const Read& read) {
-  try {
-    read();
-  } catch (const Error& error) {
-    return error;
-  }
-  ADD_FAILURE() << "no Error thrown";
-  return Error(ErrorCode::kInternal, "test", "no error");
-}
 
 TEST(ReadReportInputs, ReadsBackTheFixtureValues) {
   TempDir dir;

@@ -22,6 +22,8 @@ namespace arcwheel::reports {
 namespace {
 
 namespace fs = std::filesystem;
+using arcwheel::testing::ReadText;
+using arcwheel::testing::Shell;
 using arcwheel::testing::TempDir;
 using testing::BrowserRun;
 using testing::FixtureOptions;
@@ -34,19 +36,6 @@ using testing::WriteFixture;
 // mm with 4 decimals (mean radius and sigma with 5), um with 2, percent with 3.
 const std::vector<std::string> kFixtureHeadline = {
     "75.01234 ± 0.00021 mm", "0.0061 mm", "0.008 %", "0.0043 mm", "1.58 µm", "7.13 µm", "3.47 µm"};
-
-std::string ReadText(const fs::path& path) {
-  std::ifstream stream(path, std::ios::binary);
-  std::ostringstream text;
-  text << stream.rdbuf();
-  return text.str();
-}
-
-// Runs a shell command, returning its exit status; output goes where the command redirects it.
-int Shell(const std::string& command) {
-  const int status = std::system(command.c_str());
-  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-}
 
 Tolerances FixtureTolerances() {
   Tolerances t;

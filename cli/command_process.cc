@@ -18,6 +18,8 @@
 #include "processing/process_scan.h"
 #include "reports/report.h"
 #include "reports/tolerances.h"
+#include "schema/summary.h"
+#include "schema/wheel_map.h"
 
 namespace arcwheel::cli {
 namespace {
@@ -46,34 +48,36 @@ fitting::RunRecord MakeRecord(const ProcessArgs& args, const acquisition::Scan& 
   record.metadata = scan.metadata;
   record.has_encoder = scan.has_encoder();
   const auto& p = args.processing;
+  namespace parameter = schema::summary::processing;
   record.numeric_parameters = {
-      {"phases", p.map.phases},
-      {"band_half_width_mm", args.fit.band_half_width_mm},
-      {"despike_window_half_width", p.despike.window_half_width},
-      {"despike_threshold_um", p.despike.threshold_um},
-      {"despike_threshold_sigmas", p.despike.threshold_sigmas},
-      {"despike_min_threshold_um", p.despike.min_threshold_um},
-      {"speed_max_harmonic", p.speed.max_harmonic},
-      {"speed_significance_sigmas", p.speed.significance_sigmas},
-      {"map_min_support", p.map.min_support},
-      {"map_max_sigma_ratio", p.map.max_sigma_ratio},
-      {"fit_min_points", args.fit.min_points},
-      {"fit_min_band_coverage", args.fit.min_band_coverage},
-      {"runout_min_phase_coverage", args.fit.min_phase_coverage},
-      {"beam_offset_mm", p.beam_offset_mm},
-      {"wheel_radius_mm", p.wheel_radius_mm},
-      {"stuck_run_deg", p.stuck_run_deg},
+      {std::string(parameter::kPhases), p.map.phases},
+      {std::string(parameter::kBandHalfWidthMm), args.fit.band_half_width_mm},
+      {std::string(parameter::kDespikeWindowHalfWidth), p.despike.window_half_width},
+      {std::string(parameter::kDespikeThresholdUm), p.despike.threshold_um},
+      {std::string(parameter::kDespikeThresholdSigmas), p.despike.threshold_sigmas},
+      {std::string(parameter::kDespikeMinThresholdUm), p.despike.min_threshold_um},
+      {std::string(parameter::kSpeedMaxHarmonic), p.speed.max_harmonic},
+      {std::string(parameter::kSpeedSignificanceSigmas), p.speed.significance_sigmas},
+      {std::string(parameter::kMapMinSupport), p.map.min_support},
+      {std::string(parameter::kMapMaxSigmaRatio), p.map.max_sigma_ratio},
+      {std::string(parameter::kFitMinPoints), args.fit.min_points},
+      {std::string(parameter::kFitMinBandCoverage), args.fit.min_band_coverage},
+      {std::string(parameter::kRunoutMinPhaseCoverage), args.fit.min_phase_coverage},
+      {std::string(parameter::kBeamOffsetMm), p.beam_offset_mm},
+      {std::string(parameter::kWheelRadiusMm), p.wheel_radius_mm},
+      {std::string(parameter::kStuckRunDeg), p.stuck_run_deg},
   };
-  record.text_parameters = {{"despike_method", args.despike_method},
-                            {"rpm_source", args.rpm_source},
-                            {"fit_span", args.fit_span},
-                            {"filter", "none"}};
+  record.text_parameters = {{std::string(parameter::kDespikeMethod), args.despike_method},
+                            {std::string(parameter::kRpmSource), args.rpm_source},
+                            {std::string(parameter::kFitSpan), args.fit_span},
+                            {std::string(parameter::kFilter), "none"}};
   return record;
 }
 
 void PrintHeadline(const ProcessArgs& args, const processing::ProcessedScan& p, const fitting::WheelFit& f) {
   const std::filesystem::path out(args.outdir);
-  fmt::print("summary: {}\nmap:     {}\n", (out / "summary.json").string(), (out / "wheel_map.h5").string());
+  fmt::print("summary: {}\nmap:     {}\n", (out / schema::summary::kFileName).string(),
+             (out / schema::wheel_map::kFileName).string());
   fmt::print("samples {} (valid {}, despiked {}); noise {:.3f} um; spindle {:.4f} rpm ({})\n", p.samples,
              p.valid_samples, p.despike.rejected, p.noise_sigma_mm * 1000.0, p.rpm_used,
              p.phase_source == processing::PhaseSource::kEncoder     ? "encoder"

@@ -14,6 +14,8 @@
 #include "reports/polish_report.h"
 #include "reports/report.h"
 #include "reports/tolerances.h"
+#include "schema/polish_outputs.h"
+#include "schema/summary.h"
 
 namespace arcwheel::cli {
 namespace {
@@ -29,8 +31,8 @@ void RunWheelReport(const ReportArguments& arguments);
 void RunReport(const ReportArguments& arguments) {
   // A folder written by `arcwheel polish` gets the polishing report, one written by `process` the
   // wheel report (and a folder with neither the wheel report's refusal).
-  const bool polish = std::filesystem::exists(arguments.outdir / "polish_summary.json");
-  const bool wheel = std::filesystem::exists(arguments.outdir / "summary.json");
+  const bool polish = std::filesystem::exists(arguments.outdir / schema::polish::kSummaryFileName);
+  const bool wheel = std::filesystem::exists(arguments.outdir / schema::summary::kFileName);
   if (polish && !wheel && (!arguments.tolerance_file.empty() || !arguments.tolerance_flags.empty())) {
     throw Error(
         ErrorCode::kInvalidOption, "reports",

@@ -8,11 +8,15 @@
 #include "core/error.h"
 #include "core/hdf5.h"
 #include "core/version.h"
+#include "schema/summary.h"
+#include "schema/wheel_map.h"
 
 namespace arcwheel::fitting {
 namespace {
 
 using nlohmann::json;
+namespace key = schema::summary;
+namespace h5 = schema::wheel_map;
 
 // JSON has no NaN: a number that could not be computed is null.
 json Number(double value) { return std::isfinite(value) ? json(value) : json(nullptr); }
@@ -39,29 +43,29 @@ std::string PhaseSourceName(processing::PhaseSource source) {
 
 json PhasesJson(const processing::WheelMap& map, const WheelFit& fit) {
   json phases;
-  phases["phase_deg"] = map.phase_deg;
+  phases[key::phases::kPhaseDeg] = map.phase_deg;
   const auto column = [&](auto member) {
     json list = json::array();
     for (const PhaseFit& p : fit.phases) list.push_back(p.usable ? Number(p.*member) : json(nullptr));
     return list;
   };
-  phases["arc_radius_mm"] = column(&PhaseFit::arc_radius_mm);
-  phases["arc_radius_sigma_mm"] = column(&PhaseFit::arc_radius_sigma_mm);
-  phases["center_axial_mm"] = column(&PhaseFit::center_axial_mm);
-  phases["center_axial_sigma_mm"] = column(&PhaseFit::center_axial_sigma_mm);
-  phases["center_radial_mm"] = column(&PhaseFit::center_radial_mm);
-  phases["center_radial_sigma_mm"] = column(&PhaseFit::center_radial_sigma_mm);
-  phases["arc_error_um"] = column(&PhaseFit::arc_error_um);
-  phases["chi2_per_dof"] = column(&PhaseFit::chi2_per_dof);
+  phases[key::phases::kArcRadiusMm] = column(&PhaseFit::arc_radius_mm);
+  phases[key::phases::kArcRadiusSigmaMm] = column(&PhaseFit::arc_radius_sigma_mm);
+  phases[key::phases::kCenterAxialMm] = column(&PhaseFit::center_axial_mm);
+  phases[key::phases::kCenterAxialSigmaMm] = column(&PhaseFit::center_axial_sigma_mm);
+  phases[key::phases::kCenterRadialMm] = column(&PhaseFit::center_radial_mm);
+  phases[key::phases::kCenterRadialSigmaMm] = column(&PhaseFit::center_radial_sigma_mm);
+  phases[key::phases::kArcErrorUm] = column(&PhaseFit::arc_error_um);
+  phases[key::phases::kChi2PerDof] = column(&PhaseFit::chi2_per_dof);
   json points = json::array(), usable = json::array(), flag = json::array();
   for (const PhaseFit& p : fit.phases) {
     points.push_back(p.points);
     usable.push_back(p.usable);
     flag.push_back(p.flag);
   }
-  phases["points_in_band"] = points;
-  phases["usable"] = usable;
-  phases["flag"] = flag;
+  phases[key::phases::kPointsInBand] = points;
+  phases[key::phases::kUsable] = usable;
+  phases[key::phases::kFlag] = flag;
   return phases;
 }
 
@@ -71,45 +75,47 @@ void WriteMap(const std::filesystem::path& path, const RunRecord& record,
   hdf5::File file = hdf5::File::Create(path);
   const hsize_t n_phase = map.n_phase();
   const hsize_t n_y = map.n_y();
-  file.CreateGroup("/map");
-  file.WriteDoubles("/map/phase_deg", map.phase_deg, {n_phase});
-  file.WriteDoubles("/map/y_mm", map.y_mm, {n_y});
-  file.WriteDoubles("/map/rho", map.rho_mm, {n_phase, n_y});
-  file.WriteDoubles("/map/form_error_um", fit.form_error_um, {n_phase, n_y});
-  file.WriteInts("/map/sample_count", map.sample_count, {n_phase, n_y});
-  file.WriteInts("/map/despiked_count", map.despiked_count, {n_phase, n_y});
-  file.CreateGroup("/fit");
-  const auto column = [&](const char* name, auto member) {
+  file.CreateGroup(std::string(h5::kMapGroup));
+  file.WriteDoubles(std::string(h5::kMapPhaseDeg), map.phase_deg, {n_phase});
+  file.WriteDoubles(std::string(h5::kMapYMm), map.y_mm, {n_y});
+  file.WriteDoubles(std::string(h5::kMapRhoMm), map.rho_mm, {n_phase, n_y});
+  file.WriteDoubles(std::string(h5::kMapFormErrorUm), fit.form_error_um, {n_phase, n_y});
+  file.WriteInts(std::string(h5::kMapSampleCount), map.sample_count, {n_phase, n_y});
+  file.WriteInts(std::string(h5::kMapDespikedCount), map.despiked_count, {n_phase, n_y});
+  file.CreateGroup(std::string(h5::kFitGroup));
+  const auto column = [&](std::string_view dataset, auto member) {
     std::vector<double> values;
     for (const PhaseFit& p : fit.phases) values.push_back(p.usable ? p.*member : std::nan(""));
-    file.WriteDoubles(std::string("/fit/") + name, values, {n_phase});
+    file.WriteDoubles(std::string(dataset), values, {n_phase});
   };
-  column("arc_radius_mm", &PhaseFit::arc_radius_mm);
-  column("arc_radius_sigma_mm", &PhaseFit::arc_radius_sigma_mm);
-  column("center_axial_mm", &PhaseFit::center_axial_mm);
-  column("center_axial_sigma_mm", &PhaseFit::center_axial_sigma_mm);
-  column("center_radial_mm", &PhaseFit::center_radial_mm);
-  column("center_radial_sigma_mm", &PhaseFit::center_radial_sigma_mm);
-  column("arc_error_um", &PhaseFit::arc_error_um);
+  column(h5::kFitArcRadiusMm, &PhaseFit::arc_radius_mm);
+  column(h5::kFitArcRadiusSigmaMm, &PhaseFit::arc_radius_sigma_mm);
+  column(h5::kFitCenterAxialMm, &PhaseFit::center_axial_mm);
+  column(h5::kFitCenterAxialSigmaMm, &PhaseFit::center_axial_sigma_mm);
+  column(h5::kFitCenterRadialMm, &PhaseFit::center_radial_mm);
+  column(h5::kFitCenterRadialSigmaMm, &PhaseFit::center_radial_sigma_mm);
+  column(h5::kFitArcErrorUm, &PhaseFit::arc_error_um);
   std::vector<int> usable, points;
   for (const PhaseFit& p : fit.phases) {
     usable.push_back(p.usable ? 1 : 0);
     points.push_back(p.points);
   }
-  file.WriteInts("/fit/usable", usable, {n_phase});
-  file.WriteInts("/fit/points_in_band", points, {n_phase});
-  file.CreateGroup("/axial");
+  file.WriteInts(std::string(h5::kFitUsable), usable, {n_phase});
+  file.WriteInts(std::string(h5::kFitPointsInBand), points, {n_phase});
+  file.CreateGroup(std::string(h5::kAxialGroup));
   const hsize_t n_band = fit.axial_y_mm.size();
-  file.WriteDoubles("/axial/y_mm", fit.axial_y_mm, {n_band});
-  file.WriteDoubles("/axial/runout_um", fit.runout_um, {n_band});
-  file.WriteDoubles("/axial/roundness_um", fit.roundness_um, {n_band});
-  file.WriteAttribute("/", "arcwheel_version", std::string(kVersion));
-  file.WriteAttribute("/", "input_path", record.input_path);
-  file.WriteAttribute("/", "input_sha256", record.input_sha256);
-  file.WriteAttribute("/", "noise_sigma_um", processed.noise_sigma_mm * 1000.0);
-  file.WriteAttribute("/", "spindle_rpm_used", processed.rpm_used);
-  for (const auto& [name, value] : record.numeric_parameters) file.WriteAttribute("/", name, value);
-  for (const auto& [name, value] : record.text_parameters) file.WriteAttribute("/", name, value);
+  file.WriteDoubles(std::string(h5::kAxialYMm), fit.axial_y_mm, {n_band});
+  file.WriteDoubles(std::string(h5::kAxialRunoutUm), fit.runout_um, {n_band});
+  file.WriteDoubles(std::string(h5::kAxialRoundnessUm), fit.roundness_um, {n_band});
+  const std::string root(h5::kRoot);
+  file.WriteAttribute(root, std::string(h5::kSchemaVersionAttribute), schema::VersionText(h5::kVersion));
+  file.WriteAttribute(root, std::string(h5::kArcwheelVersionAttribute), std::string(kVersion));
+  file.WriteAttribute(root, std::string(h5::kInputPathAttribute), record.input_path);
+  file.WriteAttribute(root, std::string(h5::kInputSha256Attribute), record.input_sha256);
+  file.WriteAttribute(root, std::string(h5::kNoiseSigmaUmAttribute), processed.noise_sigma_mm * 1000.0);
+  file.WriteAttribute(root, std::string(h5::kSpindleRpmUsedAttribute), processed.rpm_used);
+  for (const auto& [name, value] : record.numeric_parameters) file.WriteAttribute(root, name, value);
+  for (const auto& [name, value] : record.text_parameters) file.WriteAttribute(root, name, value);
 }
 
 }  // namespace
@@ -119,80 +125,82 @@ std::string SummaryJson(const RunRecord& record, const processing::ProcessedScan
   const processing::WheelMap& map = processed.map;
   const acquisition::ScanMetadata& m = record.metadata;
   json s;
-  s["arcwheel_version"] = kVersion;
-  s["input"] = {{"path", record.input_path},
-                {"sha256", record.input_sha256},
-                {"format", record.input_format},
-                {"samples", processed.samples},
-                {"valid_samples", processed.valid_samples},
-                {"despiked_samples", processed.despike.rejected},
-                {"stuck_samples", processed.stuck.dropped}};
-  s["scan"] = {{"wheel_id", m.wheel_id},
-               {"sensor", m.sensor},
-               {"operator", m.operator_name},
-               {"timestamp", m.timestamp},
-               {"wheel_diameter_mm", Optional(m.wheel_diameter_mm)},
-               {"wheel_width_mm", Optional(m.wheel_width_mm)},
-               {"feed_mm_per_min", Optional(m.feed_mm_per_min)},
-               {"sample_period_s", Optional(m.sample_period_s)},
-               {"radius_sign", m.radius_sign},
-               {"start_y_mm", m.start_y_mm},
-               {"has_encoder", record.has_encoder},
-               {"first_valid_sample", processed.first_valid},
-               {"last_valid_sample", processed.last_valid}};
-  s["spindle_rpm_nominal"] = Optional(m.spindle_rpm);
-  s["spindle_rpm_estimated"] = processed.rpm_used;
-  s["spindle_rpm_source"] = PhaseSourceName(processed.phase_source);
-  s["spindle_rpm_sigma"] = processed.speed.available ? json(processed.speed.sigma_rpm) : json(nullptr);
-  s["spindle_rpm_fitted"] = processed.speed.available ? json(processed.speed.fitted_rpm) : json(nullptr);
-  s["noise_sigma_um"] = processed.noise_sigma_mm * 1000.0;
+  s[key::kSchemaVersion] = schema::VersionText(key::kVersion);
+  s[key::kArcwheelVersion] = kVersion;
+  s[key::kInput] = {{key::input::kPath, record.input_path},
+                    {key::input::kSha256, record.input_sha256},
+                    {key::input::kFormat, record.input_format},
+                    {key::input::kSamples, processed.samples},
+                    {key::input::kValidSamples, processed.valid_samples},
+                    {key::input::kDespikedSamples, processed.despike.rejected},
+                    {key::input::kStuckSamples, processed.stuck.dropped}};
+  s[key::kScan] = {{key::scan::kWheelId, m.wheel_id},
+                   {key::scan::kSensor, m.sensor},
+                   {key::scan::kOperator, m.operator_name},
+                   {key::scan::kTimestamp, m.timestamp},
+                   {key::scan::kWheelDiameterMm, Optional(m.wheel_diameter_mm)},
+                   {key::scan::kWheelWidthMm, Optional(m.wheel_width_mm)},
+                   {key::scan::kFeedMmPerMin, Optional(m.feed_mm_per_min)},
+                   {key::scan::kSamplePeriodS, Optional(m.sample_period_s)},
+                   {key::scan::kRadiusSign, m.radius_sign},
+                   {key::scan::kStartYMm, m.start_y_mm},
+                   {key::scan::kHasEncoder, record.has_encoder},
+                   {key::scan::kFirstValidSample, processed.first_valid},
+                   {key::scan::kLastValidSample, processed.last_valid}};
+  s[key::kSpindleRpmNominal] = Optional(m.spindle_rpm);
+  s[key::kSpindleRpmEstimated] = processed.rpm_used;
+  s[key::kSpindleRpmSource] = PhaseSourceName(processed.phase_source);
+  s[key::kSpindleRpmSigma] = processed.speed.available ? json(processed.speed.sigma_rpm) : json(nullptr);
+  s[key::kSpindleRpmFitted] = processed.speed.available ? json(processed.speed.fitted_rpm) : json(nullptr);
+  s[key::kNoiseSigmaUm] = processed.noise_sigma_mm * 1000.0;
   std::vector<double> point_sigmas;
   for (const auto& section : map.sections)
     point_sigmas.insert(point_sigmas.end(), section.sigma_mm.begin(), section.sigma_mm.end());
   std::sort(point_sigmas.begin(), point_sigmas.end());
-  s["map_sigma_um"] =
+  s[key::kMapSigmaUm] =
       point_sigmas.empty() ? json(nullptr) : json(point_sigmas[point_sigmas.size() / 2] * 1000.0);
-  s["mean_arc_radius_mm"] = fit.mean_arc_radius_mm;
-  s["mean_arc_radius_sigma_mm"] = fit.mean_arc_radius_sigma_mm;
-  s["arc_radius_range_mm"] = fit.arc_radius_range_mm;
-  s["arc_radius_fluctuation_pct"] = fit.arc_radius_fluctuation_pct;
-  s["arc_radius_std_mm"] = fit.arc_radius_std_mm;
-  s["arc_radius_noise_std_mm"] = fit.arc_radius_noise_std_mm;
-  s["arc_radius_excess_std_mm"] = fit.arc_radius_excess_std_mm;
-  s["mean_center_axial_mm"] = fit.mean_center_axial_mm;
-  s["mean_center_axial_sigma_mm"] = fit.mean_center_axial_sigma_mm;
-  s["center_axial_deviation_mm"] = fit.center_axial_deviation_mm;
-  s["mean_center_radial_mm"] = fit.mean_center_radial_mm;
+  s[key::kMeanArcRadiusMm] = fit.mean_arc_radius_mm;
+  s[key::kMeanArcRadiusSigmaMm] = fit.mean_arc_radius_sigma_mm;
+  s[key::kArcRadiusRangeMm] = fit.arc_radius_range_mm;
+  s[key::kArcRadiusFluctuationPct] = fit.arc_radius_fluctuation_pct;
+  s[key::kArcRadiusStdMm] = fit.arc_radius_std_mm;
+  s[key::kArcRadiusNoiseStdMm] = fit.arc_radius_noise_std_mm;
+  s[key::kArcRadiusExcessStdMm] = fit.arc_radius_excess_std_mm;
+  s[key::kMeanCenterAxialMm] = fit.mean_center_axial_mm;
+  s[key::kMeanCenterAxialSigmaMm] = fit.mean_center_axial_sigma_mm;
+  s[key::kCenterAxialDeviationMm] = fit.center_axial_deviation_mm;
+  s[key::kMeanCenterRadialMm] = fit.mean_center_radial_mm;
   double band_half = 8.0;
   for (const auto& [name, value] : record.numeric_parameters) {
-    if (name == "band_half_width_mm") band_half = value;
+    if (name == key::processing::kBandHalfWidthMm) band_half = value;
   }
-  s["band_half_width_mm"] = band_half;
-  s["band_mm"] = {fit.band_low_mm, fit.band_high_mm};
-  s["max_arc_error_um"] = fit.max_arc_error_um;
-  s["max_runout_um"] = fit.max_runout_um;
-  s["max_roundness_um"] = fit.max_roundness_um;
-  s["median_chi2_per_dof"] = Number(fit.median_chi2_per_dof);
-  s["usable_phases"] = fit.usable_phases;
-  s["runout_note"] =
+  s[key::kBandHalfWidthMm] = band_half;
+  s[key::kBandMm] = {fit.band_low_mm, fit.band_high_mm};
+  s[key::kMaxArcErrorUm] = fit.max_arc_error_um;
+  s[key::kMaxRunoutUm] = fit.max_runout_um;
+  s[key::kMaxRoundnessUm] = fit.max_roundness_um;
+  s[key::kMedianChi2PerDof] = Number(fit.median_chi2_per_dof);
+  s[key::kUsablePhases] = fit.usable_phases;
+  s[key::kRunoutNote] =
       "runout is that of the wheel plus the spindle's error motion: one sensor cannot separate them";
-  s["phases"] = PhasesJson(map, fit);
-  s["axial"] = {{"y_mm", fit.axial_y_mm},
-                {"runout_um", Numbers(fit.runout_um)},
-                {"roundness_um", Numbers(fit.roundness_um)}};
-  s["mean_profile"] = {{"u_mm", fit.profile_u_mm}, {"error_um", Numbers(fit.profile_error_um)}};
+  s[key::kPhases] = PhasesJson(map, fit);
+  s[key::kAxial] = {{key::axial::kYMm, fit.axial_y_mm},
+                    {key::axial::kRunoutUm, Numbers(fit.runout_um)},
+                    {key::axial::kRoundnessUm, Numbers(fit.roundness_um)}};
+  s[key::kMeanProfile] = {{key::mean_profile::kUMm, fit.profile_u_mm},
+                          {key::mean_profile::kErrorUm, Numbers(fit.profile_error_um)}};
   json parameters;
   for (const auto& [name, value] : record.numeric_parameters) parameters[name] = value;
   for (const auto& [name, value] : record.text_parameters) parameters[name] = value;
-  parameters["knot_step_deg"] = map.knot_step_deg;
-  parameters["axial_step_mm"] = map.axial_step_mm;
-  parameters["despike_threshold_used_um"] = processed.despike.threshold_um;
-  parameters["stuck_run_samples_used"] = processed.stuck.min_run;
-  s["processing"] = parameters;
+  parameters[key::processing::kKnotStepDeg] = map.knot_step_deg;
+  parameters[key::processing::kAxialStepMm] = map.axial_step_mm;
+  parameters[key::processing::kDespikeThresholdUsedUm] = processed.despike.threshold_um;
+  parameters[key::processing::kStuckRunSamplesUsed] = processed.stuck.min_run;
+  s[key::kProcessing] = parameters;
   json warnings = json::array();
   for (const auto& w : processed.warnings) warnings.push_back(w);
   for (const auto& w : fit.warnings) warnings.push_back(w);
-  s["warnings"] = warnings;
+  s[key::kWarnings] = warnings;
   return s.dump(2) + "\n";
 }
 
@@ -200,8 +208,8 @@ void WriteProcessOutputs(const std::filesystem::path& outdir, const RunRecord& r
                          const processing::ProcessedScan& processed, const WheelFit& fit) {
   EnsureDirectory(outdir);
   OutputSet outputs;
-  const auto summary_path = outputs.Stage(outdir / "summary.json");
-  const auto map_path = outputs.Stage(outdir / "wheel_map.h5");
+  const auto summary_path = outputs.Stage(outdir / key::kFileName);
+  const auto map_path = outputs.Stage(outdir / h5::kFileName);
   {
     const std::string summary = SummaryJson(record, processed, fit);
     std::ofstream out(summary_path, std::ios::binary);
@@ -209,7 +217,7 @@ void WriteProcessOutputs(const std::filesystem::path& outdir, const RunRecord& r
     out.flush();
     if (!out)
       throw Error(ErrorCode::kIo, "output",
-                  "cannot write '" + (outdir / "summary.json").string() + "' (disk full?)");
+                  "cannot write '" + (outdir / key::kFileName).string() + "' (disk full?)");
   }
   WriteMap(map_path, record, processed, fit);
   outputs.Commit();

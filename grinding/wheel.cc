@@ -6,27 +6,35 @@
 #include <cmath>
 #include <fstream>
 #include <nlohmann/json.hpp>
+#include <optional>
 
 #include "core/error.h"
 #include "core/json_text.h"
+#include "schema/summary.h"
 
 namespace arcwheel::grinding {
 namespace {
 
 constexpr const char* kStage = "grinding.wheel";
 using nlohmann::json;
+namespace key = schema::summary;
 
-[[noreturn]] void Bad(const std::filesystem::path& path, const std::string& key, const std::string& what) {
+// "phases.arc_radius_mm" for messages.
+std::string Dotted(std::string_view object, std::string_view name) {
+  return fmt::format("{}.{}", object, name);
+}
+
+[[noreturn]] void Bad(const std::filesystem::path& path, std::string_view key, const std::string& what) {
   throw Error(ErrorCode::kBadInput, kStage, fmt::format("'{}': key '{}' {}", path.string(), key, what));
 }
 
-double RequiredNumber(const json& object, const std::filesystem::path& path, const std::string& key) {
+double RequiredNumber(const json& object, const std::filesystem::path& path, std::string_view key) {
   if (!object.contains(key)) Bad(path, key, "is missing");
   if (!object.at(key).is_number()) Bad(path, key, "must be a number");
   return object.at(key).get<double>();
 }
 
-std::vector<double> NumberArray(const json& object, const std::filesystem::path& path, const std::string& key,
+std::vector<double> NumberArray(const json& object, const std::filesystem::path& path, std::string_view key,
                                 const std::string& full_key) {
   if (!object.contains(key) || !object.at(key).is_array()) Bad(path, full_key, "must be an array");
   std::vector<double> values;
@@ -37,18 +45,21 @@ std::vector<double> NumberArray(const json& object, const std::filesystem::path&
 }
 
 void ReadPhases(const json& root, const std::filesystem::path& path, WheelSummary& s) {
-  if (!root.contains("phases") || !root.at("phases").is_object()) return;
-  const json& phases = root.at("phases");
-  const std::vector<double> phase = NumberArray(phases, path, "phase_deg", "phases.phase_deg");
-  const std::vector<double> ra = NumberArray(phases, path, "arc_radius_mm", "phases.arc_radius_mm");
-  const std::vector<double> rb = NumberArray(phases, path, "center_radial_mm", "phases.center_radial_mm");
+  if (!root.contains(key::kPhases) || !root.at(key::kPhases).is_object()) return;
+  const json& phases = root.at(key::kPhases);
+  const auto array = [&](std::string_view name) {
+    return NumberArray(phases, path, name, Dotted(key::kPhases, name));
+  };
+  const std::vector<double> phase = array(key::phases::kPhaseDeg);
+  const std::vector<double> ra = array(key::phases::kArcRadiusMm);
+  const std::vector<double> rb = array(key::phases::kCenterRadialMm);
   if (ra.size() != phase.size() || rb.size() != phase.size()) {
-    Bad(path, "phases", "arrays differ in length");
+    Bad(path, key::kPhases, "arrays differ in length");
   }
   std::vector<bool> usable(phase.size(), true);
-  if (phases.contains("usable") && phases.at("usable").is_array() &&
-      phases.at("usable").size() == phase.size()) {
-    for (size_t i = 0; i < phase.size(); ++i) usable[i] = phases.at("usable")[i] == true;
+  if (phases.contains(key::phases::kUsable) && phases.at(key::phases::kUsable).is_array() &&
+      phases.at(key::phases::kUsable).size() == phase.size()) {
+    for (size_t i = 0; i < phase.size(); ++i) usable[i] = phases.at(key::phases::kUsable)[i] == true;
   }
   for (size_t i = 0; i < phase.size(); ++i) {
     if (!usable[i] || !std::isfinite(phase[i]) || !std::isfinite(ra[i]) || !std::isfinite(rb[i])) {
@@ -58,6 +69,17 @@ void ReadPhases(const json& root, const std::filesystem::path& path, WheelSummar
     s.arc_radius_mm.push_back(ra[i]);
     s.center_radial_mm.push_back(rb[i]);
   }
+}
+
+// A file without schema_version was written before versions were recorded: read it as 1.0.
+void CheckSchemaVersion(const json& root, const std::filesystem::path& path) {
+  std::optional<std::string> version;
+  if (const auto it = root.find(key::kSchemaVersion); it != root.end()) {
+    if (!it->is_string()) Bad(path, key::kSchemaVersion, "must be a string such as \"1.0\"");
+    version = it->get<std::string>();
+  }
+  schema::CheckVersion(version, key::kVersion, path.string(), fmt::format("key '{}'", key::kSchemaVersion),
+                       kStage);
 }
 
 }  // namespace
@@ -108,31 +130,35 @@ std::vector<std::string> Wheel::Problems() const {
 WheelSummary ReadWheelSummary(const std::filesystem::path& path) {
   const json root = ReadJsonFile(path, kStage);
   if (!root.is_object()) Bad(path, "(root)", "must be a JSON object");
+  CheckSchemaVersion(root, path);
   WheelSummary s;
-  s.mean_arc_radius_mm = RequiredNumber(root, path, "mean_arc_radius_mm");
-  if (!(s.mean_arc_radius_mm > 0.0)) Bad(path, "mean_arc_radius_mm", "must be > 0");
-  s.mean_arc_radius_sigma_mm = RequiredNumber(root, path, "mean_arc_radius_sigma_mm");
-  if (root.contains("max_runout_um") && root.at("max_runout_um").is_number()) {
-    s.max_runout_um = root.at("max_runout_um").get<double>();
+  s.mean_arc_radius_mm = RequiredNumber(root, path, key::kMeanArcRadiusMm);
+  if (!(s.mean_arc_radius_mm > 0.0)) Bad(path, key::kMeanArcRadiusMm, "must be > 0");
+  s.mean_arc_radius_sigma_mm = RequiredNumber(root, path, key::kMeanArcRadiusSigmaMm);
+  if (root.contains(key::kMaxRunoutUm) && root.at(key::kMaxRunoutUm).is_number()) {
+    s.max_runout_um = root.at(key::kMaxRunoutUm).get<double>();
   }
-  if (root.contains("scan") && root.at("scan").is_object()) {
-    const json& scan = root.at("scan");
-    if (scan.contains("wheel_diameter_mm") && scan.at("wheel_diameter_mm").is_number()) {
-      s.wheel_diameter_mm = scan.at("wheel_diameter_mm").get<double>();
+  if (root.contains(key::kScan) && root.at(key::kScan).is_object()) {
+    const json& scan = root.at(key::kScan);
+    if (scan.contains(key::scan::kWheelDiameterMm) && scan.at(key::scan::kWheelDiameterMm).is_number()) {
+      s.wheel_diameter_mm = scan.at(key::scan::kWheelDiameterMm).get<double>();
     }
-    if (scan.contains("wheel_id") && scan.at("wheel_id").is_string()) {
-      s.wheel_id = scan.at("wheel_id").get<std::string>();
+    if (scan.contains(key::scan::kWheelId) && scan.at(key::scan::kWheelId).is_string()) {
+      s.wheel_id = scan.at(key::scan::kWheelId).get<std::string>();
     }
   }
-  if (root.contains("arcwheel_version") && root.at("arcwheel_version").is_string()) {
-    s.arcwheel_version = root.at("arcwheel_version").get<std::string>();
+  if (root.contains(key::kArcwheelVersion) && root.at(key::kArcwheelVersion).is_string()) {
+    s.arcwheel_version = root.at(key::kArcwheelVersion).get<std::string>();
   }
-  if (root.contains("mean_profile") && root.at("mean_profile").is_object()) {
-    const json& profile = root.at("mean_profile");
-    s.profile_u_mm = NumberArray(profile, path, "u_mm", "mean_profile.u_mm");
-    s.profile_error_um = NumberArray(profile, path, "error_um", "mean_profile.error_um");
+  if (root.contains(key::kMeanProfile) && root.at(key::kMeanProfile).is_object()) {
+    const json& profile = root.at(key::kMeanProfile);
+    s.profile_u_mm = NumberArray(profile, path, key::mean_profile::kUMm,
+                                 Dotted(key::kMeanProfile, key::mean_profile::kUMm));
+    s.profile_error_um = NumberArray(profile, path, key::mean_profile::kErrorUm,
+                                     Dotted(key::kMeanProfile, key::mean_profile::kErrorUm));
     if (s.profile_u_mm.size() != s.profile_error_um.size()) {
-      Bad(path, "mean_profile", "u_mm and error_um differ in length");
+      Bad(path, key::kMeanProfile,
+          fmt::format("{} and {} differ in length", key::mean_profile::kUMm, key::mean_profile::kErrorUm));
     }
   }
   ReadPhases(root, path, s);

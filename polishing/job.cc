@@ -17,6 +17,7 @@
 #include "core/error.h"
 #include "core/json_text.h"
 #include "core/version.h"
+#include "schema/polish_outputs.h"
 
 namespace arcwheel::polishing {
 namespace {
@@ -413,7 +414,7 @@ void CheckOnSurface(const PolishJob& job, std::span<const Eigen::Vector2d> path)
 
 std::string ResidualCsv(const ErrorMap& target, const DwellSolution& d) {
   fmt::memory_buffer out;
-  fmt::format_to(std::back_inserter(out), "x_mm,y_mm,target_um,removal_um,residual_um\n");
+  fmt::format_to(std::back_inserter(out), "{}\n", fmt::join(schema::polish::residual_map::kColumns, ","));
   for (int j = 0; j < target.ny; ++j) {
     for (int i = 0; i < target.nx; ++i) {
       const std::size_t k = static_cast<std::size_t>(j) * target.nx + i;
@@ -447,34 +448,41 @@ PolishRunReport RunPolishJob(const PolishJob& job, const std::filesystem::path& 
                                              fmt::format("surface: {}", job.surface->Describe()),
                                              fmt::format("aperture: {}", job.aperture.Describe()),
                                              fmt::format("removal function: {}", job.removal.Describe())};
-  json summary = {{"arcwheel_version", kVersion},
-                  {"job", job.resolved},
-                  {"points", report.points},
-                  {"total_time_s", report.dwell.total_time_s},
-                  {"before", {{"pv_um", report.dwell.before.pv_um}, {"rms_um", report.dwell.before.rms_um}}},
-                  {"after", {{"pv_um", report.dwell.after.pv_um}, {"rms_um", report.dwell.after.rms_um}}},
-                  {"aperture_nodes", report.dwell.before.nodes},
-                  {"speed_mm_s", {{"min", report.min_speed_mm_s}, {"max", report.max_speed_mm_s}}},
-                  {"max_acceleration_mm_s2", report.dwell.max_acceleration_mm_s2},
-                  {"solver",
-                   {{"iterations", report.dwell.iterations},
-                    {"converged", report.dwell.converged},
-                    {"nonzeros", report.dwell.nonzeros},
-                    {"shaping_rounds", report.dwell.shaping_rounds}}}};
+  namespace key = schema::polish::summary;
+  const auto figures = [](const auto& f) {
+    return json{{key::figures::kPvUm, f.pv_um}, {key::figures::kRmsUm, f.rms_um}};
+  };
+  json summary = {
+      {key::kSchemaVersion, schema::VersionText(schema::polish::kVersion)},
+      {key::kArcwheelVersion, kVersion},
+      {key::kJob, job.resolved},
+      {key::kPoints, report.points},
+      {key::kTotalTimeS, report.dwell.total_time_s},
+      {key::kBefore, figures(report.dwell.before)},
+      {key::kAfter, figures(report.dwell.after)},
+      {key::kApertureNodes, report.dwell.before.nodes},
+      {key::kSpeedMmS,
+       {{key::speed_mm_s::kMin, report.min_speed_mm_s}, {key::speed_mm_s::kMax, report.max_speed_mm_s}}},
+      {key::kMaxAccelerationMmS2, report.dwell.max_acceleration_mm_s2},
+      {key::kSolver,
+       {{key::solver::kIterations, report.dwell.iterations},
+        {key::solver::kConverged, report.dwell.converged},
+        {key::solver::kNonzeros, report.dwell.nonzeros},
+        {key::solver::kShapingRounds, report.dwell.shaping_rounds}}}};
 
   EnsureDirectory(output_folder);
   OutputSet outputs;
-  auto write = [&](const std::string& name, const std::string& text) {
+  auto write = [&](std::string_view name, const std::string& text) {
     const std::filesystem::path temporary = outputs.Stage(output_folder / name);
     std::ofstream out(temporary, std::ios::binary);
     out << text;
     out.close();
     if (!out) throw Error(ErrorCode::kIo, kStage, fmt::format("cannot write '{}'", temporary.string()));
   };
-  write("polishing_path.csv", PolishingPathCsv(points, comments));
+  write(schema::polish::kPathFileName, PolishingPathCsv(points, comments));
   write("polish.mod", RapidModule(points, job.tool, job.work_object, "ArcwheelPolish", comments));
-  write("residual_map.csv", ResidualCsv(target, report.dwell));
-  write("polish_summary.json", summary.dump(2) + "\n");
+  write(schema::polish::kResidualMapFileName, ResidualCsv(target, report.dwell));
+  write(schema::polish::kSummaryFileName, summary.dump(2) + "\n");
   outputs.Commit();
   return report;
 }

@@ -61,6 +61,7 @@ TEST(PolishCommand, WritesPathRapidResidualAndSummaryWithATenfoldRmsDrop) {
   const nlohmann::json summary = nlohmann::json::parse(summary_file);
   EXPECT_LT(summary["after"]["rms_um"].get<double>(), summary["before"]["rms_um"].get<double>() / 10.0)
       << summary.dump(2);
+  EXPECT_EQ(summary["schema_version"], "1.0");
   EXPECT_LE(summary["speed_mm_s"]["max"].get<double>(), 150.0 * (1 + 1e-12));
   EXPECT_GE(summary["speed_mm_s"]["min"].get<double>(), 0.5 * (1 - 1e-12));
   std::ifstream csv(dir / "out" / "polishing_path.csv");

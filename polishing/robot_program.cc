@@ -10,6 +10,7 @@
 
 #include "core/error.h"
 #include "core/version.h"
+#include "schema/polish_outputs.h"
 
 namespace arcwheel::polishing {
 namespace {
@@ -83,7 +84,7 @@ Eigen::Vector3d ToolData::CorrectedTcpMm() const {
 std::string PolishingPathCsv(std::span<const PolishingPoint> points, std::span<const std::string> comments) {
   fmt::memory_buffer out;
   for (const std::string& c : comments) fmt::format_to(std::back_inserter(out), "# {}\n", c);
-  fmt::format_to(std::back_inserter(out), "x,y,z,q1,q2,q3,q4,speed_mm_s,dwell_s\n");
+  fmt::format_to(std::back_inserter(out), "{}\n", fmt::join(schema::polish::path::kColumns, ","));
   for (const PolishingPoint& p : points) {
     // "{}" is the shortest representation that reads back to the same double.
     fmt::format_to(std::back_inserter(out), "{},{},{},{},{},{},{},{},{}\n", p.position_mm.x(),

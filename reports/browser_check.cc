@@ -15,19 +15,9 @@ namespace arcwheel::reports::testing {
 namespace {
 
 namespace fs = std::filesystem;
+using arcwheel::testing::ReadText;
+using arcwheel::testing::Shell;
 using arcwheel::testing::TempDir;
-
-std::string ReadText(const fs::path& path) {
-  std::ifstream stream(path, std::ios::binary);
-  std::ostringstream text;
-  text << stream.rdbuf();
-  return text.str();
-}
-
-int Shell(const std::string& command) {
-  const int status = std::system(command.c_str());
-  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-}
 
 std::size_t DistinctColours(const fs::path& png) {
   cairo_surface_t* image = cairo_image_surface_create_from_png(png.c_str());

@@ -8,12 +8,15 @@
 #include <fstream>
 #include <limits>
 #include <map>
+#include <optional>
 #include <set>
+#include <span>
 #include <sstream>
 
 #include "core/error.h"
 #include "core/json_text.h"
 #include "core/sha256.h"
+#include "schema/polish_outputs.h"
 
 namespace arcwheel::reports {
 namespace {
@@ -70,13 +73,13 @@ bool ParseDouble(std::string_view cell, double& value) {
 }
 
 // Header cells to column indices; every name of `required` must be present.
-std::vector<std::size_t> Columns(std::string_view header, const std::vector<std::string>& required,
+std::vector<std::size_t> Columns(std::string_view header, std::span<const std::string_view> required,
                                  const std::string& source, std::size_t line) {
   std::map<std::string, std::size_t, std::less<>> index;
   const std::vector<std::string_view> cells = SplitCells(header);
   for (std::size_t c = 0; c < cells.size(); ++c) index.emplace(std::string(cells[c]), c);
   std::vector<std::size_t> columns;
-  for (const std::string& name : required) {
+  for (const std::string_view name : required) {
     const auto it = index.find(name);
     if (it == index.end()) {
       BadLine(
@@ -91,7 +94,7 @@ std::vector<std::size_t> Columns(std::string_view header, const std::vector<std:
 // Reads the data rows of a CSV with the named columns: `row(values, line)` gets the values in
 // the order of `required`. Lines starting with '#' are passed to `comment`.
 template <typename Row, typename Comment>
-void ReadCsv(std::string_view text, const std::string& source, const std::vector<std::string>& required,
+void ReadCsv(std::string_view text, const std::string& source, std::span<const std::string_view> required,
              const Row& row, const Comment& comment) {
   Lines lines(text);
   std::string_view line;
@@ -155,6 +158,7 @@ class JsonReader {
  public:
   JsonReader(const json& root, std::string source) : root_(root), source_(std::move(source)) {}
 
+  [[nodiscard]] const std::string& source() const { return source_; }
   [[noreturn]] void Fail(const std::string& key, const std::string& problem) const {
     Bad(fmt::format("'{}' key '{}' {}", source_, key, problem));
   }
@@ -215,6 +219,19 @@ class JsonReader {
   std::string source_;
 };
 
+// "before.pv_um": the reader's dotted form of a nested key.
+std::string Dotted(std::string_view object, std::string_view name) {
+  return fmt::format("{}.{}", object, name);
+}
+
+// A file without schema_version was written before versions were recorded: read it as 1.0.
+void CheckPolishSummaryVersion(const JsonReader& r) {
+  const std::string name(schema::polish::summary::kSchemaVersion);
+  const std::optional<std::string> version =
+      r.Find(name) == nullptr ? std::nullopt : std::optional<std::string>(r.String(name));
+  schema::CheckVersion(version, schema::polish::kVersion, r.source(), fmt::format("key '{}'", name), kStage);
+}
+
 std::string ReadWhole(const std::filesystem::path& path) {
   std::ifstream in(path, std::ios::binary);
   if (!in) {
@@ -236,10 +253,12 @@ ResidualMap ParseResidualMapCsv(std::string_view text, const std::string& source
   };
   std::vector<Node> nodes;
   ReadCsv(
-      text, source_name, {"x_mm", "y_mm", "target_um", "removal_um", "residual_um"},
+      text, source_name, schema::polish::residual_map::kColumns,
       [&](const std::vector<double>& v, std::size_t line) {
         if (!std::isfinite(v[0]) || !std::isfinite(v[1]))
-          BadLine(source_name, line, "x_mm and y_mm must be finite");
+          BadLine(source_name, line,
+                  fmt::format("{} and {} must be finite", schema::polish::residual_map::kXMm,
+                              schema::polish::residual_map::kYMm));
         nodes.push_back({v[0], v[1], v[2], v[3], v[4], line});
       },
       [](std::string_view) {});
@@ -281,15 +300,20 @@ ResidualMap ParseResidualMapCsv(std::string_view text, const std::string& source
 }
 
 PolishingPathTable ParsePolishingPathCsv(std::string_view text, const std::string& source_name) {
+  namespace column = schema::polish::path;
+  // The lambda below takes the values by their position in kColumns.
+  static_assert(column::kColumns[7] == column::kSpeedMmS && column::kColumns[8] == column::kDwellS);
   PolishingPathTable path;
   ReadCsv(
-      text, source_name, {"x", "y", "z", "q1", "q2", "q3", "q4", "speed_mm_s", "dwell_s"},
+      text, source_name, column::kColumns,
       [&](const std::vector<double>& v, std::size_t line) {
         for (double value : v) {
           if (!std::isfinite(value)) BadLine(source_name, line, "every value must be finite");
         }
-        if (!(v[7] > 0.0)) BadLine(source_name, line, fmt::format("speed_mm_s = {} is not > 0", v[7]));
-        if (!(v[8] >= 0.0)) BadLine(source_name, line, fmt::format("dwell_s = {} is negative", v[8]));
+        if (!(v[7] > 0.0))
+          BadLine(source_name, line, fmt::format("{} = {} is not > 0", column::kSpeedMmS, v[7]));
+        if (!(v[8] >= 0.0))
+          BadLine(source_name, line, fmt::format("{} = {} is negative", column::kDwellS, v[8]));
         double length = 0.0;
         if (!path.x_mm.empty()) {
           length = path.path_length_mm.back() +
@@ -315,50 +339,62 @@ PolishSummary ParsePolishSummary(const std::string& text, const std::string& sou
   const json root = ParseJsonText(text, source_name, kStage);
   if (!root.is_object()) Bad(fmt::format("'{}' is not a JSON object", source_name));
   const JsonReader r(root, source_name);
+  namespace key = schema::polish::summary;
+  const std::string before_pv = Dotted(key::kBefore, key::figures::kPvUm);
+  const std::string before_rms = Dotted(key::kBefore, key::figures::kRmsUm);
+  const std::string after_pv = Dotted(key::kAfter, key::figures::kPvUm);
+  const std::string after_rms = Dotted(key::kAfter, key::figures::kRmsUm);
+  const std::string total_time(key::kTotalTimeS);
+  const std::string job(key::kJob);
+  const std::string machine = Dotted(key::kJob, key::job::kMachine);
+  CheckPolishSummaryVersion(r);
   PolishSummary s;
-  s.arcwheel_version = r.String("arcwheel_version");
-  if (!r.Require("job").is_object()) r.Fail("job", "is not a JSON object");
-  s.job = r.Require("job");
-  s.job_name = r.String("job.name");
-  if (r.Find("job.error_map.file") != nullptr) s.error_map_file = r.String("job.error_map.file");
-  s.points = r.Count("points");
-  s.aperture_nodes = r.Count("aperture_nodes");
-  s.total_time_s = r.Number("total_time_s");
-  s.before_pv_um = r.Number("before.pv_um");
-  s.before_rms_um = r.Number("before.rms_um");
-  s.after_pv_um = r.Number("after.pv_um");
-  s.after_rms_um = r.Number("after.rms_um");
-  s.min_speed_mm_s = r.Number("speed_mm_s.min");
-  s.max_speed_mm_s = r.Number("speed_mm_s.max");
-  s.max_acceleration_mm_s2 = r.Number("max_acceleration_mm_s2");
-  s.solver_iterations = r.Count("solver.iterations");
-  s.solver_converged = r.Boolean("solver.converged");
-  s.limit_max_speed_mm_s = r.Number("job.machine.max_speed_mm_s");
-  s.limit_min_speed_mm_s = r.OptionalNumber("job.machine.min_speed_mm_s", 0.0);
-  s.limit_max_acceleration_mm_s2 = r.OptionalNumber("job.machine.max_acceleration_mm_s2", 0.0);
-  s.total_time_text = r.NumberText("total_time_s");
-  s.before_pv_text = r.NumberText("before.pv_um");
-  s.before_rms_text = r.NumberText("before.rms_um");
-  s.after_pv_text = r.NumberText("after.pv_um");
-  s.after_rms_text = r.NumberText("after.rms_um");
+  s.arcwheel_version = r.String(std::string(key::kArcwheelVersion));
+  if (!r.Require(job).is_object()) r.Fail(job, "is not a JSON object");
+  s.job = r.Require(job);
+  s.job_name = r.String(Dotted(job, key::job::kName));
+  const std::string error_map_file = Dotted(Dotted(job, key::job::kErrorMap), key::job::error_map::kFile);
+  if (r.Find(error_map_file) != nullptr) s.error_map_file = r.String(error_map_file);
+  s.points = r.Count(std::string(key::kPoints));
+  s.aperture_nodes = r.Count(std::string(key::kApertureNodes));
+  s.total_time_s = r.Number(total_time);
+  s.before_pv_um = r.Number(before_pv);
+  s.before_rms_um = r.Number(before_rms);
+  s.after_pv_um = r.Number(after_pv);
+  s.after_rms_um = r.Number(after_rms);
+  s.min_speed_mm_s = r.Number(Dotted(key::kSpeedMmS, key::speed_mm_s::kMin));
+  s.max_speed_mm_s = r.Number(Dotted(key::kSpeedMmS, key::speed_mm_s::kMax));
+  s.max_acceleration_mm_s2 = r.Number(std::string(key::kMaxAccelerationMmS2));
+  s.solver_iterations = r.Count(Dotted(key::kSolver, key::solver::kIterations));
+  s.solver_converged = r.Boolean(Dotted(key::kSolver, key::solver::kConverged));
+  s.limit_max_speed_mm_s = r.Number(Dotted(machine, key::job::machine::kMaxSpeedMmS));
+  s.limit_min_speed_mm_s = r.OptionalNumber(Dotted(machine, key::job::machine::kMinSpeedMmS), 0.0);
+  s.limit_max_acceleration_mm_s2 =
+      r.OptionalNumber(Dotted(machine, key::job::machine::kMaxAccelerationMmS2), 0.0);
+  s.total_time_text = r.NumberText(total_time);
+  s.before_pv_text = r.NumberText(before_pv);
+  s.before_rms_text = r.NumberText(before_rms);
+  s.after_pv_text = r.NumberText(after_pv);
+  s.after_rms_text = r.NumberText(after_rms);
   return s;
 }
 
 PolishReportInputs ReadPolishReportInputs(const std::filesystem::path& outdir) {
-  const std::filesystem::path summary_path = outdir / "polish_summary.json";
-  const std::filesystem::path residual_path = outdir / "residual_map.csv";
-  const std::filesystem::path path_path = outdir / "polishing_path.csv";
+  const std::filesystem::path summary_path = outdir / schema::polish::kSummaryFileName;
+  const std::filesystem::path residual_path = outdir / schema::polish::kResidualMapFileName;
+  const std::filesystem::path path_path = outdir / schema::polish::kPathFileName;
   PolishReportInputs inputs;
   inputs.summary = ParsePolishSummary(ReadWhole(summary_path), summary_path.string());
   inputs.residual = ParseResidualMapCsv(ReadWhole(residual_path), residual_path.string());
   inputs.path = ParsePolishingPathCsv(ReadWhole(path_path), path_path.string());
   if (inputs.path.size() != static_cast<std::size_t>(inputs.summary.points)) {
-    Bad(fmt::format("'{}' has {} points but '{}' key 'points' says {}", path_path.string(),
-                    inputs.path.size(), summary_path.string(), inputs.summary.points));
+    Bad(fmt::format("'{}' has {} points but '{}' key '{}' says {}", path_path.string(), inputs.path.size(),
+                    summary_path.string(), schema::polish::summary::kPoints, inputs.summary.points));
   }
   if (inputs.residual.nodes != static_cast<std::size_t>(inputs.summary.aperture_nodes)) {
-    Bad(fmt::format("'{}' has {} nodes but '{}' key 'aperture_nodes' says {}", residual_path.string(),
-                    inputs.residual.nodes, summary_path.string(), inputs.summary.aperture_nodes));
+    Bad(fmt::format("'{}' has {} nodes but '{}' key '{}' says {}", residual_path.string(),
+                    inputs.residual.nodes, summary_path.string(), schema::polish::summary::kApertureNodes,
+                    inputs.summary.aperture_nodes));
   }
   for (const auto& file : {summary_path, residual_path, path_path})
     inputs.sources.push_back({file, Sha256OfFile(file)});

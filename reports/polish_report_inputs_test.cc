@@ -12,19 +12,9 @@
 namespace arcwheel::reports {
 namespace {
 
+using arcwheel::testing::ErrorOf;
 using arcwheel::testing::TempDir;
 using ::testing::HasSubstr;
-
-template <typename Read>
-Error ErrorOf(const Read& read) {
-  try {
-    read();
-  } catch (const Error& error) {
-    return error;
-  }
-  ADD_FAILURE() << "no Error thrown";
-  return Error(ErrorCode::kInternal, "test", "no error");
-}
 
 // A 3 x 2 grid (x = -2, 0, 2 mm; y = 5, 6 mm) with the node (2, 6) missing, rows in any order.
 constexpr const char* kResidual =
@@ -166,6 +156,18 @@ TEST(ParsePolishSummary, RefusesMissingOrMistypedKeysByDottedName) {
     EXPECT_EQ(error.code(), ErrorCode::kBadInput);
     EXPECT_THAT(error.what(), HasSubstr(message));
   }
+}
+
+// kSummary records no schema_version, as files written before 1.0: it is read (test above).
+TEST(ParsePolishSummary, ReadsTheSameMajorVersionAndRefusesANewerOne) {
+  nlohmann::json summary = nlohmann::json::parse(kSummary);
+  summary["schema_version"] = "1.2";
+  EXPECT_EQ(ParsePolishSummary(summary.dump(), "sum.json").points, 3);
+  summary["schema_version"] = "2.0";
+  const Error error = ErrorOf([&] { (void)ParsePolishSummary(summary.dump(), "out/polish_summary.json"); });
+  EXPECT_EQ(error.code(), ErrorCode::kBadInput);
+  EXPECT_THAT(error.what(), HasSubstr("'out/polish_summary.json' key 'schema_version' = '2.0'"));
+  EXPECT_THAT(error.what(), HasSubstr("reads schema version 1.x only"));
 }
 
 TEST(ReadPolishReportInputs, RefusesFilesThatDisagreeAndNamesMissingFiles) {

@@ -23,27 +23,18 @@ namespace {
 
 namespace fs = std::filesystem;
 using arcwheel::testing::ListFolder;
+using arcwheel::testing::PdfText;
+using arcwheel::testing::ReadText;
 using arcwheel::testing::RunArcwheel;
 using arcwheel::testing::SourceDir;
 using arcwheel::testing::TempDir;
 using ::testing::HasSubstr;
 using ::testing::Not;
 
-std::string ReadText(const fs::path& path) {
-  std::ifstream stream(path, std::ios::binary);
-  std::ostringstream text;
-  text << stream.rdbuf();
-  return text.str();
-}
-
 // Output of a shell command (stdout), or "" when it fails.
 std::string Capture(const std::string& command, const fs::path& scratch) {
   if (std::system((command + " > '" + scratch.string() + "'").c_str()) != 0) return "";
   return ReadText(scratch);
-}
-
-std::string PdfText(const fs::path& pdf, const fs::path& scratch) {
-  return Capture("pdftotext -enc UTF-8 '" + pdf.string() + "' -", scratch);
 }
 
 // Runs the example disc job into `out`, with `extra` arguments.
@@ -72,7 +63,7 @@ TEST(PolishReport, PdfCarriesPvRmsBeforeAfterAndTotalTimeAsInTheSummary) {
             "csv\nresidual_map.csv\n");
   const std::string summary_text = ReadText(dir / "out" / "polish_summary.json");
   const nlohmann::json summary = nlohmann::json::parse(summary_text);
-  const std::string text = PdfText(dir / "out" / "polish_report.pdf", dir / "pdf.txt");
+  const std::string text = PdfText(dir / "out" / "polish_report.pdf");
   ASSERT_FALSE(text.empty()) << "poppler-utils' pdftotext is installed by scripts/install_deps.sh";
   for (const char* pointer : {"/before/pv_um", "/before/rms_um", "/after/pv_um", "/after/rms_um"}) {
     EXPECT_THAT(text, HasSubstr(AsWritten(summary_text, summary, pointer) + " µm")) << pointer;

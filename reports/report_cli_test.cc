@@ -15,27 +15,12 @@
 namespace arcwheel::reports {
 namespace {
 
-namespace fs = std::filesystem;
 using arcwheel::testing::ListFolder;
+using arcwheel::testing::PdfText;
+using arcwheel::testing::ReadText;
 using arcwheel::testing::RunArcwheel;
 using arcwheel::testing::TempDir;
 using ::testing::HasSubstr;
-
-std::string ReadText(const fs::path& path) {
-  std::ifstream stream(path, std::ios::binary);
-  std::ostringstream text;
-  text << stream.rdbuf();
-  return text.str();
-}
-
-std::string PdfText(const fs::path& pdf) {
-  const fs::path text = fs::path(pdf).replace_extension(".txt");
-  const std::string command = "pdftotext -enc UTF-8 '" + pdf.string() + "' '" + text.string() + "'";
-  EXPECT_EQ(std::system(command.c_str()), 0) << command;
-  std::string contents = ReadText(text);
-  fs::remove(text);
-  return contents;
-}
 
 TEST(ReportCommand, WritesBothReportsAndJudgesAToleranceFile) {
   TempDir dir;
@@ -77,6 +62,17 @@ TEST(ReportCommand, RefusesASummaryMissingAKeyAndWritesNothing) {
   const auto result = RunArcwheel("report '" + dir.path().string() + "'");
   EXPECT_EQ(result.exit_status, 3) << result.output;
   EXPECT_THAT(result.output, HasSubstr("summary.json' key 'mean_arc_radius_sigma_mm' is missing"));
+  EXPECT_EQ(ListFolder(dir.path()), "summary.json\nwheel_map.h5\n");
+}
+
+TEST(ReportCommand, RefusesASummaryOfANewerSchemaMajorVersionAsBadInput) {
+  TempDir dir;
+  nlohmann::json summary = testing::FixtureSummary({.n_phase = 12, .n_y = 21});
+  summary["schema_version"] = "3.1";
+  testing::WriteFixture(dir.path(), {.n_phase = 12, .n_y = 21}, summary);
+  const auto result = RunArcwheel("report '" + dir.path().string() + "'");
+  EXPECT_EQ(result.exit_status, 3) << result.output;
+  EXPECT_THAT(result.output, HasSubstr("summary.json' key 'schema_version' = '3.1'"));
   EXPECT_EQ(ListFolder(dir.path()), "summary.json\nwheel_map.h5\n");
 }
 

@@ -7,15 +7,17 @@
 #include <limits>
 
 #include "core/version.h"
+#include "schema/summary.h"
 
 namespace arcwheel::reports {
 namespace {
 
 using nlohmann::json;
+namespace key = schema::summary;
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 struct HeadlineSpec {
-  const char* key;
+  std::string_view key;
   const char* label;
   const char* unit;
   int decimals;
@@ -23,22 +25,22 @@ struct HeadlineSpec {
 
 // Same order as kHeadlineKeys.
 constexpr std::array<HeadlineSpec, 7> kHeadline = {{
-    {"mean_arc_radius_mm", "Mean arc radius (± 1σ)", "mm", 5},
-    {"arc_radius_range_mm", "Arc radius range (max − min)", "mm", 4},
-    {"arc_radius_fluctuation_pct", "Arc radius fluctuation (range / mean)", "%", 3},
-    {"center_axial_deviation_mm", "Arc centre axial deviation (max − min)", "mm", 4},
-    {"max_arc_error_um", "Max arc error in the band", "µm", 2},
-    {"max_runout_um", "Max runout in the band", "µm", 2},
-    {"max_roundness_um", "Max roundness in the band", "µm", 2},
+    {key::kMeanArcRadiusMm, "Mean arc radius (± 1σ)", "mm", 5},
+    {key::kArcRadiusRangeMm, "Arc radius range (max − min)", "mm", 4},
+    {key::kArcRadiusFluctuationPct, "Arc radius fluctuation (range / mean)", "%", 3},
+    {key::kCenterAxialDeviationMm, "Arc centre axial deviation (max − min)", "mm", 4},
+    {key::kMaxArcErrorUm, "Max arc error in the band", "µm", 2},
+    {key::kMaxRunoutUm, "Max runout in the band", "µm", 2},
+    {key::kMaxRoundnessUm, "Max roundness in the band", "µm", 2},
 }};
 
-double HeadlineValue(const Summary& s, const std::string& key) {
-  if (key == "mean_arc_radius_mm") return s.mean_arc_radius_mm;
-  if (key == "arc_radius_range_mm") return s.arc_radius_range_mm;
-  if (key == "arc_radius_fluctuation_pct") return s.arc_radius_fluctuation_pct;
-  if (key == "center_axial_deviation_mm") return s.center_axial_deviation_mm;
-  if (key == "max_arc_error_um") return s.max_arc_error_um;
-  if (key == "max_runout_um") return s.max_runout_um;
+double HeadlineValue(const Summary& s, std::string_view name) {
+  if (name == key::kMeanArcRadiusMm) return s.mean_arc_radius_mm;
+  if (name == key::kArcRadiusRangeMm) return s.arc_radius_range_mm;
+  if (name == key::kArcRadiusFluctuationPct) return s.arc_radius_fluctuation_pct;
+  if (name == key::kCenterAxialDeviationMm) return s.center_axial_deviation_mm;
+  if (name == key::kMaxArcErrorUm) return s.max_arc_error_um;
+  if (name == key::kMaxRunoutUm) return s.max_runout_um;
   return s.max_roundness_um;
 }
 
@@ -62,7 +64,7 @@ std::vector<HeadlineRow> HeadlineRows(const Summary& summary, const Tolerances& 
     row.label = spec.label;
     const double value = HeadlineValue(summary, spec.key);
     row.value = WithUnit(FormatNumber(value, spec.decimals), spec.unit);
-    if (row.key == "mean_arc_radius_mm" && std::isfinite(value)) {
+    if (row.key == key::kMeanArcRadiusMm && std::isfinite(value)) {
       row.value = FormatNumber(value, spec.decimals) + " ± " +
                   FormatNumber(summary.mean_arc_radius_sigma_mm, spec.decimals) + " mm";
     }
@@ -84,15 +86,15 @@ Verdict Overall(const std::vector<HeadlineRow>& rows) {
   return overall;
 }
 
-std::string ScanText(const json& scan, const char* key) {
-  const auto it = scan.find(key);
+std::string ScanText(const json& scan, std::string_view name) {
+  const auto it = scan.find(name);
   if (it == scan.end() || it->is_null()) return "not recorded";
   if (it->is_string()) return it->get<std::string>().empty() ? "not recorded" : it->get<std::string>();
   return it->dump();
 }
 
-std::string ScanNumber(const json& scan, const char* key, int decimals, const char* unit) {
-  const auto it = scan.find(key);
+std::string ScanNumber(const json& scan, std::string_view name, int decimals, const char* unit) {
+  const auto it = scan.find(name);
   if (it == scan.end() || !it->is_number()) return "not recorded";
   return FormatNumber(it->get<double>(), decimals) + " " + unit;
 }
@@ -105,14 +107,14 @@ std::vector<KeyValue> Provenance(const ReportInputs& inputs) {
   std::string estimated = FormatNumber(s.spindle_rpm_estimated, 2) + " rpm";
   if (!s.spindle_rpm_source.empty()) estimated += " (used: " + s.spindle_rpm_source + ")";
   std::vector<KeyValue> rows = {
-      {"Wheel id", ScanText(s.scan, "wheel_id")},
-      {"Scan date/time", ScanText(s.scan, "timestamp")},
-      {"Sensor", ScanText(s.scan, "sensor")},
-      {"Operator", ScanText(s.scan, "operator")},
+      {"Wheel id", ScanText(s.scan, key::scan::kWheelId)},
+      {"Scan date/time", ScanText(s.scan, key::scan::kTimestamp)},
+      {"Sensor", ScanText(s.scan, key::scan::kSensor)},
+      {"Operator", ScanText(s.scan, key::scan::kOperator)},
       {"Spindle speed, nominal", FormatNumber(s.spindle_rpm_nominal, 2) + " rpm"},
       {"Spindle speed, estimated", estimated},
-      {"Feed", ScanNumber(s.scan, "feed_mm_per_min", 3, "mm/min")},
-      {"Sample period", ScanNumber(s.scan, "sample_period_s", 7, "s")},
+      {"Feed", ScanNumber(s.scan, key::scan::kFeedMmPerMin, 3, "mm/min")},
+      {"Sample period", ScanNumber(s.scan, key::scan::kSamplePeriodS, 7, "s")},
       {"Samples", fmt::format("{}", in.samples)},
       {"Valid samples", fmt::format("{} ({}%)", in.valid_samples, FormatNumber(valid_pct, 2))},
       {"Despiked samples", fmt::format("{}", in.despiked_samples)},
@@ -387,7 +389,7 @@ std::vector<KeyValue> FlattenJson(const nlohmann::json& object) {
 ReportContent ComposeReport(const ReportInputs& inputs, const Tolerances& tolerances) {
   const Summary& s = inputs.summary;
   ReportContent content;
-  const std::string wheel = ScanText(s.scan, "wheel_id");
+  const std::string wheel = ScanText(s.scan, key::scan::kWheelId);
   content.title =
       "Wheel inspection report: " + (wheel == "not recorded" ? std::string("wheel id not recorded") : wheel);
   content.provenance = Provenance(inputs);

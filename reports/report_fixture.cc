@@ -6,7 +6,8 @@
 #include <string>
 #include <vector>
 
-#include "core/hdf5.h"
+#include "fitting/outputs.h"
+#include "schema/summary.h"
 
 namespace arcwheel::reports::testing {
 namespace {
@@ -46,134 +47,144 @@ double FixtureArcRadius_mm(double phase_deg) { return 75.0 + 0.003 * std::sin(2.
 double FixtureCenterAxial_mm(double phase_deg) { return 10.0 + 0.002 * std::cos(phase_deg * kDegToRad); }
 double FixtureCenterRadial_mm(double phase_deg) { return 25.0 + 0.001 * std::sin(phase_deg * kDegToRad); }
 
-nlohmann::json FixtureSummary(const FixtureOptions& options) {
-  using nlohmann::json;
-  const std::vector<double> phases = PhaseNodes(options);
-  json p = {{"phase_deg", phases}};
-  for (const char* key :
-       {"arc_radius_mm", "arc_radius_sigma_mm", "center_axial_mm", "center_axial_sigma_mm",
-        "center_radial_mm", "center_radial_sigma_mm", "arc_error_um", "points_in_band", "usable", "flag"}) {
-    p[key] = json::array();
+namespace {
+
+namespace parameter = schema::summary::processing;
+
+processing::ProcessedScan FixtureScan(const FixtureOptions& options) {
+  processing::ProcessedScan scan;
+  scan.samples = 2400000;
+  scan.valid_samples = 2399000;
+  scan.first_valid = 0;
+  scan.last_valid = scan.samples - 1;
+  scan.despike.rejected = 37;
+  scan.despike.threshold_um = 5.0;
+  scan.noise_sigma_mm = 0.31e-3;
+  scan.speed.available = true;
+  scan.speed.fitted_rpm = 999.87;
+  scan.speed.sigma_rpm = 0.02;
+  scan.phase_source = processing::PhaseSource::kEstimated;
+  scan.rpm_used = 999.87;
+  scan.warnings = {"spindle speed estimated from the data (999.87 rpm vs 1000 nominal)"};
+
+  processing::WheelMap& map = scan.map;
+  map.phase_deg = PhaseNodes(options);
+  map.y_mm = AxialNodes(options);
+  map.knot_step_deg = 360.0 / static_cast<double>(options.n_phase);
+  map.axial_step_mm = 0.1;
+  const std::size_t cells = options.n_phase * options.n_y;
+  map.rho_mm.resize(cells);
+  map.sample_count.assign(cells, 4);
+  map.despiked_count.assign(cells, 0);
+  for (std::size_t i = 0; i < options.n_phase; ++i) {
+    for (std::size_t j = 0; j < options.n_y; ++j) {
+      const std::size_t k = i * options.n_y + j;
+      map.rho_mm[k] = Rho(map.phase_deg[i], map.y_mm[j], options.radial_offset_um);
+      if (IsMissing(map.phase_deg[i], map.y_mm[j])) {
+        map.rho_mm[k] = kNaN;
+        map.sample_count[k] = 0;
+      }
+      if (IsDespiked(map.phase_deg[i], map.y_mm[j])) map.despiked_count[k] = 1;
+    }
   }
-  for (double c : phases) {
-    p["arc_radius_mm"].push_back(FixtureArcRadius_mm(c));
-    p["arc_radius_sigma_mm"].push_back(0.0004);
-    p["center_axial_mm"].push_back(FixtureCenterAxial_mm(c));
-    p["center_axial_sigma_mm"].push_back(0.0002);
-    p["center_radial_mm"].push_back(FixtureCenterRadial_mm(c));
-    p["center_radial_sigma_mm"].push_back(0.0003);
-    p["arc_error_um"].push_back(1.0 + 0.5 * std::cos(3.0 * c * kDegToRad));
-    p["points_in_band"].push_back(160);
-    p["usable"].push_back(true);
-    p["flag"].push_back("");
+  // Every map value has a 1-sigma of 0.05 um, so the median the writer records is 0.05 um.
+  processing::Section section;
+  section.sigma_mm = {0.05e-3};
+  map.sections.assign(options.n_phase, section);
+  return scan;
+}
+
+fitting::WheelFit FixtureFit(const FixtureOptions& options, const processing::WheelMap& map) {
+  fitting::WheelFit fit;
+  for (const double c : map.phase_deg) {
+    fit.phases.push_back({.arc_radius_mm = FixtureArcRadius_mm(c),
+                          .arc_radius_sigma_mm = 0.0004,
+                          .center_axial_mm = FixtureCenterAxial_mm(c),
+                          .center_axial_sigma_mm = 0.0002,
+                          .center_radial_mm = FixtureCenterRadial_mm(c),
+                          .center_radial_sigma_mm = 0.0003,
+                          .arc_error_um = 1.0 + 0.5 * std::cos(3.0 * c * kDegToRad),
+                          .chi2_per_dof = 1.0,
+                          .points = 160,
+                          .usable = true,
+                          .flag = ""});
   }
-  json axial = {{"y_mm", json::array()}, {"runout_um", json::array()}, {"roundness_um", json::array()}};
-  for (double y : AxialNodes(options)) {
+  // Headline literals; their printed forms are "75.01234 ± 0.00021 mm", "0.0061 mm",
+  // "0.008 %", "0.0043 mm", "1.58 µm", "7.13 µm", "3.47 µm".
+  fit.mean_arc_radius_mm = 75.01234;
+  fit.mean_arc_radius_sigma_mm = 0.00021;
+  fit.arc_radius_range_mm = 0.0061;
+  fit.arc_radius_fluctuation_pct = 0.008;
+  fit.arc_radius_std_mm = 0.0021;
+  fit.mean_center_axial_mm = 10.0;
+  fit.center_axial_deviation_mm = 0.0043;
+  fit.mean_center_radial_mm = 25.0;
+  fit.band_low_mm = 2.0;
+  fit.band_high_mm = 18.0;
+  fit.max_arc_error_um = 1.58;
+  fit.max_runout_um = 7.13;
+  fit.max_roundness_um = 3.47;
+  fit.median_chi2_per_dof = 1.0;
+  fit.usable_phases = static_cast<int>(options.n_phase);
+  for (const double y : map.y_mm) {
     if (y < 2.0 || y > 18.0) continue;
-    axial["y_mm"].push_back(y);
-    axial["runout_um"].push_back(6.0 + 0.05 * y);
-    axial["roundness_um"].push_back(3.0 + 0.02 * y);
+    fit.axial_y_mm.push_back(y);
+    fit.runout_um.push_back(6.0 + 0.05 * y);
+    fit.roundness_um.push_back(3.0 + 0.02 * y);
   }
-  return {
-      {"arcwheel_version", "0.1.0"},
-      {"input",
-       {{"path", "/data/scans/wheel_W17.h5"},
-        {"sha256", kSha},
-        {"samples", 2400000},
-        {"valid_samples", 2399000},
-        {"despiked_samples", 37},
-        {"format", "hdf5"}}},
-      {"scan",
-       {{"wheel_id", "W17-arc75"},
-        {"sensor", "Keyence LK-H008"},
-        {"operator", "A. Operator"},
-        {"timestamp", "2026-03-04T10:20:30Z"},
-        {"wheel_diameter_mm", 200.0},
-        {"wheel_width_mm", 20.0},
-        {"feed_mm_per_min", 10.0},
-        {"sample_period_s", 0.0001},
-        {"radius_sign", 1},
-        {"start_y_mm", 0.0},
-        {"has_encoder", false}}},
-      {"spindle_rpm_nominal", 1000.0},
-      {"spindle_rpm_estimated", 999.87},
-      {"spindle_rpm_sigma", 0.02},
-      {"spindle_rpm_source", "estimated"},
-      {"noise_sigma_um", 0.31},
-      {"map_sigma_um", 0.05},
-      // Headline literals; their printed forms are "75.01234 ± 0.00021 mm", "0.0061 mm",
-      // "0.008 %", "0.0043 mm", "1.58 µm", "7.13 µm", "3.47 µm".
-      {"mean_arc_radius_mm", 75.01234},
-      {"mean_arc_radius_sigma_mm", 0.00021},
-      {"arc_radius_range_mm", 0.0061},
-      {"arc_radius_fluctuation_pct", 0.008},
-      {"arc_radius_std_mm", 0.0021},
-      {"mean_center_axial_mm", 10.0},
-      {"center_axial_deviation_mm", 0.0043},
-      {"mean_center_radial_mm", 25.0},
-      {"band_half_width_mm", 8.0},
-      {"band_mm", {2.0, 18.0}},
-      {"max_arc_error_um", 1.58},
-      {"max_runout_um", 7.13},
-      {"max_roundness_um", 3.47},
-      {"runout_note", "runout is the wheel's runout plus the spindle's error motion"},
-      {"phases", p},
-      {"axial", axial},
-      {"processing",
-       {{"despike", {{"window_half_width", 5}, {"threshold_um", 5.0}}},
-        {"map", {{"phases", static_cast<int>(options.n_phase)}, {"axial_step_mm", 0.1}}},
-        {"fit", {{"band_half_width_mm", 8.0}, {"fit_span", "band"}}}}},
-      {"warnings", {"spindle speed estimated from the data (999.87 rpm vs 1000 nominal)"}},
-  };
+  // Form error against the mean wheel (Ra 75 mm, centre (10, 25) mm).
+  fit.form_error_um.resize(map.rho_mm.size());
+  for (std::size_t i = 0; i < map.n_phase(); ++i) {
+    for (std::size_t j = 0; j < map.n_y(); ++j) {
+      const double u = map.y_mm[j] - 10.0;
+      fit.form_error_um[i * map.n_y() + j] =
+          (map.rho(i, j) - (25.0 + std::sqrt(75.0 * 75.0 - u * u))) * 1000.0;
+    }
+  }
+  return fit;
+}
+
+fitting::RunRecord FixtureRecord(const FixtureOptions& options) {
+  fitting::RunRecord record;
+  record.input_path = "/data/scans/wheel_W17.h5";
+  record.input_sha256 = kSha;
+  record.input_format = "hdf5";
+  record.metadata.wheel_id = "W17-arc75";
+  record.metadata.sensor = "Keyence LK-H008";
+  record.metadata.operator_name = "A. Operator";
+  record.metadata.timestamp = "2026-03-04T10:20:30Z";
+  record.metadata.wheel_diameter_mm = 200.0;
+  record.metadata.wheel_width_mm = 20.0;
+  record.metadata.feed_mm_per_min = 10.0;
+  record.metadata.sample_period_s = 0.0001;
+  record.metadata.spindle_rpm = 1000.0;
+  record.metadata.radius_sign = 1;
+  record.metadata.start_y_mm = 0.0;
+  record.numeric_parameters = {{std::string(parameter::kPhases), static_cast<double>(options.n_phase)},
+                               {std::string(parameter::kBandHalfWidthMm), 8.0},
+                               {std::string(parameter::kDespikeWindowHalfWidth), 5.0},
+                               {std::string(parameter::kDespikeThresholdUm), 5.0}};
+  record.text_parameters = {{std::string(parameter::kFitSpan), "band"}};
+  return record;
+}
+
+}  // namespace
+
+nlohmann::json FixtureSummary(const FixtureOptions& options) {
+  const processing::ProcessedScan scan = FixtureScan(options);
+  return nlohmann::json::parse(
+      fitting::SummaryJson(FixtureRecord(options), scan, FixtureFit(options, scan.map)));
 }
 
 void WriteFixture(const std::filesystem::path& outdir, const FixtureOptions& options,
                   const nlohmann::json& summary) {
-  std::filesystem::create_directories(outdir);
-  std::ofstream(outdir / "summary.json") << summary.dump(2);
-  const std::vector<double> phases = PhaseNodes(options);
-  const std::vector<double> y = AxialNodes(options);
-  const std::size_t cells = options.n_phase * options.n_y;
-  std::vector<double> rho(cells), form_error(cells);
-  std::vector<int> samples(cells, 4), despiked(cells, 0);
-  for (std::size_t i = 0; i < options.n_phase; ++i) {
-    for (std::size_t j = 0; j < options.n_y; ++j) {
-      const std::size_t k = i * options.n_y + j;
-      rho[k] = Rho(phases[i], y[j], options.radial_offset_um);
-      form_error[k] = (rho[k] - (25.0 + std::sqrt(75.0 * 75.0 - (y[j] - 10.0) * (y[j] - 10.0)))) * 1000.0;
-      if (IsMissing(phases[i], y[j])) {
-        rho[k] = form_error[k] = kNaN;
-        samples[k] = 0;
-      }
-      if (IsDespiked(phases[i], y[j])) despiked[k] = 1;
-    }
-  }
-  hdf5::File file = hdf5::File::Create(outdir / "wheel_map.h5");
-  const std::vector<hsize_t> grid = {options.n_phase, options.n_y};
-  file.CreateGroup("/map");
-  file.WriteDoubles("/map/phase_deg", phases, {options.n_phase});
-  file.WriteDoubles("/map/y_mm", y, {options.n_y});
-  file.WriteDoubles("/map/rho", rho, grid);
-  file.WriteDoubles("/map/form_error_um", form_error, grid);
-  file.WriteInts("/map/sample_count", samples, grid);
-  file.WriteInts("/map/despiked_count", despiked, grid);
-  file.CreateGroup("/fit");
-  const nlohmann::json& p = summary.at("phases");
-  for (const char* key :
-       {"arc_radius_mm", "arc_radius_sigma_mm", "center_axial_mm", "center_radial_mm", "arc_error_um"}) {
-    if (p.contains(key) && p.at(key).size() == options.n_phase) {
-      std::vector<double> values;
-      for (const auto& v : p.at(key)) values.push_back(v.is_number() ? v.get<double>() : kNaN);
-      file.WriteDoubles(std::string("/fit/") + key, values, {options.n_phase});
-    }
-  }
-  file.WriteAttribute("/", "arcwheel_version", std::string("0.1.0"));
-  file.WriteAttribute("/", "input_path", std::string("/data/scans/wheel_W17.h5"));
-  file.WriteAttribute("/", "input_sha256", std::string(kSha));
+  WriteFixture(outdir, options);
+  std::ofstream(outdir / schema::summary::kFileName) << summary.dump(2);
 }
 
 void WriteFixture(const std::filesystem::path& outdir, const FixtureOptions& options) {
-  WriteFixture(outdir, options, FixtureSummary(options));
+  const processing::ProcessedScan scan = FixtureScan(options);
+  fitting::WriteProcessOutputs(outdir, FixtureRecord(options), scan, FixtureFit(options, scan.map));
 }
 
 }  // namespace arcwheel::reports::testing

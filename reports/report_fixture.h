@@ -1,13 +1,16 @@
 #pragma once
-// Test and benchmark fixture: writes a synthetic OUTDIR (summary.json and wheel_map.h5, laid out
-// as docs/outputs.md describes) for a wheel whose every section is an exact circle arc with
-// known parameters, so that tests know the answers independently of the report code.
+// Test and benchmark fixture: an OUTDIR (summary.json and wheel_map.h5) written by the real writer,
+// fitting::WriteProcessOutputs, for a wheel whose every section is an exact circle arc with known
+// parameters, so that tests know the answers independently of the report code and read the shape
+// that `arcwheel process` writes.
 //
 // The wheel: phase nodes c_i = i * 360 / n_phase deg, axial nodes y_j = 20 * j / (n_y - 1) mm,
 //   Ra(c) = 75 + 0.003 sin(2c) mm, a(c) = 10 + 0.002 cos(c) mm, b(c) = 25 + 0.001 sin(c) mm,
 //   rho(c, y) = b(c) + sqrt(Ra(c)^2 - (y - a(c))^2) + radial_offset_um / 1000,
 // with cells of no valid sample (rho NaN, sample_count 0) where 90 <= c < 100 and y < 1, and
 // despiked samples in the cells where 180 <= c < 190 and 5 <= y < 6.
+// Processing parameters recorded: phases = n_phase, band_half_width_mm = 8,
+// despike_window_half_width = 5, despike_threshold_um = 5, fit_span = "band".
 
 #include <cstddef>
 #include <filesystem>
@@ -27,11 +30,12 @@ double FixtureArcRadius_mm(double phase_deg);
 double FixtureCenterAxial_mm(double phase_deg);
 double FixtureCenterRadial_mm(double phase_deg);
 
-// The summary.json document. Headline numbers are fixed literals (documented in the .cc) so that
-// tests can expect their printed form.
+// The summary.json document the writer makes for the fixture. Headline numbers are fixed literals
+// (documented in the .cc) so that tests can expect their printed form.
 [[nodiscard]] nlohmann::json FixtureSummary(const FixtureOptions& options);
 
-// Writes OUTDIR/summary.json (from `summary`) and OUTDIR/wheel_map.h5.
+// Writes OUTDIR/wheel_map.h5 and then OUTDIR/summary.json from `summary` (a FixtureSummary that a
+// test changed), or both as the writer makes them.
 void WriteFixture(const std::filesystem::path& outdir, const FixtureOptions& options,
                   const nlohmann::json& summary);
 void WriteFixture(const std::filesystem::path& outdir, const FixtureOptions& options = {});

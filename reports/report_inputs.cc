@@ -10,11 +10,15 @@
 #include "core/error.h"
 #include "core/hdf5.h"
 #include "core/json_text.h"
+#include "schema/summary.h"
+#include "schema/wheel_map.h"
 
 namespace arcwheel::reports {
 namespace {
 
 using nlohmann::json;
+namespace key = schema::summary;
+namespace h5 = schema::wheel_map;
 constexpr const char* kSummaryStage = "reports.summary";
 constexpr const char* kMapStage = "reports.wheel_map";
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
@@ -24,8 +28,8 @@ struct JsonWhere {
   const std::string& file;
   std::string key;
   [[nodiscard]] std::string Describe() const { return "'" + file + "' key '" + key + "'"; }
-  [[nodiscard]] JsonWhere Child(const std::string& name) const {
-    return {file, key.empty() ? name : key + "." + name};
+  [[nodiscard]] JsonWhere Child(std::string_view name) const {
+    return {file, key.empty() ? std::string(name) : key + "." + std::string(name)};
   }
 };
 
@@ -33,13 +37,13 @@ struct JsonWhere {
   throw Error(ErrorCode::kBadInput, kSummaryStage, where.Describe() + " " + problem);
 }
 
-const json& RequireKey(const json& object, const JsonWhere& parent, const std::string& name) {
+const json& RequireKey(const json& object, const JsonWhere& parent, std::string_view name) {
   const auto it = object.find(name);
   if (it == object.end()) BadSummary(parent.Child(name), "is missing");
   return *it;
 }
 
-const json& RequireObject(const json& object, const JsonWhere& parent, const std::string& name) {
+const json& RequireObject(const json& object, const JsonWhere& parent, std::string_view name) {
   const json& value = RequireKey(object, parent, name);
   if (!value.is_object()) BadSummary(parent.Child(name), "is not a JSON object");
   return value;
@@ -52,16 +56,16 @@ double NumberOrNull(const json& value, const JsonWhere& where) {
   return value.get<double>();
 }
 
-double RequireNumber(const json& object, const JsonWhere& parent, const std::string& name) {
+double RequireNumber(const json& object, const JsonWhere& parent, std::string_view name) {
   return NumberOrNull(RequireKey(object, parent, name), parent.Child(name));
 }
 
-double OptionalNumber(const json& object, const JsonWhere& parent, const std::string& name) {
+double OptionalNumber(const json& object, const JsonWhere& parent, std::string_view name) {
   const auto it = object.find(name);
   return it == object.end() ? kNaN : NumberOrNull(*it, parent.Child(name));
 }
 
-std::int64_t RequireCount(const json& object, const JsonWhere& parent, const std::string& name) {
+std::int64_t RequireCount(const json& object, const JsonWhere& parent, std::string_view name) {
   const json& value = RequireKey(object, parent, name);
   if (!value.is_number_integer() || value.get<std::int64_t>() < 0) {
     BadSummary(parent.Child(name), "is not a non-negative integer (found " + value.dump() + ")");
@@ -69,20 +73,20 @@ std::int64_t RequireCount(const json& object, const JsonWhere& parent, const std
   return value.get<std::int64_t>();
 }
 
-std::string RequireString(const json& object, const JsonWhere& parent, const std::string& name) {
+std::string RequireString(const json& object, const JsonWhere& parent, std::string_view name) {
   const json& value = RequireKey(object, parent, name);
   if (!value.is_string()) BadSummary(parent.Child(name), "is not a string (found " + value.dump() + ")");
   return value.get<std::string>();
 }
 
-std::string OptionalString(const json& object, const JsonWhere& parent, const std::string& name) {
+std::string OptionalString(const json& object, const JsonWhere& parent, std::string_view name) {
   const auto it = object.find(name);
   if (it == object.end() || it->is_null()) return "";
   if (!it->is_string()) BadSummary(parent.Child(name), "is not a string (found " + it->dump() + ")");
   return it->get<std::string>();
 }
 
-std::vector<double> RequireNumberArray(const json& object, const JsonWhere& parent, const std::string& name,
+std::vector<double> RequireNumberArray(const json& object, const JsonWhere& parent, std::string_view name,
                                        std::size_t expected_size) {
   const json& value = RequireKey(object, parent, name);
   const JsonWhere where = parent.Child(name);
@@ -100,33 +104,33 @@ std::vector<double> RequireNumberArray(const json& object, const JsonWhere& pare
 }
 
 InputProvenance ParseInput(const json& root, const JsonWhere& top) {
-  const JsonWhere where = top.Child("input");
-  const json& input = RequireObject(root, top, "input");
+  const JsonWhere where = top.Child(key::kInput);
+  const json& input = RequireObject(root, top, key::kInput);
   InputProvenance provenance;
-  provenance.path = RequireString(input, where, "path");
-  provenance.sha256 = RequireString(input, where, "sha256");
-  provenance.format = OptionalString(input, where, "format");
-  provenance.samples = RequireCount(input, where, "samples");
-  provenance.valid_samples = RequireCount(input, where, "valid_samples");
-  provenance.despiked_samples = RequireCount(input, where, "despiked_samples");
+  provenance.path = RequireString(input, where, key::input::kPath);
+  provenance.sha256 = RequireString(input, where, key::input::kSha256);
+  provenance.format = OptionalString(input, where, key::input::kFormat);
+  provenance.samples = RequireCount(input, where, key::input::kSamples);
+  provenance.valid_samples = RequireCount(input, where, key::input::kValidSamples);
+  provenance.despiked_samples = RequireCount(input, where, key::input::kDespikedSamples);
   return provenance;
 }
 
 PhaseSeries ParsePhases(const json& root, const JsonWhere& top) {
-  const JsonWhere where = top.Child("phases");
-  const json& phases = RequireObject(root, top, "phases");
+  const JsonWhere where = top.Child(key::kPhases);
+  const json& phases = RequireObject(root, top, key::kPhases);
   PhaseSeries series;
-  series.phase_deg = RequireNumberArray(phases, where, "phase_deg", std::string::npos);
+  series.phase_deg = RequireNumberArray(phases, where, key::phases::kPhaseDeg, std::string::npos);
   const std::size_t n = series.phase_deg.size();
-  if (n == 0) BadSummary(where.Child("phase_deg"), "is empty");
-  series.arc_radius_mm = RequireNumberArray(phases, where, "arc_radius_mm", n);
-  series.arc_radius_sigma_mm = RequireNumberArray(phases, where, "arc_radius_sigma_mm", n);
-  series.center_axial_mm = RequireNumberArray(phases, where, "center_axial_mm", n);
-  series.center_radial_mm = RequireNumberArray(phases, where, "center_radial_mm", n);
-  series.arc_error_um = RequireNumberArray(phases, where, "arc_error_um", n);
+  if (n == 0) BadSummary(where.Child(key::phases::kPhaseDeg), "is empty");
+  series.arc_radius_mm = RequireNumberArray(phases, where, key::phases::kArcRadiusMm, n);
+  series.arc_radius_sigma_mm = RequireNumberArray(phases, where, key::phases::kArcRadiusSigmaMm, n);
+  series.center_axial_mm = RequireNumberArray(phases, where, key::phases::kCenterAxialMm, n);
+  series.center_radial_mm = RequireNumberArray(phases, where, key::phases::kCenterRadialMm, n);
+  series.arc_error_um = RequireNumberArray(phases, where, key::phases::kArcErrorUm, n);
   series.usable.assign(n, true);
-  if (const auto it = phases.find("usable"); it != phases.end()) {
-    const JsonWhere usable_where = where.Child("usable");
+  if (const auto it = phases.find(key::phases::kUsable); it != phases.end()) {
+    const JsonWhere usable_where = where.Child(key::phases::kUsable);
     if (!it->is_array() || it->size() != n)
       BadSummary(usable_where, fmt::format("is not an array of {} booleans", n));
     for (std::size_t i = 0; i < n; ++i) {
@@ -138,30 +142,30 @@ PhaseSeries ParsePhases(const json& root, const JsonWhere& top) {
 }
 
 AxialSeries ParseAxial(const json& root, const JsonWhere& top) {
-  const JsonWhere where = top.Child("axial");
-  const json& axial = RequireObject(root, top, "axial");
+  const JsonWhere where = top.Child(key::kAxial);
+  const json& axial = RequireObject(root, top, key::kAxial);
   AxialSeries series;
-  series.y_mm = RequireNumberArray(axial, where, "y_mm", std::string::npos);
-  series.runout_um = RequireNumberArray(axial, where, "runout_um", series.y_mm.size());
-  series.roundness_um = RequireNumberArray(axial, where, "roundness_um", series.y_mm.size());
+  series.y_mm = RequireNumberArray(axial, where, key::axial::kYMm, std::string::npos);
+  series.runout_um = RequireNumberArray(axial, where, key::axial::kRunoutUm, series.y_mm.size());
+  series.roundness_um = RequireNumberArray(axial, where, key::axial::kRoundnessUm, series.y_mm.size());
   return series;
 }
 
 void ParseBand(const json& root, const JsonWhere& top, Summary& summary) {
   summary.band_low_mm = summary.mean_center_axial_mm - summary.band_half_width_mm;
   summary.band_high_mm = summary.mean_center_axial_mm + summary.band_half_width_mm;
-  const auto it = root.find("band_mm");
+  const auto it = root.find(key::kBandMm);
   if (it == root.end() || it->is_null()) return;
-  const std::vector<double> band = RequireNumberArray(root, top, "band_mm", 2);
+  const std::vector<double> band = RequireNumberArray(root, top, key::kBandMm, 2);
   summary.band_low_mm = band[0];
   summary.band_high_mm = band[1];
 }
 
 std::vector<std::string> ParseWarnings(const json& root, const JsonWhere& top) {
   std::vector<std::string> warnings;
-  const auto it = root.find("warnings");
+  const auto it = root.find(key::kWarnings);
   if (it == root.end() || it->is_null()) return warnings;
-  const JsonWhere where = top.Child("warnings");
+  const JsonWhere where = top.Child(key::kWarnings);
   if (!it->is_array()) BadSummary(where, "is not an array of strings");
   for (std::size_t i = 0; i < it->size(); ++i) {
     if (!(*it)[i].is_string()) BadSummary(where.Child(std::to_string(i)), "is not a string");
@@ -171,21 +175,29 @@ std::vector<std::string> ParseWarnings(const json& root, const JsonWhere& top) {
 }
 
 void ParseHeadline(const json& root, const JsonWhere& top, Summary& summary) {
-  summary.spindle_rpm_nominal = RequireNumber(root, top, "spindle_rpm_nominal");
-  summary.spindle_rpm_estimated = RequireNumber(root, top, "spindle_rpm_estimated");
-  summary.mean_arc_radius_mm = RequireNumber(root, top, "mean_arc_radius_mm");
-  summary.mean_arc_radius_sigma_mm = RequireNumber(root, top, "mean_arc_radius_sigma_mm");
-  summary.arc_radius_range_mm = RequireNumber(root, top, "arc_radius_range_mm");
-  summary.arc_radius_fluctuation_pct = RequireNumber(root, top, "arc_radius_fluctuation_pct");
-  summary.mean_center_axial_mm = RequireNumber(root, top, "mean_center_axial_mm");
-  summary.center_axial_deviation_mm = RequireNumber(root, top, "center_axial_deviation_mm");
-  summary.band_half_width_mm = RequireNumber(root, top, "band_half_width_mm");
-  summary.max_arc_error_um = RequireNumber(root, top, "max_arc_error_um");
-  summary.max_runout_um = RequireNumber(root, top, "max_runout_um");
-  summary.max_roundness_um = RequireNumber(root, top, "max_roundness_um");
-  summary.noise_sigma_um = OptionalNumber(root, top, "noise_sigma_um");
-  summary.map_sigma_um = OptionalNumber(root, top, "map_sigma_um");
-  summary.spindle_rpm_source = OptionalString(root, top, "spindle_rpm_source");
+  summary.spindle_rpm_nominal = RequireNumber(root, top, key::kSpindleRpmNominal);
+  summary.spindle_rpm_estimated = RequireNumber(root, top, key::kSpindleRpmEstimated);
+  summary.mean_arc_radius_mm = RequireNumber(root, top, key::kMeanArcRadiusMm);
+  summary.mean_arc_radius_sigma_mm = RequireNumber(root, top, key::kMeanArcRadiusSigmaMm);
+  summary.arc_radius_range_mm = RequireNumber(root, top, key::kArcRadiusRangeMm);
+  summary.arc_radius_fluctuation_pct = RequireNumber(root, top, key::kArcRadiusFluctuationPct);
+  summary.mean_center_axial_mm = RequireNumber(root, top, key::kMeanCenterAxialMm);
+  summary.center_axial_deviation_mm = RequireNumber(root, top, key::kCenterAxialDeviationMm);
+  summary.band_half_width_mm = RequireNumber(root, top, key::kBandHalfWidthMm);
+  summary.max_arc_error_um = RequireNumber(root, top, key::kMaxArcErrorUm);
+  summary.max_runout_um = RequireNumber(root, top, key::kMaxRunoutUm);
+  summary.max_roundness_um = RequireNumber(root, top, key::kMaxRoundnessUm);
+  summary.noise_sigma_um = OptionalNumber(root, top, key::kNoiseSigmaUm);
+  summary.map_sigma_um = OptionalNumber(root, top, key::kMapSigmaUm);
+  summary.spindle_rpm_source = OptionalString(root, top, key::kSpindleRpmSource);
+}
+
+// A file without schema_version was written before versions were recorded: read it as 1.0.
+void CheckSummaryVersion(const json& root, const JsonWhere& top) {
+  const std::string version = OptionalString(root, top, key::kSchemaVersion);
+  const bool recorded = root.contains(key::kSchemaVersion) && !root.at(key::kSchemaVersion).is_null();
+  schema::CheckVersion(recorded ? std::optional<std::string>(version) : std::nullopt, key::kVersion, top.file,
+                       fmt::format("key '{}'", key::kSchemaVersion), kSummaryStage);
 }
 
 std::string ReadWholeFile(const std::filesystem::path& path, const char* stage) {
@@ -203,8 +215,9 @@ std::string ReadWholeFile(const std::filesystem::path& path, const char* stage) 
               "'" + path.string() + "' dataset '" + dataset + "' " + problem);
 }
 
-std::vector<double> ReadDataset(const hdf5::File& file, const std::string& dataset,
+std::vector<double> ReadDataset(const hdf5::File& file, std::string_view dataset_path,
                                 const std::vector<hsize_t>& expected_shape) {
+  const std::string dataset(dataset_path);
   if (!file.HasObject(dataset)) BadMap(file.path(), dataset, "is missing");
   const std::vector<hsize_t> shape = file.Shape(dataset);
   if (shape != expected_shape) {
@@ -214,7 +227,8 @@ std::vector<double> ReadDataset(const hdf5::File& file, const std::string& datas
   return file.ReadDoubles(dataset);
 }
 
-std::vector<double> ReadAxisDataset(const hdf5::File& file, const std::string& dataset) {
+std::vector<double> ReadAxisDataset(const hdf5::File& file, std::string_view dataset_path) {
+  const std::string dataset(dataset_path);
   if (!file.HasObject(dataset)) BadMap(file.path(), dataset, "is missing");
   const std::vector<hsize_t> shape = file.Shape(dataset);
   if (shape.size() != 1 || shape[0] < 2)
@@ -236,16 +250,17 @@ Summary ParseSummary(const std::string& text, const std::string& name) {
   const JsonWhere top{name, ""};
   if (!root.is_object())
     throw Error(ErrorCode::kBadInput, kSummaryStage, "'" + name + "' is not a JSON object");
+  CheckSummaryVersion(root, top);
   Summary summary;
-  summary.arcwheel_version = RequireString(root, top, "arcwheel_version");
+  summary.arcwheel_version = RequireString(root, top, key::kArcwheelVersion);
   summary.input = ParseInput(root, top);
   ParseHeadline(root, top, summary);
   ParseBand(root, top, summary);
   summary.phases = ParsePhases(root, top);
   summary.axial = ParseAxial(root, top);
-  summary.processing = RequireObject(root, top, "processing");
-  if (const auto it = root.find("scan"); it != root.end() && !it->is_null()) {
-    if (!it->is_object()) BadSummary(top.Child("scan"), "is not a JSON object");
+  summary.processing = RequireObject(root, top, key::kProcessing);
+  if (const auto it = root.find(key::kScan); it != root.end() && !it->is_null()) {
+    if (!it->is_object()) BadSummary(top.Child(key::kScan), "is not a JSON object");
     summary.scan = *it;
   }
   summary.warnings = ParseWarnings(root, top);
@@ -268,46 +283,51 @@ WheelMapData ReadWheelMap(const std::filesystem::path& path) {
   hdf5::ReadFirstInChildProcess(path, [&] { (void)ReadWheelMap(path); });
   const hdf5::File file = hdf5::File::OpenReadOnly(path);
   WheelMapData map;
-  map.phase_deg = ReadAxisDataset(file, "/map/phase_deg");
-  map.y_mm = ReadAxisDataset(file, "/map/y_mm");
+  const std::string root(h5::kRoot);
+  schema::CheckVersion(file.ReadAttributeString(root, std::string(h5::kSchemaVersionAttribute)), h5::kVersion,
+                       path.string(), fmt::format("attribute '{}'", h5::kSchemaVersionAttribute), kMapStage);
+  map.phase_deg = ReadAxisDataset(file, h5::kMapPhaseDeg);
+  map.y_mm = ReadAxisDataset(file, h5::kMapYMm);
   const std::vector<hsize_t> grid = {map.n_phase(), map.n_y()};
-  map.rho_mm = ReadDataset(file, "/map/rho", grid);
-  map.form_error_um = ReadDataset(file, "/map/form_error_um", grid);
-  map.sample_count = ReadDataset(file, "/map/sample_count", grid);
-  map.despiked_count = ReadDataset(file, "/map/despiked_count", grid);
-  map.arcwheel_version = file.ReadAttributeString("/", "arcwheel_version").value_or("");
-  map.input_sha256 = file.ReadAttributeString("/", "input_sha256").value_or("");
+  map.rho_mm = ReadDataset(file, h5::kMapRhoMm, grid);
+  map.form_error_um = ReadDataset(file, h5::kMapFormErrorUm, grid);
+  map.sample_count = ReadDataset(file, h5::kMapSampleCount, grid);
+  map.despiked_count = ReadDataset(file, h5::kMapDespikedCount, grid);
+  map.arcwheel_version =
+      file.ReadAttributeString(root, std::string(h5::kArcwheelVersionAttribute)).value_or("");
+  map.input_sha256 = file.ReadAttributeString(root, std::string(h5::kInputSha256Attribute)).value_or("");
   return map;
 }
 
 ReportInputs ReadReportInputs(const std::filesystem::path& outdir) {
   ReportInputs inputs;
-  inputs.summary_path = outdir / "summary.json";
-  inputs.map_path = outdir / "wheel_map.h5";
+  inputs.summary_path = outdir / key::kFileName;
+  inputs.map_path = outdir / h5::kFileName;
   inputs.summary = ReadSummary(inputs.summary_path);
   inputs.map = ReadWheelMap(inputs.map_path);
   const Summary& summary = inputs.summary;
   if (!inputs.map.input_sha256.empty() && inputs.map.input_sha256 != summary.input.sha256) {
-    throw Error(ErrorCode::kBadInput, kMapStage,
-                "'" + inputs.map_path.string() + "' attribute 'input_sha256' (" + inputs.map.input_sha256 +
-                    ") differs from '" + inputs.summary_path.string() + "' key 'input.sha256' (" +
-                    summary.input.sha256 + "): the two files describe different scans");
+    throw Error(
+        ErrorCode::kBadInput, kMapStage,
+        fmt::format("'{}' attribute '{}' ({}) differs from '{}' key '{}.{}' ({}): the two files "
+                    "describe different scans",
+                    inputs.map_path.string(), h5::kInputSha256Attribute, inputs.map.input_sha256,
+                    inputs.summary_path.string(), key::kInput, key::input::kSha256, summary.input.sha256));
   }
   if (inputs.map.n_phase() != summary.phases.phase_deg.size()) {
     throw Error(
         ErrorCode::kBadInput, kMapStage,
-        fmt::format("'{}' dataset '/map/phase_deg' has {} phases but '{}' key 'phases.phase_deg' has {}",
-                    inputs.map_path.string(), inputs.map.n_phase(), inputs.summary_path.string(),
-                    summary.phases.phase_deg.size()));
+        fmt::format("'{}' dataset '{}' has {} phases but '{}' key '{}.{}' has {}", inputs.map_path.string(),
+                    h5::kMapPhaseDeg, inputs.map.n_phase(), inputs.summary_path.string(), key::kPhases,
+                    key::phases::kPhaseDeg, summary.phases.phase_deg.size()));
   }
   for (std::size_t i = 0; i < inputs.map.n_phase(); ++i) {
     if (std::abs(inputs.map.phase_deg[i] - summary.phases.phase_deg[i]) > 1e-6) {
-      throw Error(
-          ErrorCode::kBadInput, kMapStage,
-          fmt::format(
-              "'{}' dataset '/map/phase_deg' [{}] = {} differs from '{}' key 'phases.phase_deg.{}' = {}",
-              inputs.map_path.string(), i, inputs.map.phase_deg[i], inputs.summary_path.string(), i,
-              summary.phases.phase_deg[i]));
+      throw Error(ErrorCode::kBadInput, kMapStage,
+                  fmt::format("'{}' dataset '{}' [{}] = {} differs from '{}' key '{}.{}.{}' = {}",
+                              inputs.map_path.string(), h5::kMapPhaseDeg, i, inputs.map.phase_deg[i],
+                              inputs.summary_path.string(), key::kPhases, key::phases::kPhaseDeg, i,
+                              summary.phases.phase_deg[i]));
     }
   }
   return inputs;

@@ -14,23 +14,12 @@
 namespace arcwheel::reports {
 namespace {
 
+using arcwheel::testing::ErrorOf;
 using arcwheel::testing::TempDir;
 using testing::FixtureOptions;
 using testing::FixtureSummary;
 using ::testing::HasSubstr;
 using testing::WriteFixture;
-
-// Runs `read` and returns the Error it throws; fails the test if it throws nothing.
-template <typename Read>
-Error ErrorOf(const Read& read) {
-  try {
-    read();
-  } catch (const Error& error) {
-    return error;
-  }
-  ADD_FAILURE() << "no Error thrown";
-  return Error(ErrorCode::kInternal, "test", "no error");
-}
 
 TEST(ReadReportInputs, ReadsBackTheFixtureValues) {
   TempDir dir;
@@ -50,7 +39,8 @@ TEST(ReadReportInputs, ReadsBackTheFixtureValues) {
   EXPECT_DOUBLE_EQ(s.phases.phase_deg[9], 90.0);
   EXPECT_DOUBLE_EQ(s.phases.arc_radius_mm[9], testing::FixtureArcRadius_mm(90.0));
   EXPECT_EQ(s.scan.at("wheel_id"), "W17-arc75");
-  EXPECT_EQ(s.processing.at("despike").at("threshold_um"), 5.0);
+  EXPECT_EQ(s.processing.at("despike_threshold_um"), 5.0);
+  EXPECT_EQ(s.processing.at("fit_span"), "band");
   ASSERT_EQ(s.warnings.size(), 1u);
 
   const WheelMapData& map = inputs.map;
@@ -75,6 +65,46 @@ TEST(ReadSummary, ReadsNullAsNaN) {
   const Summary s = ParseSummary(summary.dump(), "s.json");
   EXPECT_TRUE(std::isnan(s.max_roundness_um));
   EXPECT_TRUE(std::isnan(s.phases.arc_radius_mm[3]));
+}
+
+TEST(WriteFixture, RecordsSchemaVersion1_0InBothFiles) {
+  TempDir dir;
+  WriteFixture(dir.path(), {.n_phase = 12, .n_y = 21});
+  std::ifstream summary_file(dir / "summary.json");
+  EXPECT_EQ(nlohmann::json::parse(summary_file).at("schema_version"), "1.0");
+  EXPECT_EQ(hdf5::File::OpenReadOnly(dir / "wheel_map.h5").ReadAttributeString("/", "schema_version"), "1.0");
+}
+
+TEST(ReadSummary, ReadsAFileWrittenBeforeSchemaVersions) {
+  nlohmann::json summary = FixtureSummary({.n_phase = 12, .n_y = 21});
+  summary.erase("schema_version");
+  const Summary s = ParseSummary(summary.dump(), "old/summary.json");
+  EXPECT_DOUBLE_EQ(s.mean_arc_radius_mm, 75.01234);
+  EXPECT_EQ(s.phases.phase_deg.size(), 12u);
+}
+
+TEST(ReadSummary, ReadsALaterMinorVersionOfTheSameMajor) {
+  nlohmann::json summary = FixtureSummary({.n_phase = 12, .n_y = 21});
+  summary["schema_version"] = "1.7";
+  summary["a_key_added_in_1_7"] = 42;
+  EXPECT_DOUBLE_EQ(ParseSummary(summary.dump(), "s.json").max_runout_um, 7.13);
+}
+
+TEST(ReadSummary, RefusesANewerMajorVersionNamingTheFileAndBothVersions) {
+  nlohmann::json summary = FixtureSummary({.n_phase = 12, .n_y = 21});
+  summary["schema_version"] = "2.0";
+  const Error error = ErrorOf([&] { (void)ParseSummary(summary.dump(), "out/summary.json"); });
+  EXPECT_EQ(error.code(), ErrorCode::kBadInput);
+  EXPECT_THAT(error.what(), HasSubstr("'out/summary.json' key 'schema_version' = '2.0'"));
+  EXPECT_THAT(error.what(), HasSubstr("reads schema version 1.x only"));
+}
+
+TEST(ReadSummary, RefusesASchemaVersionThatIsNotText) {
+  nlohmann::json summary = FixtureSummary({.n_phase = 12, .n_y = 21});
+  summary["schema_version"] = 2;
+  const Error error = ErrorOf([&] { (void)ParseSummary(summary.dump(), "out/summary.json"); });
+  EXPECT_EQ(error.code(), ErrorCode::kBadInput);
+  EXPECT_THAT(error.what(), HasSubstr("key 'schema_version' is not a string (found 2)"));
 }
 
 TEST(ReadSummary, RefusesAMissingFileNamingIt) {
@@ -149,9 +179,12 @@ TEST(ReadWheelMap, RefusesAFileThatIsNotHdf5) {
   EXPECT_THAT(error.what(), HasSubstr("not an HDF5 file"));
 }
 
-// Writes a 3 x 2 map; `rho_shape` may differ from it, and form_error_um may be left out.
-void WriteMapWith(const std::filesystem::path& path, bool with_form_error, std::vector<hsize_t> rho_shape) {
+// Writes a 3 x 2 map; `rho_shape` may differ from it, and form_error_um may be left out. Without
+// `schema_version`, the map is one written before versions were recorded.
+void WriteMapWith(const std::filesystem::path& path, bool with_form_error, std::vector<hsize_t> rho_shape,
+                  const std::string& schema_version = "") {
   hdf5::File file = hdf5::File::Create(path);
+  if (!schema_version.empty()) file.WriteAttribute("/", "schema_version", schema_version);
   file.CreateGroup("/map");
   file.WriteDoubles("/map/phase_deg", {0.0, 120.0, 240.0}, {3});
   file.WriteDoubles("/map/y_mm", {0.0, 1.0}, {2});
@@ -176,6 +209,25 @@ TEST(ReadWheelMap, RefusesAGridOfTheWrongShape) {
   const Error error = ErrorOf([&] { (void)ReadWheelMap(dir / "wheel_map.h5"); });
   EXPECT_EQ(error.code(), ErrorCode::kBadInput);
   EXPECT_THAT(error.what(), HasSubstr("dataset '/map/rho' has shape [2, 3], expected [3, 2]"));
+}
+
+TEST(ReadWheelMap, ReadsAMapWrittenBeforeSchemaVersionsAndOneOfTheSameMajor) {
+  TempDir dir;
+  for (const std::string version : {"", "1.0", "1.4"}) {
+    WriteMapWith(dir / "wheel_map.h5", true, {3, 2}, version);
+    const WheelMapData map = ReadWheelMap(dir / "wheel_map.h5");
+    EXPECT_EQ(map.n_phase(), 3u) << "schema_version '" << version << "'";
+    EXPECT_EQ(map.n_y(), 2u);
+  }
+}
+
+TEST(ReadWheelMap, RefusesANewerMajorVersionNamingTheFileAndBothVersions) {
+  TempDir dir;
+  WriteMapWith(dir / "wheel_map.h5", true, {3, 2}, "2.1");
+  const Error error = ErrorOf([&] { (void)ReadWheelMap(dir / "wheel_map.h5"); });
+  EXPECT_EQ(error.code(), ErrorCode::kBadInput);
+  EXPECT_THAT(error.what(), HasSubstr("wheel_map.h5' attribute 'schema_version' = '2.1'"));
+  EXPECT_THAT(error.what(), HasSubstr("reads schema version 1.x only"));
 }
 
 TEST(ReadReportInputs, RefusesASummaryAndMapOfDifferentScans) {

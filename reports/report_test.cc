@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <map>
 #include <nlohmann/json.hpp>
 #include <regex>
 #include <set>
@@ -21,6 +22,8 @@ namespace arcwheel::reports {
 namespace {
 
 namespace fs = std::filesystem;
+using arcwheel::testing::ReadText;
+using arcwheel::testing::Shell;
 using arcwheel::testing::TempDir;
 using testing::BrowserRun;
 using testing::FixtureOptions;
@@ -33,19 +36,6 @@ using testing::WriteFixture;
 // mm with 4 decimals (mean radius and sigma with 5), um with 2, percent with 3.
 const std::vector<std::string> kFixtureHeadline = {
     "75.01234 ± 0.00021 mm", "0.0061 mm", "0.008 %", "0.0043 mm", "1.58 µm", "7.13 µm", "3.47 µm"};
-
-std::string ReadText(const fs::path& path) {
-  std::ifstream stream(path, std::ios::binary);
-  std::ostringstream text;
-  text << stream.rdbuf();
-  return text.str();
-}
-
-// Runs a shell command, returning its exit status; output goes where the command redirects it.
-int Shell(const std::string& command) {
-  const int status = std::system(command.c_str());
-  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-}
 
 Tolerances FixtureTolerances() {
   Tolerances t;
@@ -84,15 +74,18 @@ TEST(ComposeReport, PassesOverallOnlyWhenEveryToleranceHolds) {
   EXPECT_EQ(ComposeReport(inputs, Tolerances{}).overall, Verdict::kNoTolerance);
 }
 
-TEST(ComposeReport, ListsTheProcessingParametersByDottedName) {
+// `processing` is flat in the file (one key per parameter, as the writer records them).
+TEST(ComposeReport, ListsTheProcessingParametersByTheirKeys) {
   TempDir dir;
   WriteFixture(dir.path());
   const ReportContent content = ComposeReport(ReadReportInputs(dir.path()), {});
-  bool found = false;
-  for (const KeyValue& row : content.processing) {
-    if (row.key == "despike.threshold_um") found = row.value == "5.0";
-  }
-  EXPECT_TRUE(found);
+  std::map<std::string, std::string> rows;
+  for (const KeyValue& row : content.processing) rows[row.key] = row.value;
+  // The parameters the fixture records (report_fixture.h), strings unquoted.
+  EXPECT_EQ(rows["despike_threshold_um"], "5.0");
+  EXPECT_EQ(rows["band_half_width_mm"], "8.0");
+  EXPECT_EQ(rows["fit_span"], "band");
+  EXPECT_EQ(rows["axial_step_mm"], "0.1");
 }
 
 TEST(SectionResiduals, AreZeroForPointsOnTheCircle) {
@@ -138,7 +131,7 @@ TEST(WriteReports, PdfTextCarriesTheHeadlineNumbersAsInTheSummary) {
   EXPECT_THAT(text, HasSubstr("W17-arc75"));
   EXPECT_THAT(text, HasSubstr("3b1f5e0c9a7d4e2b8c6f1a0d9e8b7c6a")) << "SHA-256 of the input";
   EXPECT_THAT(text, HasSubstr("Overall: FAIL"));
-  EXPECT_THAT(text, HasSubstr("despike.threshold_um"));
+  EXPECT_THAT(text, HasSubstr("despike_threshold_um"));
   // The plots are vector drawings with their own text: axis labels come through too.
   EXPECT_THAT(text, HasSubstr("phase c (deg)"));
   EXPECT_THAT(text, HasSubstr("form error (µm)"));

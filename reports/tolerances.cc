@@ -20,7 +20,7 @@ bool IsHeadlineKey(const std::string& key) {
 
 std::string KnownKeys() {
   std::string keys;
-  for (const char* key : kHeadlineKeys) keys += (keys.empty() ? "" : ", ") + std::string(key);
+  for (const std::string_view key : kHeadlineKeys) keys += (keys.empty() ? "" : ", ") + std::string(key);
   return keys;
 }
 

@@ -16,6 +16,9 @@
 #include <map>
 #include <optional>
 #include <string>
+#include <string_view>
+
+#include "schema/summary.h"
 
 namespace arcwheel::reports {
 
@@ -25,10 +28,11 @@ struct Limit {
 };
 
 // The headline quantities, in report order.
-inline constexpr std::array<const char*, 7> kHeadlineKeys = {
-    "mean_arc_radius_mm",        "arc_radius_range_mm", "arc_radius_fluctuation_pct",
-    "center_axial_deviation_mm", "max_arc_error_um",    "max_runout_um",
-    "max_roundness_um"};
+inline constexpr std::array<std::string_view, 7> kHeadlineKeys = {
+    schema::summary::kMeanArcRadiusMm,         schema::summary::kArcRadiusRangeMm,
+    schema::summary::kArcRadiusFluctuationPct, schema::summary::kCenterAxialDeviationMm,
+    schema::summary::kMaxArcErrorUm,           schema::summary::kMaxRunoutUm,
+    schema::summary::kMaxRoundnessUm};
 
 struct Tolerances {
   std::map<std::string, Limit> limits;  // by headline key; absent = no tolerance

@@ -7,7 +7,9 @@
 #include <array>
 #include <cstdio>
 #include <cstdlib>
+#include <fstream>
 #include <random>
+#include <sstream>
 #include <stdexcept>
 #include <vector>
 
@@ -54,6 +56,29 @@ std::string ListFolder(const fs::path& folder) {
   std::string listing;
   for (const auto& name : names) listing += name + "\n";
   return listing;
+}
+
+std::string ReadText(const fs::path& path) {
+  std::ifstream stream(path, std::ios::binary);
+  std::ostringstream text;
+  text << stream.rdbuf();
+  return text.str();
+}
+
+int Shell(const std::string& command) {
+  const int status = std::system(command.c_str());
+  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+std::string PdfText(const fs::path& pdf) {
+  const fs::path text = fs::path(pdf).replace_extension(".txt");
+  const std::string command = "pdftotext -enc UTF-8 '" + pdf.string() + "' '" + text.string() + "'";
+  if (Shell(command) != 0) {
+    ADD_FAILURE() << command << " failed (poppler-utils' pdftotext is installed by scripts/install_deps.sh)";
+  }
+  std::string contents = ReadText(text);
+  fs::remove(text);
+  return contents;
 }
 
 }  // namespace arcwheel::testing

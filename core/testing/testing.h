@@ -1,8 +1,13 @@
 #pragma once
-// Helpers shared by the test binaries: temporary folders, source paths and running the CLI.
+// Helpers shared by the test binaries: temporary folders, source paths, running the CLI and
+// other commands, reading files back and catching the Error a call throws.
+
+#include <gtest/gtest.h>
 
 #include <filesystem>
 #include <string>
+
+#include "core/error.h"
 
 namespace arcwheel::testing {
 
@@ -32,5 +37,27 @@ struct CommandResult {
 
 // Names of the entries of a folder, sorted.
 [[nodiscard]] std::string ListFolder(const std::filesystem::path& folder);
+
+// The bytes of a file; "" when it cannot be read.
+[[nodiscard]] std::string ReadText(const std::filesystem::path& path);
+
+// Runs a shell command, returning its exit status (-1 if it did not exit); output goes where the
+// command redirects it.
+int Shell(const std::string& command);
+
+// The text of a PDF as poppler's pdftotext gives it (UTF-8); a test failure when pdftotext fails.
+[[nodiscard]] std::string PdfText(const std::filesystem::path& pdf);
+
+// Runs `call` and returns the Error it throws; fails the test if it throws nothing.
+template <typename Call>
+Error ErrorOf(const Call& call) {
+  try {
+    call();
+  } catch (const Error& error) {
+    return error;
+  }
+  ADD_FAILURE() << "no Error thrown";
+  return Error(ErrorCode::kInternal, "test", "no error");
+}
 
 }  // namespace arcwheel::testing

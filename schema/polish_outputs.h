@@ -1,0 +1,94 @@
+#pragma once
+// The outputs of `arcwheel polish` that the polish report reads back (docs/polishing.md), written
+// by polishing/job.cc and polishing/robot_program.cc and read by reports/polish_report_inputs.cc:
+// the one place that spells polish_summary.json's keys and the CSV column names. polish.mod is a
+// robot program, not read back, and has no schema here.
+//
+// The version recorded in polish_summary.json covers the set: the CSV files carry none.
+
+#include <array>
+#include <string_view>
+
+#include "schema/version.h"
+
+namespace arcwheel::schema::polish {
+
+inline constexpr int kMajorVersion = 1;
+inline constexpr int kMinorVersion = 0;
+inline constexpr Version kVersion{kMajorVersion, kMinorVersion};
+
+inline constexpr std::string_view kSummaryFileName = "polish_summary.json";
+inline constexpr std::string_view kResidualMapFileName = "residual_map.csv";
+inline constexpr std::string_view kPathFileName = "polishing_path.csv";
+
+// polish_summary.json. A key of a nested object lives in the namespace named after the object.
+namespace summary {
+inline constexpr std::string_view kSchemaVersion = "schema_version";  // "MAJOR.MINOR"; absent before 1.0
+inline constexpr std::string_view kArcwheelVersion = "arcwheel_version";
+// The job as used, every default filled in: the keys of the polish job file (docs/polishing.md).
+inline constexpr std::string_view kJob = "job";
+namespace job {
+inline constexpr std::string_view kName = "name";
+inline constexpr std::string_view kErrorMap = "error_map";
+namespace error_map {
+inline constexpr std::string_view kFile = "file";
+}  // namespace error_map
+inline constexpr std::string_view kMachine = "machine";
+namespace machine {
+inline constexpr std::string_view kMaxSpeedMmS = "max_speed_mm_s";
+inline constexpr std::string_view kMinSpeedMmS = "min_speed_mm_s";
+inline constexpr std::string_view kMaxAccelerationMmS2 = "max_acceleration_mm_s2";
+}  // namespace machine
+}  // namespace job
+inline constexpr std::string_view kPoints = "points";  // rows of polishing_path.csv
+inline constexpr std::string_view kTotalTimeS = "total_time_s";
+// Figures of the residual over the aperture before and after the planned removal.
+inline constexpr std::string_view kBefore = "before";
+inline constexpr std::string_view kAfter = "after";
+namespace figures {
+inline constexpr std::string_view kPvUm = "pv_um";
+inline constexpr std::string_view kRmsUm = "rms_um";
+}  // namespace figures
+inline constexpr std::string_view kApertureNodes = "aperture_nodes";  // rows of residual_map.csv
+inline constexpr std::string_view kSpeedMmS = "speed_mm_s";
+namespace speed_mm_s {
+inline constexpr std::string_view kMin = "min";
+inline constexpr std::string_view kMax = "max";
+}  // namespace speed_mm_s
+inline constexpr std::string_view kMaxAccelerationMmS2 = "max_acceleration_mm_s2";
+inline constexpr std::string_view kSolver = "solver";
+namespace solver {
+inline constexpr std::string_view kIterations = "iterations";
+inline constexpr std::string_view kConverged = "converged";
+inline constexpr std::string_view kNonzeros = "nonzeros";
+inline constexpr std::string_view kShapingRounds = "shaping_rounds";
+}  // namespace solver
+}  // namespace summary
+
+// residual_map.csv: one row per aperture node, in this column order.
+namespace residual_map {
+inline constexpr std::string_view kXMm = "x_mm";
+inline constexpr std::string_view kYMm = "y_mm";
+inline constexpr std::string_view kTargetUm = "target_um";
+inline constexpr std::string_view kRemovalUm = "removal_um";
+inline constexpr std::string_view kResidualUm = "residual_um";
+inline constexpr std::array<std::string_view, 5> kColumns = {kXMm, kYMm, kTargetUm, kRemovalUm, kResidualUm};
+}  // namespace residual_map
+
+// polishing_path.csv: "# " comment lines, then one row per path point in this column order:
+// position in mm (part frame), the tool orientation as an ABB quaternion (q1 = w), speed, dwell.
+namespace path {
+inline constexpr std::string_view kXMm = "x";
+inline constexpr std::string_view kYMm = "y";
+inline constexpr std::string_view kZMm = "z";
+inline constexpr std::string_view kQ1 = "q1";
+inline constexpr std::string_view kQ2 = "q2";
+inline constexpr std::string_view kQ3 = "q3";
+inline constexpr std::string_view kQ4 = "q4";
+inline constexpr std::string_view kSpeedMmS = "speed_mm_s";
+inline constexpr std::string_view kDwellS = "dwell_s";
+inline constexpr std::array<std::string_view, 9> kColumns = {kXMm, kYMm, kZMm,      kQ1,    kQ2,
+                                                             kQ3,  kQ4,  kSpeedMmS, kDwellS};
+}  // namespace path
+
+}  // namespace arcwheel::schema::polish

@@ -1,0 +1,150 @@
+#pragma once
+// summary.json, written by `arcwheel process` (fitting/outputs.cc) and read by grinding's wheel
+// reader and the inspection report: the one place that spells its keys (docs/outputs.md). A key
+// of a nested object lives in the namespace named after that object, e.g. `phases::kArcRadiusMm`
+// inside `kPhases`. Bump kMinorVersion when adding a key, kMajorVersion when a key changes meaning,
+// unit or shape, or disappears.
+
+#include <string_view>
+
+#include "schema/version.h"
+
+namespace arcwheel::schema::summary {
+
+inline constexpr int kMajorVersion = 1;
+inline constexpr int kMinorVersion = 0;
+inline constexpr Version kVersion{kMajorVersion, kMinorVersion};
+inline constexpr std::string_view kFileName = "summary.json";
+
+// "MAJOR.MINOR" of the schema the file follows; absent in files written before 1.0.
+inline constexpr std::string_view kSchemaVersion = "schema_version";
+inline constexpr std::string_view kArcwheelVersion = "arcwheel_version";
+
+// Provenance of the scan.
+inline constexpr std::string_view kInput = "input";
+namespace input {
+inline constexpr std::string_view kPath = "path";
+inline constexpr std::string_view kSha256 = "sha256";
+inline constexpr std::string_view kFormat = "format";  // "hdf5" or "csv"
+inline constexpr std::string_view kSamples = "samples";
+inline constexpr std::string_view kValidSamples = "valid_samples";
+inline constexpr std::string_view kDespikedSamples = "despiked_samples";
+inline constexpr std::string_view kStuckSamples = "stuck_samples";
+}  // namespace input
+
+// The scan's metadata as recorded in the scan file.
+inline constexpr std::string_view kScan = "scan";
+namespace scan {
+inline constexpr std::string_view kWheelId = "wheel_id";
+inline constexpr std::string_view kSensor = "sensor";
+inline constexpr std::string_view kOperator = "operator";
+inline constexpr std::string_view kTimestamp = "timestamp";
+inline constexpr std::string_view kWheelDiameterMm = "wheel_diameter_mm";
+inline constexpr std::string_view kWheelWidthMm = "wheel_width_mm";
+inline constexpr std::string_view kFeedMmPerMin = "feed_mm_per_min";
+inline constexpr std::string_view kSamplePeriodS = "sample_period_s";
+inline constexpr std::string_view kRadiusSign = "radius_sign";
+inline constexpr std::string_view kStartYMm = "start_y_mm";
+inline constexpr std::string_view kHasEncoder = "has_encoder";
+inline constexpr std::string_view kFirstValidSample = "first_valid_sample";
+inline constexpr std::string_view kLastValidSample = "last_valid_sample";
+}  // namespace scan
+
+// Spindle speed in rpm.
+inline constexpr std::string_view kSpindleRpmNominal = "spindle_rpm_nominal";
+inline constexpr std::string_view kSpindleRpmEstimated = "spindle_rpm_estimated";
+inline constexpr std::string_view kSpindleRpmSource =
+    "spindle_rpm_source";  // "nominal", "estimated", "encoder"
+inline constexpr std::string_view kSpindleRpmSigma = "spindle_rpm_sigma";
+inline constexpr std::string_view kSpindleRpmFitted = "spindle_rpm_fitted";
+
+inline constexpr std::string_view kNoiseSigmaUm = "noise_sigma_um";
+inline constexpr std::string_view kMapSigmaUm = "map_sigma_um";
+
+// Headline figures.
+inline constexpr std::string_view kMeanArcRadiusMm = "mean_arc_radius_mm";
+inline constexpr std::string_view kMeanArcRadiusSigmaMm = "mean_arc_radius_sigma_mm";
+inline constexpr std::string_view kArcRadiusRangeMm = "arc_radius_range_mm";
+inline constexpr std::string_view kArcRadiusFluctuationPct = "arc_radius_fluctuation_pct";
+inline constexpr std::string_view kArcRadiusStdMm = "arc_radius_std_mm";
+inline constexpr std::string_view kArcRadiusNoiseStdMm = "arc_radius_noise_std_mm";
+inline constexpr std::string_view kArcRadiusExcessStdMm = "arc_radius_excess_std_mm";
+inline constexpr std::string_view kMeanCenterAxialMm = "mean_center_axial_mm";
+inline constexpr std::string_view kMeanCenterAxialSigmaMm = "mean_center_axial_sigma_mm";
+inline constexpr std::string_view kCenterAxialDeviationMm = "center_axial_deviation_mm";
+inline constexpr std::string_view kMeanCenterRadialMm = "mean_center_radial_mm";
+inline constexpr std::string_view kBandHalfWidthMm = "band_half_width_mm";
+inline constexpr std::string_view kBandMm = "band_mm";  // [low, high]
+inline constexpr std::string_view kMaxArcErrorUm = "max_arc_error_um";
+inline constexpr std::string_view kMaxRunoutUm = "max_runout_um";
+inline constexpr std::string_view kMaxRoundnessUm = "max_roundness_um";
+inline constexpr std::string_view kMedianChi2PerDof = "median_chi2_per_dof";
+inline constexpr std::string_view kUsablePhases = "usable_phases";
+inline constexpr std::string_view kRunoutNote = "runout_note";
+
+// Per-phase arrays, one entry per phase node.
+inline constexpr std::string_view kPhases = "phases";
+namespace phases {
+inline constexpr std::string_view kPhaseDeg = "phase_deg";
+inline constexpr std::string_view kArcRadiusMm = "arc_radius_mm";
+inline constexpr std::string_view kArcRadiusSigmaMm = "arc_radius_sigma_mm";
+inline constexpr std::string_view kCenterAxialMm = "center_axial_mm";
+inline constexpr std::string_view kCenterAxialSigmaMm = "center_axial_sigma_mm";
+inline constexpr std::string_view kCenterRadialMm = "center_radial_mm";
+inline constexpr std::string_view kCenterRadialSigmaMm = "center_radial_sigma_mm";
+inline constexpr std::string_view kArcErrorUm = "arc_error_um";
+inline constexpr std::string_view kChi2PerDof = "chi2_per_dof";
+inline constexpr std::string_view kPointsInBand = "points_in_band";
+inline constexpr std::string_view kUsable = "usable";
+inline constexpr std::string_view kFlag = "flag";
+}  // namespace phases
+
+// Per-axial-node arrays over the band.
+inline constexpr std::string_view kAxial = "axial";
+namespace axial {
+inline constexpr std::string_view kYMm = "y_mm";
+inline constexpr std::string_view kRunoutUm = "runout_um";
+inline constexpr std::string_view kRoundnessUm = "roundness_um";
+}  // namespace axial
+
+// The mean measured profile against the mean circle.
+inline constexpr std::string_view kMeanProfile = "mean_profile";
+namespace mean_profile {
+inline constexpr std::string_view kUMm = "u_mm";
+inline constexpr std::string_view kErrorUm = "error_um";
+}  // namespace mean_profile
+
+// Every processing parameter as used, flat (one number or string per key). The same names are
+// the root attributes of wheel_map.h5.
+inline constexpr std::string_view kProcessing = "processing";
+namespace processing {
+inline constexpr std::string_view kPhases = "phases";
+inline constexpr std::string_view kBandHalfWidthMm = "band_half_width_mm";
+inline constexpr std::string_view kDespikeWindowHalfWidth = "despike_window_half_width";
+inline constexpr std::string_view kDespikeThresholdUm = "despike_threshold_um";
+inline constexpr std::string_view kDespikeThresholdSigmas = "despike_threshold_sigmas";
+inline constexpr std::string_view kDespikeMinThresholdUm = "despike_min_threshold_um";
+inline constexpr std::string_view kSpeedMaxHarmonic = "speed_max_harmonic";
+inline constexpr std::string_view kSpeedSignificanceSigmas = "speed_significance_sigmas";
+inline constexpr std::string_view kMapMinSupport = "map_min_support";
+inline constexpr std::string_view kMapMaxSigmaRatio = "map_max_sigma_ratio";
+inline constexpr std::string_view kFitMinPoints = "fit_min_points";
+inline constexpr std::string_view kFitMinBandCoverage = "fit_min_band_coverage";
+inline constexpr std::string_view kRunoutMinPhaseCoverage = "runout_min_phase_coverage";
+inline constexpr std::string_view kBeamOffsetMm = "beam_offset_mm";
+inline constexpr std::string_view kWheelRadiusMm = "wheel_radius_mm";
+inline constexpr std::string_view kStuckRunDeg = "stuck_run_deg";
+inline constexpr std::string_view kDespikeMethod = "despike_method";
+inline constexpr std::string_view kRpmSource = "rpm_source";
+inline constexpr std::string_view kFitSpan = "fit_span";
+inline constexpr std::string_view kFilter = "filter";
+// Written by the writer itself (summary.json only).
+inline constexpr std::string_view kKnotStepDeg = "knot_step_deg";
+inline constexpr std::string_view kAxialStepMm = "axial_step_mm";
+inline constexpr std::string_view kDespikeThresholdUsedUm = "despike_threshold_used_um";
+inline constexpr std::string_view kStuckRunSamplesUsed = "stuck_run_samples_used";
+}  // namespace processing
+
+inline constexpr std::string_view kWarnings = "warnings";  // array of strings
+
+}  // namespace arcwheel::schema::summary

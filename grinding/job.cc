@@ -11,6 +11,17 @@
 #include "core/json_text.h"
 
 namespace arcwheel::grinding {
+
+using surfaces::Aperture;
+using surfaces::CheckApertureInDomain;
+using surfaces::EvenAsphere;
+using surfaces::EvenAsphereParameters;
+using surfaces::HeightGrid;
+using surfaces::HeightGridParameters;
+using surfaces::Surface;
+using surfaces::XyPolynomial;
+using surfaces::XyPolynomialTerm;
+
 namespace {
 
 constexpr const char* kStage = "grinding.job";

@@ -9,9 +9,9 @@
 #include <string>
 
 #include "grinding/prediction.h"
-#include "grinding/surface.h"
 #include "grinding/toolpath.h"
 #include "grinding/wheel.h"
+#include "surfaces/surface.h"
 
 namespace arcwheel::grinding {
 
@@ -30,8 +30,8 @@ struct OutputChoice {
 struct Job {
   std::string name;  // "name" key, or the job file's stem
   std::filesystem::path source;
-  std::shared_ptr<const Surface> surface;
-  Aperture aperture;
+  std::shared_ptr<const surfaces::Surface> surface;
+  surfaces::Aperture aperture;
   Wheel wheel;
   ToolpathOptions path;
   MachineOptions machine;

@@ -13,6 +13,9 @@
 #include "grinding/toolpath_writer.h"
 
 namespace arcwheel::grinding {
+
+using surfaces::EvenAsphere;
+
 namespace {
 
 using nlohmann::json;

@@ -125,18 +125,18 @@ class Section {
   json resolved_ = json::object();
 };
 
-std::shared_ptr<const grinding::Surface> ReadSurface(Section& s) {
+std::shared_ptr<const surfaces::Surface> ReadSurface(Section& s) {
   const std::string type = s.Choice("type", {"even_asphere", "xy_polynomial"});
   if (type == "xy_polynomial") {
     // The same form as the grinding job: [{"x_power": i, "y_power": j, "coefficient": c}, ...].
     if (!s.Has("terms") || !s.Raw("terms").is_array()) {
       s.Fail("terms", "must be an array of {\"x_power\", \"y_power\", \"coefficient\"} objects");
     }
-    std::vector<grinding::XyPolynomialTerm> terms;
+    std::vector<surfaces::XyPolynomialTerm> terms;
     json resolved = json::array();
     for (std::size_t k = 0; k < s.Raw("terms").size(); ++k) {
       Section t(&s.Raw("terms")[k], s.Dotted(fmt::format("terms[{}]", k)), s.source());
-      grinding::XyPolynomialTerm term;
+      surfaces::XyPolynomialTerm term;
       term.x_power = t.WholeNumber("x_power", 0, 0, 20);
       term.y_power = t.WholeNumber("y_power", 0, 0, 20);
       term.coefficient = t.RequiredNumber("coefficient");
@@ -145,9 +145,9 @@ std::shared_ptr<const grinding::Surface> ReadSurface(Section& s) {
       resolved.push_back(t.resolved());
     }
     s.SetResolved("terms", resolved);
-    return std::make_shared<grinding::XyPolynomial>(std::move(terms));
+    return std::make_shared<surfaces::XyPolynomial>(std::move(terms));
   }
-  grinding::EvenAsphereParameters p;
+  surfaces::EvenAsphereParameters p;
   p.vertex_radius_mm = s.RequiredNumber("vertex_radius_mm");
   if (!(p.vertex_radius_mm > 0.0)) s.Fail("vertex_radius_mm", "must be > 0 (use \"form\" for the side)");
   p.conic = s.Number("conic", 0.0);
@@ -165,16 +165,16 @@ std::shared_ptr<const grinding::Surface> ReadSurface(Section& s) {
   p.off_axis_y_mm = off[1];
   p.concave = s.Choice("form", {"concave", "convex"}) == "concave";
   try {
-    return std::make_shared<grinding::EvenAsphere>(p);
+    return std::make_shared<surfaces::EvenAsphere>(p);
   } catch (const Error& e) {
     s.Fail("", fmt::format("is not usable: {}", e.what()));
   }
 }
 
-grinding::Aperture ReadAperture(Section& s) {
-  grinding::Aperture a;
+surfaces::Aperture ReadAperture(Section& s) {
+  surfaces::Aperture a;
   if (s.Choice("shape", {"circle", "rectangle"}) == "circle") {
-    a.shape = grinding::Aperture::Shape::kCircle;
+    a.shape = surfaces::Aperture::Shape::kCircle;
     a.diameter_mm = s.RequiredNumber("diameter_mm");
     if (!(a.diameter_mm > 0.0)) s.Fail("diameter_mm", "must be > 0");
   } else {

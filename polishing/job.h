@@ -7,20 +7,20 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
-#include "grinding/surface.h"
 #include "polishing/dwell.h"
 #include "polishing/error_map_io.h"
 #include "polishing/removal_target.h"
 #include "polishing/robot_program.h"
 #include "polishing/tool_frame.h"
+#include "surfaces/surface.h"
 
 namespace arcwheel::polishing {
 
 struct PolishJob {
   std::string name;
   std::filesystem::path source;
-  std::shared_ptr<const grinding::Surface> surface;
-  grinding::Aperture aperture;
+  std::shared_ptr<const surfaces::Surface> surface;
+  surfaces::Aperture aperture;
   std::filesystem::path error_map_file;
   ErrorMap error_map;
   RemovalTargetOptions target;

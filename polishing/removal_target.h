@@ -10,7 +10,7 @@
 #include <span>
 #include <vector>
 
-#include "grinding/surface.h"
+#include "surfaces/surface.h"
 
 namespace arcwheel::polishing {
 
@@ -34,7 +34,7 @@ struct MapStatistics {
   double rms_um = 0.0;
   int nodes = 0;
 };
-[[nodiscard]] MapStatistics StatisticsInAperture(const ErrorMap& map, const grinding::Aperture& aperture);
+[[nodiscard]] MapStatistics StatisticsInAperture(const ErrorMap& map, const surfaces::Aperture& aperture);
 
 struct RemovalTargetOptions {
   // Uniform depth added to the whole aperture (um), >= 0.
@@ -44,7 +44,7 @@ struct RemovalTargetOptions {
 // Removal target: error - min(error over the aperture) + uniform layer inside the aperture, NaN
 // outside it. Throws Error{kBadInput, "polishing.target"} if the aperture holds no finite node
 // ("empty aperture"), Error{kInvalidOption} for a negative layer or a malformed grid.
-[[nodiscard]] ErrorMap RemovalTarget(const ErrorMap& error, const grinding::Aperture& aperture,
+[[nodiscard]] ErrorMap RemovalTarget(const ErrorMap& error, const surfaces::Aperture& aperture,
                                      const RemovalTargetOptions& options);
 
 // The paper's trial profile (method.md B) is written as y^2 = sum_i c_i x^i with x along the

@@ -20,7 +20,7 @@ std::string Quaternion9(const AbbQuaternion& q) {
 
 }  // namespace
 
-std::vector<PolishingPoint> BuildPolishingPath(const grinding::Surface& surface,
+std::vector<PolishingPoint> BuildPolishingPath(const surfaces::Surface& surface,
                                                std::span<const Eigen::Vector2d> path_xy_mm,
                                                const DwellSolution& dwell, RobotSide side,
                                                const PathPrecession& precession) {
@@ -56,7 +56,7 @@ std::vector<PolishingPoint> BuildPolishingPath(const grinding::Surface& surface,
       const Eigen::Vector3d c = -frame.col(2);
       const Eigen::Vector2d d =
           k > 0 ? Eigen::Vector2d(p - path_xy_mm[k - 1]) : Eigen::Vector2d(path_xy_mm[1] - p);
-      const grinding::SurfacePoint sp = surface.Evaluate(p.x(), p.y());
+      const surfaces::SurfacePoint sp = surface.Evaluate(p.x(), p.y());
       const Eigen::Vector3d feed(d.x(), d.y(), sp.fx * d.x() + sp.fy * d.y());
       const Eigen::Vector3d a = (feed - feed.dot(c) * c).normalized();
       const double theta = precession.tilt_deg * std::numbers::pi / 180.0;

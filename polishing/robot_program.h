@@ -9,9 +9,9 @@
 #include <string>
 #include <vector>
 
-#include "grinding/surface.h"
 #include "polishing/dwell.h"
 #include "polishing/tool_frame.h"
+#include "surfaces/surface.h"
 
 namespace arcwheel::polishing {
 
@@ -39,7 +39,7 @@ struct PathPrecession {
 // Places the tool on the surface at each path point (ToolFrameAt, or precessed) with the dwell
 // solution's speed and dwell. Throws Error{kBadInput, "polishing.path"} naming the first point
 // off the surface, Error{kInvalidOption} for precession options out of range.
-[[nodiscard]] std::vector<PolishingPoint> BuildPolishingPath(const grinding::Surface& surface,
+[[nodiscard]] std::vector<PolishingPoint> BuildPolishingPath(const surfaces::Surface& surface,
                                                              std::span<const Eigen::Vector2d> path_xy_mm,
                                                              const DwellSolution& dwell, RobotSide side,
                                                              const PathPrecession& precession = {});

@@ -7,6 +7,7 @@
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "grinding/prediction.h"
 #include "grinding/toolpath.h"
@@ -19,6 +20,8 @@ struct MachineOptions {
   int pmac_program = 1;     // PMAC motion program number, >= 1
   int decimals = 4;         // decimals of mm in G-code and PMAC moves (4 = 0.1 um), 1 .. 9
   double retract_mm = 5.0;  // lift between rows (one-way) and between passes, >= 0
+  // Empty when valid, else one line per violation naming the job key and the value.
+  [[nodiscard]] std::vector<std::string> Problems() const;
 };
 
 struct OutputChoice {

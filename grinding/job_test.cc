@@ -74,16 +74,17 @@ TEST(ParseJob, RefusesUnknownKeysByTheirDottedName) {
 TEST(ParseJob, RefusesWrongTypesAndValuesNamingTheKey) {
   json job = SmallJob();
   job["path"]["passes"] = 1.5;
-  EXPECT_THAT(ExpectRefused(job), HasSubstr("key 'path.passes' must be an integer"));
+  EXPECT_THAT(ExpectRefused(job), HasSubstr("key 'path.passes' expected an integer, got 1.5"));
   job = SmallJob();
   job["path"]["step_over_mm"] = -2.0;
-  EXPECT_THAT(ExpectRefused(job), HasSubstr("key 'path.step_over_mm' = -2 violates > 0"));
+  EXPECT_THAT(ExpectRefused(job), HasSubstr("path.step_over_mm = -2 violates > 0"));
   job = SmallJob();
   job["surface"]["form"] = "flat";
-  EXPECT_THAT(ExpectRefused(job), HasSubstr("key 'surface.form' = 'flat' is not one of 'concave', 'convex'"));
+  EXPECT_THAT(ExpectRefused(job),
+              HasSubstr("key 'surface.form' expected one of \"concave\", \"convex\", got \"flat\""));
   job = SmallJob();
   job["wheel"].erase("width_mm");
-  EXPECT_THAT(ExpectRefused(job), HasSubstr("key 'wheel.width_mm' is missing"));
+  EXPECT_THAT(ExpectRefused(job), HasSubstr("key 'wheel.width_mm' expected a finite number, got nothing"));
   job = SmallJob();
   job["wheel"]["total_radius_mm"] = 40.0;
   EXPECT_THAT(ExpectRefused(job), HasSubstr("base radius"));

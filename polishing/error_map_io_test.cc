@@ -732,13 +732,15 @@ TEST(PolishJobErrorMap, RefusesUnknownAndMisappliedKeysByDottedName) {
   auto message = [&](const std::string& error_map) {
     return ErrorOf([&] { (void)ReadJob(dir, error_map); });
   };
-  EXPECT_TRUE(Contains(message(R"({"file": "map.csv", "pixel_size": 1})"),
-                       "'error_map.pixel_size' is an unknown key"));
+  EXPECT_TRUE(
+      Contains(message(R"({"file": "map.csv", "pixel_size": 1})"), "unknown key 'error_map.pixel_size'"));
   EXPECT_TRUE(Contains(message(R"({"file": "map.csv", "rotation_deg": 90})"),
                        "'error_map.rotation_deg' applies only"));
   EXPECT_TRUE(Contains(message(R"({"file": "map.csv", "grid_spacing_mm": 1})"),
                        "'error_map.grid_spacing_mm' applies only"));
-  EXPECT_TRUE(Contains(message(R"({"file": "map.csv", "format": "zyg"})"), "'error_map.format' = \"zyg\""));
+  EXPECT_TRUE(
+      Contains(message(R"({"file": "map.csv", "format": "zyg"})"),
+               "key 'error_map.format' expected one of \"csv\", \"dat\", \"datx\", \"h5\", got \"zyg\""));
   EXPECT_TRUE(Contains(message(R"({"file": "map.txt"})"), "'error_map.format' is required"));
   EXPECT_TRUE(Contains(message(R"({"file": "map.csv", "scale": 0})"), "'error_map.scale' must be non-zero"));
 }

@@ -35,21 +35,48 @@ AbbQuaternion ReadQuaternion(JsonSection& s, const std::string& key) {
 
 void ReadMachine(JsonSection& s, PolishJob& job) {
   job.dwell.max_speed_mm_s = s.RequiredNumber("max_speed_mm_s");
-  if (!(job.dwell.max_speed_mm_s > 0.0)) s.Fail("max_speed_mm_s", "must be > 0");
   job.dwell.min_speed_mm_s = s.Number("min_speed_mm_s", 0.0);
-  if (!(job.dwell.min_speed_mm_s >= 0.0 && job.dwell.min_speed_mm_s <= job.dwell.max_speed_mm_s)) {
-    s.Fail("min_speed_mm_s", fmt::format("= {} is unreachable: it must lie in [0, max_speed_mm_s = {}]",
-                                         job.dwell.min_speed_mm_s, job.dwell.max_speed_mm_s));
-  }
   job.dwell.min_dwell_s = s.Number("min_dwell_s", 0.0);
-  if (!(job.dwell.min_dwell_s >= 0.0)) s.Fail("min_dwell_s", "must be >= 0");
-  if (job.dwell.min_dwell_s > 0.0 && job.dwell.min_speed_mm_s > 0.0) {
-    s.Fail("min_dwell_s", "is unreachable together with min_speed_mm_s: give one of them");
-  }
   job.dwell.max_acceleration_mm_s2 = s.Number("max_acceleration_mm_s2", 0.0);
-  if (!(job.dwell.max_acceleration_mm_s2 >= 0.0))
-    s.Fail("max_acceleration_mm_s2", "must be >= 0 (0 = no limit)");
   job.robot_side = s.Choice("robot_side", {"+x", "-x"}) == "+x" ? RobotSide::kPlusX : RobotSide::kMinusX;
+}
+
+// The range checks of DwellOptions and RasterOptions (polishing/dwell.h), by job key.
+std::vector<std::string> DwellProblems(const DwellOptions& d) {
+  std::vector<std::string> problems;
+  const auto require = [&problems](bool ok, const std::string& text) {
+    if (!ok) problems.push_back(text);
+  };
+  require(d.max_speed_mm_s > 0.0, fmt::format("machine.max_speed_mm_s = {} violates > 0", d.max_speed_mm_s));
+  // Against a bad maximum only the lower bound says anything about the minimum itself.
+  require(d.min_speed_mm_s >= 0.0 && (d.min_speed_mm_s <= d.max_speed_mm_s || !(d.max_speed_mm_s > 0.0)),
+          fmt::format("machine.min_speed_mm_s = {} violates 0 <= min_speed_mm_s <= max_speed_mm_s = {} "
+                      "(unreachable)",
+                      d.min_speed_mm_s, d.max_speed_mm_s));
+  require(d.min_dwell_s >= 0.0, fmt::format("machine.min_dwell_s = {} violates >= 0", d.min_dwell_s));
+  require(!(d.min_dwell_s > 0.0 && d.min_speed_mm_s > 0.0),
+          fmt::format("machine.min_dwell_s = {} violates min_speed_mm_s = 0 (both are unreachable together: "
+                      "give one of them)",
+                      d.min_dwell_s));
+  require(d.max_acceleration_mm_s2 >= 0.0,
+          fmt::format("machine.max_acceleration_mm_s2 = {} violates >= 0 (0 = no limit)",
+                      d.max_acceleration_mm_s2));
+  require(d.relative_tolerance > 0.0,
+          fmt::format("solver.relative_tolerance = {} violates > 0", d.relative_tolerance));
+  return problems;
+}
+
+std::vector<std::string> PathProblems(const RasterOptions& p) {
+  std::vector<std::string> problems;
+  if (!(p.line_spacing_mm > 0.0)) {
+    problems.push_back(fmt::format("path.line_spacing_mm = {} violates > 0", p.line_spacing_mm));
+  }
+  if (!(p.point_spacing_mm > 0.0)) {
+    problems.push_back(fmt::format("path.point_spacing_mm = {} violates > 0", p.point_spacing_mm));
+  }
+  if (!(p.extension_mm >= 0.0))
+    problems.push_back(fmt::format("path.extension_mm = {} violates >= 0", p.extension_mm));
+  return problems;
 }
 
 void ReadTool(JsonSection& s, PolishJob& job) {
@@ -59,13 +86,14 @@ void ReadTool(JsonSection& s, PolishJob& job) {
   const std::vector<double> offset = s.Numbers("removal_centre_offset_mm", {0.0, 0.0});
   job.tool.removal_centre_offset_mm = {offset[0], offset[1]};
   job.tool.mass_kg = s.Number("mass_kg", 5.0);
-  if (!(job.tool.mass_kg > 0.0)) s.Fail("mass_kg", "must be > 0");
   const std::vector<double> cog = s.Numbers("centre_of_gravity_mm", {0.0, 0.0, 75.0});
   job.tool.centre_of_gravity_mm = {cog[0], cog[1], cog[2]};
 }
 
 // A Gaussian footprint, or a measured table from a file beside the job.
-RemovalFunction ReadRemovalFunctionSection(JsonSection& s, const std::filesystem::path& job_path) {
+// A Gaussian's range problems are added to `problems`.
+RemovalFunction ReadRemovalFunctionSection(JsonSection& s, const std::filesystem::path& job_path,
+                                           std::vector<std::string>& problems) {
   if (s.Has("file")) {
     if (s.Has("peak_rate_um_per_s") || s.Has("fwhm_mm")) {
       s.Fail("file", "is an alternative to peak_rate_um_per_s and fwhm_mm: give one or the other");
@@ -75,9 +103,8 @@ RemovalFunction ReadRemovalFunctionSection(JsonSection& s, const std::filesystem
   }
   GaussianRemovalFunction gaussian;
   gaussian.peak_rate_um_per_s = s.RequiredNumber("peak_rate_um_per_s");
-  if (!(gaussian.peak_rate_um_per_s > 0.0)) s.Fail("peak_rate_um_per_s", "must be > 0");
   gaussian.fwhm_mm = s.RequiredNumber("fwhm_mm");
-  if (!(gaussian.fwhm_mm > 0.0)) s.Fail("fwhm_mm", "must be > 0");
+  for (std::string& p : gaussian.Problems()) problems.push_back(std::move(p));
   return gaussian;
 }
 
@@ -86,21 +113,15 @@ void ReadPath(JsonSection& s, PolishJob& job) {
       s.Choice("type", {"raster", "spiral"}) == "spiral" ? PathPattern::kSpiral : PathPattern::kRaster;
   // Defaults from the removal function's (equivalent) width: see removal_function.h.
   job.path.line_spacing_mm = s.Number("line_spacing_mm", job.removal.EquivalentFwhmMm() / 5.0);
-  if (!(job.path.line_spacing_mm > 0.0)) s.Fail("line_spacing_mm", "must be > 0");
   job.path.point_spacing_mm = s.Number("point_spacing_mm", job.path.line_spacing_mm);
-  if (!(job.path.point_spacing_mm > 0.0)) s.Fail("point_spacing_mm", "must be > 0");
   job.path.extension_mm = s.Number("extension_mm", 1.75 * job.removal.EquivalentSigmaMm());
-  if (!(job.path.extension_mm >= 0.0)) s.Fail("extension_mm", "must be >= 0");
 }
 
 void ReadPrecession(JsonSection& s, PolishJob& job) {
   job.precession.enabled = true;
   job.precession.tilt_deg = s.RequiredNumber("tilt_deg");
-  if (!(job.precession.tilt_deg >= 0.0 && job.precession.tilt_deg < 90.0))
-    s.Fail("tilt_deg", "must lie in [0, 90)");
   job.precession.precession_rate_rpm = s.RequiredNumber("precession_rate_rpm");
   job.precession.bonnet_radius_mm = s.Number("bonnet_radius_mm", 0.0);
-  if (!(job.precession.bonnet_radius_mm >= 0.0)) s.Fail("bonnet_radius_mm", "must be >= 0");
 }
 
 // The error_map section: the file, its format and, for interferometer maps, the placement in the
@@ -184,6 +205,7 @@ PolishJob ReadPolishJob(const std::filesystem::path& path) {
   PolishJob job;
   job.source = path;
   JsonSection s(document, {.file = path.string(), .stage = kStage, .docs_page = "docs/polishing.md"});
+  std::vector<std::string> problems;  // every range problem, reported together at the end
   job.name = s.String("name", path.stem().string());
   s.Section("surface", true, [&](JsonSection& c) {
     job.surface = surfaces::ReadSurface(c, {"even_asphere", "xy_polynomial"});
@@ -196,19 +218,16 @@ PolishJob ReadPolishJob(const std::filesystem::path& path) {
         std::filesystem::path(file).is_absolute() ? std::filesystem::path(file) : path.parent_path() / file;
     job.error_map = ReadErrorMapSection(c, job.error_map_file);
   });
-  s.Section("removal_target", false, [&](JsonSection& c) {
-    job.target.uniform_layer_um = c.Number("uniform_layer_um", 0.0);
-    if (!(job.target.uniform_layer_um >= 0.0)) c.Expected("uniform_layer_um", "a layer >= 0");
-  });
+  s.Section("removal_target", false,
+            [&](JsonSection& c) { job.target.uniform_layer_um = c.Number("uniform_layer_um", 0.0); });
   s.Section("removal_function", true,
-            [&](JsonSection& c) { job.removal = ReadRemovalFunctionSection(c, path); });
+            [&](JsonSection& c) { job.removal = ReadRemovalFunctionSection(c, path, problems); });
   s.Section("path", false, [&](JsonSection& c) { ReadPath(c, job); });
   s.Section("machine", true, [&](JsonSection& c) { ReadMachine(c, job); });
   s.Section("solver", false, [&](JsonSection& c) {
     const DwellOptions defaults;
     job.dwell.max_iterations = c.WholeNumber("max_iterations", defaults.max_iterations, 1, 10'000'000);
     job.dwell.relative_tolerance = c.Number("relative_tolerance", defaults.relative_tolerance);
-    if (!(job.dwell.relative_tolerance > 0.0)) c.Expected("relative_tolerance", "a tolerance > 0");
   });
   s.Section("tool", false, [&](JsonSection& c) { ReadTool(c, job); });
   if (s.Has("precession")) s.Section("precession", false, [&](JsonSection& c) { ReadPrecession(c, job); });
@@ -218,6 +237,15 @@ PolishJob ReadPolishJob(const std::filesystem::path& path) {
     job.work_object.orientation = ReadQuaternion(c, "quaternion");
   });
   s.Finish();
+  // The path's defaults come from the removal function's width: with a bad width (already in
+  // `problems`) they would only repeat it.
+  const bool removal_usable = problems.empty();
+  for (std::vector<std::string> more :
+       {job.target.Problems(), removal_usable ? PathProblems(job.path) : std::vector<std::string>{},
+        DwellProblems(job.dwell), job.tool.Problems(), job.precession.Problems()}) {
+    problems.insert(problems.end(), more.begin(), more.end());
+  }
+  s.ThrowIfProblems(problems);
   job.resolved = s.resolved();
   return job;
 }

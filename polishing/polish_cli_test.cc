@@ -214,7 +214,7 @@ TEST(PolishCommand, RefusesAnUnknownKeyByItsDottedName) {
 
 TEST(PolishCommand, RefusesUnreachableSpeeds) {
   ExpectRefused(Job().replace(Job().find("\"min_speed_mm_s\": 0.5"), 21, "\"min_speed_mm_s\": 500"),
-                "'machine.min_speed_mm_s' = 500 is unreachable");
+                "machine.min_speed_mm_s = 500 violates 0 <= min_speed_mm_s <= max_speed_mm_s = 150");
 }
 
 TEST(PolishCommand, RefusesAMapOffTheSurface) {

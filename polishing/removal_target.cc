@@ -117,4 +117,9 @@ double SphereSagMm(double radius_mm, double y_mm) {
   return radius_mm - std::sqrt(radius_mm * radius_mm - y_mm * y_mm);
 }
 
+std::vector<std::string> RemovalTargetOptions::Problems() const {
+  if (uniform_layer_um >= 0.0) return {};
+  return {fmt::format("removal_target.uniform_layer_um = {} violates >= 0", uniform_layer_um)};
+}
+
 }  // namespace arcwheel::polishing

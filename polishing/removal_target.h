@@ -8,6 +8,7 @@
 // run everywhere at a finite speed).
 
 #include <span>
+#include <string>
 #include <vector>
 
 #include "surfaces/surface.h"
@@ -39,6 +40,9 @@ struct MapStatistics {
 struct RemovalTargetOptions {
   // Uniform depth added to the whole aperture (um), >= 0.
   double uniform_layer_um = 0.0;
+  // Empty when valid, else one line per violation naming the job key and the value, e.g.
+  // "removal_target.uniform_layer_um = -1 violates >= 0".
+  [[nodiscard]] std::vector<std::string> Problems() const;
 };
 
 // Removal target: error - min(error over the aperture) + uniform layer inside the aperture, NaN

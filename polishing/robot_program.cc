@@ -140,4 +140,25 @@ std::string RapidModule(std::span<const PolishingPoint> points, const ToolData& 
   return fmt::to_string(out);
 }
 
+std::vector<std::string> PathPrecession::Problems() const {
+  std::vector<std::string> problems;
+  if (!enabled) return problems;
+  if (!(tilt_deg >= 0.0 && tilt_deg < 90.0)) {
+    problems.push_back(fmt::format("precession.tilt_deg = {} violates 0 <= tilt_deg < 90", tilt_deg));
+  }
+  if (!std::isfinite(precession_rate_rpm)) {
+    problems.push_back(
+        fmt::format("precession.precession_rate_rpm = {} violates finite", precession_rate_rpm));
+  }
+  if (!(bonnet_radius_mm >= 0.0)) {
+    problems.push_back(fmt::format("precession.bonnet_radius_mm = {} violates >= 0", bonnet_radius_mm));
+  }
+  return problems;
+}
+
+std::vector<std::string> ToolData::Problems() const {
+  if (mass_kg > 0.0) return {};
+  return {fmt::format("tool.mass_kg = {} violates > 0", mass_kg)};
+}
+
 }  // namespace arcwheel::polishing

@@ -217,7 +217,7 @@ Job ParseJob(const std::string& text, const std::filesystem::path& source,
   });
   root.Finish();
   Validate(root, job);
-  job.resolved = root.resolved();
+  job.resolved_json = root.resolved().dump();
   return job;
 }
 

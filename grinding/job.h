@@ -4,7 +4,6 @@
 
 #include <filesystem>
 #include <memory>
-#include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
 #include <vector>
@@ -42,7 +41,9 @@ struct Job {
   bool predict = true;
   PredictionOptions prediction;
   std::optional<std::filesystem::path> wheel_summary;  // where the wheel came from, if a summary
-  nlohmann::json resolved;                             // the job with every default filled in, as used
+  // The job with every default filled in, as used: JSON text (parse it where it is written out),
+  // so that this header does not pull nlohmann/json into every includer.
+  std::string resolved_json;
 };
 
 // Reads and validates a job. `wheel_summary_override` (the CLI's --wheel) replaces the job's

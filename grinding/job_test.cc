@@ -5,6 +5,7 @@
 
 #include <cmath>
 #include <fstream>
+#include <nlohmann/json.hpp>
 #include <sstream>
 
 #include "core/error.h"
@@ -55,7 +56,7 @@ TEST(ParseJob, ReadsTheShippedTrialPart) {
   EXPECT_DOUBLE_EQ(job.wheel.arc_radius_mm, 55.4423);
   EXPECT_DOUBLE_EQ(job.wheel.base_radius_mm, 200.0 - 55.4423);
   EXPECT_DOUBLE_EQ(job.path.feed_mm_per_min, 6000.0);
-  EXPECT_EQ(job.resolved["path"]["direction"], "zigzag");  // defaults are recorded
+  EXPECT_EQ(json::parse(job.resolved_json)["path"]["direction"], "zigzag");  // defaults are recorded
   EXPECT_EQ(job.prediction.runout_phase_deg.size(), 360u);
 }
 

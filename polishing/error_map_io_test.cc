@@ -11,6 +11,7 @@
 #include <fstream>
 #include <functional>
 #include <iterator>
+#include <nlohmann/json.hpp>
 #include <random>
 #include <string>
 #include <string_view>
@@ -706,8 +707,9 @@ TEST(PolishJobErrorMap, ReadsEachFormatByItsExtensionAndAppliesThePlacementKeys)
     EXPECT_TRUE(job.error_map.error_um[k] == expected.error_um[k] ||
                 (std::isnan(job.error_map.error_um[k]) && std::isnan(expected.error_um[k])));
   }
-  EXPECT_EQ(job.resolved["error_map"]["centre_px"], nlohmann::json::array({3.0, 2.0}));
-  EXPECT_EQ(job.resolved["error_map"]["format"], "dat");
+  const nlohmann::json resolved = nlohmann::json::parse(job.resolved_json);
+  EXPECT_EQ(resolved["error_map"]["centre_px"], nlohmann::json::array({3.0, 2.0}));
+  EXPECT_EQ(resolved["error_map"]["format"], "dat");
 
   std::ofstream(dir / "pts.csv") << "x_mm,y_mm,error_um\n-10,-10,1\n10,-10,1\n0,10,1\n";
   job = ReadJob(dir, R"({"file": "pts.csv", "layout": "scattered", "grid_spacing_mm": 0.5})");

@@ -246,7 +246,7 @@ PolishJob ReadPolishJob(const std::filesystem::path& path) {
     problems.insert(problems.end(), more.begin(), more.end());
   }
   s.ThrowIfProblems(problems);
-  job.resolved = s.resolved();
+  job.resolved_json = s.resolved().dump();
   return job;
 }
 
@@ -312,7 +312,7 @@ PolishRunReport RunPolishJob(const PolishJob& job, const std::filesystem::path& 
                                              fmt::format("aperture: {}", job.aperture.Describe()),
                                              fmt::format("removal function: {}", job.removal.Describe())};
   json summary = {{"arcwheel_version", kVersion},
-                  {"job", job.resolved},
+                  {"job", json::parse(job.resolved_json)},
                   {"points", report.points},
                   {"total_time_s", report.dwell.total_time_s},
                   {"before", {{"pv_um", report.dwell.before.pv_um}, {"rms_um", report.dwell.before.rms_um}}},

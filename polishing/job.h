@@ -4,7 +4,6 @@
 
 #include <filesystem>
 #include <memory>
-#include <nlohmann/json.hpp>
 #include <string>
 
 #include "polishing/dwell.h"
@@ -32,7 +31,8 @@ struct PolishJob {
   PathPrecession precession;  // enabled when the job has a "precession" section
   ToolData tool;
   WorkObject work_object;
-  nlohmann::json resolved;  // the job with every default filled in
+  // The job with every default filled in, as JSON text (keeps nlohmann/json out of this header).
+  std::string resolved_json;
 };
 
 // Reads and validates a job; the error map's "file" is relative to the job's folder.

@@ -26,19 +26,56 @@ namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
-// Runs `read` and returns the message of the Error it throws (and checks its code).
-std::string ErrorOf(const std::function<void()>& read, ErrorCode code = ErrorCode::kBadInput) {
-  try {
-    read();
-  } catch (const Error& e) {
-    EXPECT_EQ(e.code(), code) << e.what();
-    return e.what();
-  }
-  return "accepted";
-}
+using arcwheel::testing::ErrorOf;
 
 bool Contains(const std::string& text, const std::string& part) {
   return text.find(part) != std::string::npos;
+}
+
+// The grid placement of `map` (size, origin, spacing) against `expected`'s, exactly: the
+// readers copy these numbers, or take them as differences of numbers exact in binary.
+void ExpectPlacement(const ErrorMap& map, const ErrorMap& expected) {
+  EXPECT_EQ(map.nx, expected.nx);
+  EXPECT_EQ(map.ny, expected.ny);
+  EXPECT_EQ(map.x0_mm, expected.x0_mm);
+  EXPECT_EQ(map.y0_mm, expected.y0_mm);
+  EXPECT_EQ(map.dx_mm, expected.dx_mm);
+  EXPECT_EQ(map.dy_mm, expected.dy_mm);
+}
+
+// ------------------------------------------------------------------------------------------------
+// Map CSV (formerly in job_test.cc, which now tests the job reader).
+
+std::string CsvError(const std::string& text) {
+  arcwheel::testing::TempDir dir;
+  std::ofstream(dir / "map.csv") << text;
+  return ErrorOf([&dir] { (void)ReadErrorMapCsv(dir / "map.csv"); });
+}
+
+TEST(ReadErrorMapCsv, PlacesScatteredRowsOnTheirGridAndLeavesGapsWithoutData) {
+  arcwheel::testing::TempDir dir;
+  std::ofstream(dir / "map.csv")
+      << "# comment\nx_mm,y_mm,error_um\n2.5,-1,0.25\n-2.5,-1,1\n0,1,nan\n2.5,1,-3\n";
+  const ErrorMap map = ReadErrorMapCsv(dir / "map.csv");
+  ExpectPlacement(
+      map, {.x0_mm = -2.5, .y0_mm = -1.0, .dx_mm = 2.5, .dy_mm = 2.0, .nx = 3, .ny = 2, .error_um = {}});
+  EXPECT_DOUBLE_EQ(map.At(0, 0), 1.0);
+  EXPECT_TRUE(std::isnan(map.At(1, 0)));  // never given
+  EXPECT_DOUBLE_EQ(map.At(2, 0), 0.25);
+  EXPECT_TRUE(std::isnan(map.At(1, 1)));  // given as nan
+  EXPECT_DOUBLE_EQ(map.At(2, 1), -3.0);
+}
+
+TEST(ReadErrorMapCsv, NamesTheFileAndLineOfMalformedInput) {
+  EXPECT_NE(CsvError("x,y,z\n").find("map.csv' line 1: header 'x,y,z'"), std::string::npos);
+  EXPECT_NE(CsvError("x_mm,y_mm,error_um\n0,0,1\n1,0,abc\n").find("line 3: 'abc' is not a number"),
+            std::string::npos);
+  EXPECT_NE(CsvError("x_mm,y_mm,error_um\n0,0,1\n1,0\n").find("line 3: has 2 values"), std::string::npos);
+  EXPECT_NE(CsvError("x_mm,y_mm,error_um\n0,0,1\n1,0,2\n2,0,2\n3,0,2\n3.4,0,3\n")
+                .find("line 6: (3.4, 0) mm is not on the regular grid"),
+            std::string::npos);
+  EXPECT_NE(CsvError("x_mm,y_mm,error_um\n0,0,1\n1,0,2\n1,0,3\n").find("line 4: (1, 0) mm appears twice"),
+            std::string::npos);
 }
 
 // ------------------------------------------------------------------------------------------------
@@ -490,12 +527,7 @@ TEST(ErrorMapHdf5, RoundTripsEveryNodeAndTheGridPlacement) {
   for (int k = 0; k < 15; ++k) map.error_um.push_back(k == 7 ? kNaN : 0.1 * k - 0.3);
   WriteErrorMapHdf5(map, dir / "grid.h5");
   const ErrorMap read = ReadErrorMapHdf5(dir / "grid.h5");
-  EXPECT_EQ(read.nx, 5);
-  EXPECT_EQ(read.ny, 3);
-  EXPECT_EQ(read.x0_mm, -12.5);
-  EXPECT_EQ(read.y0_mm, 3.0);
-  EXPECT_EQ(read.dx_mm, 0.25);
-  EXPECT_EQ(read.dy_mm, 0.5);
+  ExpectPlacement(read, map);
   for (std::size_t k = 0; k < 15; ++k) {
     if (k == 7) {
       EXPECT_TRUE(std::isnan(read.error_um[k]));

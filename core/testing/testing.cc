@@ -1,5 +1,6 @@
 #include "core/testing/testing.h"
 
+#include <gtest/gtest.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -54,6 +55,16 @@ std::string ListFolder(const fs::path& folder) {
   std::string listing;
   for (const auto& name : names) listing += name + "\n";
   return listing;
+}
+
+std::string ErrorOf(const std::function<void()>& run, ErrorCode code) {
+  try {
+    run();
+  } catch (const Error& e) {
+    EXPECT_EQ(e.code(), code) << e.what();
+    return e.what();
+  }
+  return "accepted";
 }
 
 }  // namespace arcwheel::testing

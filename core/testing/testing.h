@@ -2,7 +2,10 @@
 // Helpers shared by the test binaries: temporary folders, source paths and running the CLI.
 
 #include <filesystem>
+#include <functional>
 #include <string>
+
+#include "core/error.h"
 
 namespace arcwheel::testing {
 
@@ -29,6 +32,10 @@ struct CommandResult {
 };
 // Runs the arcwheel binary (ARCWHEEL_BINARY, set by CTest) with `arguments` through the shell.
 [[nodiscard]] CommandResult RunArcwheel(const std::string& arguments);
+
+// The message of the Error that `run` throws, checking (as a test failure) that its code is
+// `code`; "accepted" if it throws nothing.
+[[nodiscard]] std::string ErrorOf(const std::function<void()>& run, ErrorCode code = ErrorCode::kBadInput);
 
 // Names of the entries of a folder, sorted.
 [[nodiscard]] std::string ListFolder(const std::filesystem::path& folder);

@@ -9,10 +9,13 @@
 #include "grinding/prediction.h"
 #include "grinding/toolpath.h"
 #include "grinding/toolpath_writer.h"
+#include "surfaces/surface.h"
 
 namespace {
 
 using namespace arcwheel::grinding;
+using arcwheel::surfaces::Aperture;
+using arcwheel::surfaces::EvenAsphere;
 
 const EvenAsphere& TrialPart() {  // method.md A.9
   static const EvenAsphere part(

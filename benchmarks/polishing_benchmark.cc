@@ -18,7 +18,7 @@ void BM_SolveDwell(benchmark::State& state) {
   const double extension_mm = 5.0;
   const double side_mm =
       std::round(std::sqrt(static_cast<double>(state.range(0)))) - 1.0 - 2.0 * extension_mm;
-  const arcwheel::grinding::Aperture aperture{.width_x_mm = side_mm, .width_y_mm = side_mm};
+  const arcwheel::surfaces::Aperture aperture{.width_x_mm = side_mm, .width_y_mm = side_mm};
   const std::vector<Eigen::Vector2d> path =
       RasterPath(aperture, {.line_spacing_mm = 1.0, .point_spacing_mm = 1.0, .extension_mm = extension_mm});
   const int nodes = static_cast<int>(side_mm) + 1;

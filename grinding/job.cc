@@ -4,264 +4,18 @@
 
 #include <cmath>
 #include <fstream>
-#include <set>
 #include <sstream>
 
 #include "core/error.h"
+#include "core/json_job.h"
 #include "core/json_text.h"
+#include "surfaces/surface_json.h"
 
 namespace arcwheel::grinding {
+
 namespace {
 
 constexpr const char* kStage = "grinding.job";
-using nlohmann::json;
-
-// One JSON object of the job: typed reads by key, a record of the values used (defaults filled
-// in) and a refusal of any key nobody read.
-class Section {
- public:
-  Section(const json* object, std::string prefix, const std::filesystem::path& source)
-      : object_(object), prefix_(std::move(prefix)), source_(source) {
-    if (object_ != nullptr && !object_->is_object()) Fail("", "must be a JSON object");
-  }
-
-  [[noreturn]] void Fail(const std::string& key, const std::string& what) const {
-    const std::string name = key.empty() ? (prefix_.empty() ? "(root)" : prefix_) : Dotted(key);
-    throw Error(ErrorCode::kBadInput, kStage, fmt::format("'{}': key '{}' {}", source_.string(), name, what));
-  }
-  [[nodiscard]] std::string Dotted(const std::string& key) const {
-    return prefix_.empty() ? key : prefix_ + "." + key;
-  }
-  [[nodiscard]] bool Has(const std::string& key) const {
-    return object_ != nullptr && object_->contains(key) && !object_->at(key).is_null();
-  }
-  const json& Raw(const std::string& key) {
-    used_.insert(key);
-    return object_->at(key);
-  }
-
-  double Number(const std::string& key, double fallback) {
-    used_.insert(key);
-    const double value = Has(key) ? FiniteNumber(key) : fallback;
-    resolved_[key] = value;
-    return value;
-  }
-  std::optional<double> OptionalNumber(const std::string& key) {
-    used_.insert(key);
-    if (!Has(key)) return std::nullopt;
-    const double value = FiniteNumber(key);
-    resolved_[key] = value;
-    return value;
-  }
-  double RequiredNumber(const std::string& key, const std::string& why = "is missing") {
-    if (!Has(key)) Fail(key, why);
-    return Number(key, 0.0);
-  }
-  int Integer(const std::string& key, int fallback) {
-    used_.insert(key);
-    int value = fallback;
-    if (Has(key)) {
-      const json& v = object_->at(key);
-      if (!v.is_number_integer()) Fail(key, "must be an integer");
-      value = v.get<int>();
-    }
-    resolved_[key] = value;
-    return value;
-  }
-  bool Boolean(const std::string& key, bool fallback) {
-    used_.insert(key);
-    bool value = fallback;
-    if (Has(key)) {
-      if (!object_->at(key).is_boolean()) Fail(key, "must be true or false");
-      value = object_->at(key).get<bool>();
-    }
-    resolved_[key] = value;
-    return value;
-  }
-  std::string Choice(const std::string& key, const std::vector<std::string>& choices) {
-    used_.insert(key);
-    std::string value = choices.front();
-    if (Has(key)) {
-      if (!object_->at(key).is_string()) Fail(key, "must be a string");
-      value = object_->at(key).get<std::string>();
-      bool known = false;
-      for (const std::string& c : choices) known = known || c == value;
-      if (!known) {
-        std::string list;
-        for (const std::string& c : choices) list += (list.empty() ? "'" : ", '") + c + "'";
-        Fail(key, fmt::format("= '{}' is not one of {}", value, list));
-      }
-    }
-    resolved_[key] = value;
-    return value;
-  }
-  std::optional<std::string> OptionalString(const std::string& key) {
-    used_.insert(key);
-    if (!Has(key)) return std::nullopt;
-    if (!object_->at(key).is_string()) Fail(key, "must be a string");
-    resolved_[key] = object_->at(key).get<std::string>();
-    return object_->at(key).get<std::string>();
-  }
-  std::vector<double> Numbers(const std::string& key, size_t count) {
-    used_.insert(key);
-    if (!Has(key) || !object_->at(key).is_array())
-      Fail(key, fmt::format("must be an array of {} numbers", count));
-    std::vector<double> values;
-    for (const json& v : object_->at(key)) {
-      if (!v.is_number() || !std::isfinite(v.get<double>())) Fail(key, "must hold finite numbers only");
-      values.push_back(v.get<double>());
-    }
-    if (count != 0 && values.size() != count) {
-      Fail(key, fmt::format("must be an array of {} numbers, has {}", count, values.size()));
-    }
-    resolved_[key] = values;
-    return values;
-  }
-  // A nested section (empty if absent); its resolved values are merged in when it finishes.
-  Section Child(const std::string& key) {
-    used_.insert(key);
-    return Section(Has(key) ? &object_->at(key) : nullptr, Dotted(key), source_);
-  }
-  // Element `index` of the array at `key`, as a section of its own.
-  Section Element(const std::string& key, size_t index) const {
-    return Section(&object_->at(key).at(index), fmt::format("{}[{}]", Dotted(key), index), source_);
-  }
-  void Adopt(const std::string& key, const Section& child) { resolved_[key] = child.resolved_; }
-  void SetResolved(const std::string& key, const json& value) { resolved_[key] = value; }
-
-  // Refuses keys nobody read, naming them all.
-  void Finish() const {
-    if (object_ == nullptr) return;
-    std::string unknown;
-    for (const auto& [key, value] : object_->items()) {
-      if (!used_.count(key)) unknown += (unknown.empty() ? "'" : ", '") + Dotted(key) + "'";
-    }
-    if (!unknown.empty()) {
-      throw Error(ErrorCode::kBadInput, kStage,
-                  fmt::format("'{}': unknown key {} (see docs/grinding.md for the job keys)",
-                              source_.string(), unknown));
-    }
-  }
-  [[nodiscard]] const json& resolved() const { return resolved_; }
-
- private:
-  double FiniteNumber(const std::string& key) const {
-    const json& v = object_->at(key);
-    if (!v.is_number() || !std::isfinite(v.get<double>())) Fail(key, "must be a finite number");
-    return v.get<double>();
-  }
-
-  const json* object_;
-  std::string prefix_;
-  const std::filesystem::path& source_;
-  std::set<std::string> used_;
-  json resolved_ = json::object();
-};
-
-std::shared_ptr<const Surface> ReadEvenAsphere(Section& s) {
-  EvenAsphereParameters p;
-  p.vertex_radius_mm = s.RequiredNumber("vertex_radius_mm");
-  if (!(p.vertex_radius_mm > 0.0)) s.Fail("vertex_radius_mm", "must be > 0 (use \"form\" for the side)");
-  p.conic = s.Number("conic", 0.0);
-  if (s.Has("coefficients")) {
-    Section c = s.Child("coefficients");
-    for (int order = 4; order <= 20; order += 2) {
-      const double a = c.Number(fmt::format("A{}", order), 0.0);
-      p.even_coefficients.push_back(a);
-    }
-    while (!p.even_coefficients.empty() && p.even_coefficients.back() == 0.0) p.even_coefficients.pop_back();
-    c.Finish();
-    s.Adopt("coefficients", c);
-  }
-  std::vector<double> off{0.0, 0.0};
-  if (s.Has("off_axis_mm")) off = s.Numbers("off_axis_mm", 2);
-  s.SetResolved("off_axis_mm", off);
-  p.off_axis_x_mm = off[0];
-  p.off_axis_y_mm = off[1];
-  p.concave = s.Choice("form", {"concave", "convex"}) == "concave";
-  try {
-    return std::make_shared<EvenAsphere>(p);
-  } catch (const Error& e) {
-    s.Fail("off_axis_mm", fmt::format("is not usable: {}", e.what()));
-  }
-}
-
-std::shared_ptr<const Surface> ReadXyPolynomial(Section& s) {
-  if (!s.Has("terms") || !s.Raw("terms").is_array()) {
-    s.Fail("terms", "must be an array of {\"x_power\", \"y_power\", \"coefficient\"} objects");
-  }
-  std::vector<XyPolynomialTerm> terms;
-  json resolved = json::array();
-  for (size_t k = 0; k < s.Raw("terms").size(); ++k) {
-    Section t = s.Element("terms", k);
-    XyPolynomialTerm term;
-    term.x_power = t.Integer("x_power", 0);
-    term.y_power = t.Integer("y_power", 0);
-    term.coefficient = t.RequiredNumber("coefficient");
-    if (term.x_power < 0 || term.y_power < 0 || term.x_power > 20 || term.y_power > 20) {
-      t.Fail("x_power", "and y_power must be within 0 .. 20");
-    }
-    t.Finish();
-    terms.push_back(term);
-    resolved.push_back(t.resolved());
-  }
-  s.SetResolved("terms", resolved);
-  return std::make_shared<XyPolynomial>(std::move(terms));
-}
-
-std::shared_ptr<const Surface> ReadHeightGrid(Section& s) {
-  HeightGridParameters g;
-  g.x0_mm = s.RequiredNumber("x0_mm");
-  g.y0_mm = s.RequiredNumber("y0_mm");
-  g.dx_mm = s.RequiredNumber("dx_mm");
-  g.dy_mm = s.RequiredNumber("dy_mm");
-  if (!(g.dx_mm > 0.0) || !(g.dy_mm > 0.0)) s.Fail("dx_mm", "and dy_mm must be > 0");
-  if (!s.Has("heights_mm") || !s.Raw("heights_mm").is_array()) {
-    s.Fail("heights_mm", "must be an array of rows (one per y, each along x)");
-  }
-  const json& rows = s.Raw("heights_mm");
-  g.ny = static_cast<int>(rows.size());
-  for (size_t j = 0; j < rows.size(); ++j) {
-    const std::string key = fmt::format("heights_mm[{}]", j);
-    if (!rows[j].is_array()) s.Fail(key, "must be an array of heights");
-    if (j == 0) g.nx = static_cast<int>(rows[j].size());
-    if (static_cast<int>(rows[j].size()) != g.nx) {
-      s.Fail(key, fmt::format("has {} heights, row 0 has {}", rows[j].size(), g.nx));
-    }
-    for (const json& h : rows[j]) {
-      if (!h.is_number() || !std::isfinite(h.get<double>())) s.Fail(key, "must hold finite numbers only");
-      g.heights_mm.push_back(h.get<double>());
-    }
-  }
-  s.SetResolved("heights_mm", rows);
-  try {
-    return std::make_shared<HeightGrid>(std::move(g));
-  } catch (const Error& e) {
-    s.Fail("heights_mm", fmt::format("is not usable: {}", e.what()));
-  }
-}
-
-std::shared_ptr<const Surface> ReadSurface(Section& s) {
-  const std::string type = s.Choice("type", {"even_asphere", "xy_polynomial", "height_grid"});
-  if (type == "even_asphere") return ReadEvenAsphere(s);
-  if (type == "xy_polynomial") return ReadXyPolynomial(s);
-  return ReadHeightGrid(s);
-}
-
-Aperture ReadAperture(Section& s) {
-  Aperture a;
-  if (s.Choice("shape", {"rectangle", "circle"}) == "circle") {
-    a.shape = Aperture::Shape::kCircle;
-    a.diameter_mm = s.RequiredNumber("diameter_mm");
-    if (!(a.diameter_mm > 0.0)) s.Fail("diameter_mm", "must be > 0");
-  } else {
-    const std::vector<double> size = s.Numbers("size_mm", 2);
-    if (!(size[0] > 0.0) || !(size[1] > 0.0)) s.Fail("size_mm", "must be two sizes > 0");
-    a.width_x_mm = size[0];
-    a.width_y_mm = size[1];
-  }
-  return a;
-}
 
 // Wheel from the job's own numbers or from a summary.json.
 struct WheelSource {
@@ -269,7 +23,7 @@ struct WheelSource {
   std::optional<WheelSummary> summary;
 };
 
-WheelSource ReadWheel(Section& s, const std::filesystem::path& job_path,
+WheelSource ReadWheel(JsonSection& s, const std::filesystem::path& job_path,
                       const std::optional<std::filesystem::path>& override_summary,
                       std::optional<std::filesystem::path>& summary_path) {
   WheelSource out;
@@ -317,7 +71,9 @@ WheelSource ReadWheel(Section& s, const std::filesystem::path& job_path,
                                 w.arc_radius_mm, m.mean_arc_radius_sigma_mm, w.base_radius_mm,
                                 w.HasProfile() ? ", with its mean arc profile" : "");
   } else {
-    w.arc_radius_mm = s.RequiredNumber("arc_radius_mm", "is missing (or give wheel.summary / --wheel)");
+    if (!s.Has("arc_radius_mm"))
+      s.Expected("arc_radius_mm", "the arc radius in mm (or wheel.summary / --wheel)");
+    w.arc_radius_mm = s.RequiredNumber("arc_radius_mm");
     const double total = s.RequiredNumber("total_radius_mm");
     w.base_radius_mm = total - w.arc_radius_mm;
     s.Boolean("use_profile", false);
@@ -327,11 +83,10 @@ WheelSource ReadWheel(Section& s, const std::filesystem::path& job_path,
   w.half_width_mm = 0.5 * width;
   if (const std::optional<std::string> name = s.OptionalString("name"))
     w.description = *name + ": " + w.description;
-  if (const auto problems = w.Problems(); !problems.empty()) s.Fail("", "is not usable: " + problems.front());
   return out;
 }
 
-ToolpathOptions ReadPath(Section& s) {
+ToolpathOptions ReadPath(JsonSection& s) {
   ToolpathOptions o;
   o.step_over_mm = s.Number("step_over_mm", o.step_over_mm);
   o.point_spacing_mm = s.Number("point_spacing_mm", o.point_spacing_mm);
@@ -345,13 +100,13 @@ ToolpathOptions ReadPath(Section& s) {
   return o;
 }
 
-void ReadGougeCheck(Section& s, ToolpathOptions& o) {
+void ReadGougeCheck(JsonSection& s, ToolpathOptions& o) {
   o.gouge_check_spacing_mm = s.Number("spacing_mm", o.gouge_check_spacing_mm);
   o.gouge_samples = s.Integer("samples", o.gouge_samples);
   o.gouge_tolerance_mm = 1e-3 * s.Number("tolerance_um", o.gouge_tolerance_mm * 1e3);
 }
 
-void ReadPrediction(Section& s, const std::optional<WheelSummary>& summary, double feed, Job& job) {
+void ReadPrediction(JsonSection& s, const std::optional<WheelSummary>& summary, double feed, Job& job) {
   job.predict = s.Boolean("enabled", true);
   PredictionOptions& p = job.prediction;
   p.feed_mm_per_min = feed;
@@ -382,35 +137,29 @@ void ReadPrediction(Section& s, const std::optional<WheelSummary>& summary, doub
     p.runout_radial_um.clear();
   }
   if (any_runout && job.predict && !rpm) {
-    s.Fail("spindle_rpm", "is missing: the grinding spindle speed places the runout ripple");
+    s.Expected("spindle_rpm", "the grinding spindle speed in rpm (it places the runout ripple)");
   }
   p.spindle_rpm = rpm.value_or(0.0);
-  std::vector<double> nodes{201, 201};
-  if (s.Has("map_nodes")) nodes = s.Numbers("map_nodes", 2);
-  s.SetResolved("map_nodes", nodes);
+  const std::vector<double> nodes = s.Numbers("map_nodes", {201, 201});
   p.nodes_x = static_cast<int>(nodes[0]);
   p.nodes_y = static_cast<int>(nodes[1]);
 }
 
-void Validate(const Section& root, Job& job) {
-  if (const auto problems = job.path.Problems(); !problems.empty()) {
-    const std::string& first = problems.front();
-    root.Fail(first.substr(0, first.find(' ')), first.substr(first.find(' ') + 1));
-  }
-  if (job.machine.pmac_program < 1) root.Fail("machine.pmac_program", "must be >= 1");
-  if (job.machine.decimals < 1 || job.machine.decimals > 9)
-    root.Fail("machine.decimals", "must be within 1 .. 9");
-  if (!(job.machine.retract_mm >= 0.0)) root.Fail("machine.retract_mm", "must be >= 0");
+// Every range problem of the options at once, then the aperture against the surface.
+void Validate(const JsonSection& root, const Job& job) {
+  std::vector<std::string> problems = job.wheel.Problems();
+  for (std::string& p : job.path.Problems()) problems.push_back(std::move(p));
+  for (std::string& p : job.machine.Problems()) problems.push_back(std::move(p));
   if (job.predict) {
-    if (const auto problems = job.prediction.Problems(); !problems.empty()) {
-      root.Fail("prediction", "is not usable: " + problems.front());
-    }
+    for (std::string& p : job.prediction.Problems()) problems.push_back(std::move(p));
   }
+  root.ThrowIfProblems(problems);
   // Contacts run lead_in / lead_out past the aperture and up to Ra |fy| / N3 < half width
   // across it; the surface must exist there.
   try {
-    CheckApertureInDomain(*job.surface, job.aperture, std::max(job.path.lead_in_mm, job.path.lead_out_mm),
-                          job.wheel.half_width_mm);
+    surfaces::CheckApertureInDomain(*job.surface, job.aperture,
+                                    std::max(job.path.lead_in_mm, job.path.lead_out_mm),
+                                    job.wheel.half_width_mm);
   } catch (const Error& e) {
     root.Fail("aperture", fmt::format("does not fit the surface: {}", e.what()));
   }
@@ -418,72 +167,57 @@ void Validate(const Section& root, Job& job) {
 
 }  // namespace
 
+std::vector<std::string> MachineOptions::Problems() const {
+  std::vector<std::string> problems;
+  if (pmac_program < 1)
+    problems.push_back(fmt::format("machine.pmac_program = {} violates >= 1", pmac_program));
+  if (decimals < 1 || decimals > 9) {
+    problems.push_back(fmt::format("machine.decimals = {} violates 1 .. 9", decimals));
+  }
+  if (!(retract_mm >= 0.0))
+    problems.push_back(fmt::format("machine.retract_mm = {} violates >= 0", retract_mm));
+  return problems;
+}
+
 Job ParseJob(const std::string& text, const std::filesystem::path& source,
              const std::optional<std::filesystem::path>& wheel_summary_override) {
-  json document = ParseJsonText(text, source.string(), kStage);
-  Section root(&document, "", source);
+  const nlohmann::json document = ParseJsonText(text, source.string(), kStage);
+  JsonSection root(document, {.file = source.string(), .stage = kStage, .docs_page = "docs/grinding.md"});
   Job job;
   job.source = source;
   job.name = root.OptionalString("name").value_or(source.stem().string());
+  root.SetResolved("name", job.name);
 
-  Section surface = root.Child("surface");
-  if (!root.Has("surface")) root.Fail("surface", "is missing");
-  job.surface = ReadSurface(surface);
-  surface.Finish();
-
-  Section aperture = root.Child("aperture");
-  if (!root.Has("aperture")) root.Fail("aperture", "is missing");
-  job.aperture = ReadAperture(aperture);
-  aperture.Finish();
-
-  Section wheel = root.Child("wheel");
-  WheelSource wheel_source = ReadWheel(wheel, source, wheel_summary_override, job.wheel_summary);
-  job.wheel = wheel_source.wheel;
-  wheel.Finish();
-
-  Section path = root.Child("path");
-  if (!root.Has("path")) root.Fail("path", "is missing");
-  job.path = ReadPath(path);
-  path.Finish();
-
-  Section gouge = root.Child("gouge_check");
-  ReadGougeCheck(gouge, job.path);
-  gouge.Finish();
-
-  Section machine = root.Child("machine");
-  job.path.threads = machine.Integer("threads", 0);
-  job.machine.pmac_program = machine.Integer("pmac_program", job.machine.pmac_program);
-  job.machine.decimals = machine.Integer("decimals", job.machine.decimals);
-  job.machine.retract_mm = machine.Number("retract_mm", job.machine.retract_mm);
-  machine.Finish();
-
-  Section prediction = root.Child("prediction");
-  ReadPrediction(prediction, wheel_source.summary, job.path.feed_mm_per_min, job);
-  job.prediction.threads = job.path.threads;
-  prediction.Finish();
-
-  Section outputs = root.Child("outputs");
-  job.outputs.csv = outputs.Boolean("csv", true);
-  job.outputs.gcode = outputs.Boolean("gcode", true);
-  job.outputs.pmac = outputs.Boolean("pmac", true);
-  outputs.Finish();
-
+  root.Section("surface", true, [&](JsonSection& s) {
+    job.surface = surfaces::ReadSurface(s, {"even_asphere", "xy_polynomial", "height_grid"});
+  });
+  root.Section("aperture", true, [&](JsonSection& s) { job.aperture = surfaces::ReadAperture(s); });
+  std::optional<WheelSummary> summary;
+  root.Section("wheel", false, [&](JsonSection& s) {
+    WheelSource wheel = ReadWheel(s, source, wheel_summary_override, job.wheel_summary);
+    job.wheel = std::move(wheel.wheel);
+    summary = std::move(wheel.summary);
+  });
+  root.Section("path", true, [&](JsonSection& s) { job.path = ReadPath(s); });
+  root.Section("gouge_check", false, [&](JsonSection& s) { ReadGougeCheck(s, job.path); });
+  root.Section("machine", false, [&](JsonSection& s) {
+    job.path.threads = s.Integer("threads", 0);
+    job.machine.pmac_program = s.Integer("pmac_program", job.machine.pmac_program);
+    job.machine.decimals = s.Integer("decimals", job.machine.decimals);
+    job.machine.retract_mm = s.Number("retract_mm", job.machine.retract_mm);
+  });
+  root.Section("prediction", false, [&](JsonSection& s) {
+    ReadPrediction(s, summary, job.path.feed_mm_per_min, job);
+    job.prediction.threads = job.path.threads;
+  });
+  root.Section("outputs", false, [&](JsonSection& s) {
+    job.outputs.csv = s.Boolean("csv", true);
+    job.outputs.gcode = s.Boolean("gcode", true);
+    job.outputs.pmac = s.Boolean("pmac", true);
+  });
   root.Finish();
   Validate(root, job);
-
-  job.resolved = root.resolved();
-  for (const auto& [key, section] :
-       std::vector<std::pair<std::string, const Section*>>{{"surface", &surface},
-                                                           {"aperture", &aperture},
-                                                           {"wheel", &wheel},
-                                                           {"path", &path},
-                                                           {"gouge_check", &gouge},
-                                                           {"machine", &machine},
-                                                           {"prediction", &prediction},
-                                                           {"outputs", &outputs}}) {
-    job.resolved[key] = section->resolved();
-  }
-  job.resolved["name"] = job.name;
+  job.resolved_json = root.resolved().dump();
   return job;
 }
 

@@ -4,14 +4,14 @@
 
 #include <filesystem>
 #include <memory>
-#include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "grinding/prediction.h"
-#include "grinding/surface.h"
 #include "grinding/toolpath.h"
 #include "grinding/wheel.h"
+#include "surfaces/surface.h"
 
 namespace arcwheel::grinding {
 
@@ -19,6 +19,8 @@ struct MachineOptions {
   int pmac_program = 1;     // PMAC motion program number, >= 1
   int decimals = 4;         // decimals of mm in G-code and PMAC moves (4 = 0.1 um), 1 .. 9
   double retract_mm = 5.0;  // lift between rows (one-way) and between passes, >= 0
+  // Empty when valid, else one line per violation naming the job key and the value.
+  [[nodiscard]] std::vector<std::string> Problems() const;
 };
 
 struct OutputChoice {
@@ -30,8 +32,8 @@ struct OutputChoice {
 struct Job {
   std::string name;  // "name" key, or the job file's stem
   std::filesystem::path source;
-  std::shared_ptr<const Surface> surface;
-  Aperture aperture;
+  std::shared_ptr<const surfaces::Surface> surface;
+  surfaces::Aperture aperture;
   Wheel wheel;
   ToolpathOptions path;
   MachineOptions machine;
@@ -39,7 +41,9 @@ struct Job {
   bool predict = true;
   PredictionOptions prediction;
   std::optional<std::filesystem::path> wheel_summary;  // where the wheel came from, if a summary
-  nlohmann::json resolved;                             // the job with every default filled in, as used
+  // The job with every default filled in, as used: JSON text (parse it where it is written out),
+  // so that this header does not pull nlohmann/json into every includer.
+  std::string resolved_json;
 };
 
 // Reads and validates a job. `wheel_summary_override` (the CLI's --wheel) replaces the job's

@@ -15,6 +15,11 @@
 #include "grinding/toolpath.h"
 
 namespace arcwheel::grinding {
+
+using surfaces::Aperture;
+using surfaces::Surface;
+using surfaces::SurfacePoint;
+
 namespace {
 
 constexpr const char* kStage = "grinding.prediction";

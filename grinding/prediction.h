@@ -27,8 +27,8 @@
 #include <string>
 #include <vector>
 
-#include "grinding/surface.h"
 #include "grinding/wheel.h"
+#include "surfaces/surface.h"
 
 namespace arcwheel::grinding {
 
@@ -69,8 +69,9 @@ struct FormPrediction {
 
 // Throws Error{kInvalidOption, "grinding.prediction"} for invalid options and
 // Error{kBadInput} when a node lies off the surface's domain.
-[[nodiscard]] FormPrediction PredictFormError(const Surface& surface, const Aperture& aperture,
-                                              const Wheel& wheel, const PredictionOptions& options);
+[[nodiscard]] FormPrediction PredictFormError(const surfaces::Surface& surface,
+                                              const surfaces::Aperture& aperture, const Wheel& wheel,
+                                              const PredictionOptions& options);
 
 // Writes /prediction/{x_mm, y_mm, error_um, low_order_um} and the PV/RMS figures as attributes to
 // an HDF5 file (through the caller's atomic staging). Throws Error{kIo}.

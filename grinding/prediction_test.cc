@@ -14,6 +14,13 @@
 #include "core/testing/testing.h"
 
 namespace arcwheel::grinding {
+
+using surfaces::Aperture;
+using surfaces::EvenAsphere;
+using surfaces::Surface;
+using surfaces::SurfacePoint;
+using surfaces::XyPolynomial;
+
 namespace {
 
 Wheel PaperWheel() {  // fig. 7: Ra = 50 mm on a 400 mm wheel

@@ -14,6 +14,11 @@
 #include "core/parallel.h"
 
 namespace arcwheel::grinding {
+
+using surfaces::Aperture;
+using surfaces::Surface;
+using surfaces::SurfacePoint;
+
 namespace {
 
 constexpr const char* kStage = "grinding.toolpath";

@@ -17,8 +17,8 @@
 #include <string>
 #include <vector>
 
-#include "grinding/surface.h"
 #include "grinding/wheel.h"
+#include "surfaces/surface.h"
 
 namespace arcwheel::grinding {
 
@@ -31,8 +31,8 @@ struct ControlPoint {
 // Eq. 5 at contact (x, y): the wheel centre for the surface point there. With a measured profile,
 // Ra is replaced by the profile's effective radius at the contact's axial offset u = Ra fy / N3.
 // Precondition: surface.InDomain(x, y).
-[[nodiscard]] ControlPoint ControlPointForContact(const Surface& surface, const Wheel& wheel, double x_mm,
-                                                  double y_mm);
+[[nodiscard]] ControlPoint ControlPointForContact(const surfaces::Surface& surface, const Wheel& wheel,
+                                                  double x_mm, double y_mm);
 
 // Lowest point of the wheel (a solid disc with a toroidal rim, width limited to the wheel's
 // half width) above (x, y) when its centre is at `wheel_centre_mm`; +infinity where the wheel does
@@ -50,26 +50,26 @@ struct ControlPoint {
 // Solves eq. 5 backwards: the contact whose wheel centre has the given (Xw, Yw). `guess` is a
 // contact (x, y) to start from. Throws Error{kBadInput, "grinding.toolpath"} naming the target if
 // Newton's method fails (the wheel cannot follow the surface there).
-[[nodiscard]] ControlPoint SolveContactForWheelCentre(const Surface& surface, const Wheel& wheel,
+[[nodiscard]] ControlPoint SolveContactForWheelCentre(const surfaces::Surface& surface, const Wheel& wheel,
                                                       double xw_mm, double yw_mm, Eigen::Vector2d guess_mm);
 // The same with the contact's X fixed and Yw given: used for row ends.
-[[nodiscard]] ControlPoint SolveContactOnRow(const Surface& surface, const Wheel& wheel, double contact_x_mm,
-                                             double yw_mm, Eigen::Vector2d guess_mm);
+[[nodiscard]] ControlPoint SolveContactOnRow(const surfaces::Surface& surface, const Wheel& wheel,
+                                             double contact_x_mm, double yw_mm, Eigen::Vector2d guess_mm);
 
 // Jacobian d(Xw, Yw) / d(X, Y) of eq. 5 at contact (x, y), from the surface's exact second
 // derivatives (the slope of a measured profile is neglected).
-[[nodiscard]] Eigen::Matrix2d Eq5Jacobian(const Surface& surface, const Wheel& wheel, double x_mm,
+[[nodiscard]] Eigen::Matrix2d Eq5Jacobian(const surfaces::Surface& surface, const Wheel& wheel, double x_mm,
                                           double y_mm);
 
 // Hessian (1/mm) of the wheel's lower surface W(x, y) minus the surface's Hessian, at the contact
 // of `point` (the wheel placed at its centre). Positive definite: the wheel clears the surface
 // around the contact.
-[[nodiscard]] Eigen::Matrix2d ClearanceHessian(const Surface& surface, const Wheel& wheel,
+[[nodiscard]] Eigen::Matrix2d ClearanceHessian(const surfaces::Surface& surface, const Wheel& wheel,
                                                const ControlPoint& point);
 
 // Smallest eigenvalue (1/mm) of ClearanceHessian: negative means that in some direction the
 // surface (concave there) is more curved than the wheel, which then cuts in beside the contact.
-[[nodiscard]] double LocalClearanceCurvature(const Surface& surface, const Wheel& wheel,
+[[nodiscard]] double LocalClearanceCurvature(const surfaces::Surface& surface, const Wheel& wheel,
                                              const ControlPoint& point);
 
 // Smallest gap between the wheel placed at `point` and the surface, over a samples x samples grid
@@ -81,8 +81,8 @@ struct GougeProbe {
   double x_mm = 0.0;  // where the smallest gap is
   double y_mm = 0.0;
 };
-[[nodiscard]] GougeProbe ProbeGouge(const Surface& surface, const Aperture& aperture, const Wheel& wheel,
-                                    const ControlPoint& point, int samples);
+[[nodiscard]] GougeProbe ProbeGouge(const surfaces::Surface& surface, const surfaces::Aperture& aperture,
+                                    const Wheel& wheel, const ControlPoint& point, int samples);
 
 struct ToolpathOptions {
   // Distance between rows (wheel-centre Y), mm, > 0. Rows are spread evenly, never wider.
@@ -147,7 +147,7 @@ struct ToolpathSummary {
 // Generates the toolpath row by row and hands each row to `sink`. Throws
 // Error{kBadInput, "grinding.toolpath"} naming the point where the wheel cannot reach the surface,
 // would leave its usable arc, or would gouge; Error{kInvalidOption} for invalid options.
-ToolpathSummary GenerateToolpath(const Surface& surface, const Aperture& aperture, const Wheel& wheel,
-                                 const ToolpathOptions& options, const RowSink& sink);
+ToolpathSummary GenerateToolpath(const surfaces::Surface& surface, const surfaces::Aperture& aperture,
+                                 const Wheel& wheel, const ToolpathOptions& options, const RowSink& sink);
 
 }  // namespace arcwheel::grinding

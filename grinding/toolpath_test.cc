@@ -10,6 +10,15 @@
 #include "core/error.h"
 
 namespace arcwheel::grinding {
+
+using surfaces::Aperture;
+using surfaces::EvenAsphere;
+using surfaces::EvenAsphereParameters;
+using surfaces::Surface;
+using surfaces::SurfacePoint;
+using surfaces::XyPolynomial;
+using surfaces::XyPolynomialTerm;
+
 namespace {
 
 using ::testing::HasSubstr;

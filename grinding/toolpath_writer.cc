@@ -10,6 +10,7 @@
 #include <cstring>
 #include <fstream>
 #include <iterator>
+#include <nlohmann/json.hpp>
 
 #include "core/atomic_file.h"
 #include "core/check.h"
@@ -155,7 +156,7 @@ nlohmann::json SummaryJson(const Job& job, const ToolpathRunReport& report,
                            const std::vector<std::string>& files) {
   nlohmann::json j;
   j["arcwheel_version"] = kVersion;
-  j["job"] = job.resolved;
+  j["job"] = nlohmann::json::parse(job.resolved_json);
   j["job_path"] = job.source.string();
   j["surface"] = job.surface->Describe();
   j["wheel"] = job.wheel.description;

@@ -72,7 +72,7 @@ struct Rows {
   Eigen::VectorXd target;
 };
 
-Rows ApertureRows(const ErrorMap& target, const grinding::Aperture& aperture) {
+Rows ApertureRows(const ErrorMap& target, const surfaces::Aperture& aperture) {
   Rows rows;
   rows.row_of_node.assign(target.error_um.size(), -1);
   std::vector<double> values;
@@ -329,9 +329,9 @@ void CheckPathOptions(const RasterOptions& o) {
 }
 }  // namespace
 
-std::vector<Eigen::Vector2d> SpiralPath(const grinding::Aperture& aperture, const RasterOptions& o) {
+std::vector<Eigen::Vector2d> SpiralPath(const surfaces::Aperture& aperture, const RasterOptions& o) {
   CheckPathOptions(o);
-  const bool circle = aperture.shape == grinding::Aperture::Shape::kCircle;
+  const bool circle = aperture.shape == surfaces::Aperture::Shape::kCircle;
   const double radius =
       circle ? aperture.HalfY() + o.extension_mm
              : std::hypot(aperture.HalfX() + o.extension_mm, aperture.HalfY() + o.extension_mm);
@@ -362,9 +362,9 @@ std::vector<Eigen::Vector2d> SpiralPath(const grinding::Aperture& aperture, cons
   return path;
 }
 
-std::vector<Eigen::Vector2d> RasterPath(const grinding::Aperture& aperture, const RasterOptions& o) {
+std::vector<Eigen::Vector2d> RasterPath(const surfaces::Aperture& aperture, const RasterOptions& o) {
   CheckPathOptions(o);
-  const bool circle = aperture.shape == grinding::Aperture::Shape::kCircle;
+  const bool circle = aperture.shape == surfaces::Aperture::Shape::kCircle;
   const double half_y = aperture.HalfY() + o.extension_mm;
   const int lines = static_cast<int>(std::ceil(2.0 * half_y / o.line_spacing_mm - 1e-9)) + 1;
   std::vector<Eigen::Vector2d> path;
@@ -385,7 +385,7 @@ std::vector<Eigen::Vector2d> RasterPath(const grinding::Aperture& aperture, cons
   return path;
 }
 
-DwellSolution SolveDwell(const ErrorMap& target, const grinding::Aperture& aperture,
+DwellSolution SolveDwell(const ErrorMap& target, const surfaces::Aperture& aperture,
                          std::span<const Eigen::Vector2d> path, const RemovalFunction& removal,
                          const DwellOptions& options) {
   CheckOptions(removal, options, path.size());

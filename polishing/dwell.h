@@ -29,9 +29,9 @@
 #include <string>
 #include <vector>
 
-#include "grinding/surface.h"
 #include "polishing/removal_function.h"
 #include "polishing/removal_target.h"
+#include "surfaces/surface.h"
 
 namespace arcwheel::polishing {
 
@@ -43,14 +43,14 @@ struct RasterOptions {
 
 // A zigzag raster: lines along x, stepping in y, over the aperture grown by the extension; each
 // line is cut into equal steps of at most point_spacing_mm. Throws Error{kInvalidOption}.
-[[nodiscard]] std::vector<Eigen::Vector2d> RasterPath(const grinding::Aperture& aperture,
+[[nodiscard]] std::vector<Eigen::Vector2d> RasterPath(const surfaces::Aperture& aperture,
                                                       const RasterOptions& options);
 
 // An Archimedean spiral r = pitch theta / (2 pi) from the aperture's centre outwards, pitch =
 // line_spacing_mm, cut into equal arc-length steps of at most point_spacing_mm, out to the radius
 // of the grown aperture (a rectangle's: its half diagonal, so the corners are covered).
 // Throws Error{kInvalidOption}.
-[[nodiscard]] std::vector<Eigen::Vector2d> SpiralPath(const grinding::Aperture& aperture,
+[[nodiscard]] std::vector<Eigen::Vector2d> SpiralPath(const surfaces::Aperture& aperture,
                                                       const RasterOptions& options);
 
 enum class PathPattern { kRaster, kSpiral };
@@ -106,7 +106,7 @@ struct DwellSolution {
 // somewhere (naming the point and the uniform layer that would make it reachable), or when the
 // speeds shaped to the maximum acceleration do not settle within max_shaping_rounds (naming the
 // point that still needed shaping).
-[[nodiscard]] DwellSolution SolveDwell(const ErrorMap& target, const grinding::Aperture& aperture,
+[[nodiscard]] DwellSolution SolveDwell(const ErrorMap& target, const surfaces::Aperture& aperture,
                                        std::span<const Eigen::Vector2d> path_xy_mm,
                                        const RemovalFunction& removal, const DwellOptions& options);
 

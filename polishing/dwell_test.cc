@@ -15,7 +15,7 @@ namespace {
 
 using testing::SampledGaussian;
 
-const grinding::Aperture kDisc{.shape = grinding::Aperture::Shape::kCircle, .diameter_mm = 100.0};
+const surfaces::Aperture kDisc{.shape = surfaces::Aperture::Shape::kCircle, .diameter_mm = 100.0};
 
 // A simulated error map over a 100 mm disc (1 mm grid): astigmatism, a ring and two bumps whose
 // widths are above the tool's, as a ground part shows after grinding. Known parameters, seeded.
@@ -196,7 +196,7 @@ TEST(SolveDwell, PredictsTheRemovalOfAnOffsetEllipticFootprintAsABruteForceConvo
   // Removal centred 2 mm in +x and 1 mm in -y of the tool centre, sigmas 3 and 1.5 mm, on a
   // 0.5 mm table: the interpolation is visible at the map's 1 mm nodes.
   const TabulatedRemovalFunction table = SampledGaussian(3.0, 2.0, -1.0, 3.0, 1.5, -6.0, -6.0, 0.5, 33, 21);
-  const grinding::Aperture square{.width_x_mm = 30.0, .width_y_mm = 30.0};
+  const surfaces::Aperture square{.width_x_mm = 30.0, .width_y_mm = 30.0};
   ErrorMap error{.x0_mm = -15.0, .y0_mm = -15.0, .dx_mm = 1.0, .dy_mm = 1.0, .nx = 31, .ny = 31};
   for (int j = 0; j < error.ny; ++j) {
     for (int i = 0; i < error.nx; ++i) {
@@ -230,7 +230,7 @@ TEST(SolveDwell, PredictsTheRemovalOfAnOffsetEllipticFootprintAsABruteForceConvo
 TEST(SolveDwell, RecoversAKnownDwellToWithinTheConditioningOfTheProblem) {
   // Target made by a known smooth dwell through the same model: the residual must vanish.
   const GaussianRemovalFunction tool{.peak_rate_um_per_s = 1.0, .fwhm_mm = 10.0};
-  const grinding::Aperture square{.width_x_mm = 40.0, .width_y_mm = 40.0};
+  const surfaces::Aperture square{.width_x_mm = 40.0, .width_y_mm = 40.0};
   const std::vector<Eigen::Vector2d> path =
       RasterPath(square, {.line_spacing_mm = 2.0, .point_spacing_mm = 2.0, .extension_mm = 8.0});
   ErrorMap target{.x0_mm = -20.0, .y0_mm = -20.0, .dx_mm = 1.0, .dy_mm = 1.0, .nx = 41, .ny = 41};

@@ -11,6 +11,7 @@
 #include <fstream>
 #include <functional>
 #include <iterator>
+#include <nlohmann/json.hpp>
 #include <random>
 #include <string>
 #include <string_view>
@@ -25,19 +26,56 @@ namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
-// Runs `read` and returns the message of the Error it throws (and checks its code).
-std::string ErrorOf(const std::function<void()>& read, ErrorCode code = ErrorCode::kBadInput) {
-  try {
-    read();
-  } catch (const Error& e) {
-    EXPECT_EQ(e.code(), code) << e.what();
-    return e.what();
-  }
-  return "accepted";
-}
+using arcwheel::testing::ErrorMessageOf;
 
 bool Contains(const std::string& text, const std::string& part) {
   return text.find(part) != std::string::npos;
+}
+
+// The grid placement of `map` (size, origin, spacing) against `expected`'s, exactly: the
+// readers copy these numbers, or take them as differences of numbers exact in binary.
+void ExpectPlacement(const ErrorMap& map, const ErrorMap& expected) {
+  EXPECT_EQ(map.nx, expected.nx);
+  EXPECT_EQ(map.ny, expected.ny);
+  EXPECT_EQ(map.x0_mm, expected.x0_mm);
+  EXPECT_EQ(map.y0_mm, expected.y0_mm);
+  EXPECT_EQ(map.dx_mm, expected.dx_mm);
+  EXPECT_EQ(map.dy_mm, expected.dy_mm);
+}
+
+// ------------------------------------------------------------------------------------------------
+// Map CSV (formerly in job_test.cc, which now tests the job reader).
+
+std::string CsvError(const std::string& text) {
+  arcwheel::testing::TempDir dir;
+  std::ofstream(dir / "map.csv") << text;
+  return ErrorMessageOf([&dir] { (void)ReadErrorMapCsv(dir / "map.csv"); });
+}
+
+TEST(ReadErrorMapCsv, PlacesScatteredRowsOnTheirGridAndLeavesGapsWithoutData) {
+  arcwheel::testing::TempDir dir;
+  std::ofstream(dir / "map.csv")
+      << "# comment\nx_mm,y_mm,error_um\n2.5,-1,0.25\n-2.5,-1,1\n0,1,nan\n2.5,1,-3\n";
+  const ErrorMap map = ReadErrorMapCsv(dir / "map.csv");
+  ExpectPlacement(
+      map, {.x0_mm = -2.5, .y0_mm = -1.0, .dx_mm = 2.5, .dy_mm = 2.0, .nx = 3, .ny = 2, .error_um = {}});
+  EXPECT_DOUBLE_EQ(map.At(0, 0), 1.0);
+  EXPECT_TRUE(std::isnan(map.At(1, 0)));  // never given
+  EXPECT_DOUBLE_EQ(map.At(2, 0), 0.25);
+  EXPECT_TRUE(std::isnan(map.At(1, 1)));  // given as nan
+  EXPECT_DOUBLE_EQ(map.At(2, 1), -3.0);
+}
+
+TEST(ReadErrorMapCsv, NamesTheFileAndLineOfMalformedInput) {
+  EXPECT_NE(CsvError("x,y,z\n").find("map.csv' line 1: header 'x,y,z'"), std::string::npos);
+  EXPECT_NE(CsvError("x_mm,y_mm,error_um\n0,0,1\n1,0,abc\n").find("line 3: 'abc' is not a number"),
+            std::string::npos);
+  EXPECT_NE(CsvError("x_mm,y_mm,error_um\n0,0,1\n1,0\n").find("line 3: has 2 values"), std::string::npos);
+  EXPECT_NE(CsvError("x_mm,y_mm,error_um\n0,0,1\n1,0,2\n2,0,2\n3,0,2\n3.4,0,3\n")
+                .find("line 6: (3.4, 0) mm is not on the regular grid"),
+            std::string::npos);
+  EXPECT_NE(CsvError("x_mm,y_mm,error_um\n0,0,1\n1,0,2\n1,0,3\n").find("line 4: (1, 0) mm appears twice"),
+            std::string::npos);
 }
 
 // ------------------------------------------------------------------------------------------------
@@ -217,7 +255,7 @@ TEST(PlaceInPartFrame, NeedsALateralResolutionFromTheFileOrTheJob) {
   spec.height_m = TestHeightM;
   const PixelMap pixels = ParseMetroProDat(MetroProImage(spec), "nores.dat");
   EXPECT_TRUE(std::isnan(pixels.pixel_x_mm));
-  const std::string message = ErrorOf([&] { (void)PlaceInPartFrame(pixels, {}, "nores.dat"); });
+  const std::string message = ErrorMessageOf([&] { (void)PlaceInPartFrame(pixels, {}, "nores.dat"); });
   EXPECT_TRUE(Contains(message, "'nores.dat'") && Contains(message, "pixel_mm")) << message;
   const ErrorMap map = PlaceInPartFrame(pixels, {.pixel_mm = 0.2}, "nores.dat");
   EXPECT_DOUBLE_EQ(map.dx_mm, 0.2);
@@ -228,7 +266,7 @@ TEST(ParseMetroProDat, RefusesCorruptHeadersNamingTheFileAndTheField) {
   spec.height_m = TestHeightM;
   const std::vector<unsigned char> good = MetroProImage(spec);
   auto error = [](std::vector<unsigned char> bytes) {
-    return ErrorOf([&] { (void)ParseMetroProDat(bytes, "bad.dat"); });
+    return ErrorMessageOf([&] { (void)ParseMetroProDat(bytes, "bad.dat"); });
   };
   std::vector<unsigned char> b = good;
   b[3] = 0x00;
@@ -413,12 +451,12 @@ TEST(ReadZygoDatx, RefusesAFileWithoutTheSurfaceDatasetOrAHeightUnit) {
   DatxSpec spec;
   spec.with_surface = false;
   WriteDatx(dir / "empty.datx", spec, 3, 2, DatxHeightNm);
-  std::string message = ErrorOf([&] { (void)ReadZygoDatx(dir / "empty.datx"); });
+  std::string message = ErrorMessageOf([&] { (void)ReadZygoDatx(dir / "empty.datx"); });
   EXPECT_TRUE(Contains(message, "empty.datx'") && Contains(message, "/Measurement/Surface")) << message;
   spec.with_surface = true;
   spec.z_unit = "Volts";
   WriteDatx(dir / "volts.datx", spec, 3, 2, DatxHeightNm);
-  message = ErrorOf([&] { (void)ReadZygoDatx(dir / "volts.datx"); });
+  message = ErrorMessageOf([&] { (void)ReadZygoDatx(dir / "volts.datx"); });
   EXPECT_TRUE(Contains(message, "volts.datx'") && Contains(message, "Z Converter") &&
               Contains(message, "Volts"))
       << message;
@@ -441,8 +479,8 @@ TEST(ReadZygoDatx, RefusesAGlobalHeapThatWouldHangTheLibrary) {
   ASSERT_LE(collection + size, bytes.size());
   std::fill(bytes.begin() + static_cast<std::ptrdiff_t>(collection + 16),
             bytes.begin() + static_cast<std::ptrdiff_t>(collection + size), 0);
-  const std::string message =
-      ErrorOf([&] { (void)ReadZygoDatx(hdf5::File::OpenImage(bytes.data(), bytes.size(), "zeroed.datx")); });
+  const std::string message = ErrorMessageOf(
+      [&] { (void)ReadZygoDatx(hdf5::File::OpenImage(bytes.data(), bytes.size(), "zeroed.datx")); });
   EXPECT_TRUE(Contains(message, "zeroed.datx'") &&
               Contains(message, "global heap at byte " + std::to_string(collection) + " is damaged"))
       << message;
@@ -465,7 +503,7 @@ TEST(ReadZygoDatx, RefusesAReferenceToAMissingOrLongerHeapObject) {
   std::vector<unsigned char> orphaned = good;
   orphaned[object] = 0xff;
   orphaned[object + 1] = 0x7f;
-  std::string message = ErrorOf(
+  std::string message = ErrorMessageOf(
       [&] { (void)ReadZygoDatx(hdf5::File::OpenImage(orphaned.data(), orphaned.size(), "orphaned.datx")); });
   EXPECT_TRUE(Contains(message, "orphaned.datx'") &&
               Contains(message, "'Category' of attribute 'Z Converter'") &&
@@ -474,7 +512,7 @@ TEST(ReadZygoDatx, RefusesAReferenceToAMissingOrLongerHeapObject) {
 
   std::vector<unsigned char> longer = good;
   longer[object + 8] = 15;  // same step through the collection: 15 and 9 both align to 16
-  message = ErrorOf(
+  message = ErrorMessageOf(
       [&] { (void)ReadZygoDatx(hdf5::File::OpenImage(longer.data(), longer.size(), "longer.datx")); });
   EXPECT_TRUE(Contains(message, "longer.datx'") && Contains(message, "refers to 9 bytes") &&
               Contains(message, "which holds 15"))
@@ -489,12 +527,7 @@ TEST(ErrorMapHdf5, RoundTripsEveryNodeAndTheGridPlacement) {
   for (int k = 0; k < 15; ++k) map.error_um.push_back(k == 7 ? kNaN : 0.1 * k - 0.3);
   WriteErrorMapHdf5(map, dir / "grid.h5");
   const ErrorMap read = ReadErrorMapHdf5(dir / "grid.h5");
-  EXPECT_EQ(read.nx, 5);
-  EXPECT_EQ(read.ny, 3);
-  EXPECT_EQ(read.x0_mm, -12.5);
-  EXPECT_EQ(read.y0_mm, 3.0);
-  EXPECT_EQ(read.dx_mm, 0.25);
-  EXPECT_EQ(read.dy_mm, 0.5);
+  ExpectPlacement(read, map);
   for (std::size_t k = 0; k < 15; ++k) {
     if (k == 7) {
       EXPECT_TRUE(std::isnan(read.error_um[k]));
@@ -513,10 +546,10 @@ TEST(ErrorMapHdf5, RefusesAMissingAttributeOrDatasetByName) {
     file.WriteAttribute("/", "y0_mm", 0.0);
     file.WriteAttribute("/", "dx_mm", 1.0);
   }
-  std::string message = ErrorOf([&] { (void)ReadErrorMapHdf5(dir / "noattr.h5"); });
+  std::string message = ErrorMessageOf([&] { (void)ReadErrorMapHdf5(dir / "noattr.h5"); });
   EXPECT_TRUE(Contains(message, "noattr.h5'") && Contains(message, "'dy_mm' is missing")) << message;
   { hdf5::File file = hdf5::File::Create(dir / "nodata.h5"); }
-  message = ErrorOf([&] { (void)ReadErrorMapHdf5(dir / "nodata.h5"); });
+  message = ErrorMessageOf([&] { (void)ReadErrorMapHdf5(dir / "nodata.h5"); });
   EXPECT_TRUE(Contains(message, "nodata.h5'") && Contains(message, "'error_um' is missing")) << message;
 }
 
@@ -654,7 +687,7 @@ TEST(ReadScatteredCsv, RefusesTooFewCollinearOrCoincidentPointsNamingTheFile) {
   arcwheel::testing::TempDir dir;
   auto error = [&](const std::string& text) {
     std::ofstream(dir / "pts.csv") << text;
-    return ErrorOf([&] {
+    return ErrorMessageOf([&] {
       (void)InterpolateScattered(ReadScatteredCsv(dir / "pts.csv"), 1.0, (dir / "pts.csv").string());
     });
   };
@@ -706,8 +739,9 @@ TEST(PolishJobErrorMap, ReadsEachFormatByItsExtensionAndAppliesThePlacementKeys)
     EXPECT_TRUE(job.error_map.error_um[k] == expected.error_um[k] ||
                 (std::isnan(job.error_map.error_um[k]) && std::isnan(expected.error_um[k])));
   }
-  EXPECT_EQ(job.resolved["error_map"]["centre_px"], nlohmann::json::array({3.0, 2.0}));
-  EXPECT_EQ(job.resolved["error_map"]["format"], "dat");
+  const nlohmann::json resolved = nlohmann::json::parse(job.resolved_json);
+  EXPECT_EQ(resolved["error_map"]["centre_px"], nlohmann::json::array({3.0, 2.0}));
+  EXPECT_EQ(resolved["error_map"]["format"], "dat");
 
   std::ofstream(dir / "pts.csv") << "x_mm,y_mm,error_um\n-10,-10,1\n10,-10,1\n0,10,1\n";
   job = ReadJob(dir, R"({"file": "pts.csv", "layout": "scattered", "grid_spacing_mm": 0.5})");
@@ -730,15 +764,17 @@ TEST(PolishJobErrorMap, RefusesUnknownAndMisappliedKeysByDottedName) {
   arcwheel::testing::TempDir dir;
   std::ofstream(dir / "map.csv") << "x_mm,y_mm,error_um\n0,0,1\n1,0,1\n";
   auto message = [&](const std::string& error_map) {
-    return ErrorOf([&] { (void)ReadJob(dir, error_map); });
+    return ErrorMessageOf([&] { (void)ReadJob(dir, error_map); });
   };
-  EXPECT_TRUE(Contains(message(R"({"file": "map.csv", "pixel_size": 1})"),
-                       "'error_map.pixel_size' is an unknown key"));
+  EXPECT_TRUE(
+      Contains(message(R"({"file": "map.csv", "pixel_size": 1})"), "unknown key 'error_map.pixel_size'"));
   EXPECT_TRUE(Contains(message(R"({"file": "map.csv", "rotation_deg": 90})"),
                        "'error_map.rotation_deg' applies only"));
   EXPECT_TRUE(Contains(message(R"({"file": "map.csv", "grid_spacing_mm": 1})"),
                        "'error_map.grid_spacing_mm' applies only"));
-  EXPECT_TRUE(Contains(message(R"({"file": "map.csv", "format": "zyg"})"), "'error_map.format' = \"zyg\""));
+  EXPECT_TRUE(
+      Contains(message(R"({"file": "map.csv", "format": "zyg"})"),
+               "key 'error_map.format' expected one of \"csv\", \"dat\", \"datx\", \"h5\", got \"zyg\""));
   EXPECT_TRUE(Contains(message(R"({"file": "map.txt"})"), "'error_map.format' is required"));
   EXPECT_TRUE(Contains(message(R"({"file": "map.csv", "scale": 0})"), "'error_map.scale' must be non-zero"));
 }

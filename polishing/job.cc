@@ -9,15 +9,16 @@
 #include <iterator>
 #include <limits>
 #include <map>
-#include <set>
 #include <sstream>
 #include <utility>
 
 #include "core/atomic_file.h"
 #include "core/error.h"
+#include "core/json_job.h"
 #include "core/json_text.h"
 #include "core/version.h"
 #include "schema/polish_outputs.h"
+#include "surfaces/surface_json.h"
 
 namespace arcwheel::polishing {
 namespace {
@@ -25,169 +26,7 @@ namespace {
 using nlohmann::json;
 constexpr const char* kStage = "polishing.job";
 
-// One JSON object of the job: typed reads by key, remembered for the unknown-key check.
-class Section {
- public:
-  Section(const json* object, std::string prefix, const std::filesystem::path& source)
-      : object_(object), prefix_(std::move(prefix)), source_(source) {
-    if (object_ != nullptr && !object_->is_object()) Fail("", "must be an object");
-  }
-  [[noreturn]] void Fail(const std::string& key, const std::string& what) const {
-    throw Error(ErrorCode::kBadInput, kStage,
-                fmt::format("'{}': '{}' {}", source_.string(), Dotted(key), what));
-  }
-  [[nodiscard]] bool Has(const std::string& key) const {
-    return object_ != nullptr && object_->contains(key);
-  }
-  double Number(const std::string& key, double fallback) {
-    used_.insert(key);
-    double v = fallback;
-    if (Has(key)) {
-      if (!object_->at(key).is_number() || !std::isfinite(object_->at(key).get<double>()))
-        Fail(key, "must be a finite number");
-      v = object_->at(key).get<double>();
-    }
-    resolved_[key] = v;
-    return v;
-  }
-  // A count or power: checked as a double first, so 2.5 is refused rather than used as 2 and a
-  // value beyond int's range is never cast (undefined behaviour).
-  int WholeNumber(const std::string& key, int fallback, int low, int high) {
-    const double v = Number(key, fallback);
-    if (!(v >= low && v <= high) || v != std::floor(v)) {
-      Fail(key, fmt::format("must be a whole number within {} .. {}, got {}", low, high, v));
-    }
-    return static_cast<int>(v);
-  }
-  double RequiredNumber(const std::string& key) {
-    if (!Has(key)) Fail(key, "is required");
-    return Number(key, 0.0);
-  }
-  std::vector<double> Numbers(const std::string& key, std::vector<double> fallback) {
-    used_.insert(key);
-    if (Has(key)) {
-      const json& v = object_->at(key);
-      if (!v.is_array() || (!fallback.empty() && v.size() != fallback.size())) {
-        Fail(key, fmt::format("must be an array of {} numbers", fallback.size()));
-      }
-      fallback.clear();
-      for (const json& e : v) {
-        if (!e.is_number() || !std::isfinite(e.get<double>())) Fail(key, "must hold finite numbers only");
-        fallback.push_back(e.get<double>());
-      }
-    }
-    resolved_[key] = fallback;
-    return fallback;
-  }
-  std::string String(const std::string& key, const std::string& fallback) {
-    used_.insert(key);
-    std::string v = fallback;
-    if (Has(key)) {
-      if (!object_->at(key).is_string()) Fail(key, "must be a string");
-      v = object_->at(key).get<std::string>();
-    }
-    resolved_[key] = v;
-    return v;
-  }
-  std::string Choice(const std::string& key, const std::vector<std::string>& allowed) {
-    const std::string v = String(key, allowed.front());
-    if (std::find(allowed.begin(), allowed.end(), v) == allowed.end()) {
-      Fail(key, fmt::format("= \"{}\" is not one of \"{}\"", v, fmt::join(allowed, "\", \"")));
-    }
-    return v;
-  }
-  Section Child(const std::string& key) {
-    used_.insert(key);
-    return Section(Has(key) ? &object_->at(key) : nullptr, Dotted(key), source_);
-  }
-  void Adopt(const std::string& key, const Section& child) { resolved_[key] = child.resolved_; }
-  void SetResolved(const std::string& key, const json& value) { resolved_[key] = value; }
-  [[nodiscard]] const json& Raw(const std::string& key) {
-    used_.insert(key);
-    return object_->at(key);
-  }
-  [[nodiscard]] const std::filesystem::path& source() const { return source_; }
-  void Finish() const {
-    if (object_ == nullptr) return;
-    for (const auto& [key, value] : object_->items()) {
-      if (!used_.count(key)) Fail(key, "is an unknown key (see docs/polishing.md for the job keys)");
-    }
-  }
-  [[nodiscard]] const json& resolved() const { return resolved_; }
-  [[nodiscard]] std::string Dotted(const std::string& key) const {
-    return prefix_.empty() ? key : (key.empty() ? prefix_ : prefix_ + "." + key);
-  }
-
- private:
-  const json* object_;
-  std::string prefix_;
-  const std::filesystem::path& source_;
-  std::set<std::string> used_;
-  json resolved_ = json::object();
-};
-
-std::shared_ptr<const grinding::Surface> ReadSurface(Section& s) {
-  const std::string type = s.Choice("type", {"even_asphere", "xy_polynomial"});
-  if (type == "xy_polynomial") {
-    // The same form as the grinding job: [{"x_power": i, "y_power": j, "coefficient": c}, ...].
-    if (!s.Has("terms") || !s.Raw("terms").is_array()) {
-      s.Fail("terms", "must be an array of {\"x_power\", \"y_power\", \"coefficient\"} objects");
-    }
-    std::vector<grinding::XyPolynomialTerm> terms;
-    json resolved = json::array();
-    for (std::size_t k = 0; k < s.Raw("terms").size(); ++k) {
-      Section t(&s.Raw("terms")[k], s.Dotted(fmt::format("terms[{}]", k)), s.source());
-      grinding::XyPolynomialTerm term;
-      term.x_power = t.WholeNumber("x_power", 0, 0, 20);
-      term.y_power = t.WholeNumber("y_power", 0, 0, 20);
-      term.coefficient = t.RequiredNumber("coefficient");
-      t.Finish();
-      terms.push_back(term);
-      resolved.push_back(t.resolved());
-    }
-    s.SetResolved("terms", resolved);
-    return std::make_shared<grinding::XyPolynomial>(std::move(terms));
-  }
-  grinding::EvenAsphereParameters p;
-  p.vertex_radius_mm = s.RequiredNumber("vertex_radius_mm");
-  if (!(p.vertex_radius_mm > 0.0)) s.Fail("vertex_radius_mm", "must be > 0 (use \"form\" for the side)");
-  p.conic = s.Number("conic", 0.0);
-  if (s.Has("coefficients")) {
-    // The same form as the grinding job: {"A4": ..., "A6": ..., ..., "A20": ...}.
-    Section c = s.Child("coefficients");
-    for (int order = 4; order <= 20; order += 2)
-      p.even_coefficients.push_back(c.Number(fmt::format("A{}", order), 0.0));
-    while (!p.even_coefficients.empty() && p.even_coefficients.back() == 0.0) p.even_coefficients.pop_back();
-    c.Finish();
-    s.Adopt("coefficients", c);
-  }
-  const std::vector<double> off = s.Numbers("off_axis_mm", {0.0, 0.0});
-  p.off_axis_x_mm = off[0];
-  p.off_axis_y_mm = off[1];
-  p.concave = s.Choice("form", {"concave", "convex"}) == "concave";
-  try {
-    return std::make_shared<grinding::EvenAsphere>(p);
-  } catch (const Error& e) {
-    s.Fail("", fmt::format("is not usable: {}", e.what()));
-  }
-}
-
-grinding::Aperture ReadAperture(Section& s) {
-  grinding::Aperture a;
-  if (s.Choice("shape", {"circle", "rectangle"}) == "circle") {
-    a.shape = grinding::Aperture::Shape::kCircle;
-    a.diameter_mm = s.RequiredNumber("diameter_mm");
-    if (!(a.diameter_mm > 0.0)) s.Fail("diameter_mm", "must be > 0");
-  } else {
-    const std::vector<double> size = s.Numbers("size_mm", {0.0, 0.0});
-    if (!(size[0] > 0.0) || !(size[1] > 0.0)) s.Fail("size_mm", "must be two sizes > 0");
-    a.width_x_mm = size[0];
-    a.width_y_mm = size[1];
-  }
-  return a;
-}
-
-AbbQuaternion ReadQuaternion(Section& s, const std::string& key) {
+AbbQuaternion ReadQuaternion(JsonSection& s, const std::string& key) {
   const std::vector<double> q = s.Numbers(key, {1.0, 0.0, 0.0, 0.0});
   const double norm = std::sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
   if (std::abs(norm - 1.0) > 1e-6)
@@ -195,40 +34,100 @@ AbbQuaternion ReadQuaternion(Section& s, const std::string& key) {
   return {q[0] / norm, q[1] / norm, q[2] / norm, q[3] / norm};
 }
 
-void ReadMachine(Section& s, PolishJob& job) {
+void ReadMachine(JsonSection& s, PolishJob& job) {
   job.dwell.max_speed_mm_s = s.RequiredNumber("max_speed_mm_s");
-  if (!(job.dwell.max_speed_mm_s > 0.0)) s.Fail("max_speed_mm_s", "must be > 0");
   job.dwell.min_speed_mm_s = s.Number("min_speed_mm_s", 0.0);
-  if (!(job.dwell.min_speed_mm_s >= 0.0 && job.dwell.min_speed_mm_s <= job.dwell.max_speed_mm_s)) {
-    s.Fail("min_speed_mm_s", fmt::format("= {} is unreachable: it must lie in [0, max_speed_mm_s = {}]",
-                                         job.dwell.min_speed_mm_s, job.dwell.max_speed_mm_s));
-  }
   job.dwell.min_dwell_s = s.Number("min_dwell_s", 0.0);
-  if (!(job.dwell.min_dwell_s >= 0.0)) s.Fail("min_dwell_s", "must be >= 0");
-  if (job.dwell.min_dwell_s > 0.0 && job.dwell.min_speed_mm_s > 0.0) {
-    s.Fail("min_dwell_s", "is unreachable together with min_speed_mm_s: give one of them");
-  }
   job.dwell.max_acceleration_mm_s2 = s.Number("max_acceleration_mm_s2", 0.0);
-  if (!(job.dwell.max_acceleration_mm_s2 >= 0.0))
-    s.Fail("max_acceleration_mm_s2", "must be >= 0 (0 = no limit)");
   job.robot_side = s.Choice("robot_side", {"+x", "-x"}) == "+x" ? RobotSide::kPlusX : RobotSide::kMinusX;
 }
 
-void ReadTool(Section& s, PolishJob& job) {
+// The range checks of DwellOptions and RasterOptions (polishing/dwell.h), by job key.
+std::vector<std::string> DwellProblems(const DwellOptions& d) {
+  std::vector<std::string> problems;
+  const auto require = [&problems](bool ok, const std::string& text) {
+    if (!ok) problems.push_back(text);
+  };
+  require(d.max_speed_mm_s > 0.0, fmt::format("machine.max_speed_mm_s = {} violates > 0", d.max_speed_mm_s));
+  // Against a bad maximum only the lower bound says anything about the minimum itself.
+  require(d.min_speed_mm_s >= 0.0 && (d.min_speed_mm_s <= d.max_speed_mm_s || !(d.max_speed_mm_s > 0.0)),
+          fmt::format("machine.min_speed_mm_s = {} violates 0 <= min_speed_mm_s <= max_speed_mm_s = {} "
+                      "(unreachable)",
+                      d.min_speed_mm_s, d.max_speed_mm_s));
+  require(d.min_dwell_s >= 0.0, fmt::format("machine.min_dwell_s = {} violates >= 0", d.min_dwell_s));
+  require(!(d.min_dwell_s > 0.0 && d.min_speed_mm_s > 0.0),
+          fmt::format("machine.min_dwell_s = {} violates min_speed_mm_s = 0 (both are unreachable together: "
+                      "give one of them)",
+                      d.min_dwell_s));
+  require(d.max_acceleration_mm_s2 >= 0.0,
+          fmt::format("machine.max_acceleration_mm_s2 = {} violates >= 0 (0 = no limit)",
+                      d.max_acceleration_mm_s2));
+  require(d.relative_tolerance > 0.0,
+          fmt::format("solver.relative_tolerance = {} violates > 0", d.relative_tolerance));
+  return problems;
+}
+
+std::vector<std::string> PathProblems(const RasterOptions& p) {
+  std::vector<std::string> problems;
+  if (!(p.line_spacing_mm > 0.0)) {
+    problems.push_back(fmt::format("path.line_spacing_mm = {} violates > 0", p.line_spacing_mm));
+  }
+  if (!(p.point_spacing_mm > 0.0)) {
+    problems.push_back(fmt::format("path.point_spacing_mm = {} violates > 0", p.point_spacing_mm));
+  }
+  if (!(p.extension_mm >= 0.0))
+    problems.push_back(fmt::format("path.extension_mm = {} violates >= 0", p.extension_mm));
+  return problems;
+}
+
+void ReadTool(JsonSection& s, PolishJob& job) {
   const std::vector<double> tcp = s.Numbers("tcp_mm", {0.0, 0.0, 150.0});
   job.tool.tcp_mm = {tcp[0], tcp[1], tcp[2]};
   job.tool.orientation = ReadQuaternion(s, "quaternion");
   const std::vector<double> offset = s.Numbers("removal_centre_offset_mm", {0.0, 0.0});
   job.tool.removal_centre_offset_mm = {offset[0], offset[1]};
   job.tool.mass_kg = s.Number("mass_kg", 5.0);
-  if (!(job.tool.mass_kg > 0.0)) s.Fail("mass_kg", "must be > 0");
   const std::vector<double> cog = s.Numbers("centre_of_gravity_mm", {0.0, 0.0, 75.0});
   job.tool.centre_of_gravity_mm = {cog[0], cog[1], cog[2]};
 }
 
+// A Gaussian footprint, or a measured table from a file beside the job.
+// A Gaussian's range problems are added to `problems`.
+RemovalFunction ReadRemovalFunctionSection(JsonSection& s, const std::filesystem::path& job_path,
+                                           std::vector<std::string>& problems) {
+  if (s.Has("file")) {
+    if (s.Has("peak_rate_um_per_s") || s.Has("fwhm_mm")) {
+      s.Fail("file", "is an alternative to peak_rate_um_per_s and fwhm_mm: give one or the other");
+    }
+    const std::filesystem::path file = s.String("file", "");
+    return ReadRemovalFunction(file.is_absolute() ? file : job_path.parent_path() / file);
+  }
+  GaussianRemovalFunction gaussian;
+  gaussian.peak_rate_um_per_s = s.RequiredNumber("peak_rate_um_per_s");
+  gaussian.fwhm_mm = s.RequiredNumber("fwhm_mm");
+  for (std::string& p : gaussian.Problems()) problems.push_back(std::move(p));
+  return gaussian;
+}
+
+void ReadPath(JsonSection& s, PolishJob& job) {
+  job.path_pattern =
+      s.Choice("type", {"raster", "spiral"}) == "spiral" ? PathPattern::kSpiral : PathPattern::kRaster;
+  // Defaults from the removal function's (equivalent) width: see removal_function.h.
+  job.path.line_spacing_mm = s.Number("line_spacing_mm", job.removal.EquivalentFwhmMm() / 5.0);
+  job.path.point_spacing_mm = s.Number("point_spacing_mm", job.path.line_spacing_mm);
+  job.path.extension_mm = s.Number("extension_mm", 1.75 * job.removal.EquivalentSigmaMm());
+}
+
+void ReadPrecession(JsonSection& s, PolishJob& job) {
+  job.precession.enabled = true;
+  job.precession.tilt_deg = s.RequiredNumber("tilt_deg");
+  job.precession.precession_rate_rpm = s.RequiredNumber("precession_rate_rpm");
+  job.precession.bonnet_radius_mm = s.Number("bonnet_radius_mm", 0.0);
+}
+
 // The error_map section: the file, its format and, for interferometer maps, the placement in the
 // part frame (docs/polishing.md, "Error-map formats").
-ErrorMap ReadErrorMapSection(Section& s, const std::filesystem::path& file) {
+ErrorMap ReadErrorMapSection(JsonSection& s, const std::filesystem::path& file) {
   std::vector<std::string> formats = {"csv", "dat", "datx", "h5"};
   if (!s.Has("format")) {
     try {
@@ -303,87 +202,52 @@ ErrorMap ReadErrorMapSection(Section& s, const std::filesystem::path& file) {
 }  // namespace
 
 PolishJob ReadPolishJob(const std::filesystem::path& path) {
-  json root = ReadJsonFile(path, kStage);
+  const json document = ReadJsonFile(path, kStage);
   PolishJob job;
   job.source = path;
-  Section s(&root, "", path);
+  JsonSection s(document, {.file = path.string(), .stage = kStage, .docs_page = "docs/polishing.md"});
+  std::vector<std::string> problems;  // every range problem, reported together at the end
   job.name = s.String("name", path.stem().string());
-  auto section = [&](const std::string& key, auto&& read) {
-    if (!s.Has(key) && key != "removal_target" && key != "path" && key != "solver" && key != "tool" &&
-        key != "workobject" && key != "precession") {
-      s.Fail(key, "is required");
-    }
-    Section child = s.Child(key);
-    read(child);
-    child.Finish();
-    s.Adopt(key, child);
-  };
-  section("surface", [&](Section& c) { job.surface = ReadSurface(c); });
-  section("aperture", [&](Section& c) { job.aperture = ReadAperture(c); });
-  section("error_map", [&](Section& c) {
+  s.Section("surface", true, [&](JsonSection& c) {
+    job.surface = surfaces::ReadSurface(c, {"even_asphere", "xy_polynomial"});
+  });
+  s.Section("aperture", true, [&](JsonSection& c) { job.aperture = surfaces::ReadAperture(c); });
+  s.Section("error_map", true, [&](JsonSection& c) {
     const std::string file = c.String("file", "");
-    if (file.empty()) c.Fail("file", "is required: the error map (.csv, .dat, .datx or .h5)");
+    if (file.empty()) c.Expected("file", "the error map's file name (.csv, .dat, .datx or .h5)");
     job.error_map_file =
         std::filesystem::path(file).is_absolute() ? std::filesystem::path(file) : path.parent_path() / file;
     job.error_map = ReadErrorMapSection(c, job.error_map_file);
   });
-  section("removal_target", [&](Section& c) {
-    job.target.uniform_layer_um = c.Number("uniform_layer_um", 0.0);
-    if (!(job.target.uniform_layer_um >= 0.0)) c.Fail("uniform_layer_um", "must be >= 0");
-  });
-  section("removal_function", [&](Section& c) {
-    if (c.Has("file")) {
-      if (c.Has("peak_rate_um_per_s") || c.Has("fwhm_mm")) {
-        c.Fail("file", "is an alternative to peak_rate_um_per_s and fwhm_mm: give one or the other");
-      }
-      const std::filesystem::path file = c.String("file", "");
-      job.removal = ReadRemovalFunction(file.is_absolute() ? file : path.parent_path() / file);
-      return;
-    }
-    GaussianRemovalFunction gaussian;
-    gaussian.peak_rate_um_per_s = c.RequiredNumber("peak_rate_um_per_s");
-    if (!(gaussian.peak_rate_um_per_s > 0.0)) c.Fail("peak_rate_um_per_s", "must be > 0");
-    gaussian.fwhm_mm = c.RequiredNumber("fwhm_mm");
-    if (!(gaussian.fwhm_mm > 0.0)) c.Fail("fwhm_mm", "must be > 0");
-    job.removal = gaussian;
-  });
-  section("path", [&](Section& c) {
-    job.path_pattern =
-        c.Choice("type", {"raster", "spiral"}) == "spiral" ? PathPattern::kSpiral : PathPattern::kRaster;
-    // Defaults from the removal function's (equivalent) width: see removal_function.h.
-    job.path.line_spacing_mm = c.Number("line_spacing_mm", job.removal.EquivalentFwhmMm() / 5.0);
-    if (!(job.path.line_spacing_mm > 0.0)) c.Fail("line_spacing_mm", "must be > 0");
-    job.path.point_spacing_mm = c.Number("point_spacing_mm", job.path.line_spacing_mm);
-    if (!(job.path.point_spacing_mm > 0.0)) c.Fail("point_spacing_mm", "must be > 0");
-    job.path.extension_mm = c.Number("extension_mm", 1.75 * job.removal.EquivalentSigmaMm());
-    if (!(job.path.extension_mm >= 0.0)) c.Fail("extension_mm", "must be >= 0");
-  });
-  section("machine", [&](Section& c) { ReadMachine(c, job); });
-  section("solver", [&](Section& c) {
+  s.Section("removal_target", false,
+            [&](JsonSection& c) { job.target.uniform_layer_um = c.Number("uniform_layer_um", 0.0); });
+  s.Section("removal_function", true,
+            [&](JsonSection& c) { job.removal = ReadRemovalFunctionSection(c, path, problems); });
+  s.Section("path", false, [&](JsonSection& c) { ReadPath(c, job); });
+  s.Section("machine", true, [&](JsonSection& c) { ReadMachine(c, job); });
+  s.Section("solver", false, [&](JsonSection& c) {
     const DwellOptions defaults;
     job.dwell.max_iterations = c.WholeNumber("max_iterations", defaults.max_iterations, 1, 10'000'000);
     job.dwell.relative_tolerance = c.Number("relative_tolerance", defaults.relative_tolerance);
-    if (!(job.dwell.relative_tolerance > 0.0)) c.Fail("relative_tolerance", "must be > 0");
   });
-  section("tool", [&](Section& c) { ReadTool(c, job); });
-  if (s.Has("precession")) {
-    section("precession", [&](Section& c) {
-      job.precession.enabled = true;
-      job.precession.tilt_deg = c.RequiredNumber("tilt_deg");
-      if (!(job.precession.tilt_deg >= 0.0 && job.precession.tilt_deg < 90.0))
-        c.Fail("tilt_deg", "must lie in [0, 90)");
-      job.precession.precession_rate_rpm = c.RequiredNumber("precession_rate_rpm");
-      job.precession.bonnet_radius_mm = c.Number("bonnet_radius_mm", 0.0);
-      if (!(job.precession.bonnet_radius_mm >= 0.0)) c.Fail("bonnet_radius_mm", "must be >= 0");
-    });
-  }
-  section("workobject", [&](Section& c) {
+  s.Section("tool", false, [&](JsonSection& c) { ReadTool(c, job); });
+  if (s.Has("precession")) s.Section("precession", false, [&](JsonSection& c) { ReadPrecession(c, job); });
+  s.Section("workobject", false, [&](JsonSection& c) {
     const std::vector<double> origin = c.Numbers("origin_mm", {0.0, 0.0, 0.0});
     job.work_object.origin_mm = {origin[0], origin[1], origin[2]};
     job.work_object.orientation = ReadQuaternion(c, "quaternion");
   });
   s.Finish();
-  job.resolved = s.resolved();
+  // The path's defaults come from the removal function's width: with a bad width (already in
+  // `problems`) they would only repeat it.
+  const bool removal_usable = problems.empty();
+  for (std::vector<std::string> more :
+       {job.target.Problems(), removal_usable ? PathProblems(job.path) : std::vector<std::string>{},
+        DwellProblems(job.dwell), job.tool.Problems(), job.precession.Problems()}) {
+    problems.insert(problems.end(), more.begin(), more.end());
+  }
+  s.ThrowIfProblems(problems);
+  job.resolved_json = s.resolved().dump();
   return job;
 }
 
@@ -455,7 +319,7 @@ PolishRunReport RunPolishJob(const PolishJob& job, const std::filesystem::path& 
   json summary = {
       {key::kSchemaVersion, schema::VersionText(schema::polish::kVersion)},
       {key::kArcwheelVersion, kVersion},
-      {key::kJob, job.resolved},
+      {key::kJob, json::parse(job.resolved_json)},
       {key::kPoints, report.points},
       {key::kTotalTimeS, report.dwell.total_time_s},
       {key::kBefore, figures(report.dwell.before)},

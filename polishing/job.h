@@ -4,23 +4,22 @@
 
 #include <filesystem>
 #include <memory>
-#include <nlohmann/json.hpp>
 #include <string>
 
-#include "grinding/surface.h"
 #include "polishing/dwell.h"
 #include "polishing/error_map_io.h"
 #include "polishing/removal_target.h"
 #include "polishing/robot_program.h"
 #include "polishing/tool_frame.h"
+#include "surfaces/surface.h"
 
 namespace arcwheel::polishing {
 
 struct PolishJob {
   std::string name;
   std::filesystem::path source;
-  std::shared_ptr<const grinding::Surface> surface;
-  grinding::Aperture aperture;
+  std::shared_ptr<const surfaces::Surface> surface;
+  surfaces::Aperture aperture;
   std::filesystem::path error_map_file;
   ErrorMap error_map;
   RemovalTargetOptions target;
@@ -32,7 +31,8 @@ struct PolishJob {
   PathPrecession precession;  // enabled when the job has a "precession" section
   ToolData tool;
   WorkObject work_object;
-  nlohmann::json resolved;  // the job with every default filled in
+  // The job with every default filled in, as JSON text (keeps nlohmann/json out of this header).
+  std::string resolved_json;
 };
 
 // Reads and validates a job; the error map's "file" is relative to the job's folder.

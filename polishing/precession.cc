@@ -25,13 +25,13 @@ void CheckOptions(const PrecessionOptions& o) {
   if (!(o.time_step_s > 0.0)) bad("time_step_s", o.time_step_s, "> 0");
 }
 
-Eigen::Vector3d UpwardNormal(const grinding::SurfacePoint& p) {
+Eigen::Vector3d UpwardNormal(const surfaces::SurfacePoint& p) {
   return Eigen::Vector3d(-p.fx, -p.fy, 1.0).normalized();
 }
 
 }  // namespace
 
-std::vector<PrecessionSample> PrecessionTrajectory(const grinding::Surface& surface,
+std::vector<PrecessionSample> PrecessionTrajectory(const surfaces::Surface& surface,
                                                    std::span<const Eigen::Vector2d> path_xy_mm,
                                                    const PrecessionOptions& options) {
   CheckOptions(options);
@@ -65,7 +65,7 @@ std::vector<PrecessionSample> PrecessionTrajectory(const grinding::Surface& surf
     const double span_mm = length_mm[segment] - length_mm[segment - 1];
     const double u = span_mm > 0.0 ? (s - length_mm[segment - 1]) / span_mm : 0.0;
     const Eigen::Vector2d xy = (1.0 - u) * path_xy_mm[segment - 1] + u * path_xy_mm[segment];
-    const grinding::SurfacePoint sp = surface.Evaluate(xy.x(), xy.y());
+    const surfaces::SurfacePoint sp = surface.Evaluate(xy.x(), xy.y());
     const Eigen::Vector3d c = UpwardNormal(sp);
     const Eigen::Vector2d d = path_xy_mm[segment] - path_xy_mm[segment - 1];
     // Feed direction on the surface (the chord's tangent), then projected on the tangent plane.

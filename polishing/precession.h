@@ -16,7 +16,7 @@
 #include <span>
 #include <vector>
 
-#include "grinding/surface.h"
+#include "surfaces/surface.h"
 
 namespace arcwheel::polishing {
 
@@ -42,7 +42,7 @@ struct PrecessionSample {
 // (part-frame (x, y), heights from the surface) at the feed speed, from its start to its end.
 // Throws Error{kInvalidOption, "polishing.precession"} for options out of range or a path with
 // fewer than two distinct points; Error{kBadInput} if the path leaves the surface's domain.
-[[nodiscard]] std::vector<PrecessionSample> PrecessionTrajectory(const grinding::Surface& surface,
+[[nodiscard]] std::vector<PrecessionSample> PrecessionTrajectory(const surfaces::Surface& surface,
                                                                  std::span<const Eigen::Vector2d> path_xy_mm,
                                                                  const PrecessionOptions& options);
 

@@ -13,7 +13,7 @@ namespace {
 
 TEST(PrecessionTrajectory, StraightFeedOnAPlaneTracesTheProlateCycloidOfMethodC) {
   // method.md C: theta = 20 deg, v = 5 mm/s, w2 = 5 r/min, the point 127 mm up the axis.
-  const grinding::XyPolynomial plane({});
+  const surfaces::XyPolynomial plane({});
   const std::vector<Eigen::Vector2d> path = {{0.0, 0.0}, {60.0, 0.0}};
   const PrecessionOptions options{.tilt_deg = 20.0,
                                   .precession_rate_rpm = 5.0,
@@ -44,7 +44,7 @@ TEST(PrecessionTrajectory, StraightFeedOnAPlaneTracesTheProlateCycloidOfMethodC)
 }
 
 TEST(PrecessionTrajectory, AxisKeepsTheTiltFromTheNormalOnACurvedSurface) {
-  const grinding::EvenAsphere sphere({.vertex_radius_mm = 300.0, .concave = false});
+  const surfaces::EvenAsphere sphere({.vertex_radius_mm = 300.0, .concave = false});
   const std::vector<Eigen::Vector2d> path = {{-80.0, -20.0}, {0.0, 10.0}, {70.0, 40.0}};
   const PrecessionOptions options{
       .tilt_deg = 25.0, .precession_rate_rpm = 30.0, .feed_mm_per_s = 10.0, .time_step_s = 0.05};
@@ -64,7 +64,7 @@ TEST(PrecessionTrajectory, AxisKeepsTheTiltFromTheNormalOnACurvedSurface) {
 }
 
 TEST(PrecessionTrajectory, RefusesATiltOf90DegreesAndAPathOffTheSurface) {
-  const grinding::EvenAsphere sphere({.vertex_radius_mm = 50.0});
+  const surfaces::EvenAsphere sphere({.vertex_radius_mm = 50.0});
   const std::vector<Eigen::Vector2d> path = {{0.0, 0.0}, {60.0, 0.0}};
   EXPECT_THROW((void)PrecessionTrajectory(sphere, path, {.tilt_deg = 90.0}), Error);
   try {

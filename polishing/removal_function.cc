@@ -199,4 +199,15 @@ TabulatedRemovalFunction ReadRemovalFunctionHdf5(const std::filesystem::path& pa
   return t;
 }
 
+std::vector<std::string> GaussianRemovalFunction::Problems() const {
+  std::vector<std::string> problems;
+  if (!(peak_rate_um_per_s > 0.0)) {
+    problems.push_back(
+        fmt::format("removal_function.peak_rate_um_per_s = {} violates > 0", peak_rate_um_per_s));
+  }
+  if (!(fwhm_mm > 0.0))
+    problems.push_back(fmt::format("removal_function.fwhm_mm = {} violates > 0", fwhm_mm));
+  return problems;
+}
+
 }  // namespace arcwheel::polishing

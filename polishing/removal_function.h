@@ -35,6 +35,9 @@ struct FootprintBox {
 struct GaussianRemovalFunction {
   double peak_rate_um_per_s = 1.0;  // removal rate at the centre, > 0
   double fwhm_mm = 10.0;            // full width at half maximum, > 0
+  // Empty when valid, else one line per violation naming the job key and the value, e.g.
+  // "removal_function.fwhm_mm = -2 violates > 0".
+  [[nodiscard]] std::vector<std::string> Problems() const;
   [[nodiscard]] double SigmaMm() const { return fwhm_mm / (2.0 * std::sqrt(2.0 * std::numbers::ln2)); }
   [[nodiscard]] double SupportRadiusMm() const { return 3.5 * SigmaMm(); }  // the truncation radius
   // Rate at an offset from the centre; zero beyond the support radius. Inline: the removal

@@ -25,7 +25,7 @@ void CheckGrid(const ErrorMap& map) {
 
 }  // namespace
 
-MapStatistics StatisticsInAperture(const ErrorMap& map, const grinding::Aperture& aperture) {
+MapStatistics StatisticsInAperture(const ErrorMap& map, const surfaces::Aperture& aperture) {
   double lo = std::numeric_limits<double>::infinity(), hi = -lo, sum = 0.0, sum2 = 0.0;
   int n = 0;
   for (int j = 0; j < map.ny; ++j) {
@@ -49,7 +49,7 @@ MapStatistics StatisticsInAperture(const ErrorMap& map, const grinding::Aperture
   return {hi - lo, std::sqrt(sum2 / n), n};
 }
 
-ErrorMap RemovalTarget(const ErrorMap& error, const grinding::Aperture& aperture,
+ErrorMap RemovalTarget(const ErrorMap& error, const surfaces::Aperture& aperture,
                        const RemovalTargetOptions& options) {
   CheckGrid(error);
   if (!(options.uniform_layer_um >= 0.0) || !std::isfinite(options.uniform_layer_um)) {
@@ -115,6 +115,11 @@ double PolynomialProfileSagMm(std::span<const double> c, double y_mm) {
 
 double SphereSagMm(double radius_mm, double y_mm) {
   return radius_mm - std::sqrt(radius_mm * radius_mm - y_mm * y_mm);
+}
+
+std::vector<std::string> RemovalTargetOptions::Problems() const {
+  if (uniform_layer_um >= 0.0) return {};
+  return {fmt::format("removal_target.uniform_layer_um = {} violates >= 0", uniform_layer_um)};
 }
 
 }  // namespace arcwheel::polishing

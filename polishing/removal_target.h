@@ -8,9 +8,10 @@
 // run everywhere at a finite speed).
 
 #include <span>
+#include <string>
 #include <vector>
 
-#include "grinding/surface.h"
+#include "surfaces/surface.h"
 
 namespace arcwheel::polishing {
 
@@ -34,17 +35,20 @@ struct MapStatistics {
   double rms_um = 0.0;
   int nodes = 0;
 };
-[[nodiscard]] MapStatistics StatisticsInAperture(const ErrorMap& map, const grinding::Aperture& aperture);
+[[nodiscard]] MapStatistics StatisticsInAperture(const ErrorMap& map, const surfaces::Aperture& aperture);
 
 struct RemovalTargetOptions {
   // Uniform depth added to the whole aperture (um), >= 0.
   double uniform_layer_um = 0.0;
+  // Empty when valid, else one line per violation naming the job key and the value, e.g.
+  // "removal_target.uniform_layer_um = -1 violates >= 0".
+  [[nodiscard]] std::vector<std::string> Problems() const;
 };
 
 // Removal target: error - min(error over the aperture) + uniform layer inside the aperture, NaN
 // outside it. Throws Error{kBadInput, "polishing.target"} if the aperture holds no finite node
 // ("empty aperture"), Error{kInvalidOption} for a negative layer or a malformed grid.
-[[nodiscard]] ErrorMap RemovalTarget(const ErrorMap& error, const grinding::Aperture& aperture,
+[[nodiscard]] ErrorMap RemovalTarget(const ErrorMap& error, const surfaces::Aperture& aperture,
                                      const RemovalTargetOptions& options);
 
 // The paper's trial profile (method.md B) is written as y^2 = sum_i c_i x^i with x along the

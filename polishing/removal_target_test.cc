@@ -39,7 +39,7 @@ TEST(PolynomialProfileSag, MatchesBisectionAcrossTheLens) {
 TEST(RemovalTarget, ClosestSphereOfTheLensNeeds14Point2Micrometres) {
   // Error of a 1767.657 mm sphere tangent at the vertex against the asphere, on a 2D grid of the
   // 460 mm aperture (rotational symmetry: radius r = sqrt(x^2 + y^2)).
-  const grinding::Aperture aperture{.shape = grinding::Aperture::Shape::kCircle, .diameter_mm = 460.0};
+  const surfaces::Aperture aperture{.shape = surfaces::Aperture::Shape::kCircle, .diameter_mm = 460.0};
   ErrorMap error{.x0_mm = -230.0, .y0_mm = -230.0, .dx_mm = 2.5, .dy_mm = 2.5, .nx = 185, .ny = 185};
   for (int j = 0; j < error.ny; ++j) {
     for (int i = 0; i < error.nx; ++i) {
@@ -66,8 +66,8 @@ TEST(RemovalTarget, ClosestSphereOfTheLensNeeds14Point2Micrometres) {
 }
 
 TEST(RemovalTarget, AddsTheUniformLayerAndBlanksOutsideTheAperture) {
-  const grinding::Aperture aperture{
-      .shape = grinding::Aperture::Shape::kRectangle, .width_x_mm = 2.0, .width_y_mm = 2.0};
+  const surfaces::Aperture aperture{
+      .shape = surfaces::Aperture::Shape::kRectangle, .width_x_mm = 2.0, .width_y_mm = 2.0};
   const ErrorMap error{.x0_mm = -2.0,
                        .y0_mm = 0.0,
                        .dx_mm = 1.0,
@@ -84,7 +84,7 @@ TEST(RemovalTarget, AddsTheUniformLayerAndBlanksOutsideTheAperture) {
 }
 
 TEST(RemovalTarget, RefusesAnEmptyAperture) {
-  const grinding::Aperture aperture{.shape = grinding::Aperture::Shape::kCircle, .diameter_mm = 1.0};
+  const surfaces::Aperture aperture{.shape = surfaces::Aperture::Shape::kCircle, .diameter_mm = 1.0};
   const ErrorMap error{.x0_mm = 10.0, .y0_mm = 10.0, .nx = 2, .ny = 1, .error_um = {1.0, 2.0}};
   try {
     (void)RemovalTarget(error, aperture, {});

@@ -21,7 +21,7 @@ std::string Quaternion9(const AbbQuaternion& q) {
 
 }  // namespace
 
-std::vector<PolishingPoint> BuildPolishingPath(const grinding::Surface& surface,
+std::vector<PolishingPoint> BuildPolishingPath(const surfaces::Surface& surface,
                                                std::span<const Eigen::Vector2d> path_xy_mm,
                                                const DwellSolution& dwell, RobotSide side,
                                                const PathPrecession& precession) {
@@ -57,7 +57,7 @@ std::vector<PolishingPoint> BuildPolishingPath(const grinding::Surface& surface,
       const Eigen::Vector3d c = -frame.col(2);
       const Eigen::Vector2d d =
           k > 0 ? Eigen::Vector2d(p - path_xy_mm[k - 1]) : Eigen::Vector2d(path_xy_mm[1] - p);
-      const grinding::SurfacePoint sp = surface.Evaluate(p.x(), p.y());
+      const surfaces::SurfacePoint sp = surface.Evaluate(p.x(), p.y());
       const Eigen::Vector3d feed(d.x(), d.y(), sp.fx * d.x() + sp.fy * d.y());
       const Eigen::Vector3d a = (feed - feed.dot(c) * c).normalized();
       const double theta = precession.tilt_deg * std::numbers::pi / 180.0;
@@ -139,6 +139,27 @@ std::string RapidModule(std::span<const PolishingPoint> points, const ToolData& 
   line("  ENDPROC");
   line("ENDMODULE");
   return fmt::to_string(out);
+}
+
+std::vector<std::string> PathPrecession::Problems() const {
+  std::vector<std::string> problems;
+  if (!enabled) return problems;
+  if (!(tilt_deg >= 0.0 && tilt_deg < 90.0)) {
+    problems.push_back(fmt::format("precession.tilt_deg = {} violates 0 <= tilt_deg < 90", tilt_deg));
+  }
+  if (!std::isfinite(precession_rate_rpm)) {
+    problems.push_back(
+        fmt::format("precession.precession_rate_rpm = {} violates finite", precession_rate_rpm));
+  }
+  if (!(bonnet_radius_mm >= 0.0)) {
+    problems.push_back(fmt::format("precession.bonnet_radius_mm = {} violates >= 0", bonnet_radius_mm));
+  }
+  return problems;
+}
+
+std::vector<std::string> ToolData::Problems() const {
+  if (mass_kg > 0.0) return {};
+  return {fmt::format("tool.mass_kg = {} violates > 0", mass_kg)};
 }
 
 }  // namespace arcwheel::polishing

@@ -9,9 +9,9 @@
 #include <string>
 #include <vector>
 
-#include "grinding/surface.h"
 #include "polishing/dwell.h"
 #include "polishing/tool_frame.h"
+#include "surfaces/surface.h"
 
 namespace arcwheel::polishing {
 
@@ -34,12 +34,15 @@ struct PathPrecession {
   double tilt_deg = 20.0;            // theta, [0, 90)
   double precession_rate_rpm = 5.0;  // w2, finite
   double bonnet_radius_mm = 0.0;     // >= 0
+  // Empty when valid (or not enabled), else one line per violation naming the job key and the
+  // value, e.g. "precession.tilt_deg = 90 violates 0 <= tilt_deg < 90".
+  [[nodiscard]] std::vector<std::string> Problems() const;
 };
 
 // Places the tool on the surface at each path point (ToolFrameAt, or precessed) with the dwell
 // solution's speed and dwell. Throws Error{kBadInput, "polishing.path"} naming the first point
 // off the surface, Error{kInvalidOption} for precession options out of range.
-[[nodiscard]] std::vector<PolishingPoint> BuildPolishingPath(const grinding::Surface& surface,
+[[nodiscard]] std::vector<PolishingPoint> BuildPolishingPath(const surfaces::Surface& surface,
                                                              std::span<const Eigen::Vector2d> path_xy_mm,
                                                              const DwellSolution& dwell, RobotSide side,
                                                              const PathPrecession& precession = {});
@@ -55,6 +58,9 @@ struct ToolData {
   double mass_kg = 5.0;  // > 0
   Eigen::Vector3d centre_of_gravity_mm = Eigen::Vector3d(0.0, 0.0, 75.0);
   [[nodiscard]] Eigen::Vector3d CorrectedTcpMm() const;
+  // Empty when valid, else one line per violation naming the job key and the value, e.g.
+  // "tool.mass_kg = 0 violates > 0".
+  [[nodiscard]] std::vector<std::string> Problems() const;
 };
 
 // The part frame in the robot's user frame (the frames issue's workobject): origin and rotation.

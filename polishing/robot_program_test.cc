@@ -35,7 +35,7 @@ std::vector<std::vector<double>> ParseCsvRows(const std::string& text, std::stri
 }
 
 struct Fixture {
-  grinding::EvenAsphere surface{{.vertex_radius_mm = 600.0, .conic = -1.0, .concave = false}};
+  surfaces::EvenAsphere surface{{.vertex_radius_mm = 600.0, .conic = -1.0, .concave = false}};
   std::vector<Eigen::Vector2d> path = {{-30.0, 5.0}, {-10.0, 5.0}, {12.5, 5.0}, {40.0, 7.0}};
   DwellSolution dwell;
   Fixture() {
@@ -137,7 +137,7 @@ TEST(BuildPolishingPath, PrecessesTheBonnetAxisAboutTheNormalAtTheTiltAndRate) {
 
 TEST(BuildPolishingPath, RefusesAPointOffTheSurface) {
   Fixture f;
-  const grinding::EvenAsphere small({.vertex_radius_mm = 35.0});
+  const surfaces::EvenAsphere small({.vertex_radius_mm = 35.0});
   try {
     (void)BuildPolishingPath(small, f.path, f.dwell, RobotSide::kPlusX);
     FAIL() << "accepted";

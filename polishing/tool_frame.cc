@@ -17,9 +17,9 @@ Eigen::Matrix3d ToolFrameFromSlopes(double fx, double fy, RobotSide side) {
   return frame;
 }
 
-Eigen::Matrix3d ToolFrameAt(const grinding::Surface& surface, double x_mm, double y_mm, RobotSide side) {
+Eigen::Matrix3d ToolFrameAt(const surfaces::Surface& surface, double x_mm, double y_mm, RobotSide side) {
   ARCWHEEL_CHECK(surface.InDomain(x_mm, y_mm)) << "(" << x_mm << ", " << y_mm << ")";
-  const grinding::SurfacePoint p = surface.Evaluate(x_mm, y_mm);
+  const surfaces::SurfacePoint p = surface.Evaluate(x_mm, y_mm);
   return ToolFrameFromSlopes(p.fx, p.fy, side);
 }
 

@@ -1,8 +1,8 @@
 #pragma once
 // Tool frames and robot quaternions for polishing along a surface (method.md B, eqs. 2-10).
 //
-// The surface is a grinding::Surface, z = f(x, y) in the part frame with the part below it
-// (grinding/surface.h). As an implicit surface F = f(x, y) - z = 0, so F_x = f_x, F_y = f_y, F_z = -1.
+// The surface is a surfaces::Surface, z = f(x, y) in the part frame with the part below it
+// (surfaces/surface.h). As an implicit surface F = f(x, y) - z = 0, so F_x = f_x, F_y = f_y, F_z = -1.
 //  - tool z (eq. 3): the tool axis, pointing into the part: (f_x, f_y, -1) / sqrt(f_x^2 + f_y^2 + 1),
 //    the opposite of the upward (outward) normal, for concave and convex parts alike;
 //  - tool x (eq. 4): in the reference plane y = 0, perpendicular to tool z: (1, 0, -F_x / F_z) =
@@ -14,7 +14,7 @@
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 
-#include "grinding/surface.h"
+#include "surfaces/surface.h"
 
 namespace arcwheel::polishing {
 
@@ -25,7 +25,7 @@ enum class RobotSide { kPlusX, kMinusX };
 [[nodiscard]] Eigen::Matrix3d ToolFrameFromSlopes(double fx, double fy, RobotSide side);
 
 // Tool frame at (x, y) of the surface. Precondition: surface.InDomain(x, y).
-[[nodiscard]] Eigen::Matrix3d ToolFrameAt(const grinding::Surface& surface, double x_mm, double y_mm,
+[[nodiscard]] Eigen::Matrix3d ToolFrameAt(const surfaces::Surface& surface, double x_mm, double y_mm,
                                           RobotSide side);
 
 // A unit quaternion in ABB order: q1 scalar, then q2, q3, q4 (i, j, k). Note that Eigen stores

@@ -24,8 +24,8 @@ double MinAbsComponent(const AbbQuaternion& q) {
   return std::min({std::abs(q.q1), std::abs(q.q2), std::abs(q.q3), std::abs(q.q4)});
 }
 
-grinding::EvenAsphere Asphere(bool concave, double off_axis_x_mm) {
-  return grinding::EvenAsphere({.vertex_radius_mm = 800.0,
+surfaces::EvenAsphere Asphere(bool concave, double off_axis_x_mm) {
+  return surfaces::EvenAsphere({.vertex_radius_mm = 800.0,
                                 .conic = -0.6,
                                 .even_coefficients = {1e-11},
                                 .off_axis_x_mm = off_axis_x_mm,
@@ -84,7 +84,7 @@ TEST(AbbQuaternion, ToolDownAtTheVertexIsAHalfTurnWhereThePaperGivesZero) {
 TEST(ToolFrame, ZIsTheInwardNormalAndXLiesInTheXzPlaneAlongPaths) {
   for (const bool concave : {true, false}) {
     for (const RobotSide side : {RobotSide::kPlusX, RobotSide::kMinusX}) {
-      const grinding::EvenAsphere surface = Asphere(concave, 150.0);
+      const surfaces::EvenAsphere surface = Asphere(concave, 150.0);
       for (int k = 0; k <= 200; ++k) {
         // A spiral-like path crossing the aperture, off the y = 0 line too.
         const double t = k / 200.0;

@@ -1,5 +1,6 @@
 #include "core/testing/testing.h"
 
+#include <gtest/gtest.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -79,6 +80,16 @@ std::string PdfText(const fs::path& pdf) {
   std::string contents = ReadText(text);
   fs::remove(text);
   return contents;
+}
+
+std::string ErrorMessageOf(const std::function<void()>& run, ErrorCode code) {
+  try {
+    run();
+  } catch (const Error& e) {
+    EXPECT_EQ(e.code(), code) << e.what();
+    return e.what();
+  }
+  return "accepted";
 }
 
 }  // namespace arcwheel::testing

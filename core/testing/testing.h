@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
+#include <functional>
 #include <string>
 
 #include "core/error.h"
@@ -34,6 +35,11 @@ struct CommandResult {
 };
 // Runs the arcwheel binary (ARCWHEEL_BINARY, set by CTest) with `arguments` through the shell.
 [[nodiscard]] CommandResult RunArcwheel(const std::string& arguments);
+
+// The message of the Error that `run` throws, checking (as a test failure) that its code is
+// `code`; "accepted" if it throws nothing.
+[[nodiscard]] std::string ErrorMessageOf(const std::function<void()>& run,
+                                         ErrorCode code = ErrorCode::kBadInput);
 
 // Names of the entries of a folder, sorted.
 [[nodiscard]] std::string ListFolder(const std::filesystem::path& folder);

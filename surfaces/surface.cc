@@ -1,4 +1,4 @@
-#include "grinding/surface.h"
+#include "surfaces/surface.h"
 
 #include <fmt/core.h>
 
@@ -8,7 +8,7 @@
 
 #include "core/error.h"
 
-namespace arcwheel::grinding {
+namespace arcwheel::surfaces {
 namespace {
 
 constexpr const char* kStage = "grinding.surface";
@@ -298,4 +298,4 @@ void CheckApertureInDomain(const Surface& surface, const Aperture& aperture, dou
   }
 }
 
-}  // namespace arcwheel::grinding
+}  // namespace arcwheel::surfaces

@@ -1,5 +1,5 @@
 #pragma once
-// Surfaces to grind, as heights z = f(x, y) in the part's local frame (mm), with exact first and
+// Surfaces to grind and polish, as heights z = f(x, y) in the part's local frame (mm), with exact first and
 // second derivatives. The part lies below the surface (z decreases into the material); the wheel
 // comes from above, so the unit upward normal is n = (-fx, -fy, 1) / sqrt(fx^2 + fy^2 + 1).
 //
@@ -14,7 +14,7 @@
 #include <string>
 #include <vector>
 
-namespace arcwheel::grinding {
+namespace arcwheel::surfaces {
 
 // Height and derivatives of a surface at one (x, y).
 struct SurfacePoint {
@@ -147,4 +147,4 @@ struct Aperture {
 void CheckApertureInDomain(const Surface& surface, const Aperture& aperture, double margin_x_mm,
                            double margin_y_mm);
 
-}  // namespace arcwheel::grinding
+}  // namespace arcwheel::surfaces

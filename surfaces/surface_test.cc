@@ -1,4 +1,4 @@
-#include "grinding/surface.h"
+#include "surfaces/surface.h"
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
@@ -8,7 +8,7 @@
 
 #include "core/error.h"
 
-namespace arcwheel::grinding {
+namespace arcwheel::surfaces {
 namespace {
 
 using ::testing::HasSubstr;
@@ -217,4 +217,4 @@ TEST(Aperture, ChordsAndContainment) {
 }
 
 }  // namespace
-}  // namespace arcwheel::grinding
+}  // namespace arcwheel::surfaces

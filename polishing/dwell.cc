@@ -20,39 +20,15 @@ constexpr double kOvershootToleranceUm = 1e-3;
 
 [[noreturn]] void Invalid(const std::string& what) { throw Error(ErrorCode::kInvalidOption, kStage, what); }
 
+[[noreturn]] void InvalidAll(const std::vector<std::string>& problems) {
+  std::string text = "invalid options:";
+  for (const std::string& problem : problems) text += "\n  " + problem;
+  Invalid(text);
+}
+
 void CheckOptions(const RemovalFunction& removal, const DwellOptions& o, std::size_t points) {
   removal.Check();
-  if (!(o.max_speed_mm_s > 0.0) || !std::isfinite(o.max_speed_mm_s)) {
-    Invalid(fmt::format("max_speed_mm_s = {} violates > 0", o.max_speed_mm_s));
-  }
-  if (!(o.min_speed_mm_s >= 0.0 && o.min_speed_mm_s <= o.max_speed_mm_s)) {
-    Invalid(fmt::format("unreachable speeds: min_speed_mm_s = {} must lie in [0, max_speed_mm_s = {}]",
-                        o.min_speed_mm_s, o.max_speed_mm_s));
-  }
-  if (!(o.min_dwell_s >= 0.0) || !std::isfinite(o.min_dwell_s)) {
-    Invalid(fmt::format("min_dwell_s = {} violates >= 0", o.min_dwell_s));
-  }
-  if (!(o.max_acceleration_mm_s2 >= 0.0)) {
-    Invalid(fmt::format("max_acceleration_mm_s2 = {} violates >= 0", o.max_acceleration_mm_s2));
-  }
-  if (o.min_speed_mm_s > 0.0 && o.min_dwell_s > 0.0) {
-    Invalid(
-        "unreachable speeds: give min_speed_mm_s or min_dwell_s, not both (a short segment "
-        "cannot satisfy both)");
-  }
-  if (o.max_iterations < 1) Invalid(fmt::format("max_iterations = {} violates >= 1", o.max_iterations));
-  if (o.stall_iterations < 0) Invalid(fmt::format("stall_iterations = {} violates >= 0", o.stall_iterations));
-  if (!(o.stall_improvement > 0.0)) {
-    Invalid(fmt::format("stall_improvement = {} violates > 0", o.stall_improvement));
-  }
-  if (!(o.relative_tolerance > 0.0)) {
-    Invalid(fmt::format("relative_tolerance = {} violates > 0", o.relative_tolerance));
-  }
-  if (o.max_shaping_rounds < 1)
-    Invalid(fmt::format("max_shaping_rounds = {} violates >= 1", o.max_shaping_rounds));
-  if (!(o.shaping_tolerance_um > 0.0)) {
-    Invalid(fmt::format("shaping_tolerance_um = {} violates > 0", o.shaping_tolerance_um));
-  }
+  if (const std::vector<std::string> problems = o.Problems(); !problems.empty()) InvalidAll(problems);
   if (!o.least_dwell_s.empty() && o.least_dwell_s.size() != points) {
     Invalid(fmt::format("least_dwell_s has {} values for {} path points", o.least_dwell_s.size(), points));
   }
@@ -321,11 +297,7 @@ ErrorMap Scatter(const ErrorMap& like, const Rows& rows, const Eigen::VectorXd& 
 
 namespace {
 void CheckPathOptions(const RasterOptions& o) {
-  if (!(o.line_spacing_mm > 0.0))
-    Invalid(fmt::format("line_spacing_mm = {} violates > 0", o.line_spacing_mm));
-  if (!(o.point_spacing_mm > 0.0))
-    Invalid(fmt::format("point_spacing_mm = {} violates > 0", o.point_spacing_mm));
-  if (!(o.extension_mm >= 0.0)) Invalid(fmt::format("extension_mm = {} violates >= 0", o.extension_mm));
+  if (const std::vector<std::string> problems = o.Problems(); !problems.empty()) InvalidAll(problems);
 }
 }  // namespace
 
@@ -439,6 +411,51 @@ DwellSolution SolveDwell(const ErrorMap& target, const surfaces::Aperture& apert
   solution.before = StatisticsInAperture(target, aperture);
   solution.after = StatisticsInAperture(solution.residual_um, aperture);
   return solution;
+}
+
+std::vector<std::string> DwellOptions::Problems() const {
+  std::vector<std::string> problems;
+  const auto require = [&problems](bool ok, const std::string& text) {
+    if (!ok) problems.push_back(text);
+  };
+  const bool max_ok = max_speed_mm_s > 0.0 && std::isfinite(max_speed_mm_s);
+  require(max_ok, fmt::format("machine.max_speed_mm_s = {} violates > 0", max_speed_mm_s));
+  // Against a bad maximum only the lower bound says anything about the minimum itself.
+  require(min_speed_mm_s >= 0.0 && (min_speed_mm_s <= max_speed_mm_s || !max_ok),
+          fmt::format("machine.min_speed_mm_s = {} violates 0 <= min_speed_mm_s <= max_speed_mm_s = {} "
+                      "(unreachable)",
+                      min_speed_mm_s, max_speed_mm_s));
+  require(min_dwell_s >= 0.0 && std::isfinite(min_dwell_s),
+          fmt::format("machine.min_dwell_s = {} violates >= 0", min_dwell_s));
+  require(!(min_dwell_s > 0.0 && min_speed_mm_s > 0.0),
+          fmt::format("machine.min_dwell_s = {} violates min_speed_mm_s = 0 (both are unreachable together: "
+                      "give one of them)",
+                      min_dwell_s));
+  require(max_acceleration_mm_s2 >= 0.0,
+          fmt::format("machine.max_acceleration_mm_s2 = {} violates >= 0 (0 = no limit)",
+                      max_acceleration_mm_s2));
+  require(max_iterations >= 1, fmt::format("solver.max_iterations = {} violates >= 1", max_iterations));
+  require(relative_tolerance > 0.0,
+          fmt::format("solver.relative_tolerance = {} violates > 0", relative_tolerance));
+  require(stall_iterations >= 0, fmt::format("stall_iterations = {} violates >= 0", stall_iterations));
+  require(stall_improvement > 0.0, fmt::format("stall_improvement = {} violates > 0", stall_improvement));
+  require(max_shaping_rounds >= 1, fmt::format("max_shaping_rounds = {} violates >= 1", max_shaping_rounds));
+  require(shaping_tolerance_um > 0.0,
+          fmt::format("shaping_tolerance_um = {} violates > 0", shaping_tolerance_um));
+  return problems;
+}
+
+std::vector<std::string> RasterOptions::Problems() const {
+  std::vector<std::string> problems;
+  if (!(line_spacing_mm > 0.0)) {
+    problems.push_back(fmt::format("path.line_spacing_mm = {} violates > 0", line_spacing_mm));
+  }
+  if (!(point_spacing_mm > 0.0)) {
+    problems.push_back(fmt::format("path.point_spacing_mm = {} violates > 0", point_spacing_mm));
+  }
+  if (!(extension_mm >= 0.0))
+    problems.push_back(fmt::format("path.extension_mm = {} violates >= 0", extension_mm));
+  return problems;
 }
 
 }  // namespace arcwheel::polishing

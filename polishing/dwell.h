@@ -39,6 +39,9 @@ struct RasterOptions {
   double line_spacing_mm = 2.0;   // distance between raster lines (along y), > 0
   double point_spacing_mm = 2.0;  // largest distance between dwell points along a line, > 0
   double extension_mm = 0.0;      // the path runs this far beyond the aperture, >= 0
+  // Empty when valid, else one line per violation with its value, named by the job key
+  // ("path.line_spacing_mm = 0 violates > 0").
+  [[nodiscard]] std::vector<std::string> Problems() const;
 };
 
 // A zigzag raster: lines along x, stepping in y, over the aperture grown by the extension; each
@@ -79,6 +82,10 @@ struct DwellOptions {
   // A round settles when shaping its dwell adds at most this depth (peak rate x added dwell) at
   // any point, um, > 0 (1 nm: below what the solve itself resolves on a polished map).
   double shaping_tolerance_um = 1e-3;
+  // Empty when valid, else one line per violation with its value, named by the job key
+  // ("machine.max_speed_mm_s = -3 violates > 0"). least_dwell_s is checked against the path by
+  // SolveDwell.
+  [[nodiscard]] std::vector<std::string> Problems() const;
 };
 
 struct DwellSolution {

@@ -401,6 +401,35 @@ TEST(SolveDwell, RefusesAnEmptyAperture) {
   EXPECT_THROW((void)SolveDwell(target, kDisc, path, {}, {}), Error);
 }
 
+TEST(DwellOptions, ReportsEveryViolationWithItsValueNamedByTheJobKey) {
+  EXPECT_TRUE(DwellOptions{}.Problems().empty());
+  const DwellOptions bad{.max_speed_mm_s = -3.0, .min_dwell_s = -1.0, .max_iterations = 0};
+  const std::vector<std::string> problems = bad.Problems();
+  ASSERT_EQ(problems.size(), 3u) << ::testing::PrintToString(problems);
+  EXPECT_EQ(problems[0], "machine.max_speed_mm_s = -3 violates > 0");
+  EXPECT_EQ(problems[1], "machine.min_dwell_s = -1 violates >= 0");
+  EXPECT_EQ(problems[2], "solver.max_iterations = 0 violates >= 1");
+  // SolveDwell refuses them all at once, before any work.
+  const std::vector<Eigen::Vector2d> path = {{0.0, 0.0}, {1.0, 0.0}};
+  try {
+    (void)SolveDwell(RemovalTarget(SimulatedErrorMap(1), kDisc, {}), kDisc, path, {}, bad);
+    FAIL() << "accepted";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.code(), ErrorCode::kInvalidOption);
+    for (const std::string& p : problems)
+      EXPECT_NE(std::string(e.what()).find(p), std::string::npos) << e.what();
+  }
+}
+
+TEST(RasterOptions, ReportsEveryViolationWithItsValueNamedByTheJobKey) {
+  EXPECT_TRUE(RasterOptions{}.Problems().empty());
+  const RasterOptions bad{.line_spacing_mm = 0.0, .point_spacing_mm = -2.0, .extension_mm = -1.0};
+  EXPECT_EQ(bad.Problems(), (std::vector<std::string>{"path.line_spacing_mm = 0 violates > 0",
+                                                      "path.point_spacing_mm = -2 violates > 0",
+                                                      "path.extension_mm = -1 violates >= 0"}));
+  EXPECT_THROW((void)RasterPath(kDisc, bad), Error);
+}
+
 TEST(RasterPath, CoversTheGrownDiscInZigzagWithStepsNoLongerThanAsked) {
   const auto path = RasterPath(kDisc, {.line_spacing_mm = 2.0, .point_spacing_mm = 3.0, .extension_mm = 5.0});
   for (const auto& p : path) EXPECT_LE(p.norm(), 55.0 + 1e-9);

@@ -43,43 +43,6 @@ void ReadMachine(JsonSection& s, PolishJob& job) {
 }
 
 // The range checks of DwellOptions and RasterOptions (polishing/dwell.h), by job key.
-std::vector<std::string> DwellProblems(const DwellOptions& d) {
-  std::vector<std::string> problems;
-  const auto require = [&problems](bool ok, const std::string& text) {
-    if (!ok) problems.push_back(text);
-  };
-  require(d.max_speed_mm_s > 0.0, fmt::format("machine.max_speed_mm_s = {} violates > 0", d.max_speed_mm_s));
-  // Against a bad maximum only the lower bound says anything about the minimum itself.
-  require(d.min_speed_mm_s >= 0.0 && (d.min_speed_mm_s <= d.max_speed_mm_s || !(d.max_speed_mm_s > 0.0)),
-          fmt::format("machine.min_speed_mm_s = {} violates 0 <= min_speed_mm_s <= max_speed_mm_s = {} "
-                      "(unreachable)",
-                      d.min_speed_mm_s, d.max_speed_mm_s));
-  require(d.min_dwell_s >= 0.0, fmt::format("machine.min_dwell_s = {} violates >= 0", d.min_dwell_s));
-  require(!(d.min_dwell_s > 0.0 && d.min_speed_mm_s > 0.0),
-          fmt::format("machine.min_dwell_s = {} violates min_speed_mm_s = 0 (both are unreachable together: "
-                      "give one of them)",
-                      d.min_dwell_s));
-  require(d.max_acceleration_mm_s2 >= 0.0,
-          fmt::format("machine.max_acceleration_mm_s2 = {} violates >= 0 (0 = no limit)",
-                      d.max_acceleration_mm_s2));
-  require(d.relative_tolerance > 0.0,
-          fmt::format("solver.relative_tolerance = {} violates > 0", d.relative_tolerance));
-  return problems;
-}
-
-std::vector<std::string> PathProblems(const RasterOptions& p) {
-  std::vector<std::string> problems;
-  if (!(p.line_spacing_mm > 0.0)) {
-    problems.push_back(fmt::format("path.line_spacing_mm = {} violates > 0", p.line_spacing_mm));
-  }
-  if (!(p.point_spacing_mm > 0.0)) {
-    problems.push_back(fmt::format("path.point_spacing_mm = {} violates > 0", p.point_spacing_mm));
-  }
-  if (!(p.extension_mm >= 0.0))
-    problems.push_back(fmt::format("path.extension_mm = {} violates >= 0", p.extension_mm));
-  return problems;
-}
-
 void ReadTool(JsonSection& s, PolishJob& job) {
   const std::vector<double> tcp = s.Numbers("tcp_mm", {0.0, 0.0, 150.0});
   job.tool.tcp_mm = {tcp[0], tcp[1], tcp[2]};
@@ -242,8 +205,8 @@ PolishJob ReadPolishJob(const std::filesystem::path& path) {
   // `problems`) they would only repeat it.
   const bool removal_usable = problems.empty();
   for (std::vector<std::string> more :
-       {job.target.Problems(), removal_usable ? PathProblems(job.path) : std::vector<std::string>{},
-        DwellProblems(job.dwell), job.tool.Problems(), job.precession.Problems()}) {
+       {job.target.Problems(), removal_usable ? job.path.Problems() : std::vector<std::string>{},
+        job.dwell.Problems(), job.tool.Problems(), job.precession.Problems()}) {
     problems.insert(problems.end(), more.begin(), more.end());
   }
   s.ThrowIfProblems(problems);

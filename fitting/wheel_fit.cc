@@ -9,11 +9,11 @@
 #include <numbers>
 #include <numeric>
 #include <span>
-#include <thread>
 #include <utility>
 
 #include "core/error.h"
 #include "core/interrupt.h"
+#include "core/parallel.h"
 #include "fitting/circle_fit.h"
 
 namespace arcwheel::fitting {
@@ -137,20 +137,18 @@ double Roundness(const std::vector<double>& phase_deg, const std::vector<double>
 }
 
 // Fits every phase whose index is j = k * step (k = 0, 1, ...) with the band centred on
-// band_center_mm; the others are left unfitted. The phases are independent: half of them run on a
-// second thread.
+// band_center_mm; the others are left unfitted. The phases are independent: two workers take
+// alternate ones.
 void FitPhases(const processing::WheelMap& map, double band_center_mm, std::size_t step,
                const WheelFitOptions& options, std::vector<PhaseSolution>& solutions) {
   const bool full = options.fit_span == FitSpan::kFull;
   const std::size_t n_phase = map.n_phase();
-  const auto fit_phases = [&](std::size_t first) {
-    for (std::size_t j = first * step; j < n_phase; j += 2 * step) {
+  constexpr int kWorkers = 2;
+  RunOnWorkers(kWorkers, [&](int worker) {
+    for (std::size_t j = static_cast<std::size_t>(worker) * step; j < n_phase; j += kWorkers * step) {
       solutions[j] = FitSection(map.sections[j], band_center_mm, options.band_half_width_mm, full, options);
     }
-  };
-  std::thread odd(fit_phases, 1);
-  fit_phases(0);
-  odd.join();
+  });
 }
 
 // Mean arc-centre axial position over the usable phases. Throws Error{kFitFailed} if none is usable.

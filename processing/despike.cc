@@ -1,12 +1,13 @@
 #include "processing/despike.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <deque>
 #include <limits>
-#include <thread>
 
 #include "core/error.h"
+#include "core/parallel.h"
 
 namespace arcwheel::processing {
 namespace {
@@ -105,9 +106,10 @@ std::size_t ContextEdge(std::span<const double> z, std::size_t from, int w, int 
   return direction < 0 ? i : i + 1;
 }
 
-// Runs Reject on the two halves of the scan on two threads. Each half streams w valid samples of
-// the other half as context and keeps only its own decisions, so the result is exactly that of
-// one pass over the whole scan.
+// Runs Reject on the two halves of the scan on two workers. Each half streams w valid samples of
+// the other half as context and keeps only its own decisions, so the result is that of one pass
+// over the whole scan, but for the rounding of the running mean's sum, which starts afresh at a
+// half's context: the split is fixed at two halves so that no decision depends on the machine.
 template <typename Statistic>
 std::vector<Sample> RejectInParallel(std::span<const double> z, int w, double threshold_mm) {
   const std::size_t middle = z.size() / 2;
@@ -115,24 +117,19 @@ std::vector<Sample> RejectInParallel(std::span<const double> z, int w, double th
     Statistic statistic;
     return Reject(z, w, threshold_mm, statistic);
   }
-  std::vector<Sample> second;
-  std::thread worker([&] {
-    const std::size_t begin = ContextEdge(z, middle, w, -1);
+  std::array<std::vector<Sample>, 2> kept;
+  RunOnWorkers(2, [&](int half) {
+    const bool lower = half == 0;
+    const std::size_t begin = lower ? 0 : ContextEdge(z, middle, w, -1);
+    const std::size_t end = lower ? ContextEdge(z, middle - 1, w, +1) : z.size();
     Statistic statistic;
-    for (Sample s : Reject(z.subspan(begin), w, threshold_mm, statistic)) {
+    for (Sample s : Reject(z.subspan(begin, end - begin), w, threshold_mm, statistic)) {
       s.index += begin;
-      if (s.index >= middle) second.push_back(s);
+      if ((s.index < middle) == lower) kept[static_cast<std::size_t>(half)].push_back(s);
     }
   });
-  const std::size_t end = ContextEdge(z, middle - 1, w, +1);
-  Statistic statistic;
-  std::vector<Sample> first;
-  for (const Sample& s : Reject(z.subspan(0, end), w, threshold_mm, statistic)) {
-    if (s.index < middle) first.push_back(s);
-  }
-  worker.join();
-  first.insert(first.end(), second.begin(), second.end());
-  return first;
+  kept[0].insert(kept[0].end(), kept[1].begin(), kept[1].end());
+  return std::move(kept[0]);
 }
 
 // Up to w valid samples on each side of i (i itself left out), none further than 4w positions

@@ -2,11 +2,11 @@
 
 #include <algorithm>
 #include <cmath>
-#include <thread>
 
 #include "core/check.h"
 #include "core/error.h"
 #include "core/interrupt.h"
+#include "core/parallel.h"
 
 namespace arcwheel::processing {
 namespace {
@@ -61,15 +61,19 @@ HelixSpline::HelixSpline(std::span<const double> z, const HelixGeometry& geometr
   normal_ = BandedSpd(n);
   std::vector<double> rhs(n, 0.0);
 
-  // Two threads accumulate the normal equations of the two halves; the sums are added.
+  // Two workers accumulate the normal equations of the two halves; the sums are added. Always two,
+  // so that the order of the sums, and with it every coefficient, does not depend on the machine.
   const std::size_t middle = first + (last - first) / 2;
   BandedSpd upper_normal(n);
   std::vector<double> upper_rhs(n, 0.0);
   std::vector<int> upper_counts(cells, 0);
-  std::thread upper(
-      [&, end = last] { Accumulate(z, geometry, middle, end, upper_normal, upper_rhs, upper_counts); });
-  Accumulate(z, geometry, first, middle, normal_, rhs, cell_counts_);
-  upper.join();
+  RunOnWorkers(2, [&, end = last](int half) {
+    if (half == 0) {
+      Accumulate(z, geometry, first, middle, normal_, rhs, cell_counts_);
+    } else {
+      Accumulate(z, geometry, middle, end, upper_normal, upper_rhs, upper_counts);
+    }
+  });
   for (std::size_t i = 0; i < n; ++i) {
     rhs[i] += upper_rhs[i];
     for (std::size_t j = i; j <= std::min(n - 1, i + BandedSpd::kBand); ++j)

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <limits>
 #include <numbers>
+#include <numeric>
 #include <random>
 #include <vector>
 
@@ -71,6 +72,41 @@ TEST(Noise, SecondDifferencesRecoverTheSensorNoiseDespiteSpikes) {
   std::vector<double> z = NoisySine(200000, 0.5e-3, 1);
   for (std::size_t i = 0; i < z.size(); i += 997) z[i] += 0.05;  // 0.1 % spikes of 50 um
   EXPECT_NEAR(EstimateNoiseSigmaMm(z), 0.5e-3, 0.02e-3);
+}
+
+TEST(Despike, FindsEachSpikeBesideTheSplitBetweenTheTwoHalvesOnce) {
+  // A scan long enough to be judged in two halves, split at the middle sample; noiseless, so
+  // that the spikes put in are exactly the samples to be found. A dropout just before the split
+  // makes the halves' context skip invalid samples.
+  const std::size_t middle = 100000;
+  const std::vector<double> clean = NoisySine(2 * middle, 0.0, 3);
+  std::vector<double> with_dropout = clean;
+  with_dropout[middle - 4] = with_dropout[middle - 3] = std::numeric_limits<double>::quiet_NaN();
+  std::vector<double> median = with_dropout, mean = with_dropout;
+  // A 5 um burst across the split for the median. For the mean, 6 um spikes 12 valid samples
+  // apart: every window holds at most one, which moves the mean of a full window of 10 others by
+  // 0.6 um (kept), but that of the 5 on one side by 1.2 um (rejected): the first sample of the
+  // upper half stays only if its half saw the lower half's samples as context.
+  const std::vector<std::size_t> burst = {middle - 2, middle - 1, middle, middle + 1};
+  const std::vector<std::size_t> isolated = {middle - 12, middle + 2};
+  for (const std::size_t i : burst) median[i] += 0.005;
+  for (const std::size_t i : isolated) mean[i] += 0.006;
+
+  const auto by_median = Despike(median, 0.0, {.method = DespikeMethod::kMedian, .threshold_um = 1.0});
+  const auto by_mean = Despike(mean, 0.0, {.method = DespikeMethod::kMovingMean, .threshold_um = 1.0});
+
+  EXPECT_EQ(by_median.indices, burst);
+  EXPECT_EQ(by_mean.indices, isolated);
+  // Replaced by the mean of the other samples in its window: the 5 valid ones on each side.
+  for (const std::size_t i : isolated) {
+    std::vector<double> others;
+    for (std::size_t k = i - 1; others.size() < 5; --k) {
+      if (std::isfinite(with_dropout[k])) others.push_back(clean[k]);
+    }
+    for (std::size_t k = i + 1; others.size() < 10; ++k) others.push_back(clean[k]);
+    const double mean_of_others = std::accumulate(others.begin(), others.end(), 0.0) / 10.0;
+    EXPECT_NEAR(mean[i], mean_of_others, 1e-12) << "sample " << i;
+  }
 }
 
 TEST(Despike, MedianFilterRemovesFiveSampleBurstsThatTheMovingMeanLeaves) {

@@ -2,6 +2,7 @@
 // way (the file-size limit stands in for a full disk). Earlier outputs stay intact and no partial
 // or temporary file is left.
 
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 #include <signal.h>
 #include <spawn.h>
@@ -10,9 +11,7 @@
 
 #include <chrono>
 #include <cstdlib>
-#include <fstream>
 #include <map>
-#include <sstream>
 #include <string>
 #include <thread>
 
@@ -23,15 +22,9 @@ extern char** environ;
 namespace arcwheel {
 namespace {
 
+using testing::ReadText;
 using testing::RunArcwheel;
 using testing::TempDir;
-
-std::string Slurp(const std::filesystem::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::stringstream contents;
-  contents << in.rdbuf();
-  return contents.str();
-}
 
 // A scan of the paper's settings and a finished run of it in `out`.
 void PrepareEarlierOutputs(const TempDir& dir) {
@@ -65,8 +58,8 @@ TEST(Faults, InterruptDuringProcessingLeavesEarlierOutputsIntact) {
                         " --sample-period-s 1e-5 --feed-mm-per-min 33 --noise-um 0.3 --radial-harmonic 1:3")
                 .exit_status,
             0);
-  const std::string summary_before = Slurp(dir / "out" / "summary.json");
-  const std::string map_before = Slurp(dir / "out" / "wheel_map.h5");
+  const std::string summary_before = ReadText(dir / "out" / "summary.json");
+  const std::string map_before = ReadText(dir / "out" / "wheel_map.h5");
 
   const std::string binary = std::getenv("ARCWHEEL_BINARY");
   const std::string scan = (dir / "long.h5").string();
@@ -92,21 +85,21 @@ TEST(Faults, InterruptDuringProcessingLeavesEarlierOutputsIntact) {
   ASSERT_TRUE(WIFEXITED(status));
   EXPECT_EQ(WEXITSTATUS(status), 130) << "the run should have been interrupted, not finished";
   EXPECT_EQ(testing::ListFolder(dir / "out"), "summary.json\nwheel_map.h5\n");
-  EXPECT_EQ(Slurp(dir / "out" / "summary.json"), summary_before);
-  EXPECT_EQ(Slurp(dir / "out" / "wheel_map.h5"), map_before);
+  EXPECT_EQ(ReadText(dir / "out" / "summary.json"), summary_before);
+  EXPECT_EQ(ReadText(dir / "out" / "wheel_map.h5"), map_before);
 }
 
 TEST(Faults, WriteFailingPartWayLeavesEarlierOutputsIntact) {
   TempDir dir;
   PrepareEarlierOutputs(dir);
-  const std::string summary_before = Slurp(dir / "out" / "summary.json");
+  const std::string summary_before = ReadText(dir / "out" / "summary.json");
   // A 512 KiB limit: the summary fits, the new map (~0.9 MB) does not.
   const auto run = RunWithFileSizeLimit(
       "process -q " + (dir / "short.h5").string() + " -o " + (dir / "out").string(), 512);
   EXPECT_EQ(run.exit_status, 4) << run.output;
   EXPECT_NE(run.output.find("wheel_map.h5"), std::string::npos) << run.output;
   EXPECT_EQ(testing::ListFolder(dir / "out"), "summary.json\nwheel_map.h5\n");
-  EXPECT_EQ(Slurp(dir / "out" / "summary.json"), summary_before);
+  EXPECT_EQ(ReadText(dir / "out" / "summary.json"), summary_before);
 }
 
 // Every stage that writes several files commits them together: a full disk part way through the
@@ -122,23 +115,17 @@ class StageOutputs : public ::testing::TestWithParam<StageRun> {};
 std::map<std::string, std::string> FolderContents(const std::filesystem::path& folder) {
   std::map<std::string, std::string> contents;
   for (const auto& entry : std::filesystem::directory_iterator(folder)) {
-    contents[entry.path().filename().string()] = Slurp(entry.path());
+    contents[entry.path().filename().string()] = ReadText(entry.path());
   }
   return contents;
-}
-
-std::string Expand(std::string text, const std::string& key, const std::string& value) {
-  for (auto at = text.find(key); at != std::string::npos; at = text.find(key, at + value.size())) {
-    text.replace(at, key.size(), value);
-  }
-  return text;
 }
 
 TEST_P(StageOutputs, AFullDiskLeavesTheEarlierRunIntact) {
   const StageRun& run = GetParam();
   TempDir dir;
   const std::string arguments =
-      Expand(Expand(run.arguments, "{src}", testing::SourceDir().string()), "{out}", (dir / "out").string());
+      fmt::format(fmt::runtime(run.arguments), fmt::arg("src", testing::SourceDir().string()),
+                  fmt::arg("out", (dir / "out").string()));
   ASSERT_EQ(RunArcwheel(arguments).exit_status, 0) << arguments;
   const auto before = FolderContents(dir / "out");
   ASSERT_GE(before.size(), 2U);

@@ -3,6 +3,7 @@
 // their fixes these exhausted memory, ran for seconds on a 5 kB file, or escaped as an internal
 // error.
 
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 
 #include <fstream>
@@ -28,13 +29,6 @@ struct Finding {
 
 class FuzzFinding : public ::testing::TestWithParam<Finding> {};
 
-std::string Expand(std::string text, const std::string& key, const std::string& value) {
-  for (auto at = text.find(key); at != std::string::npos; at = text.find(key, at + value.size())) {
-    text.replace(at, key.size(), value);
-  }
-  return text;
-}
-
 TEST_P(FuzzFinding, IsRefusedClearlyAndWritesNothing) {
   const Finding& finding = GetParam();
   TempDir dir;
@@ -46,8 +40,8 @@ TEST_P(FuzzFinding, IsRefusedClearlyAndWritesNothing) {
       << (finding.scattered_map ? R"(", "layout": "scattered"},)" : R"("},)") << R"(
     "removal_function": {"peak_rate_um_per_s": 1, "fwhm_mm": 8}, "machine": {"max_speed_mm_s": 100}})";
   const std::string input = (testing::SourceDir() / "testdata" / "fuzz_regressions" / finding.file).string();
-  const std::string arguments =
-      Expand(Expand(finding.arguments, "{in}", input), "{dir}", dir.path().string());
+  const std::string arguments = fmt::format(fmt::runtime(finding.arguments), fmt::arg("in", input),
+                                            fmt::arg("dir", dir.path().string()));
   const auto run = RunArcwheel(arguments);
   EXPECT_EQ(run.exit_status, 3) << run.output;
   EXPECT_NE(run.output.find(finding.file), std::string::npos) << "the message names the file: " << run.output;

@@ -1,3 +1,4 @@
+#include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -13,9 +14,11 @@
 namespace arcwheel::acquisition {
 namespace {
 
+using testing::ErrorMessageOf;
+using testing::ErrorOf;
+using ::testing::HasSubstr;
 using testing::TempDir;
-
-void WriteText(const std::filesystem::path& path, const std::string& text) { std::ofstream(path) << text; }
+using testing::WriteText;
 
 const char* kSettings = "# spindle_rpm: 500\n# feed_mm_per_min: 100\n# sample_period_s: 0.001\n";
 
@@ -57,14 +60,9 @@ TEST(CsvReader, AcceptsSemicolonAndTabSeparators) {
 TEST(CsvReader, NamesTheLineOfAValueThatDoesNotParse) {
   TempDir dir;
   WriteText(dir / "scan.csv", std::string(kSettings) + "z_mm,y_mm\n0.5,0.1\n0.5,0.1x\n");
-  try {
-    (void)ReadCsvScan(dir / "scan.csv");
-    FAIL();
-  } catch (const Error& e) {
-    EXPECT_EQ(e.code(), ErrorCode::kBadInput);
-    EXPECT_NE(std::string(e.what()).find("line 6"), std::string::npos) << e.what();
-    EXPECT_NE(std::string(e.what()).find("0.1x"), std::string::npos) << e.what();
-  }
+  const std::string message = ErrorMessageOf([&] { (void)ReadCsvScan(dir / "scan.csv"); });
+  EXPECT_THAT(message, HasSubstr("line 6"));
+  EXPECT_THAT(message, HasSubstr("0.1x"));
 }
 
 TEST(Hdf5Reader, ComparesTheInvalidValueInTheFilesOwnType) {
@@ -96,13 +94,8 @@ TEST(Hdf5Reader, RefusesColumnsOfDifferentLengths) {
     file.WriteAttribute("/scan", "spindle_rpm", 500.0);
     file.WriteAttribute("/scan", "feed_mm_per_min", 100.0);
   }
-  try {
-    (void)ReadHdf5Scan(dir / "scan.h5");
-    FAIL();
-  } catch (const Error& e) {
-    EXPECT_NE(std::string(e.what()).find("column 't' has 399 values but 'z' has 400"), std::string::npos)
-        << e.what();
-  }
+  EXPECT_THAT(ErrorMessageOf([&] { (void)ReadHdf5Scan(dir / "scan.h5"); }),
+              HasSubstr("column 't' has 399 values but 'z' has 400"));
 }
 
 TEST(Hdf5Reader, RefusesAFileWithoutTheScanGroup) {
@@ -118,12 +111,9 @@ TEST(Hdf5Reader, RefusesADatasetLargerThanTheFileCanHold) {
   std::ifstream in(path, std::ios::binary);
   const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   ASSERT_FALSE(bytes.empty());
-  try {
-    (void)ReadHdf5Scan(hdf5::File::OpenImage(bytes.data(), bytes.size(), "regression.h5"));
-    FAIL() << "expected an Error";
-  } catch (const Error& e) {
-    EXPECT_EQ(e.code(), ErrorCode::kBadInput) << e.what();
-  }
+  const Error error = ErrorOf(
+      [&] { (void)ReadHdf5Scan(hdf5::File::OpenImage(bytes.data(), bytes.size(), "regression.h5")); });
+  EXPECT_EQ(error.code(), ErrorCode::kBadInput) << error.what();
 }
 
 // Golden file: the shipped scan and its truth (testdata/README.md says how they were made).

@@ -18,8 +18,7 @@ namespace {
 using arcwheel::testing::ListFolder;
 using arcwheel::testing::RunArcwheel;
 using arcwheel::testing::TempDir;
-
-void Write(const std::filesystem::path& path, const std::string& text) { std::ofstream(path) << text; }
+using arcwheel::testing::WriteText;
 
 std::string Read(const std::filesystem::path& path) {
   std::ifstream in(path);
@@ -57,7 +56,7 @@ TEST(TransformFitCommand, WritesTheFormatsSection5Object) {
     const Eigen::Vector3d target = scale * r * s + t;
     csv += fmt::format("{},{},{},{},{},{}\n", s.x(), s.y(), s.z(), target.x(), target.y(), target.z());
   }
-  Write(dir / "pairs.csv", csv);
+  WriteText(dir / "pairs.csv", csv);
   const nlohmann::json out =
       RunJson(fmt::format("transform fit {} --model similarity3d", (dir / "pairs.csv").string()));
   EXPECT_EQ(out["model"], "similarity3d");
@@ -78,11 +77,11 @@ TEST(TransformFitCommand, WritesTheFormatsSection5Object) {
 
 TEST(TransformFitCommand, RefusesBadInputWithoutWritingOutput) {
   TempDir dir;
-  Write(dir / "two.csv", "xs_mm,ys_mm,zs_mm,xt_mm,yt_mm,zt_mm\n0,0,0,1,1,1\n1,0,0,2,1,1\n");
-  Write(dir / "line.csv", "xs_mm,ys_mm,zs_mm,xt_mm,yt_mm,zt_mm\n0,0,0,1,1,1\n1,0,0,2,1,1\n2,0,0,3,1,1\n");
-  Write(dir / "ragged.csv", "xs_mm,ys_mm,xt_mm,yt_mm\n0,0,1,1\n1,0,2,1\n0,1\n");
-  Write(dir / "nan.csv", "xs_mm,ys_mm,xt_mm,yt_mm\n0,0,1,1\n1,0,2,1\n0,1,nan,2\n");
-  Write(dir / "flat.csv", "xs_mm,ys_mm,xt_mm,yt_mm\n0,0,1,1\n1,0,2,1\n0,1,1,2\n");
+  WriteText(dir / "two.csv", "xs_mm,ys_mm,zs_mm,xt_mm,yt_mm,zt_mm\n0,0,0,1,1,1\n1,0,0,2,1,1\n");
+  WriteText(dir / "line.csv", "xs_mm,ys_mm,zs_mm,xt_mm,yt_mm,zt_mm\n0,0,0,1,1,1\n1,0,0,2,1,1\n2,0,0,3,1,1\n");
+  WriteText(dir / "ragged.csv", "xs_mm,ys_mm,xt_mm,yt_mm\n0,0,1,1\n1,0,2,1\n0,1\n");
+  WriteText(dir / "nan.csv", "xs_mm,ys_mm,xt_mm,yt_mm\n0,0,1,1\n1,0,2,1\n0,1,nan,2\n");
+  WriteText(dir / "flat.csv", "xs_mm,ys_mm,xt_mm,yt_mm\n0,0,1,1\n1,0,2,1\n0,1,1,2\n");
   const std::string out = (dir / "out.json").string();
   ExpectRefused(dir, fmt::format("transform fit {} --model rigid3d -o {}", (dir / "two.csv").string(), out),
                 3, "needs at least 3");
@@ -106,12 +105,12 @@ TEST(FrameCommand, FrameAppliedToAToolpathAndBackRestoresIt) {
   // The x axis is along P2 - P1.
   const Eigen::Vector3d x_axis = Eigen::Vector3d(150, 20, 0).normalized();
   for (int k = 0; k < 3; ++k) EXPECT_NEAR(frame["frame"]["x_axis"][k].get<double>(), x_axis(k), 1e-14);
-  Write(dir / "frame.json", frame.dump());
+  WriteText(dir / "frame.json", frame.dump());
   const std::string toolpath =
       "# surface: test\nxw_mm,yw_mm,zw_mm,x_mm,y_mm,z_mm,nx,ny,nz,feed_mm_min\n"
       "1.5,2.5,60.0,1.5,2.5,10.0,0.0,0.0,1.0,1200\n-40.25,12.0,55.0,-40.25,12.0,5.0,0.1,0.0,0.99498743710662,"
       "1200\n";
-  Write(dir / "path.csv", toolpath);
+  WriteText(dir / "path.csv", toolpath);
   const auto forward = RunArcwheel(fmt::format("transform apply {} {} -o {}", (dir / "frame.json").string(),
                                                (dir / "path.csv").string(), (dir / "machine.csv").string()));
   ASSERT_EQ(forward.exit_status, 0) << forward.output;
@@ -156,8 +155,9 @@ TEST(FrameCommand, RefusesCollinearProbesAndUntransformablePrograms) {
   const std::string out = (dir / "frame.json").string();
   ExpectRefused(dir, "frame --origin 0,0,0 --x-point 100,0,0 --xy-point 50,0,0 -o " + out, 3, "collinear");
   ExpectRefused(dir, "frame --origin 0,0,0 --x-point 0,0,0 --xy-point 50,10,0 -o " + out, 3, "coincide");
-  Write(dir / "frame.json", RunArcwheel("frame --origin 0,0,0 --x-point 100,0,0 --xy-point 50,10,0").output);
-  Write(dir / "arc.nc", "G90\nG0 X0 Y0 Z5\nG2 X10 Y0 I5 J0\n");
+  WriteText(dir / "frame.json",
+            RunArcwheel("frame --origin 0,0,0 --x-point 100,0,0 --xy-point 50,10,0").output);
+  WriteText(dir / "arc.nc", "G90\nG0 X0 Y0 Z5\nG2 X10 Y0 I5 J0\n");
   ExpectRefused(dir,
                 fmt::format("transform apply {} {} -o {}", (dir / "frame.json").string(),
                             (dir / "arc.nc").string(), (dir / "out.nc").string()),
@@ -179,19 +179,19 @@ TEST(HeadcenterCommand, SolvesASimulatedRecordAndRefusesNanForces) {
   EXPECT_NEAR(out["centre_sensor_mm"][1].get<double>(), -6.25, 0.01);
   EXPECT_EQ(out["platform_height_mm"].get<double>(), 25.0);  // from the record's note
 
-  Write(dir / "nan.csv",
-        "t_s,Fx_N,Fy_N,Fz_N,Mx_Nmm,My_Nmm,Mz_Nmm\n0,0,0,-30,10,10,0\n0.001,0,0,NaN,10,10,0\n");
+  WriteText(dir / "nan.csv",
+            "t_s,Fx_N,Fy_N,Fz_N,Mx_Nmm,My_Nmm,Mz_Nmm\n0,0,0,-30,10,10,0\n0.001,0,0,NaN,10,10,0\n");
   ExpectRefused(dir,
                 fmt::format("headcenter solve {} --z0-mm 20 -o {}", (dir / "nan.csv").string(),
                             (dir / "o.json").string()),
                 3, "line 3, column 'Fz_N'");
-  Write(dir / "short.csv", "t_s,Fx_N,Fy_N,Fz_N,Mx_Nmm,My_Nmm\n0,0,0,-30,10,10\n");
+  WriteText(dir / "short.csv", "t_s,Fx_N,Fy_N,Fz_N,Mx_Nmm,My_Nmm\n0,0,0,-30,10,10\n");
   ExpectRefused(dir,
                 fmt::format("headcenter solve {} --z0-mm 20 -o {}", (dir / "short.csv").string(),
                             (dir / "o.json").string()),
                 3, "no 'Mz' channel");
-  Write(dir / "plain.csv",
-        "t_s,Fx_N,Fy_N,Fz_N,Mx_Nmm,My_Nmm,Mz_Nmm\n0,0,0,-30,10,10,0\n0.001,0,0,-30,10,10,0\n");
+  WriteText(dir / "plain.csv",
+            "t_s,Fx_N,Fy_N,Fz_N,Mx_Nmm,My_Nmm,Mz_Nmm\n0,0,0,-30,10,10,0\n0.001,0,0,-30,10,10,0\n");
   ExpectRefused(
       dir, fmt::format("headcenter solve {} -o {}", (dir / "plain.csv").string(), (dir / "o.json").string()),
       2, "--z0-mm");
@@ -222,7 +222,7 @@ TEST(HeadcenterCommand, CalibratesTheSensorAndTabulatesMoves) {
     simulate(fmt::format("press{}.csv", i), points[i], 10 + i);
     presses += fmt::format("press{}.csv,{},{}\n", i, points[i].x(), points[i].y());
   }
-  Write(dir / "presses.csv", presses);
+  WriteText(dir / "presses.csv", presses);
   const auto calibrate =
       RunArcwheel(fmt::format("headcenter calibrate {} --tare {} -o {}", (dir / "presses.csv").string(),
                               (dir / "tare.csv").string(), (dir / "cal.json").string()));
@@ -240,7 +240,7 @@ TEST(HeadcenterCommand, CalibratesTheSensorAndTabulatesMoves) {
       records += fmt::format("{},{},{}\n", name, shift.x() + move, shift.y());
     }
   }
-  Write(dir / "moves.csv", records);
+  WriteText(dir / "moves.csv", records);
   const nlohmann::json tables =
       RunJson(fmt::format("headcenter moves {} --tare {} --calibration {}", (dir / "moves.csv").string(),
                           (dir / "tare.csv").string(), (dir / "cal.json").string()));

@@ -19,6 +19,7 @@ using surfaces::EvenAsphere;
 
 namespace {
 
+using arcwheel::testing::WriteText;
 using nlohmann::json;
 using ::testing::HasSubstr;
 
@@ -45,8 +46,6 @@ std::string ExpectRefused(const json& job, const std::filesystem::path& source =
   ADD_FAILURE() << "job was accepted: " << job.dump();
   return "";
 }
-
-void WriteText(const std::filesystem::path& path, const std::string& text) { std::ofstream(path) << text; }
 
 TEST(ParseJob, ReadsTheShippedTrialPart) {
   const Job job = ReadJob(testing::SourceDir() / "grinding/examples/trial_part.json", std::nullopt);

@@ -16,6 +16,7 @@ namespace {
 
 using arcwheel::testing::RunArcwheel;
 using arcwheel::testing::TempDir;
+using arcwheel::testing::WriteText;
 
 // Astigmatism plus a bump on a 1 mm grid over 64 x 64 mm, in micrometres.
 void WriteMap(const std::filesystem::path& path, double x_offset_mm = 0.0) {
@@ -47,8 +48,6 @@ std::string Job(const std::string& extra_machine = "", const std::string& extra_
 }})",
                      vertex_radius_mm, extra_machine, extra_root);
 }
-
-void WriteText(const std::filesystem::path& path, const std::string& text) { std::ofstream(path) << text; }
 
 TEST(PolishCommand, WritesPathRapidResidualAndSummaryWithATenfoldRmsDrop) {
   TempDir dir;

@@ -14,13 +14,12 @@ namespace {
 
 using testing::RunArcwheel;
 using testing::TempDir;
+using testing::WriteText;
 
 nlohmann::json ReadJson(const std::filesystem::path& path) {
   std::ifstream in(path);
   return nlohmann::json::parse(in);
 }
-
-void WriteText(const std::filesystem::path& path, const std::string& text) { std::ofstream(path) << text; }
 
 TEST(Cli, SimulateThenProcessWritesTheContractKeys) {
   TempDir dir;

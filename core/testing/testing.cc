@@ -66,6 +66,12 @@ std::string ReadText(const fs::path& path) {
   return text.str();
 }
 
+void WriteText(const fs::path& path, const std::string& text) {
+  std::ofstream stream(path, std::ios::binary);
+  stream << text;
+  EXPECT_TRUE(stream.good()) << "cannot write " << path;
+}
+
 int Shell(const std::string& command) {
   const int status = std::system(command.c_str());
   return WIFEXITED(status) ? WEXITSTATUS(status) : -1;

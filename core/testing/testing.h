@@ -47,6 +47,9 @@ struct CommandResult {
 // The bytes of a file; "" when it cannot be read.
 [[nodiscard]] std::string ReadText(const std::filesystem::path& path);
 
+// Writes `text` as the whole of a file; a test failure when it cannot be written.
+void WriteText(const std::filesystem::path& path, const std::string& text);
+
 // Runs a shell command, returning its exit status (-1 if it did not exit); output goes where the
 // command redirects it.
 int Shell(const std::string& command);

@@ -1,5 +1,6 @@
 #include "polishing/robot_program.h"
 
+#include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
@@ -11,9 +12,13 @@
 #include <vector>
 
 #include "core/error.h"
+#include "core/testing/testing.h"
 
 namespace arcwheel::polishing {
 namespace {
+
+using arcwheel::testing::ErrorOf;
+using ::testing::HasSubstr;
 
 std::vector<std::vector<double>> ParseCsvRows(const std::string& text, std::string& header) {
   std::istringstream in(text);
@@ -138,13 +143,8 @@ TEST(BuildPolishingPath, PrecessesTheBonnetAxisAboutTheNormalAtTheTiltAndRate) {
 TEST(BuildPolishingPath, RefusesAPointOffTheSurface) {
   Fixture f;
   const surfaces::EvenAsphere small({.vertex_radius_mm = 35.0});
-  try {
-    (void)BuildPolishingPath(small, f.path, f.dwell, RobotSide::kPlusX);
-    FAIL() << "accepted";
-  } catch (const Error& e) {
-    EXPECT_NE(std::string(e.what()).find("path point 3 (40, 7) mm is off the surface"), std::string::npos)
-        << e.what();
-  }
+  EXPECT_THAT(ErrorOf([&] { (void)BuildPolishingPath(small, f.path, f.dwell, RobotSide::kPlusX); }).what(),
+              HasSubstr("path point 3 (40, 7) mm is off the surface"));
 }
 
 }  // namespace

@@ -12,6 +12,7 @@
 namespace arcwheel::reports {
 namespace {
 
+using arcwheel::testing::ErrorMessageOf;
 using arcwheel::testing::ErrorOf;
 using arcwheel::testing::TempDir;
 using ::testing::HasSubstr;
@@ -164,10 +165,10 @@ TEST(ParsePolishSummary, ReadsTheSameMajorVersionAndRefusesANewerOne) {
   summary["schema_version"] = "1.2";
   EXPECT_EQ(ParsePolishSummary(summary.dump(), "sum.json").points, 3);
   summary["schema_version"] = "2.0";
-  const Error error = ErrorOf([&] { (void)ParsePolishSummary(summary.dump(), "out/polish_summary.json"); });
-  EXPECT_EQ(error.code(), ErrorCode::kBadInput);
-  EXPECT_THAT(error.what(), HasSubstr("'out/polish_summary.json' key 'schema_version' = '2.0'"));
-  EXPECT_THAT(error.what(), HasSubstr("reads schema version 1.x only"));
+  const std::string message =
+      ErrorMessageOf([&] { (void)ParsePolishSummary(summary.dump(), "out/polish_summary.json"); });
+  EXPECT_THAT(message, HasSubstr("'out/polish_summary.json' key 'schema_version' = '2.0'"));
+  EXPECT_THAT(message, HasSubstr("reads schema version 1.x only"));
 }
 
 TEST(ReadPolishReportInputs, RefusesFilesThatDisagreeAndNamesMissingFiles) {

@@ -46,12 +46,21 @@ TEST(ReportCommand, FlagsOverrideTheToleranceFile) {
   EXPECT_THAT(result.output, HasSubstr("overall: PASS"));
 }
 
+// Runs `arcwheel report` on `dir` with `extra` arguments and checks that it exits with `status`,
+// saying `words`, and that the folder then holds `listing` alone.
+void ExpectRefused(const TempDir& dir, const std::string& extra, int status, const std::string& words,
+                   const std::string& listing) {
+  const auto result = RunArcwheel("report '" + dir.path().string() + "'" + extra);
+  EXPECT_EQ(result.exit_status, status) << result.output;
+  EXPECT_THAT(result.output, HasSubstr(words));
+  EXPECT_EQ(ListFolder(dir.path()), listing);
+}
+
+constexpr const char* kFixtureListing = "summary.json\nwheel_map.h5\n";
+
 TEST(ReportCommand, RefusesAFolderWithoutSummaryAndWritesNothing) {
   TempDir dir;
-  const auto result = RunArcwheel("report '" + dir.path().string() + "'");
-  EXPECT_EQ(result.exit_status, 4) << result.output;
-  EXPECT_THAT(result.output, HasSubstr((dir / "summary.json").string() + "' does not exist"));
-  EXPECT_EQ(ListFolder(dir.path()), "");
+  ExpectRefused(dir, "", 4, (dir / "summary.json").string() + "' does not exist", "");
 }
 
 TEST(ReportCommand, RefusesASummaryMissingAKeyAndWritesNothing) {
@@ -59,10 +68,7 @@ TEST(ReportCommand, RefusesASummaryMissingAKeyAndWritesNothing) {
   nlohmann::json summary = testing::FixtureSummary({.n_phase = 12, .n_y = 21});
   summary.erase("mean_arc_radius_sigma_mm");
   testing::WriteFixture(dir.path(), {.n_phase = 12, .n_y = 21}, summary);
-  const auto result = RunArcwheel("report '" + dir.path().string() + "'");
-  EXPECT_EQ(result.exit_status, 3) << result.output;
-  EXPECT_THAT(result.output, HasSubstr("summary.json' key 'mean_arc_radius_sigma_mm' is missing"));
-  EXPECT_EQ(ListFolder(dir.path()), "summary.json\nwheel_map.h5\n");
+  ExpectRefused(dir, "", 3, "summary.json' key 'mean_arc_radius_sigma_mm' is missing", kFixtureListing);
 }
 
 TEST(ReportCommand, RefusesASummaryOfANewerSchemaMajorVersionAsBadInput) {
@@ -70,19 +76,13 @@ TEST(ReportCommand, RefusesASummaryOfANewerSchemaMajorVersionAsBadInput) {
   nlohmann::json summary = testing::FixtureSummary({.n_phase = 12, .n_y = 21});
   summary["schema_version"] = "3.1";
   testing::WriteFixture(dir.path(), {.n_phase = 12, .n_y = 21}, summary);
-  const auto result = RunArcwheel("report '" + dir.path().string() + "'");
-  EXPECT_EQ(result.exit_status, 3) << result.output;
-  EXPECT_THAT(result.output, HasSubstr("summary.json' key 'schema_version' = '3.1'"));
-  EXPECT_EQ(ListFolder(dir.path()), "summary.json\nwheel_map.h5\n");
+  ExpectRefused(dir, "", 3, "summary.json' key 'schema_version' = '3.1'", kFixtureListing);
 }
 
 TEST(ReportCommand, RefusesAMalformedToleranceFlag) {
   TempDir dir;
   testing::WriteFixture(dir.path(), {.n_phase = 12, .n_y = 21});
-  const auto result = RunArcwheel("report '" + dir.path().string() + "' --tolerance runout=3");
-  EXPECT_EQ(result.exit_status, 2) << result.output;
-  EXPECT_THAT(result.output, HasSubstr("tolerance 'runout=3'"));
-  EXPECT_EQ(ListFolder(dir.path()), "summary.json\nwheel_map.h5\n");
+  ExpectRefused(dir, " --tolerance runout=3", 2, "tolerance 'runout=3'", kFixtureListing);
 }
 
 TEST(ReportCommand, ReportsASimulatedAndProcessedScanWithTheSummaryNumbers) {

@@ -3,11 +3,12 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
-#include <cstdio>
+#include <cstdlib>
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <sstream>
 #include <string>
+#include <vector>
 
 #include "core/testing/testing.h"
 
@@ -88,6 +89,31 @@ TEST(PolishCommand, RunsTheShippedExampleJob) {
   EXPECT_LT(summary["after"]["rms_um"].get<double>(), summary["before"]["rms_um"].get<double>() / 10.0);
 }
 
+// The first `columns` numbers of each data row of dir/out/polishing_path.csv (after its comment
+// lines and its header); a test failure for a row that has fewer.
+std::vector<std::vector<double>> PathRows(const TempDir& dir, std::size_t columns) {
+  std::ifstream csv(dir / "out" / "polishing_path.csv");
+  std::string line;
+  while (std::getline(csv, line) && line.rfind("# ", 0) == 0) {
+  }
+  std::vector<std::vector<double>> rows;
+  while (std::getline(csv, line)) {
+    std::vector<double> row;
+    for (const char* at = line.c_str(); row.size() < columns;) {
+      char* end = nullptr;
+      row.push_back(std::strtod(at, &end));
+      if (end == at) break;
+      at = *end == ',' ? end + 1 : end;
+    }
+    if (row.size() != columns || !std::isfinite(row.back())) {
+      ADD_FAILURE() << "path row '" << line << "'";
+      continue;
+    }
+    rows.push_back(std::move(row));
+  }
+  return rows;
+}
+
 // Checks that `arcwheel polish` refuses `job` as bad input with `message` and writes nothing.
 void ExpectRefused(const std::string& job, const std::string& message, bool shifted_map = false) {
   TempDir dir;
@@ -114,18 +140,12 @@ TEST(PolishCommand, ReadsFreeformAndAsphereSurfacesInTheGrindingJobsForm) {
   const auto result = PolishJobIn(dir);
   ASSERT_EQ(result.exit_status, 0) << result.output;
   // z = -0.001 x^2 - 0.0012 y^2: the CSV's z follows the freeform.
-  std::ifstream csv(dir / "out" / "polishing_path.csv");
-  std::string line;
-  while (std::getline(csv, line) && line.rfind("# ", 0) == 0) {
-  }
-  int rows = 0;
-  while (std::getline(csv, line)) {
-    double x, y, z;
-    ASSERT_EQ(std::sscanf(line.c_str(), "%lf,%lf,%lf", &x, &y, &z), 3) << line;
+  const auto rows = PathRows(dir, 3);
+  for (const std::vector<double>& row : rows) {
+    const double x = row[0], y = row[1], z = row[2];
     EXPECT_NEAR(z, -0.001 * x * x - 0.0012 * y * y, 1e-12);
-    ++rows;
   }
-  EXPECT_GT(rows, 500);
+  EXPECT_GT(rows.size(), 500U);
 }
 
 TEST(PolishCommand, RefusesAPowerThatIsNotAWholeNumberInRangeNamingItsValue) {
@@ -154,15 +174,9 @@ TEST(PolishCommand, TiltsThePrecessingBonnetByTheJobsAngle) {
   "precession": {"tilt_deg": 20.0, "precession_rate_rpm": 5.0, "bonnet_radius_mm": 40.0})"));
   const auto result = PolishJobIn(dir);
   ASSERT_EQ(result.exit_status, 0) << result.output;
-  std::ifstream csv(dir / "out" / "polishing_path.csv");
-  std::string line;
-  while (std::getline(csv, line) && line.rfind("# ", 0) == 0) {
-  }
-  int rows = 0;
-  while (std::getline(csv, line)) {
-    double x, y, z, q1, q2, q3, q4;
-    ASSERT_EQ(std::sscanf(line.c_str(), "%lf,%lf,%lf,%lf,%lf,%lf,%lf", &x, &y, &z, &q1, &q2, &q3, &q4), 7)
-        << line;
+  const auto rows = PathRows(dir, 7);
+  for (const std::vector<double>& row : rows) {
+    const double x = row[0], y = row[1], q1 = row[3], q2 = row[4], q3 = row[5], q4 = row[6];
     // Tool z of the quaternion (third column of its rotation matrix) against the inward normal
     // of the convex conic (R0 = 400, k = -0.5) at the contact under the bonnet centre.
     const double zx = 2 * (q2 * q4 + q1 * q3), zy = 2 * (q3 * q4 - q1 * q2), zz = 1 - 2 * (q2 * q2 + q3 * q3);
@@ -179,10 +193,10 @@ TEST(PolishCommand, TiltsThePrecessingBonnetByTheJobsAngle) {
       ux = -fx / n, uy = -fy / n, uz = 1.0 / n;
       cx = x - 40.0 * ux, cy = y - 40.0 * uy;
     }
-    EXPECT_NEAR(std::acos(-(zx * ux + zy * uy + zz * uz)), 20.0 * std::acos(-1.0) / 180.0, 1e-9) << line;
-    ++rows;
+    EXPECT_NEAR(std::acos(-(zx * ux + zy * uy + zz * uz)), 20.0 * std::acos(-1.0) / 180.0, 1e-9)
+        << "point (" << x << ", " << y << ")";
   }
-  EXPECT_GT(rows, 500);
+  EXPECT_GT(rows.size(), 500U);
 }
 
 TEST(PolishCommand, RefusesAnUnknownAsphereCoefficientByItsDottedName) {

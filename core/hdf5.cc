@@ -270,6 +270,15 @@ void File::WriteInts(const std::string& dataset, const std::vector<int>& values,
   WriteDataset(handle_.id(), dataset, H5T_STD_I32LE, H5T_NATIVE_INT, values.data(), shape, Where(dataset));
 }
 
+Handle File::OpenAttribute(const std::string& object, const std::string& name) const {
+  return Handle(H5Aopen_by_name(handle_.id(), object.c_str(), name.c_str(), H5P_DEFAULT, H5P_DEFAULT),
+                H5Aclose);
+}
+
+std::string File::AttributeWhere(const std::string& object, const std::string& name) const {
+  return "attribute '" + name + "' on " + Where(object);
+}
+
 bool File::HasAttribute(const std::string& object, const std::string& name) const {
   if (object != "/" && !HasObject(object)) return false;
   return H5Aexists_by_name(handle_.id(), object.c_str(), name.c_str(), H5P_DEFAULT) > 0;
@@ -277,8 +286,8 @@ bool File::HasAttribute(const std::string& object, const std::string& name) cons
 
 std::optional<double> File::ReadAttributeDouble(const std::string& object, const std::string& name) const {
   if (!HasAttribute(object, name)) return std::nullopt;
-  const Handle attribute(
-      H5Aopen_by_name(handle_.id(), object.c_str(), name.c_str(), H5P_DEFAULT, H5P_DEFAULT), H5Aclose);
+  const std::string where = AttributeWhere(object, name);
+  const Handle attribute = OpenAttribute(object, name);
   const Handle type(H5Aget_type(attribute.id()), H5Tclose);
   const H5T_class_t type_class = H5Tget_class(type.id());
   if (type_class == H5T_STRING) {
@@ -290,22 +299,19 @@ std::optional<double> File::ReadAttributeDouble(const std::string& object, const
       if (used == text->size()) return value;
     } catch (const std::exception&) {
     }
-    throw Error(ErrorCode::kBadInput, kStage,
-                "attribute '" + name + "' on " + Where(object) + " is not a number: '" + *text + "'");
+    throw Error(ErrorCode::kBadInput, kStage, where + " is not a number: '" + *text + "'");
   }
   if (type_class != H5T_FLOAT && type_class != H5T_INTEGER) {
-    throw Error(ErrorCode::kBadInput, kStage,
-                "attribute '" + name + "' on " + Where(object) + " is not numeric");
+    throw Error(ErrorCode::kBadInput, kStage, where + " is not numeric");
   }
-  CheckNumberSize(type.id(), "attribute '" + name + "' on " + Where(object));
+  CheckNumberSize(type.id(), where);
   const Handle space(H5Aget_space(attribute.id()), H5Sclose);
   if (H5Sget_simple_extent_npoints(space.id()) != 1) {
-    throw Error(ErrorCode::kBadInput, kStage,
-                "attribute '" + name + "' on " + Where(object) + " must hold one value");
+    throw Error(ErrorCode::kBadInput, kStage, where + " must hold one value");
   }
   double value = 0.0;
   if (H5Aread(attribute.id(), H5T_NATIVE_DOUBLE, &value) < 0) {
-    throw Error(ErrorCode::kBadInput, kStage, "cannot read attribute '" + name + "' on " + Where(object));
+    throw Error(ErrorCode::kBadInput, kStage, "cannot read " + where);
   }
   return value;
 }
@@ -313,9 +319,8 @@ std::optional<double> File::ReadAttributeDouble(const std::string& object, const
 std::optional<std::string> File::ReadAttributeString(const std::string& object,
                                                      const std::string& name) const {
   if (!HasAttribute(object, name)) return std::nullopt;
-  const std::string where = "attribute '" + name + "' on " + Where(object);
-  const Handle attribute(
-      H5Aopen_by_name(handle_.id(), object.c_str(), name.c_str(), H5P_DEFAULT, H5P_DEFAULT), H5Aclose);
+  const std::string where = AttributeWhere(object, name);
+  const Handle attribute = OpenAttribute(object, name);
   const Handle type(H5Aget_type(attribute.id()), H5Tclose);
   const H5T_class_t type_class = H5Tget_class(type.id());
   const Handle space(H5Aget_space(attribute.id()), H5Sclose);
@@ -510,9 +515,8 @@ void CheckCompoundLayout(hid_t type, const std::string& where) {
 std::optional<File::Compound> File::ReadAttributeCompound(const std::string& object,
                                                           const std::string& name) const {
   if (!HasAttribute(object, name)) return std::nullopt;
-  const std::string where = "attribute '" + name + "' on " + Where(object);
-  const Handle attribute(
-      H5Aopen_by_name(handle_.id(), object.c_str(), name.c_str(), H5P_DEFAULT, H5P_DEFAULT), H5Aclose);
+  const std::string where = AttributeWhere(object, name);
+  const Handle attribute = OpenAttribute(object, name);
   const Handle type(H5Aget_type(attribute.id()), H5Tclose);
   if (!attribute.valid() || !type.valid() || H5Tget_class(type.id()) != H5T_COMPOUND) {
     throw Error(ErrorCode::kBadInput, kStage, where + " is not a compound");
@@ -589,7 +593,7 @@ void File::WriteAttribute(const std::string& object, const std::string& name, do
                                            space.id(), H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT),
                          H5Aclose);
   if (!attribute.valid() || H5Awrite(attribute.id(), H5T_NATIVE_DOUBLE, &value) < 0) {
-    throw Error(ErrorCode::kIo, kStage, "cannot write attribute '" + name + "' on " + Where(object));
+    throw Error(ErrorCode::kIo, kStage, "cannot write " + AttributeWhere(object, name));
   }
 }
 
@@ -603,7 +607,7 @@ void File::WriteAttribute(const std::string& object, const std::string& name, co
                          H5Aclose);
   const std::string padded = value.empty() ? std::string(1, '\0') : value;
   if (!attribute.valid() || H5Awrite(attribute.id(), type.id(), padded.data()) < 0) {
-    throw Error(ErrorCode::kIo, kStage, "cannot write attribute '" + name + "' on " + Where(object));
+    throw Error(ErrorCode::kIo, kStage, "cannot write " + AttributeWhere(object, name));
   }
 }
 

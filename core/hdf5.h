@@ -99,7 +99,11 @@ class File {
  private:
   File(Handle handle, std::filesystem::path path) : handle_(std::move(handle)), path_(std::move(path)) {}
   [[nodiscard]] Handle OpenDataset(const std::string& dataset) const;
+  // Attribute `name` of `object`, which the caller has checked exists.
+  [[nodiscard]] Handle OpenAttribute(const std::string& object, const std::string& name) const;
   [[nodiscard]] std::string Where(const std::string& object) const;
+  // "attribute 'name' on <Where(object)>", for messages.
+  [[nodiscard]] std::string AttributeWhere(const std::string& object, const std::string& name) const;
   // Before libhdf5 reads a variable-length attribute (or `member` of a compound one) of
   // `stored_type`: throws Error{kBadInput} unless every global heap object it refers to is one the
   // library can read safely (see hdf5_heap.cc).

@@ -2,6 +2,7 @@
 
 #include <fmt/format.h>
 
+#include "core/atomic_file.h"
 #include "reports/pdf_flow.h"
 
 namespace arcwheel::reports::internal {
@@ -106,6 +107,17 @@ std::string FigureRowHtml(const std::vector<ReportFigure>& figures, const std::s
     html += FigureHtml(figures[i], RowFigureWidthPt(figures.size()), fmt::format("{}{}-", id_prefix, i));
   }
   return html + "</div>\n";
+}
+
+void WriteHtmlAndPdf(const std::filesystem::path& html_path, const std::function<std::string()>& render_html,
+                     const std::filesystem::path& pdf_path,
+                     const std::function<void(const std::filesystem::path&)>& render_pdf) {
+  OutputSet outputs;
+  const std::filesystem::path html_temporary = outputs.Stage(html_path);
+  const std::filesystem::path pdf_temporary = outputs.Stage(pdf_path);
+  render_pdf(pdf_temporary);
+  WriteFileAtomically(html_temporary, render_html());
+  outputs.Commit();
 }
 
 }  // namespace arcwheel::reports::internal

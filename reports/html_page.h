@@ -2,6 +2,8 @@
 // The HTML machinery the reports share (wheel report, polish report): one self-contained,
 // phone-first page with inline CSS and inline SVG plots. Internal to reports/.
 
+#include <filesystem>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -31,6 +33,14 @@ namespace arcwheel::reports::internal {
 // figures in a row so that both reports show the same drawing.
 [[nodiscard]] std::string FigureRowHtml(const std::vector<ReportFigure>& figures,
                                         const std::string& id_prefix);
+
+// Writes a report's PDF, which `render_pdf` draws to the path it is given, and then its HTML page,
+// which `render_html` returns, both to temporary files renamed into place together: a failure
+// leaves neither. In that order: drawn before the PDF, the PNG images embedded in the HTML come
+// out with other bytes (seen on the shipped demo; the cause is not known). Throws Error{kIo}.
+void WriteHtmlAndPdf(const std::filesystem::path& html_path, const std::function<std::string()>& render_html,
+                     const std::filesystem::path& pdf_path,
+                     const std::function<void(const std::filesystem::path&)>& render_pdf);
 
 // Width (points) at which a full-width figure is drawn; CSS scales it to the screen.
 inline constexpr double kFigureWidth_pt = 640.0;

@@ -5,7 +5,6 @@
 #include <algorithm>
 #include <cmath>
 
-#include "core/atomic_file.h"
 #include "core/version.h"
 #include "reports/html_page.h"
 #include "reports/pdf_flow.h"
@@ -264,12 +263,9 @@ void RenderPolishPdf(const PolishReportContent& content, const std::filesystem::
 WrittenPolishReports WritePolishReports(const std::filesystem::path& outdir) {
   const PolishReportContent content = ComposePolishReport(ReadPolishReportInputs(outdir));
   WrittenPolishReports written{outdir / "polish_report.html", outdir / "polish_report.pdf"};
-  OutputSet outputs;
-  const std::filesystem::path html_temporary = outputs.Stage(written.html);
-  const std::filesystem::path pdf_temporary = outputs.Stage(written.pdf);
-  RenderPolishPdf(content, pdf_temporary);
-  WriteFileAtomically(html_temporary, RenderPolishHtml(content));
-  outputs.Commit();
+  internal::WriteHtmlAndPdf(
+      written.html, [&] { return RenderPolishHtml(content); }, written.pdf,
+      [&](const std::filesystem::path& pdf) { RenderPolishPdf(content, pdf); });
   return written;
 }
 

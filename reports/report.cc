@@ -1,6 +1,6 @@
 #include "reports/report.h"
 
-#include "core/atomic_file.h"
+#include "reports/html_page.h"
 #include "reports/report_inputs.h"
 
 namespace arcwheel::reports {
@@ -9,12 +9,9 @@ WrittenReports WriteReports(const std::filesystem::path& outdir, const Tolerance
   const ReportInputs inputs = ReadReportInputs(outdir);
   const ReportContent content = ComposeReport(inputs, tolerances);
   WrittenReports written{outdir / "report.html", outdir / "report.pdf", content.overall};
-  OutputSet outputs;
-  const std::filesystem::path html_temporary = outputs.Stage(written.html);
-  const std::filesystem::path pdf_temporary = outputs.Stage(written.pdf);
-  RenderPdf(content, pdf_temporary);
-  WriteFileAtomically(html_temporary, RenderHtml(content));
-  outputs.Commit();
+  internal::WriteHtmlAndPdf(
+      written.html, [&] { return RenderHtml(content); }, written.pdf,
+      [&](const std::filesystem::path& pdf) { RenderPdf(content, pdf); });
   return written;
 }
 

@@ -68,8 +68,9 @@ Located Locate(const Channel& channel, const std::vector<std::string>& names, co
   std::vector<Located> found;
   for (const std::string& name : names) {
     const std::string base = channel.base;
+    std::string unit;
     if (name == base) {
-      const std::string unit = channel.kind == Kind::kTime && note_unit.empty() ? "s" : note_unit;
+      unit = channel.kind == Kind::kTime && note_unit.empty() ? "s" : note_unit;
       if (unit.empty()) {
         throw Error(
             ErrorCode::kBadInput, kStage,
@@ -77,23 +78,18 @@ Located Locate(const Channel& channel, const std::vector<std::string>& names, co
                         name, base, channel.kind == Kind::kForce ? "force_unit" : "moment_unit",
                         AcceptedUnits(channel.kind)));
       }
-      const auto factor = UnitFactor(channel.kind, unit);
-      if (!factor) {
-        throw Error(
-            ErrorCode::kBadInput, kStage,
-            fmt::format("{}: unit '{}' of '{}' is not {}", where, unit, name, AcceptedUnits(channel.kind)));
-      }
-      found.push_back({name, *factor});
     } else if (name.starts_with(base + "_")) {
-      const std::string unit = name.substr(base.size() + 1);
-      const auto factor = UnitFactor(channel.kind, unit);
-      if (!factor) {
-        throw Error(
-            ErrorCode::kBadInput, kStage,
-            fmt::format("{}: unit '{}' of '{}' is not {}", where, unit, name, AcceptedUnits(channel.kind)));
-      }
-      found.push_back({name, *factor});
+      unit = name.substr(base.size() + 1);
+    } else {
+      continue;
     }
+    const auto factor = UnitFactor(channel.kind, unit);
+    if (!factor) {
+      throw Error(
+          ErrorCode::kBadInput, kStage,
+          fmt::format("{}: unit '{}' of '{}' is not {}", where, unit, name, AcceptedUnits(channel.kind)));
+    }
+    found.push_back({name, *factor});
   }
   if (found.empty()) {
     throw Error(ErrorCode::kBadInput, kStage,

@@ -27,17 +27,23 @@ Wheel PaperWheel() {
   return Wheel{.arc_radius_mm = 55.4423, .base_radius_mm = 200.0 - 55.4423, .half_width_mm = 10.0};
 }
 
+// The whole 430 x 430 mm trial part at 0.1 mm, without lead-in or lead-out, on two threads.
+Aperture TrialPartAperture() { return {.width_x_mm = 430.0, .width_y_mm = 430.0}; }
+ToolpathOptions TrialPartOptions(double gouge_check_spacing_mm) {
+  return {.step_over_mm = 0.1,
+          .point_spacing_mm = 0.1,
+          .feed_mm_per_min = 6000.0,
+          .lead_in_mm = 0.0,
+          .lead_out_mm = 0.0,
+          .gouge_check_spacing_mm = gouge_check_spacing_mm,
+          .threads = 2};
+}
+
 // Control points of the whole part, counted as they stream out (nothing kept in memory).
 // Argument: spacing of the global gouge checks, mm (the local check runs at every point).
 void BM_TrialPartControlPoints(benchmark::State& state) {
-  const Aperture aperture{.width_x_mm = 430.0, .width_y_mm = 430.0};
-  const ToolpathOptions options{.step_over_mm = 0.1,
-                                .point_spacing_mm = 0.1,
-                                .feed_mm_per_min = 6000.0,
-                                .lead_in_mm = 0.0,
-                                .lead_out_mm = 0.0,
-                                .gouge_check_spacing_mm = static_cast<double>(state.range(0)),
-                                .threads = 2};
+  const Aperture aperture = TrialPartAperture();
+  const ToolpathOptions options = TrialPartOptions(static_cast<double>(state.range(0)));
   long long points = 0;
   for (auto _ : state) {
     const ToolpathSummary s = GenerateToolpath(TrialPart(), aperture, PaperWheel(), options, {});
@@ -59,14 +65,8 @@ BENCHMARK(BM_TrialPartControlPoints)
 // The same with each row formatted as the CSV's text in the workers (what `arcwheel toolpath`
 // writes; the text is dropped here so the disk does not enter the figure).
 void BM_TrialPartCsvText(benchmark::State& state) {
-  const Aperture aperture{.width_x_mm = 430.0, .width_y_mm = 430.0};
-  const ToolpathOptions options{.step_over_mm = 0.1,
-                                .point_spacing_mm = 0.1,
-                                .feed_mm_per_min = 6000.0,
-                                .lead_in_mm = 0.0,
-                                .lead_out_mm = 0.0,
-                                .gouge_check_spacing_mm = 10.0,
-                                .threads = 2};
+  const Aperture aperture = TrialPartAperture();
+  const ToolpathOptions options = TrialPartOptions(10.0);
   std::atomic<long long> bytes = 0;
   for (auto _ : state) {
     bytes = 0;

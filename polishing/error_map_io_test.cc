@@ -27,6 +27,7 @@ namespace {
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 using arcwheel::testing::ErrorMessageOf;
+using arcwheel::testing::WriteText;
 
 bool Contains(const std::string& text, const std::string& part) {
   return text.find(part) != std::string::npos;
@@ -146,6 +147,13 @@ std::vector<unsigned char> MetroProImage(const DatSpec& s) {
 double TestHeightM(int i, int j) {
   if ((i == 0 && j == 0) || (i == 3 && j == 2) || (i == 6 && j == 4)) return kNaN;
   return 1e-9 * (40.0 * i - 25.0 * j + 3.0 * i * j - 60.0);
+}
+
+// A MetroPro .dat file of the default DatSpec with TestHeightM's heights.
+std::vector<unsigned char> TestMetroProImage() {
+  DatSpec spec;
+  spec.height_m = TestHeightM;
+  return MetroProImage(spec);
 }
 
 TEST(ParseMetroProDat, RecoversHeightsToTheQuantisationStepInEveryHeaderFormatAndPhaseResolution) {
@@ -722,11 +730,8 @@ PolishJob ReadJob(const arcwheel::testing::TempDir& dir, const std::string& erro
 
 TEST(PolishJobErrorMap, ReadsEachFormatByItsExtensionAndAppliesThePlacementKeys) {
   arcwheel::testing::TempDir dir;
-  DatSpec spec;
-  spec.height_m = TestHeightM;
-  const std::vector<unsigned char> dat = MetroProImage(spec);
-  std::ofstream(dir / "map.dat", std::ios::binary)
-      .write(reinterpret_cast<const char*>(dat.data()), static_cast<std::streamsize>(dat.size()));
+  const std::vector<unsigned char> dat = TestMetroProImage();
+  WriteText(dir / "map.dat", std::string(dat.begin(), dat.end()));
   const PixelMap pixels = ParseMetroProDat(dat, "map.dat");
   PolishJob job =
       ReadJob(dir, R"({"file": "map.dat", "rotation_deg": 90, "scale": -1, "centre_mm": [1, 2]})");
@@ -784,11 +789,8 @@ TEST(PolishJobErrorMap, RefusesUnknownAndMisappliedKeysByDottedName) {
 // ARCWHEEL_WRITE_SEEDS=fuzz/seeds they are also copied there.
 TEST(ErrorMapSeeds, SmallSamplesOfEachFormatReadBack) {
   arcwheel::testing::TempDir dir;
-  DatSpec spec;
-  spec.height_m = TestHeightM;
-  const std::vector<unsigned char> dat = MetroProImage(spec);
-  std::ofstream(dir / "map_small.dat", std::ios::binary)
-      .write(reinterpret_cast<const char*>(dat.data()), static_cast<std::streamsize>(dat.size()));
+  const std::vector<unsigned char> dat = TestMetroProImage();
+  WriteText(dir / "map_small.dat", std::string(dat.begin(), dat.end()));
   WriteDatx(dir / "map_small.datx", DatxSpec{}, 6, 4, DatxHeightNm);
   ErrorMap grid{.x0_mm = -2, .y0_mm = -1, .dx_mm = 1, .dy_mm = 1, .nx = 5, .ny = 3, .error_um = {}};
   for (int k = 0; k < 15; ++k) grid.error_um.push_back(k == 4 ? kNaN : 0.05 * k);

@@ -109,17 +109,23 @@ TEST(Viridis, LightnessRisesMonotonically) {
   }
 }
 
-TEST(HeatMap, PaintsTwoEqualHalvesInTheColoursOfTheirValues) {
+// A heat map on the nodes x = 0 .. n_x - 1, y = 0 .. n_y - 1, coloured over [0, 1]; no values yet.
+HeatMap IntegerNodeMap(std::size_t n_x, std::size_t n_y) {
   HeatMap map;
-  map.n_x = 10;
-  map.n_y = 4;
-  for (std::size_t i = 0; i < map.n_x; ++i) map.x_nodes.push_back(static_cast<double>(i));
-  for (std::size_t j = 0; j < map.n_y; ++j) map.y_nodes.push_back(static_cast<double>(j));
+  map.n_x = n_x;
+  map.n_y = n_y;
+  for (std::size_t i = 0; i < n_x; ++i) map.x_nodes.push_back(static_cast<double>(i));
+  for (std::size_t j = 0; j < n_y; ++j) map.y_nodes.push_back(static_cast<double>(j));
+  map.colour_min = 0.0;
+  map.colour_max = 1.0;
+  return map;
+}
+
+TEST(HeatMap, PaintsTwoEqualHalvesInTheColoursOfTheirValues) {
+  HeatMap map = IntegerNodeMap(10, 4);
   for (std::size_t i = 0; i < map.n_x; ++i) {
     for (std::size_t j = 0; j < map.n_y; ++j) map.values.push_back(i < 5 ? 0.0 : 1.0);
   }
-  map.colour_min = 0.0;
-  map.colour_max = 1.0;
   map.x.label = "x (mm)";
   map.y.label = "y (mm)";
   map.colour_bar_label = "v (um)";
@@ -134,14 +140,8 @@ TEST(HeatMap, KeepsEqualScalesOnBothAxesWhenAsked) {
   // Cells span 10 x 5 units. The plot area of a 400 x 300 pt figure leaves 270 x 252 pt for the
   // map (50 pt left, 80 right for the colour bar, 18 top, 30 bottom), so at equal scales the map
   // is 270 pt wide and 135 pt high.
-  HeatMap map;
-  map.n_x = 10;
-  map.n_y = 5;
-  for (std::size_t i = 0; i < map.n_x; ++i) map.x_nodes.push_back(static_cast<double>(i));
-  for (std::size_t j = 0; j < map.n_y; ++j) map.y_nodes.push_back(static_cast<double>(j));
+  HeatMap map = IntegerNodeMap(10, 5);
   map.values.assign(map.n_x * map.n_y, 1.0);
-  map.colour_min = 0.0;
-  map.colour_max = 1.0;
   map.equal_aspect = true;
   const auto histogram = PixelHistogram(RenderPng(map, 400.0, 300.0, 1.0));
   const auto yellow = histogram.find(Packed(Viridis(1.0)));

@@ -15,10 +15,7 @@
 namespace arcwheel::frames {
 namespace {
 
-using arcwheel::testing::ListFolder;
-using arcwheel::testing::RunArcwheel;
-using arcwheel::testing::TempDir;
-using arcwheel::testing::WriteText;
+using namespace arcwheel::testing;  // the shared test helpers (core/testing/testing.h)
 
 std::string Read(const std::filesystem::path& path) {
   std::ifstream in(path);

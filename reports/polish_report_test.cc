@@ -22,12 +22,7 @@ namespace arcwheel::reports {
 namespace {
 
 namespace fs = std::filesystem;
-using arcwheel::testing::ListFolder;
-using arcwheel::testing::PdfText;
-using arcwheel::testing::ReadText;
-using arcwheel::testing::RunArcwheel;
-using arcwheel::testing::SourceDir;
-using arcwheel::testing::TempDir;
+using namespace arcwheel::testing;  // the shared test helpers (core/testing/testing.h)
 using ::testing::HasSubstr;
 using ::testing::Not;
 

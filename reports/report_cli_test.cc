@@ -15,11 +15,7 @@
 namespace arcwheel::reports {
 namespace {
 
-using arcwheel::testing::ListFolder;
-using arcwheel::testing::PdfText;
-using arcwheel::testing::ReadText;
-using arcwheel::testing::RunArcwheel;
-using arcwheel::testing::TempDir;
+using namespace arcwheel::testing;  // the shared test helpers (core/testing/testing.h)
 using ::testing::HasSubstr;
 
 TEST(ReportCommand, WritesBothReportsAndJudgesAToleranceFile) {

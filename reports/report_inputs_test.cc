@@ -14,8 +14,7 @@
 namespace arcwheel::reports {
 namespace {
 
-using arcwheel::testing::ErrorMessageOf;
-using arcwheel::testing::TempDir;
+using namespace arcwheel::testing;  // the shared test helpers (core/testing/testing.h)
 using testing::FixtureOptions;
 using testing::FixtureSummary;
 using ::testing::HasSubstr;

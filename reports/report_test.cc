@@ -22,10 +22,7 @@ namespace arcwheel::reports {
 namespace {
 
 namespace fs = std::filesystem;
-using arcwheel::testing::ErrorMessageOf;
-using arcwheel::testing::ReadText;
-using arcwheel::testing::Shell;
-using arcwheel::testing::TempDir;
+using namespace arcwheel::testing;  // the shared test helpers (core/testing/testing.h)
 using testing::BrowserRun;
 using testing::FixtureOptions;
 using ::testing::HasSubstr;

@@ -101,6 +101,15 @@ TEST(ParseJob, RefusesEveryValueOutOfRangeInOneErrorWithTheFileTheKeysAndTheValu
       "grinding.job: 'job.json': path.step_over_mm = -2 violates > 0; machine.decimals = 12 violates 1 .. 9");
 }
 
+TEST(ParseJob, RefusesMapNodesThatAreNotWholeNumbers) {
+  json job = SmallJob();
+  job["prediction"]["map_nodes"] = {31.5, 21};
+  EXPECT_THAT(ExpectRefused(job),
+              HasSubstr("key 'prediction.map_nodes' expected two whole numbers, got [31.5,21]"));
+  job["prediction"]["map_nodes"] = {31, 1e12};
+  EXPECT_THAT(ExpectRefused(job), HasSubstr("key 'prediction.map_nodes' expected two whole numbers"));
+}
+
 TEST(ParseJob, RefusesAnApertureOffTheSurfacesDomainNamingThePoint) {
   json job = SmallJob();
   job["surface"] = {{"type", "even_asphere"}, {"vertex_radius_mm", 100.0}, {"conic", 0.0}};

@@ -345,11 +345,6 @@ void AddSimulate(CLI::App& headcenter) {
   simulate->add_option("--seed", args->seed, "random seed")->capture_default_str();
   simulate->callback([args] {
     frames::ForceSimulation s = args->simulation;
-    if (!(s.duration_s > 0.0 && s.sample_rate_hz > 0.0 && s.duration_s * s.sample_rate_hz >= 1.0 &&
-          s.duration_s * s.sample_rate_hz <= 1e8)) {
-      throw Error(ErrorCode::kInvalidOption, kHeadcenterStage,
-                  "--duration-s and --rate-hz must give between 1 and 1e8 samples");
-    }
     s.centre_mm = {args->centre[0], args->centre[1]};
     s.tare.force_N = {0.5, -0.3, -40.0};
     s.tare.moment_Nmm = {85.0, -140.0, 6.0};

@@ -5,6 +5,8 @@
 #include <filesystem>
 #include <future>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "acquisition/scan_reader.h"
 #include "cli/commands.h"
@@ -99,6 +101,11 @@ void Run(ProcessArgs& args) {
   args.processing.despike.method = processing::ParseDespikeMethod(args.despike_method);
   args.processing.rpm_source = processing::ParseRpmSource(args.rpm_source);
   args.fit.fit_span = fitting::ParseFitSpan(args.fit_span);
+  // Every bad option of both stages in one message, before the scan is read: the fit's would
+  // otherwise surface only after the whole scan had been processed.
+  std::vector<std::string> problems = args.processing.Problems();
+  for (std::string& problem : args.fit.Problems()) problems.push_back(std::move(problem));
+  ThrowIfProblems(ErrorCode::kInvalidOption, "process", problems);
   Progress progress(!args.quiet);
   progress.Update("reading", 0.0);
   // ReadScan forks (an HDF5 file is read first in a child process, core/hdf5_child.cc), and no

@@ -1,5 +1,7 @@
 #include "core/error.h"
 
+#include <fmt/format.h>
+
 namespace arcwheel {
 
 int ExitStatus(ErrorCode code) noexcept {
@@ -36,6 +38,14 @@ std::string_view ErrorCodeName(ErrorCode code) noexcept {
       return "internal error";
   }
   return "internal error";
+}
+
+std::string JoinProblems(const std::vector<std::string>& problems) {
+  return fmt::format("{}", fmt::join(problems, "; "));
+}
+
+void ThrowIfProblems(ErrorCode code, std::string_view stage, const std::vector<std::string>& problems) {
+  if (!problems.empty()) throw Error(code, stage, JoinProblems(problems));
 }
 
 }  // namespace arcwheel

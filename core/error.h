@@ -10,6 +10,7 @@
 #include <stdexcept>
 #include <string>
 #include <string_view>
+#include <vector>
 
 namespace arcwheel {
 
@@ -35,5 +36,13 @@ class Error : public std::runtime_error {
  private:
   ErrorCode code_;
 };
+
+// Every problem of an options struct's Problems(), in the order found, on one line:
+// "a = -1 violates > 0; b = 7 violates <= 5".
+[[nodiscard]] std::string JoinProblems(const std::vector<std::string>& problems);
+
+// Throws one Error{code, stage} listing every problem (JoinProblems), if there are any, so that a
+// user fixes them all in one go rather than one per run.
+void ThrowIfProblems(ErrorCode code, std::string_view stage, const std::vector<std::string>& problems);
 
 }  // namespace arcwheel

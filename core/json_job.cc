@@ -53,8 +53,7 @@ void JsonSection::Expected(const std::string& key, const std::string& expected) 
 void JsonSection::ThrowIfProblems(const std::vector<std::string>& problems) const {
   if (problems.empty()) return;
   throw Error(ErrorCode::kBadInput, context_->stage,
-              fmt::format("'{}': {} value{} out of range:\n  {}", context_->file, problems.size(),
-                          problems.size() == 1 ? " is" : "s are", fmt::join(problems, "\n  ")));
+              fmt::format("'{}': {}", context_->file, JoinProblems(problems)));
 }
 
 double JsonSection::FiniteNumber(const std::string& key, const std::string& expected) const {

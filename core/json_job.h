@@ -79,7 +79,7 @@ class JsonSection {
   [[noreturn]] void Fail(const std::string& key, const std::string& detail) const;
   // Throws "'<file>': key '<dotted.key>' expected <expected>, got <value as written>".
   [[noreturn]] void Expected(const std::string& key, const std::string& expected) const;
-  // Throws one Error listing every problem (one per line), if there are any.
+  // Throws one Error "'<file>': <every problem, JoinProblems>", if there are any.
   void ThrowIfProblems(const std::vector<std::string>& problems) const;
 
  private:

@@ -1,6 +1,7 @@
 #include "fitting/circle_fit.h"
 
 #include <ceres/ceres.h>
+#include <fmt/core.h>
 
 #include <Eigen/Dense>
 #include <algorithm>
@@ -9,6 +10,8 @@
 #include <string>
 #include <utility>
 #include <vector>
+
+#include "core/error.h"
 
 namespace arcwheel::fitting {
 namespace {
@@ -226,8 +229,14 @@ CircleFit Degenerate(CircleFit fit, const std::string& message) {
 
 }  // namespace
 
+std::vector<std::string> CircleFitOptions::Problems() const {
+  if (max_iterations >= 1) return {};
+  return {fmt::format("max_iterations = {} violates >= 1", max_iterations)};
+}
+
 CircleFit FitCircle(std::span<const double> x_in, std::span<const double> y_in,
                     std::span<const double> weights, const CircleFitOptions& options) {
+  ThrowIfProblems(ErrorCode::kInvalidOption, "fitting.circle", options.Problems());
   CircleFit fit;
   const std::size_t n = x_in.size();
   fit.n = static_cast<int>(n);

@@ -9,16 +9,19 @@
 #include <cmath>
 #include <span>
 #include <string>
+#include <vector>
 
 namespace arcwheel::fitting {
 
 enum class FitStatus { kNotRun, kConverged, kNoConvergence, kDegenerate };
 
 struct CircleFitOptions {
-  int max_iterations = 100;
+  int max_iterations = 100;  // Levenberg-Marquardt iterations, >= 1
   // Covariance scale: if true, the weights are 1/sigma_i and the covariance is (J^T W J)^-1
   // (known noise); if false it is scaled by the residual variance RSS/(n-3) (unknown noise).
   bool weights_are_inverse_sigmas = false;
+  // Empty when valid, else one line per violation with its value: "max_iterations = 0 violates >= 1".
+  [[nodiscard]] std::vector<std::string> Problems() const;
 };
 
 struct CircleFit {
@@ -40,7 +43,8 @@ struct CircleFit {
   [[nodiscard]] double radius_sigma_mm() const { return std::sqrt(covariance(2, 2)); }
 };
 
-// `weights` empty means all 1. Needs n >= 3 points not all on one line.
+// `weights` empty means all 1. Needs n >= 3 points not all on one line. Throws
+// Error{kInvalidOption, "fitting.circle"} for invalid options.
 [[nodiscard]] CircleFit FitCircle(std::span<const double> x, std::span<const double> y,
                                   std::span<const double> weights, const CircleFitOptions& options);
 

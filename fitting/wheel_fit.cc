@@ -333,13 +333,14 @@ void SetFormError(const processing::WheelMap& map, WheelFit& out) {
 
 std::vector<std::string> WheelFitOptions::Problems() const {
   std::vector<std::string> problems;
-  if (!(band_half_width_mm > 0)) problems.push_back("band_half_width_mm must be > 0");
-  if (min_points < 4) problems.push_back("min_points must be >= 4");
+  if (!(band_half_width_mm > 0))
+    problems.push_back(fmt::format("--band-half-width-mm = {} violates > 0", band_half_width_mm));
+  if (min_points < 4) problems.push_back(fmt::format("--min-points = {} violates >= 4", min_points));
   if (!(min_band_coverage >= 0 && min_band_coverage <= 1))
-    problems.push_back("min_band_coverage must be in 0..1");
+    problems.push_back(fmt::format("min_band_coverage = {} violates 0..1", min_band_coverage));
   if (!(min_phase_coverage > 0 && min_phase_coverage <= 1))
-    problems.push_back("min_phase_coverage must be in (0, 1]");
-  if (circle.max_iterations < 1) problems.push_back("circle.max_iterations must be >= 1");
+    problems.push_back(fmt::format("min_phase_coverage = {} violates (0, 1]", min_phase_coverage));
+  for (const std::string& p : circle.Problems()) problems.push_back("circle." + p);
   return problems;
 }
 
@@ -350,9 +351,7 @@ FitSpan ParseFitSpan(const std::string& name) {
 }
 
 WheelFit FitWheel(const processing::WheelMap& map, const WheelFitOptions& options) {
-  if (const auto problems = options.Problems(); !problems.empty()) {
-    throw Error(ErrorCode::kInvalidOption, kStage, problems.front());
-  }
+  ThrowIfProblems(ErrorCode::kInvalidOption, kStage, options.Problems());
   const CenteredFits fits = FitPhasesInCenteredBand(map, options);
   WheelFit out;
   SetBand(map, fits, options, out);

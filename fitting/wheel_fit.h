@@ -18,6 +18,9 @@ struct WheelFitOptions {
   double min_band_coverage = 0.6;   // fraction of the band's width the points must span
   double min_phase_coverage = 0.9;  // fraction of phases a runout/roundness node needs
   CircleFitOptions circle;          // each section's circle fit; a fit that does not converge is flagged
+  // Empty when valid, else one line per violation with its value, named by the flag of
+  // `arcwheel process` ("--min-points = 3 violates >= 4") or, without one, by its field here
+  // ("min_band_coverage", "circle.max_iterations").
   [[nodiscard]] std::vector<std::string> Problems() const;
 };
 

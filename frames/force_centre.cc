@@ -97,25 +97,18 @@ ForceRecord Tare(const ForceRecord& record, const Wrench& tare) {
 
 std::vector<std::string> ContactSolveOptions::Problems() const {
   std::vector<std::string> problems;
-  if (!std::isfinite(platform_height_mm)) {
-    problems.push_back(
-        fmt::format("ContactSolveOptions::platform_height_mm = {} violates finite", platform_height_mm));
-  }
+  if (!std::isfinite(platform_height_mm))
+    problems.push_back(fmt::format("--z0-mm = {} violates finite", platform_height_mm));
   if (!(min_normal_force_fraction >= 0.0 && min_normal_force_fraction < 1.0)) {
-    problems.push_back(fmt::format("ContactSolveOptions::min_normal_force_fraction = {} violates [0, 1)",
-                                   min_normal_force_fraction));
+    problems.push_back(fmt::format("--min-force-fraction = {} violates [0, 1)", min_normal_force_fraction));
   }
-  if (!(min_normal_force_N >= 0.0)) {
-    problems.push_back(
-        fmt::format("ContactSolveOptions::min_normal_force_N = {} violates >= 0", min_normal_force_N));
-  }
+  if (!(min_normal_force_N >= 0.0))
+    problems.push_back(fmt::format("--min-force-N = {} violates >= 0", min_normal_force_N));
   return problems;
 }
 
 ContactCentre SolveContactCentre(const ForceRecord& tared, const ContactSolveOptions& options) {
-  if (const auto problems = options.Problems(); !problems.empty()) {
-    throw Error(ErrorCode::kInvalidOption, kStage, problems.front());
-  }
+  ThrowIfProblems(ErrorCode::kInvalidOption, kStage, options.Problems());
   ValidateForceRecord(tared);
   const size_t n = tared.size();
   const double z0 = options.platform_height_mm;
@@ -213,6 +206,7 @@ MoveTables TabulateMoves(std::span<const MoveSample> samples) {
 namespace {
 
 ForceRecord SimulateRecord(const ForceSimulation& s, bool loaded, std::mt19937& rng) {
+  ThrowIfProblems(ErrorCode::kInvalidOption, kStage, s.Problems());
   const auto n = static_cast<size_t>(std::llround(s.duration_s * s.sample_rate_hz));
   const double omega = 2.0 * std::numbers::pi * s.pad_rpm / 60.0;
   const Eigen::Vector3d p(s.centre_mm.x(), s.centre_mm.y(), s.platform_height_mm);
@@ -249,6 +243,29 @@ ForceRecord SimulateRecord(const ForceSimulation& s, bool loaded, std::mt19937& 
 }
 
 }  // namespace
+
+std::vector<std::string> ForceSimulation::Problems() const {
+  std::vector<std::string> problems;
+  if (!centre_mm.allFinite()) {
+    problems.push_back(fmt::format("--centre-mm = {},{} violates finite", centre_mm.x(), centre_mm.y()));
+  }
+  if (!std::isfinite(platform_height_mm))
+    problems.push_back(fmt::format("--z0-mm = {} violates finite", platform_height_mm));
+  const bool duration_ok = duration_s > 0.0 && std::isfinite(duration_s);
+  const bool rate_ok = sample_rate_hz > 0.0 && std::isfinite(sample_rate_hz);
+  if (!duration_ok) problems.push_back(fmt::format("--duration-s = {} violates finite and > 0", duration_s));
+  if (!rate_ok) problems.push_back(fmt::format("--rate-hz = {} violates finite and > 0", sample_rate_hz));
+  // Only with both valid does their product say anything of its own.
+  const double samples = duration_s * sample_rate_hz;
+  if (duration_ok && rate_ok && !(samples >= 1.0 && samples <= 1e8)) {
+    problems.push_back(fmt::format("--duration-s * --rate-hz = {} samples violates 1 .. 1e8", samples));
+  }
+  if (!(normal_force_N >= 0.0 && std::isfinite(normal_force_N)))
+    problems.push_back(fmt::format("--normal-force-N = {} violates finite and >= 0", normal_force_N));
+  if (!(noise_fraction >= 0.0 && std::isfinite(noise_fraction)))
+    problems.push_back(fmt::format("--noise = {} violates finite and >= 0", noise_fraction));
+  return problems;
+}
 
 ForceRecord SimulateForceRecord(const ForceSimulation& simulation, std::mt19937& rng) {
   return SimulateRecord(simulation, true, rng);

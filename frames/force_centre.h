@@ -54,6 +54,8 @@ struct ContactSolveOptions {
   double min_normal_force_fraction = 0.1;
   // ... and those with |Fz| below this absolute value, in N. >= 0.
   double min_normal_force_N = 0.0;
+  // Empty when valid, else one line per violation with its value, named by the flag of
+  // `arcwheel headcenter`: "--min-force-N = -1 violates >= 0".
   [[nodiscard]] std::vector<std::string> Problems() const;
 };
 
@@ -129,9 +131,13 @@ struct ForceSimulation {
   // for the force channels, the normal force times |p| for the moment channels.
   double noise_fraction = 0.005;
   Wrench tare;  // sensor zero offset plus platform weight, added to all samples
+  // Empty when valid, else one line per violation with its value, named by the flag of `arcwheel
+  // headcenter simulate`: "--rate-hz = 0 violates > 0".
+  [[nodiscard]] std::vector<std::string> Problems() const;
 };
 
-// The loaded record (tare included) for `simulation`; `rng` draws the noise.
+// The loaded record (tare included) for `simulation`; `rng` draws the noise. Both simulations
+// throw Error{kInvalidOption, "frames.headcenter"} for invalid settings.
 [[nodiscard]] ForceRecord SimulateForceRecord(const ForceSimulation& simulation, std::mt19937& rng);
 // An unloaded record of the same length: tare plus noise.
 [[nodiscard]] ForceRecord SimulateUnloadedRecord(const ForceSimulation& simulation, std::mt19937& rng);

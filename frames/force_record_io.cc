@@ -5,6 +5,8 @@
 #include <array>
 #include <charconv>
 #include <map>
+#include <tuple>
+#include <vector>
 
 #include "core/error.h"
 #include "core/hdf5.h"
@@ -197,14 +199,18 @@ ForceRecordFile ReadHdf5(const std::filesystem::path& path, const ForceRecordRea
 
 }  // namespace
 
-ForceRecordFile ReadForceRecord(const std::filesystem::path& path, const ForceRecordReadOptions& options) {
-  for (const std::string* unit : {&options.force_unit, &options.moment_unit}) {
-    const Kind kind = unit == &options.force_unit ? Kind::kForce : Kind::kMoment;
-    if (!unit->empty() && !UnitFactor(kind, *unit)) {
-      throw Error(ErrorCode::kInvalidOption, kStage,
-                  fmt::format("unit '{}' is not {}", *unit, AcceptedUnits(kind)));
-    }
+std::vector<std::string> ForceRecordReadOptions::Problems() const {
+  std::vector<std::string> problems;
+  for (const auto& [unit, kind, flag] : {std::tuple{&force_unit, Kind::kForce, "--force-unit"},
+                                         std::tuple{&moment_unit, Kind::kMoment, "--moment-unit"}}) {
+    if (!unit->empty() && !UnitFactor(kind, *unit))
+      problems.push_back(fmt::format("{} = '{}' violates {}", flag, *unit, AcceptedUnits(kind)));
   }
+  return problems;
+}
+
+ForceRecordFile ReadForceRecord(const std::filesystem::path& path, const ForceRecordReadOptions& options) {
+  ThrowIfProblems(ErrorCode::kInvalidOption, kStage, options.Problems());
   const std::string extension = path.extension().string();
   if (extension == ".h5" || extension == ".hdf5") return ReadHdf5(path, options);
   return ReadCsv(path, options);

@@ -12,6 +12,7 @@
 #include <filesystem>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "frames/force_centre.h"
 
@@ -20,6 +21,9 @@ namespace arcwheel::frames {
 struct ForceRecordReadOptions {
   std::string force_unit;   // "N" or "kN"; empty: from the file
   std::string moment_unit;  // "Nmm" or "Nm"; empty: from the file
+  // Empty when valid, else one line per violation with its value, named by the flag of `arcwheel
+  // headcenter`: "--force-unit = 'lbf' violates N or kN".
+  [[nodiscard]] std::vector<std::string> Problems() const;
 };
 
 struct ForceRecordFile {

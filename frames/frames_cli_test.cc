@@ -194,6 +194,13 @@ TEST(HeadcenterCommand, SolvesASimulatedRecordAndRefusesNanForces) {
       2, "--z0-mm");
 }
 
+TEST(HeadcenterCommand, SimulateRefusesEveryBadSettingInOneMessage) {
+  TempDir dir;
+  ExpectRefused(
+      dir, fmt::format("headcenter simulate -o {} --duration-s 0 --noise -1", (dir / "rec.csv").string()), 2,
+      "frames.headcenter: --duration-s = 0 violates finite and > 0; --noise = -1 violates finite and >= 0");
+}
+
 TEST(HeadcenterCommand, CalibratesTheSensorAndTabulatesMoves) {
   TempDir dir;
   // Sensor frame = machine frame rotated by -20 deg and shifted by (300, 150).

@@ -423,7 +423,7 @@ ProgramTransformResult TransformMachineProgram(std::string_view text, bool gcode
 
 std::vector<std::string> ProgramTransformOptions::Problems() const {
   if (decimals == -1 || (decimals >= 1 && decimals <= 12)) return {};
-  return {fmt::format("ProgramTransformOptions::decimals = {} violates -1 or [1, 12]", decimals)};
+  return {fmt::format("--decimals = {} violates -1 or [1, 12]", decimals)};
 }
 
 ProgramKind ParseProgramKind(std::string_view name) {
@@ -452,9 +452,7 @@ ProgramKind DetectProgramKind(const std::filesystem::path& path, std::string_vie
 ProgramTransformResult TransformProgram(std::string_view text, ProgramKind kind, const Transform& transform,
                                         const std::string& source_name,
                                         const ProgramTransformOptions& options) {
-  if (const auto problems = options.Problems(); !problems.empty()) {
-    throw Error(ErrorCode::kInvalidOption, kStage, problems.front());
-  }
+  ThrowIfProblems(ErrorCode::kInvalidOption, kStage, options.Problems());
   switch (kind) {
     case ProgramKind::kToolpathCsv:
       return TransformToolpathCsv(text, transform, source_name);

@@ -38,6 +38,8 @@ struct ProgramTransformOptions {
   // Digits after the point of rewritten G-code and PMAC numbers, in [1, 12]; -1: the most that the
   // input's X/Y/Z words have (4 if none has a point), so the program keeps its own resolution.
   int decimals = -1;
+  // Empty when valid, else the violation with its value, named by the flag of `arcwheel transform
+  // apply`: "--decimals = 13 violates -1 or [1, 12]".
   [[nodiscard]] std::vector<std::string> Problems() const;
 };
 

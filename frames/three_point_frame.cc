@@ -1,6 +1,7 @@
 #include "frames/three_point_frame.h"
 
 #include <fmt/core.h>
+#include <fmt/format.h>
 
 #include <Eigen/Geometry>
 #include <algorithm>
@@ -34,14 +35,10 @@ std::string Signed(const std::string& number) { return number.front() == '-' ? n
 
 std::vector<std::string> ThreePointFrameOptions::Problems() const {
   std::vector<std::string> problems;
-  if (!(min_separation_mm > 0.0)) {
-    problems.push_back(
-        fmt::format("ThreePointFrameOptions::min_separation_mm = {} violates > 0", min_separation_mm));
-  }
-  if (!(min_angle_deg > 0.0 && min_angle_deg < 90.0)) {
-    problems.push_back(
-        fmt::format("ThreePointFrameOptions::min_angle_deg = {} violates (0, 90)", min_angle_deg));
-  }
+  if (!(min_separation_mm > 0.0))
+    problems.push_back(fmt::format("--min-separation-mm = {} violates > 0", min_separation_mm));
+  if (!(min_angle_deg > 0.0 && min_angle_deg < 90.0))
+    problems.push_back(fmt::format("--min-angle-deg = {} violates (0, 90)", min_angle_deg));
   return problems;
 }
 
@@ -57,9 +54,7 @@ Transform WorkpieceFrame::MachineToWorkpiece() const { return WorkpieceToMachine
 
 WorkpieceFrame ThreePointFrame(const Eigen::Vector3d& p1_mm, const Eigen::Vector3d& p2_mm,
                                const Eigen::Vector3d& p3_mm, const ThreePointFrameOptions& options) {
-  if (const auto problems = options.Problems(); !problems.empty()) {
-    throw Error(ErrorCode::kInvalidOption, kStage, problems.front());
-  }
+  ThrowIfProblems(ErrorCode::kInvalidOption, kStage, options.Problems());
   if (!p1_mm.allFinite() || !p2_mm.allFinite() || !p3_mm.allFinite()) {
     throw Error(ErrorCode::kBadInput, kStage, "a probed point has a non-finite coordinate");
   }
@@ -97,29 +92,24 @@ WorkpieceFrame ThreePointFrame(const Eigen::Vector3d& p1_mm, const Eigen::Vector
 std::vector<std::string> PmacAxisOptions::Problems() const {
   std::vector<std::string> problems;
   if (coordinate_system < 1)
-    problems.push_back(
-        fmt::format("PmacAxisOptions::coordinate_system = {} violates >= 1", coordinate_system));
+    problems.push_back(fmt::format("--coordinate-system = {} violates >= 1", coordinate_system));
   if (std::set<int>(motors.begin(), motors.end()).size() != 3 ||
       *std::min_element(motors.begin(), motors.end()) < 1) {
-    problems.push_back(fmt::format("PmacAxisOptions::motors = {},{},{} violates distinct and >= 1", motors[0],
-                                   motors[1], motors[2]));
+    problems.push_back(fmt::format("--motors = {} violates distinct and >= 1", fmt::join(motors, ",")));
   }
-  for (double counts : counts_per_mm) {
-    if (!(std::isfinite(counts) && counts != 0.0)) {
-      problems.push_back(
-          fmt::format("PmacAxisOptions::counts_per_mm = {} violates finite and non-zero", counts));
-    }
+  if (!std::all_of(counts_per_mm.begin(), counts_per_mm.end(),
+                   [](double counts) { return std::isfinite(counts) && counts != 0.0; })) {
+    problems.push_back(
+        fmt::format("--counts-per-mm = {} violates finite and non-zero", fmt::join(counts_per_mm, ",")));
   }
   if (decimals < 0 || decimals > 12)
-    problems.push_back(fmt::format("PmacAxisOptions::decimals = {} violates [0, 12]", decimals));
+    problems.push_back(fmt::format("--pmac-decimals = {} violates [0, 12]", decimals));
   return problems;
 }
 
 std::vector<std::string> PmacAxisDefinitions(const Transform& workpiece_to_machine,
                                              const PmacAxisOptions& options) {
-  if (const auto problems = options.Problems(); !problems.empty()) {
-    throw Error(ErrorCode::kInvalidOption, "frames.pmac", problems.front());
-  }
+  ThrowIfProblems(ErrorCode::kInvalidOption, "frames.pmac", options.Problems());
   const Eigen::Matrix3d linear = workpiece_to_machine.scale * workpiece_to_machine.linear;
   std::vector<std::string> lines = {fmt::format("&{}", options.coordinate_system)};
   constexpr std::array<char, 3> kAxes = {'X', 'Y', 'Z'};

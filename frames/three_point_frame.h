@@ -21,6 +21,8 @@ struct ThreePointFrameOptions {
   // The angle between P2 - P1 and P3 - P1 (and its supplement) must be at least this, in degrees;
   // below it the points are called collinear. In (0, 90).
   double min_angle_deg = 0.1;
+  // Empty when valid, else one line per violation with its value, named by the flag of `arcwheel
+  // frame`: "--min-angle-deg = 90 violates (0, 90)".
   [[nodiscard]] std::vector<std::string> Problems() const;
 };
 
@@ -45,6 +47,8 @@ struct PmacAxisOptions {
   std::array<double, 3> counts_per_mm = {1.0, 1.0, 1.0};
   // Digits after the decimal point of the coefficients (PMAC takes floating-point scale factors).
   int decimals = 6;
+  // Empty when valid, else one line per violation with its value, named by the flag of `arcwheel
+  // frame pmac`: "--motors = 1,1,3 violates distinct and >= 1".
   [[nodiscard]] std::vector<std::string> Problems() const;
 };
 

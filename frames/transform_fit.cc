@@ -316,14 +316,10 @@ void FillStatistics(std::span<const PointPair> pairs, TransformFit& fit) {
 
 std::vector<std::string> TransformFitOptions::Problems() const {
   std::vector<std::string> problems;
-  if (!(outlier_threshold > 0.0)) {
-    problems.push_back(
-        fmt::format("TransformFitOptions::outlier_threshold = {} violates > 0", outlier_threshold));
-  }
-  if (!(degenerate_ratio > 0.0 && degenerate_ratio < 1.0)) {
-    problems.push_back(
-        fmt::format("TransformFitOptions::degenerate_ratio = {} violates (0, 1)", degenerate_ratio));
-  }
+  if (!(outlier_threshold > 0.0))
+    problems.push_back(fmt::format("--outlier-threshold = {} violates > 0", outlier_threshold));
+  if (!(degenerate_ratio > 0.0 && degenerate_ratio < 1.0))
+    problems.push_back(fmt::format("degenerate_ratio = {} violates (0, 1)", degenerate_ratio));
   return problems;
 }
 
@@ -340,9 +336,7 @@ Transform FitTransformExact(std::span<const PointPair> pairs, TransformModel mod
 
 TransformFit FitTransform(std::span<const PointPair> pairs, TransformModel model,
                           const TransformFitOptions& options) {
-  if (const auto problems = options.Problems(); !problems.empty()) {
-    throw Error(ErrorCode::kInvalidOption, kStage, problems.front());
-  }
+  ThrowIfProblems(ErrorCode::kInvalidOption, kStage, options.Problems());
   TransformFit fit;
   fit.used.assign(pairs.size(), true);
   fit.transform = FitTransformExact(pairs, model, options.degenerate_ratio);

@@ -38,7 +38,9 @@ struct TransformFitOptions {
   // of the centred source points (or of the source-target cross-covariance) is below this
   // fraction of the largest. In (0, 1).
   double degenerate_ratio = 1e-9;
-  // Empty when valid, else one line per violation.
+  // Empty when valid, else one line per violation with its value, named by the flag of `arcwheel
+  // transform fit` / `headcenter calibrate` ("--outlier-threshold = 0 violates > 0") or, without
+  // one, by its field ("degenerate_ratio").
   [[nodiscard]] std::vector<std::string> Problems() const;
 };
 

@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <fstream>
+#include <limits>
 #include <sstream>
 
 #include "core/error.h"
@@ -140,7 +141,12 @@ void ReadPrediction(JsonSection& s, const std::optional<WheelSummary>& summary, 
     s.Expected("spindle_rpm", "the grinding spindle speed in rpm (it places the runout ripple)");
   }
   p.spindle_rpm = rpm.value_or(0.0);
+  // Whole numbers only: 2.5 must be refused, not used as 2, and a huge count never cast to int.
   const std::vector<double> nodes = s.Numbers("map_nodes", {201, 201});
+  for (const double n : nodes) {
+    if (n != std::floor(n) || std::abs(n) > std::numeric_limits<int>::max())
+      s.Expected("map_nodes", "two whole numbers");
+  }
   p.nodes_x = static_cast<int>(nodes[0]);
   p.nodes_y = static_cast<int>(nodes[1]);
 }

@@ -91,7 +91,26 @@ TEST(ParseJob, RefusesWrongTypesAndValuesNamingTheKey) {
   EXPECT_THAT(ExpectRefused(job), HasSubstr("key 'wheel.width_mm' expected a finite number, got nothing"));
   job = SmallJob();
   job["wheel"]["total_radius_mm"] = 40.0;
-  EXPECT_THAT(ExpectRefused(job), HasSubstr("base radius"));
+  EXPECT_THAT(ExpectRefused(job),
+              HasSubstr("wheel.total_radius_mm = 40 violates >= wheel.arc_radius_mm = 50"));
+}
+
+TEST(ParseJob, RefusesEveryValueOutOfRangeInOneErrorWithTheFileTheKeysAndTheValues) {
+  json job = SmallJob();
+  job["path"]["step_over_mm"] = -2.0;
+  job["machine"] = {{"decimals", 12}};
+  EXPECT_EQ(
+      ExpectRefused(job),
+      "grinding.job: 'job.json': path.step_over_mm = -2 violates > 0; machine.decimals = 12 violates 1 .. 9");
+}
+
+TEST(ParseJob, RefusesMapNodesThatAreNotWholeNumbers) {
+  json job = SmallJob();
+  job["prediction"]["map_nodes"] = {31.5, 21};
+  EXPECT_THAT(ExpectRefused(job),
+              HasSubstr("key 'prediction.map_nodes' expected two whole numbers, got [31.5,21]"));
+  job["prediction"]["map_nodes"] = {31, 1e12};
+  EXPECT_THAT(ExpectRefused(job), HasSubstr("key 'prediction.map_nodes' expected two whole numbers"));
 }
 
 TEST(ParseJob, RefusesAnApertureOffTheSurfacesDomainNamingThePoint) {

@@ -178,15 +178,19 @@ std::vector<double> WithoutPlane(const FormPrediction& p) {
 std::vector<std::string> PredictionOptions::Problems() const {
   std::vector<std::string> problems;
   if (!std::isfinite(arc_radius_error_mm)) {
-    problems.push_back("prediction.arc_radius_error_mm must be finite");
+    problems.push_back(
+        fmt::format("prediction.arc_radius_error_mm = {} violates finite", arc_radius_error_mm));
   }
+  // The runout comes from the wheel's summary.json (its phases) or from prediction.runout_um.
   if (runout_phase_deg.size() != runout_radial_um.size()) {
-    problems.push_back("prediction runout: phase and radial arrays differ in length");
+    problems.push_back(fmt::format("prediction runout sizes phase_deg = {}, radial_um = {} violates equal",
+                                   runout_phase_deg.size(), runout_radial_um.size()));
   }
   for (size_t i = 0; i < runout_phase_deg.size(); ++i) {
     if (!(runout_phase_deg[i] >= 0.0 && runout_phase_deg[i] < 360.0) ||
         (i > 0 && !(runout_phase_deg[i] > runout_phase_deg[i - 1]))) {
-      problems.push_back("prediction runout phases must ascend within [0, 360) degrees");
+      problems.push_back(fmt::format(
+          "prediction runout phase_deg[{}] = {} violates ascending within [0, 360)", i, runout_phase_deg[i]));
       break;
     }
   }
@@ -216,9 +220,7 @@ void SetEccentricRunout(double total_indicated_runout_um, PredictionOptions& opt
 
 FormPrediction PredictFormError(const Surface& surface, const Aperture& aperture, const Wheel& wheel,
                                 const PredictionOptions& options) {
-  if (const auto problems = options.Problems(); !problems.empty()) {
-    throw Error(ErrorCode::kInvalidOption, kStage, problems.front());
-  }
+  ThrowIfProblems(ErrorCode::kInvalidOption, kStage, options.Problems());
   FormPrediction p;
   const size_t nx = static_cast<size_t>(options.nodes_x), ny = static_cast<size_t>(options.nodes_y);
   for (int i = 0; i < options.nodes_x; ++i) {

@@ -405,12 +405,8 @@ std::vector<std::string> ToolpathOptions::Problems() const {
 
 ToolpathSummary GenerateToolpath(const Surface& surface, const Aperture& aperture, const Wheel& wheel,
                                  const ToolpathOptions& options, const RowSink& sink) {
-  if (const auto problems = options.Problems(); !problems.empty()) {
-    throw Error(ErrorCode::kInvalidOption, kStage, problems.front());
-  }
-  if (const auto problems = wheel.Problems(); !problems.empty()) {
-    throw Error(ErrorCode::kBadInput, kStage, problems.front());
-  }
+  ThrowIfProblems(ErrorCode::kInvalidOption, kStage, options.Problems());
+  ThrowIfProblems(ErrorCode::kBadInput, kStage, wheel.Problems());
   const std::vector<double> rows = PlanRows(surface, aperture, wheel, options.step_over_mm);
   const RowBuilder builder(surface, aperture, wheel, options, static_cast<int>(rows.size()));
   const int threads = WorkerCount(options.threads);

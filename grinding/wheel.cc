@@ -104,23 +104,29 @@ std::vector<std::string> Wheel::Problems() const {
   if (!(arc_radius_mm > 0.0)) {
     problems.push_back(fmt::format("wheel.arc_radius_mm = {} violates > 0", arc_radius_mm));
   }
+  // The job gives the total radius; the base radius is what is left of it below the arc.
   if (!(base_radius_mm >= 0.0)) {
-    problems.push_back(
-        fmt::format("wheel base radius = total radius - arc radius = {} mm violates >= 0", base_radius_mm));
+    problems.push_back(fmt::format("wheel.total_radius_mm = {} violates >= wheel.arc_radius_mm = {}",
+                                   TotalRadius(), arc_radius_mm));
   }
   if (!(half_width_mm > 0.0) || half_width_mm > arc_radius_mm) {
-    problems.push_back(fmt::format("wheel.width_mm / 2 = {} violates 0 < width / 2 <= arc radius {}",
-                                   half_width_mm, arc_radius_mm));
+    problems.push_back(
+        fmt::format("wheel.width_mm = {} violates 0 < width_mm <= 2 * wheel.arc_radius_mm = {}",
+                    2.0 * half_width_mm, 2.0 * arc_radius_mm));
   }
+  // The mean profile comes from the wheel's summary.json.
   if (profile_u_mm.size() != profile_error_um.size() || profile_u_mm.size() == 1) {
-    problems.push_back("wheel mean profile needs matching u_mm and error_um arrays of >= 2 values");
+    problems.push_back(
+        fmt::format("wheel profile sizes u_mm = {}, error_um = {} violates equal, and 0 or >= 2",
+                    profile_u_mm.size(), profile_error_um.size()));
   }
   for (size_t i = 0; i < profile_u_mm.size(); ++i) {
-    if (!std::isfinite(profile_u_mm[i]) ||
-        (i < profile_error_um.size() && !std::isfinite(profile_error_um[i])) ||
+    const double error_um = i < profile_error_um.size() ? profile_error_um[i] : 0.0;
+    if (!std::isfinite(profile_u_mm[i]) || !std::isfinite(error_um) ||
         (i > 0 && !(profile_u_mm[i] > profile_u_mm[i - 1]))) {
-      problems.push_back(
-          fmt::format("wheel mean profile node {} is not finite or u_mm is not strictly increasing", i));
+      problems.push_back(fmt::format(
+          "wheel profile node {}: u_mm = {}, error_um = {} violates finite, u_mm strictly increasing", i,
+          profile_u_mm[i], error_um));
       break;
     }
   }

@@ -20,15 +20,9 @@ constexpr double kOvershootToleranceUm = 1e-3;
 
 [[noreturn]] void Invalid(const std::string& what) { throw Error(ErrorCode::kInvalidOption, kStage, what); }
 
-[[noreturn]] void InvalidAll(const std::vector<std::string>& problems) {
-  std::string text = "invalid options:";
-  for (const std::string& problem : problems) text += "\n  " + problem;
-  Invalid(text);
-}
-
 void CheckOptions(const RemovalFunction& removal, const DwellOptions& o, std::size_t points) {
   removal.Check();
-  if (const std::vector<std::string> problems = o.Problems(); !problems.empty()) InvalidAll(problems);
+  ThrowIfProblems(ErrorCode::kInvalidOption, kStage, o.Problems());
   if (!o.least_dwell_s.empty() && o.least_dwell_s.size() != points) {
     Invalid(fmt::format("least_dwell_s has {} values for {} path points", o.least_dwell_s.size(), points));
   }
@@ -295,14 +289,8 @@ ErrorMap Scatter(const ErrorMap& like, const Rows& rows, const Eigen::VectorXd& 
 
 }  // namespace
 
-namespace {
-void CheckPathOptions(const RasterOptions& o) {
-  if (const std::vector<std::string> problems = o.Problems(); !problems.empty()) InvalidAll(problems);
-}
-}  // namespace
-
 std::vector<Eigen::Vector2d> SpiralPath(const surfaces::Aperture& aperture, const RasterOptions& o) {
-  CheckPathOptions(o);
+  ThrowIfProblems(ErrorCode::kInvalidOption, kStage, o.Problems());
   const bool circle = aperture.shape == surfaces::Aperture::Shape::kCircle;
   const double radius =
       circle ? aperture.HalfY() + o.extension_mm
@@ -335,7 +323,7 @@ std::vector<Eigen::Vector2d> SpiralPath(const surfaces::Aperture& aperture, cons
 }
 
 std::vector<Eigen::Vector2d> RasterPath(const surfaces::Aperture& aperture, const RasterOptions& o) {
-  CheckPathOptions(o);
+  ThrowIfProblems(ErrorCode::kInvalidOption, kStage, o.Problems());
   const bool circle = aperture.shape == surfaces::Aperture::Shape::kCircle;
   const double half_y = aperture.HalfY() + o.extension_mm;
   const int lines = static_cast<int>(std::ceil(2.0 * half_y / o.line_spacing_mm - 1e-9)) + 1;

@@ -1,5 +1,7 @@
 #include "processing/despike.h"
 
+#include <fmt/core.h>
+
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -232,13 +234,14 @@ void DespikeByMovingMean(std::span<double> z, int w, double threshold_mm, Despik
 
 std::vector<std::string> DespikeOptions::Problems() const {
   std::vector<std::string> problems;
-  if (window_half_width < 1 || window_half_width > 50) {
-    problems.push_back("despike window_half_width = " + std::to_string(window_half_width) +
-                       " violates 1..50");
-  }
-  if (!(threshold_sigmas > 0)) problems.push_back("despike threshold_sigmas must be > 0");
-  if (!(min_threshold_um >= 0)) problems.push_back("despike min_threshold_um must be >= 0");
-  if (!std::isfinite(threshold_um)) problems.push_back("despike threshold_um must be finite");
+  if (window_half_width < 1 || window_half_width > 50)
+    problems.push_back(fmt::format("--despike-window = {} violates 1..50", window_half_width));
+  if (!(threshold_sigmas > 0))
+    problems.push_back(fmt::format("--despike-sigmas = {} violates > 0", threshold_sigmas));
+  if (!(min_threshold_um >= 0))
+    problems.push_back(fmt::format("despike.min_threshold_um = {} violates >= 0", min_threshold_um));
+  if (!std::isfinite(threshold_um))
+    problems.push_back(fmt::format("--despike-threshold-um = {} violates finite", threshold_um));
   return problems;
 }
 
@@ -263,9 +266,7 @@ std::string DespikeMethodName(DespikeMethod method) {
 }
 
 DespikeResult Despike(std::span<double> z_mm, double noise_sigma_mm, const DespikeOptions& options) {
-  if (const auto problems = options.Problems(); !problems.empty()) {
-    throw Error(ErrorCode::kInvalidOption, "processing.despike", problems.front());
-  }
+  ThrowIfProblems(ErrorCode::kInvalidOption, "processing.despike", options.Problems());
   DespikeResult result;
   result.threshold_um =
       options.threshold_um > 0

@@ -27,7 +27,9 @@ struct DespikeOptions {
   double threshold_um = 0.0;
   double threshold_sigmas = 6.0;
   double min_threshold_um = 0.5;
-  // Empty when valid, else one line per violation.
+  // Empty when valid, else one line per violation naming the option as `arcwheel process` spells
+  // it, with its value: "--despike-sigmas = 0 violates > 0" (a field without a flag by its
+  // ProcessOptions path, "despike.min_threshold_um").
   [[nodiscard]] std::vector<std::string> Problems() const;
 };
 

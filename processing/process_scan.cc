@@ -55,9 +55,7 @@ std::size_t StuckRunSamples(const acquisition::Scan& scan, double stuck_run_deg)
 }
 
 void CheckOptions(const acquisition::Scan& scan, const ProcessOptions& options) {
-  if (const auto problems = options.Problems(); !problems.empty()) {
-    throw Error(ErrorCode::kInvalidOption, kStage, problems.front());
-  }
+  ThrowIfProblems(ErrorCode::kInvalidOption, kStage, options.Problems());
   if (options.rpm_source == RpmSource::kEncoder && !scan.has_encoder()) {
     throw Error(ErrorCode::kInvalidOption, kStage,
                 "'" + scan.path + "' has no angle column for --rpm-source encoder");
@@ -158,11 +156,14 @@ void ChooseSpeed(const acquisition::Scan& scan, std::span<const double> rho, con
 
 std::vector<std::string> ProcessOptions::Problems() const {
   std::vector<std::string> problems = despike.Problems();
-  for (auto& p : map.Problems()) problems.push_back(std::move(p));
-  if (!(stuck_run_deg >= 0.0 && stuck_run_deg <= 360.0)) problems.push_back("stuck_run_deg violates 0..360");
-  if (!std::isfinite(beam_offset_mm)) problems.push_back("beam_offset_mm must be finite");
-  if (speed.max_harmonic < 1 || speed.max_harmonic > 60)
-    problems.push_back("speed max_harmonic violates 1..60");
+  for (std::string& p : speed.Problems()) problems.push_back(std::move(p));
+  for (std::string& p : map.Problems()) problems.push_back(std::move(p));
+  if (!std::isfinite(beam_offset_mm))
+    problems.push_back(fmt::format("--beam-offset-mm = {} violates finite", beam_offset_mm));
+  if (!std::isfinite(wheel_radius_mm))
+    problems.push_back(fmt::format("--wheel-radius-mm = {} violates finite", wheel_radius_mm));
+  if (!(stuck_run_deg >= 0.0 && stuck_run_deg <= 360.0))
+    problems.push_back(fmt::format("--stuck-run-deg = {} violates 0..360", stuck_run_deg));
   return problems;
 }
 

@@ -34,6 +34,8 @@ struct ProcessOptions {
   // Runs of exactly equal readings lasting this much of a turn (and at least 16 samples) are a
   // stuck sensor and are dropped (processing/stuck_readings.h); 0 keeps them.
   double stuck_run_deg = 20.0;
+  // Every problem of the nested options and of these, one line each with its value, named as
+  // `arcwheel process` spells the option (see DespikeOptions::Problems).
   [[nodiscard]] std::vector<std::string> Problems() const;
 };
 

@@ -1,5 +1,7 @@
 #include "processing/spindle_speed.h"
 
+#include <fmt/core.h>
+
 #include <Eigen/Dense>
 #include <cmath>
 #include <complex>
@@ -7,6 +9,7 @@
 #include <vector>
 
 #include "core/check.h"
+#include "core/error.h"
 #include "processing/helix_geometry.h"
 
 namespace arcwheel::processing {
@@ -257,8 +260,24 @@ void SetResult(double rpm, double sigma_relative, const SpindleSpeedOptions& opt
 
 }  // namespace
 
+std::vector<std::string> SpindleSpeedOptions::Problems() const {
+  std::vector<std::string> problems;
+  const auto require_non_negative = [&problems](const char* name, double value) {
+    if (!(value >= 0.0 && std::isfinite(value)))
+      problems.push_back(fmt::format("speed.{} = {} violates finite and >= 0", name, value));
+  };
+  if (max_harmonic < 1 || max_harmonic > 60)
+    problems.push_back(fmt::format("speed.max_harmonic = {} violates 1..60", max_harmonic));
+  require_non_negative("min_harmonic_snr", min_harmonic_snr);
+  require_non_negative("min_harmonic_amplitude_um", min_harmonic_amplitude_um);
+  require_non_negative("significance_sigmas", significance_sigmas);
+  if (iterations < 0) problems.push_back(fmt::format("speed.iterations = {} violates >= 0", iterations));
+  return problems;
+}
+
 SpindleSpeedEstimate EstimateSpindleSpeed(const acquisition::Scan& scan, std::span<const double> z,
                                           const SpindleSpeedOptions& options) {
+  ThrowIfProblems(ErrorCode::kInvalidOption, "processing.speed", options.Problems());
   ARCWHEEL_CHECK(!scan.has_encoder()) << "speed estimation needs a scan without an encoder";
   SpindleSpeedEstimate estimate;
   estimate.nominal_rpm = *scan.metadata.spindle_rpm;

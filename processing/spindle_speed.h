@@ -15,17 +15,24 @@
 
 #include <span>
 #include <string>
+#include <vector>
 
 #include "acquisition/scan.h"
 
 namespace arcwheel::processing {
 
 struct SpindleSpeedOptions {
-  int max_harmonic = 12;                    // H, 1..60
-  double min_harmonic_snr = 8.0;            // a harmonic is used when its mean amplitude is this many sigmas
-  double min_harmonic_amplitude_um = 0.05;  // ... and at least this large (a phase needs an amplitude)
-  double significance_sigmas = 3.0;         // the estimate replaces the nominal only beyond this many sigmas
-  int iterations = 3;                       // re-binning at the improved speed
+  int max_harmonic = 12;  // H, 1..60
+  // A harmonic is used when its mean amplitude is this many sigmas (>= 0) ...
+  double min_harmonic_snr = 8.0;
+  // ... and at least this large (a phase needs an amplitude), >= 0.
+  double min_harmonic_amplitude_um = 0.05;
+  // The estimate replaces the nominal only beyond this many sigmas, >= 0.
+  double significance_sigmas = 3.0;
+  int iterations = 3;  // re-binning at the improved speed, >= 0
+  // Empty when valid, else one line per violation with its value. None of these has a flag of
+  // `arcwheel process`: they are named as fields of ProcessOptions ("speed.max_harmonic").
+  [[nodiscard]] std::vector<std::string> Problems() const;
 };
 
 struct SpindleSpeedEstimate {

@@ -1,5 +1,7 @@
 #include "processing/wheel_map.h"
 
+#include <fmt/core.h>
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -102,19 +104,20 @@ void InterpolateSection(const Section& section, std::span<const double> nodes, d
 std::vector<std::string> MapOptions::Problems() const {
   std::vector<std::string> problems;
   if (phases < 4 || phases > 36000)
-    problems.push_back("phases = " + std::to_string(phases) + " violates 4..36000");
-  if (!std::isfinite(knot_step_deg) || knot_step_deg > 90) problems.push_back("knot_step_deg must be <= 90");
-  if (!std::isfinite(axial_step_mm)) problems.push_back("axial_step_mm must be finite");
-  if (min_support < 1) problems.push_back("min_support must be >= 1");
-  if (!(max_sigma_ratio >= 1.0)) problems.push_back("max_sigma_ratio must be >= 1");
+    problems.push_back(fmt::format("--phases = {} violates 4..36000", phases));
+  if (!std::isfinite(knot_step_deg) || knot_step_deg > 90)
+    problems.push_back(fmt::format("--knot-step-deg = {} violates finite and <= 90", knot_step_deg));
+  if (!std::isfinite(axial_step_mm))
+    problems.push_back(fmt::format("--axial-step-mm = {} violates finite", axial_step_mm));
+  if (min_support < 1) problems.push_back(fmt::format("map.min_support = {} violates >= 1", min_support));
+  if (!(max_sigma_ratio >= 1.0))
+    problems.push_back(fmt::format("map.max_sigma_ratio = {} violates >= 1", max_sigma_ratio));
   return problems;
 }
 
 WheelMap BuildWheelMap(std::span<const double> rho, const HelixGeometry& geometry, double noise_sigma_mm,
                        std::span<const std::size_t> despiked, const MapOptions& options) {
-  if (const auto problems = options.Problems(); !problems.empty()) {
-    throw Error(ErrorCode::kInvalidOption, "processing.map", problems.front());
-  }
+  ThrowIfProblems(ErrorCode::kInvalidOption, "processing.map", options.Problems());
   const auto valid = static_cast<std::size_t>(
       std::count_if(rho.begin(), rho.end(), [](double v) { return std::isfinite(v); }));
   WheelMap map;

@@ -20,6 +20,9 @@ struct MapOptions {
   double axial_step_mm = 0.0;  // map node spacing; <= 0: one helix pitch
   int min_support = 2;         // a section point needs this many valid samples within its two knot intervals
   double max_sigma_ratio = 1.5;  // ... and a sigma at most this many times the median point's; >= 1
+  // Empty when valid, else one line per violation with its value, named by the flag of
+  // `arcwheel process` ("--phases = 2 violates 4..36000") or, without one, by its ProcessOptions
+  // path ("map.min_support").
   [[nodiscard]] std::vector<std::string> Problems() const;
 };
 

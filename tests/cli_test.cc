@@ -146,6 +146,19 @@ INSTANTIATE_TEST_SUITE_P(
         BadInput{"UnknownType", "scan.dat", "1 2 3", "unknown scan file type"}),
     [](const ::testing::TestParamInfo<BadInput>& param_info) { return std::string(param_info.param.name); });
 
+TEST(Cli, ProcessRefusesEveryBadOptionOfBothStagesInOneMessageBeforeReadingTheScan) {
+  TempDir dir;
+  WriteText(dir / "scan.csv", "never read\n");
+  const auto run = RunArcwheel("process " + (dir / "scan.csv").string() + " -o " + (dir / "out").string() +
+                               " --phases 2 --despike-sigmas 0 --min-points 3");
+  EXPECT_EQ(run.exit_status, 2) << run.output;
+  EXPECT_NE(run.output.find("process: --despike-sigmas = 0 violates > 0; --phases = 2 violates 4..36000; "
+                            "--min-points = 3 violates >= 4"),
+            std::string::npos)
+      << run.output;
+  EXPECT_FALSE(std::filesystem::exists(dir / "out"));
+}
+
 TEST(Cli, TruncatedHdf5IsRefusedAndEarlierOutputsSurvive) {
   TempDir dir;
   ASSERT_EQ(RunArcwheel("simulate " + (dir / "scan.h5").string()).exit_status, 0);

@@ -11,6 +11,8 @@
 #include "acquisition/simulate.h"
 #include "fitting/outputs.h"
 #include "fitting/wheel_fit.h"
+#include "fitting/wheel_model.h"
+#include "processing/helix_geometry.h"
 #include "processing/process_scan.h"
 
 namespace {
@@ -57,6 +59,21 @@ void BM_ProcessEndToEnd(benchmark::State& state) {
       static_cast<double>(samples) * static_cast<double>(state.iterations()), benchmark::Counter::kIsRate);
   state.counters["samples"] = static_cast<double>(samples);
 }
+
+// The wheel model's fit alone (fitting/wheel_model.h), on a scan already processed and fitted per
+// phase, with the knots chosen from the data as `process` does.
+void BM_WheelModel(benchmark::State& state) {
+  acquisition::Scan scan = acquisition::ReadScan(ScanWithSamples(static_cast<double>(state.range(0))));
+  const auto processed = processing::ProcessScanInPlace(scan, {});
+  const auto fit = fitting::FitWheel(processed.map, {});
+  const processing::HelixGeometry geometry(scan, processed.rpm_used);
+  fitting::WheelModel model;
+  for (auto _ : state) model = fitting::FitWheelModel(scan.z_mm, geometry, processed.map, fit, {});
+  state.counters["samples_in_band"] = static_cast<double>(model.samples);
+  state.counters["iterations"] = model.iterations;
+  state.counters["knots_Ra_a_b"] = model.radius_knots * 10000 + model.axial_knots * 100 + model.runout_knots;
+}
+BENCHMARK(BM_WheelModel)->Arg(1000000)->Arg(10000000)->Unit(benchmark::kMillisecond)->Iterations(3);
 
 // Not a speed figure: the error of the mean arc radius against the simulated truth, in reported
 // sigmas, at sizes beyond what the test suite runs (issue "Real-world scans", point 5). One

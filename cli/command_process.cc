@@ -4,6 +4,7 @@
 
 #include <filesystem>
 #include <future>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -17,6 +18,7 @@
 #include "core/text_encoding.h"
 #include "fitting/outputs.h"
 #include "fitting/wheel_fit.h"
+#include "fitting/wheel_model.h"
 #include "processing/process_scan.h"
 #include "reports/report.h"
 #include "reports/tolerances.h"
@@ -31,6 +33,8 @@ struct ProcessArgs {
   std::string outdir;
   processing::ProcessOptions processing;
   fitting::WheelFitOptions fit;
+  fitting::WheelModelOptions model;
+  bool no_model = false;
   std::string despike_method = "median";
   std::string rpm_source = "auto";
   std::string fit_span = "band";
@@ -68,11 +72,16 @@ fitting::RunRecord MakeRecord(const ProcessArgs& args, const acquisition::Scan& 
       {std::string(parameter::kBeamOffsetMm), p.beam_offset_mm},
       {std::string(parameter::kWheelRadiusMm), p.wheel_radius_mm},
       {std::string(parameter::kStuckRunDeg), p.stuck_run_deg},
+      {std::string(parameter::kModelKnots), args.model.radius_knots},
+      {std::string(parameter::kModelAxialKnots), args.model.axial_knots},
+      {std::string(parameter::kModelRunoutKnots), args.model.runout_knots},
+      {std::string(parameter::kModelProfileStepMm), args.model.profile_knot_step_mm},
   };
   record.text_parameters = {{std::string(parameter::kDespikeMethod), args.despike_method},
                             {std::string(parameter::kRpmSource), args.rpm_source},
                             {std::string(parameter::kFitSpan), args.fit_span},
-                            {std::string(parameter::kFilter), "none"}};
+                            {std::string(parameter::kFilter), "none"},
+                            {std::string(parameter::kModel), args.no_model ? "off" : "on"}};
   return record;
 }
 
@@ -97,6 +106,30 @@ void PrintHeadline(const ProcessArgs& args, const processing::ProcessedScan& p, 
   fmt::print("max roundness        {:.3f} um\n", f.max_roundness_um);
 }
 
+// The wheel model over every sample in the band (fitting/wheel_model.h). The per-phase fits are
+// the contract's results, so a model that cannot be fitted is a warning, not a failed run.
+std::optional<fitting::WheelModel> FitModelUnlessOff(const ProcessArgs& args, const acquisition::Scan& scan,
+                                                     processing::ProcessedScan& processed,
+                                                     const fitting::WheelFit& fit) {
+  if (args.no_model) return std::nullopt;
+  try {
+    const processing::HelixGeometry geometry(scan, processed.rpm_used);
+    return fitting::FitWheelModel(scan.z_mm, geometry, processed.map, fit, args.model);
+  } catch (const Error& e) {
+    if (e.code() != ErrorCode::kFitFailed) throw;
+    processed.warnings.push_back(std::string("no wheel model: ") + e.what());
+    return std::nullopt;
+  }
+}
+
+void PrintModelHeadline(const fitting::WheelModel& m) {
+  fmt::print("model arc radius     {:.5f} +- {:.5f} mm, range {:.5f} +- {:.5f} mm\n", m.mean_arc_radius_mm,
+             m.mean_arc_radius_sigma_mm, m.arc_radius_range_mm, m.arc_radius_range_sigma_mm);
+  fmt::print("model radius varies  {} (chi-square {:.1f} on {} dof, p = {:.2g}); knots Ra/a/b {}/{}/{}\n",
+             m.variation_significant ? "yes" : "no", m.variation_chi2, m.variation_dof, m.variation_p_value,
+             m.radius_knots, m.axial_knots, m.runout_knots);
+}
+
 void Run(ProcessArgs& args) {
   args.processing.despike.method = processing::ParseDespikeMethod(args.despike_method);
   args.processing.rpm_source = processing::ParseRpmSource(args.rpm_source);
@@ -105,6 +138,9 @@ void Run(ProcessArgs& args) {
   // otherwise surface only after the whole scan had been processed.
   std::vector<std::string> problems = args.processing.Problems();
   for (std::string& problem : args.fit.Problems()) problems.push_back(std::move(problem));
+  if (!args.no_model) {
+    for (std::string& problem : args.model.Problems()) problems.push_back(std::move(problem));
+  }
   ThrowIfProblems(ErrorCode::kInvalidOption, "process", problems);
   Progress progress(!args.quiet);
   progress.Update("reading", 0.0);
@@ -116,15 +152,18 @@ void Run(ProcessArgs& args) {
   fitting::RunRecord record = MakeRecord(args, scan);
   ThrowIfInterrupted();
   progress.Update("processing", 0.3);
-  const processing::ProcessedScan processed = processing::ProcessScan(std::move(scan), args.processing);
+  processing::ProcessedScan processed = processing::ProcessScanInPlace(scan, args.processing);
   progress.Update("fitting", 0.7);
   const fitting::WheelFit fit = fitting::FitWheel(processed.map, args.fit);
+  const std::optional<fitting::WheelModel> model = FitModelUnlessOff(args, scan, processed, fit);
+  scan = {};  // the samples are no longer needed
   progress.Update("writing", 0.9);
   record.input_sha256 = sha256.get();
   ThrowIfInterrupted();
-  fitting::WriteProcessOutputs(args.outdir, record, processed, fit);
+  fitting::WriteProcessOutputs(args.outdir, record, processed, fit, model ? &*model : nullptr);
   progress.Done();
   if (!args.quiet) PrintHeadline(args, processed, fit);
+  if (!args.quiet && model) PrintModelHeadline(*model);
   if (!args.report_formats.empty()) {
     // The report is drawn from the files just written, exactly as `arcwheel report` would.
     reports::Tolerances tolerances;
@@ -186,6 +225,19 @@ void AddProcessCommand(CLI::App& app) {
   cmd->add_option("--tolerances", args->tolerance_file,
                   "tolerance file for the report's pass/fail (docs/reports.md)")
       ->check(CLI::ExistingFile);
+  cmd->add_option("--model-knots", args->model.radius_knots,
+                  "knots per turn of the model's arc radius Ra(c); 0: chosen from the data, 1: constant")
+      ->capture_default_str();
+  cmd->add_option("--model-axial-knots", args->model.axial_knots,
+                  "knots per turn of the model's arc-centre axial position a(c); 0: chosen, 1: constant")
+      ->capture_default_str();
+  cmd->add_option("--model-runout-knots", args->model.runout_knots,
+                  "knots per turn of the model's arc-centre radial position b(c); 0: chosen")
+      ->capture_default_str();
+  cmd->add_option("--model-profile-step-mm", args->model.profile_knot_step_mm,
+                  "knot spacing of the model's common profile error p(u)")
+      ->capture_default_str();
+  cmd->add_flag("--no-model", args->no_model, "skip the wheel model (docs/wheel_model.md)");
   cmd->add_flag("-q,--quiet", args->quiet, "no progress and no headline");
   cmd->callback([args] { Run(*args); });
 }

@@ -7,6 +7,8 @@ find_package(CLI11 REQUIRED)
 find_package(fmt REQUIRED)
 find_package(OpenSSL REQUIRED COMPONENTS Crypto)
 find_package(Threads REQUIRED)
+# Boost.Math (header-only): only the chi-square distribution of the wheel model's test (fitting/).
+find_package(Boost 1.74 REQUIRED)
 # OpenCV: only the Delaunay triangulation (cv::Subdiv2D) for scattered error maps (polishing/).
 find_package(OpenCV REQUIRED COMPONENTS core imgproc)
 if(ARCWHEEL_BUILD_TESTS)

@@ -69,8 +69,63 @@ json PhasesJson(const processing::WheelMap& map, const WheelFit& fit) {
   return phases;
 }
 
+json ModelJson(const WheelModel& m) {
+  namespace mk = key::model;
+  json harmonics = json::array();
+  for (const RadiusHarmonic& h : m.radius_harmonics) {
+    harmonics.push_back({{mk::harmonic::kOrder, h.order},
+                         {mk::harmonic::kAmplitudeUm, Number(h.amplitude_um)},
+                         {mk::harmonic::kAmplitudeSigmaUm, Number(h.amplitude_sigma_um)},
+                         {mk::harmonic::kPhaseDeg, Number(h.phase_deg)},
+                         {mk::harmonic::kPhaseSigmaDeg, Number(h.phase_sigma_deg)}});
+  }
+  json j;
+  j[mk::kRadiusKnots] = m.radius_knots;
+  j[mk::kAxialKnots] = m.axial_knots;
+  j[mk::kRunoutKnots] = m.runout_knots;
+  j[mk::kKnotsChosenBy] = m.knots_chosen ? "bic" : "given";
+  j[mk::kProfileCoefficients] = m.profile_coefficients;
+  j[mk::kSamples] = m.samples;
+  j[mk::kParameters] = m.parameters;
+  j[mk::kIterations] = m.iterations;
+  j[mk::kResidualRmsUm] = Number(m.residual_rms_um);
+  j[mk::kNoiseSigmaUm] = Number(m.noise_sigma_um);
+  j[mk::kMeanArcRadiusMm] = Number(m.mean_arc_radius_mm);
+  j[mk::kMeanArcRadiusSigmaMm] = Number(m.mean_arc_radius_sigma_mm);
+  j[mk::kArcRadiusRangeMm] = Number(m.arc_radius_range_mm);
+  j[mk::kArcRadiusRangeSigmaMm] = Number(m.arc_radius_range_sigma_mm);
+  j[mk::kVariationChi2] = Number(m.variation_chi2);
+  j[mk::kVariationDof] = m.variation_dof;
+  j[mk::kVariationPValue] = Number(m.variation_p_value);
+  j[mk::kSignificanceLevel] = m.significance_level;
+  j[mk::kVariationSignificant] = m.variation_significant;
+  j[mk::kProfilePvUm] = Number(m.profile_pv_um);
+  j[mk::kRadiusHarmonics] = harmonics;
+  return j;
+}
+
+void WriteModel(hdf5::File& file, const processing::WheelMap& map, const WheelModel& m) {
+  const hsize_t n_phase = m.phase_deg.size(), n_u = m.profile_u_mm.size();
+  const hsize_t n = m.coefficients.size();
+  file.CreateGroup(std::string(h5::kModelGroup));
+  file.WriteDoubles(std::string(h5::kModelArcRadiusMm), m.arc_radius_mm, {n_phase});
+  file.WriteDoubles(std::string(h5::kModelArcRadiusSigmaMm), m.arc_radius_sigma_mm, {n_phase});
+  file.WriteDoubles(std::string(h5::kModelCenterAxialMm), m.center_axial_mm, {n_phase});
+  file.WriteDoubles(std::string(h5::kModelCenterAxialSigmaMm), m.center_axial_sigma_mm, {n_phase});
+  file.WriteDoubles(std::string(h5::kModelCenterRadialMm), m.center_radial_mm, {n_phase});
+  file.WriteDoubles(std::string(h5::kModelCenterRadialSigmaMm), m.center_radial_sigma_mm, {n_phase});
+  file.WriteDoubles(std::string(h5::kModelProfileUMm), m.profile_u_mm, {n_u});
+  file.WriteDoubles(std::string(h5::kModelProfileErrorUm), m.profile_error_um, {n_u});
+  file.WriteDoubles(std::string(h5::kModelProfileErrorSigmaUm), m.profile_error_sigma_um, {n_u});
+  if (m.residual_um.size() == map.n_phase() * map.n_y()) {
+    file.WriteDoubles(std::string(h5::kModelResidualUm), m.residual_um, {map.n_phase(), map.n_y()});
+  }
+  file.WriteDoubles(std::string(h5::kModelCoefficients), m.coefficients, {n});
+  file.WriteDoubles(std::string(h5::kModelCovariance), m.covariance, {n, n});
+}
+
 void WriteMap(const std::filesystem::path& path, const RunRecord& record,
-              const processing::ProcessedScan& processed, const WheelFit& fit) {
+              const processing::ProcessedScan& processed, const WheelFit& fit, const WheelModel* model) {
   const processing::WheelMap& map = processed.map;
   hdf5::File file = hdf5::File::Create(path);
   const hsize_t n_phase = map.n_phase();
@@ -107,6 +162,7 @@ void WriteMap(const std::filesystem::path& path, const RunRecord& record,
   file.WriteDoubles(std::string(h5::kAxialYMm), fit.axial_y_mm, {n_band});
   file.WriteDoubles(std::string(h5::kAxialRunoutUm), fit.runout_um, {n_band});
   file.WriteDoubles(std::string(h5::kAxialRoundnessUm), fit.roundness_um, {n_band});
+  if (model != nullptr && model->fitted) WriteModel(file, map, *model);
   const std::string root(h5::kRoot);
   file.WriteAttribute(root, std::string(h5::kSchemaVersionAttribute), schema::VersionText(h5::kVersion));
   file.WriteAttribute(root, std::string(h5::kArcwheelVersionAttribute), std::string(kVersion));
@@ -121,7 +177,7 @@ void WriteMap(const std::filesystem::path& path, const RunRecord& record,
 }  // namespace
 
 std::string SummaryJson(const RunRecord& record, const processing::ProcessedScan& processed,
-                        const WheelFit& fit) {
+                        const WheelFit& fit, const WheelModel* model) {
   const processing::WheelMap& map = processed.map;
   const acquisition::ScanMetadata& m = record.metadata;
   json s;
@@ -201,17 +257,19 @@ std::string SummaryJson(const RunRecord& record, const processing::ProcessedScan
   for (const auto& w : processed.warnings) warnings.push_back(w);
   for (const auto& w : fit.warnings) warnings.push_back(w);
   s[key::kWarnings] = warnings;
+  if (model != nullptr && model->fitted) s[key::kModel] = ModelJson(*model);
   return s.dump(2) + "\n";
 }
 
 void WriteProcessOutputs(const std::filesystem::path& outdir, const RunRecord& record,
-                         const processing::ProcessedScan& processed, const WheelFit& fit) {
+                         const processing::ProcessedScan& processed, const WheelFit& fit,
+                         const WheelModel* model) {
   EnsureDirectory(outdir);
   OutputSet outputs;
   const auto summary_path = outputs.Stage(outdir / key::kFileName);
   const auto map_path = outputs.Stage(outdir / h5::kFileName);
   {
-    const std::string summary = SummaryJson(record, processed, fit);
+    const std::string summary = SummaryJson(record, processed, fit, model);
     std::ofstream out(summary_path, std::ios::binary);
     out << summary;
     out.flush();
@@ -219,7 +277,7 @@ void WriteProcessOutputs(const std::filesystem::path& outdir, const RunRecord& r
       throw Error(ErrorCode::kIo, "output",
                   "cannot write '" + (outdir / key::kFileName).string() + "' (disk full?)");
   }
-  WriteMap(map_path, record, processed, fit);
+  WriteMap(map_path, record, processed, fit, model);
   outputs.Commit();
 }
 

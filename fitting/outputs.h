@@ -9,6 +9,7 @@
 
 #include "acquisition/scan.h"
 #include "fitting/wheel_fit.h"
+#include "fitting/wheel_model.h"
 #include "processing/process_scan.h"
 
 namespace arcwheel::fitting {
@@ -27,10 +28,11 @@ struct RunRecord {
 // Writes OUTDIR/summary.json and OUTDIR/wheel_map.h5; creates OUTDIR if needed.
 // Throws Error{kIo}; on any failure neither file is replaced.
 void WriteProcessOutputs(const std::filesystem::path& outdir, const RunRecord& record,
-                         const processing::ProcessedScan& processed, const WheelFit& fit);
+                         const processing::ProcessedScan& processed, const WheelFit& fit,
+                         const WheelModel* model = nullptr);
 
 // The summary document alone (what WriteProcessOutputs writes to summary.json).
 [[nodiscard]] std::string SummaryJson(const RunRecord& record, const processing::ProcessedScan& processed,
-                                      const WheelFit& fit);
+                                      const WheelFit& fit, const WheelModel* model = nullptr);
 
 }  // namespace arcwheel::fitting

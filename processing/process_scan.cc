@@ -191,6 +191,10 @@ std::string RpmSourceName(RpmSource source) {
 }
 
 ProcessedScan ProcessScan(acquisition::Scan scan, const ProcessOptions& options) {
+  return ProcessScanInPlace(scan, options);
+}
+
+ProcessedScan ProcessScanInPlace(acquisition::Scan& scan, const ProcessOptions& options) {
   CheckOptions(scan, options);
   ProcessedScan out;
   out.samples = scan.size();

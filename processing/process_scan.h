@@ -62,4 +62,8 @@ struct ProcessedScan {
 // is processed within about twice its own size). Move the scan in when it is not needed after.
 [[nodiscard]] ProcessedScan ProcessScan(acquisition::Scan scan, const ProcessOptions& options);
 
+// As ProcessScan, but the radial coordinate the map was built from (despiked; NaN where invalid)
+// stays in scan.z_mm, for the wheel model's fit of every sample (fitting/wheel_model.h).
+[[nodiscard]] ProcessedScan ProcessScanInPlace(acquisition::Scan& scan, const ProcessOptions& options);
+
 }  // namespace arcwheel::processing

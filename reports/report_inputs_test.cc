@@ -66,12 +66,13 @@ TEST(ReadSummary, ReadsNullAsNaN) {
   EXPECT_TRUE(std::isnan(s.phases.arc_radius_mm[3]));
 }
 
-TEST(WriteFixture, RecordsSchemaVersion1_0InBothFiles) {
+// 1.1 since both files gained the wheel model (docs/outputs.md).
+TEST(WriteFixture, RecordsSchemaVersion1_1InBothFiles) {
   TempDir dir;
   WriteFixture(dir.path(), {.n_phase = 12, .n_y = 21});
   std::ifstream summary_file(dir / "summary.json");
-  EXPECT_EQ(nlohmann::json::parse(summary_file).at("schema_version"), "1.0");
-  EXPECT_EQ(hdf5::File::OpenReadOnly(dir / "wheel_map.h5").ReadAttributeString("/", "schema_version"), "1.0");
+  EXPECT_EQ(nlohmann::json::parse(summary_file).at("schema_version"), "1.1");
+  EXPECT_EQ(hdf5::File::OpenReadOnly(dir / "wheel_map.h5").ReadAttributeString("/", "schema_version"), "1.1");
 }
 
 TEST(ReadSummary, ReadsAFileWrittenBeforeSchemaVersions) {

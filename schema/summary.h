@@ -12,7 +12,7 @@
 namespace arcwheel::schema::summary {
 
 inline constexpr int kMajorVersion = 1;
-inline constexpr int kMinorVersion = 0;
+inline constexpr int kMinorVersion = 1;  // 1.1: the wheel model ("model")
 inline constexpr Version kVersion{kMajorVersion, kMinorVersion};
 inline constexpr std::string_view kFileName = "summary.json";
 
@@ -114,6 +114,40 @@ inline constexpr std::string_view kUMm = "u_mm";
 inline constexpr std::string_view kErrorUm = "error_um";
 }  // namespace mean_profile
 
+// The wheel model fitted to every sample in the band (fitting/wheel_model.h, docs/wheel_model.md);
+// absent when the model was not asked for (--no-model).
+inline constexpr std::string_view kModel = "model";
+namespace model {
+inline constexpr std::string_view kRadiusKnots = "radius_knots";  // knots per turn of Ra(c); 1 = constant
+inline constexpr std::string_view kAxialKnots = "axial_knots";    // of a(c)
+inline constexpr std::string_view kRunoutKnots = "runout_knots";  // of b(c)
+inline constexpr std::string_view kKnotsChosenBy = "knots_chosen_by";  // "bic" or "given"
+inline constexpr std::string_view kProfileCoefficients = "profile_coefficients";
+inline constexpr std::string_view kSamples = "samples";
+inline constexpr std::string_view kParameters = "parameters";
+inline constexpr std::string_view kIterations = "iterations";
+inline constexpr std::string_view kResidualRmsUm = "residual_rms_um";
+inline constexpr std::string_view kNoiseSigmaUm = "noise_sigma_um";
+inline constexpr std::string_view kMeanArcRadiusMm = "mean_arc_radius_mm";
+inline constexpr std::string_view kMeanArcRadiusSigmaMm = "mean_arc_radius_sigma_mm";
+inline constexpr std::string_view kArcRadiusRangeMm = "arc_radius_range_mm";
+inline constexpr std::string_view kArcRadiusRangeSigmaMm = "arc_radius_range_sigma_mm";
+inline constexpr std::string_view kVariationChi2 = "radius_variation_chi2";
+inline constexpr std::string_view kVariationDof = "radius_variation_dof";
+inline constexpr std::string_view kVariationPValue = "radius_variation_p_value";
+inline constexpr std::string_view kSignificanceLevel = "significance_level";
+inline constexpr std::string_view kVariationSignificant = "radius_variation_significant";
+inline constexpr std::string_view kProfilePvUm = "profile_pv_um";
+inline constexpr std::string_view kRadiusHarmonics = "radius_harmonics";  // a list of objects:
+namespace harmonic {
+inline constexpr std::string_view kOrder = "order";
+inline constexpr std::string_view kAmplitudeUm = "amplitude_um";
+inline constexpr std::string_view kAmplitudeSigmaUm = "amplitude_sigma_um";
+inline constexpr std::string_view kPhaseDeg = "phase_deg";
+inline constexpr std::string_view kPhaseSigmaDeg = "phase_sigma_deg";
+}  // namespace harmonic
+}  // namespace model
+
 // Every processing parameter as used, flat (one number or string per key). The same names are
 // the root attributes of wheel_map.h5.
 inline constexpr std::string_view kProcessing = "processing";
@@ -134,6 +168,11 @@ inline constexpr std::string_view kRunoutMinPhaseCoverage = "runout_min_phase_co
 inline constexpr std::string_view kBeamOffsetMm = "beam_offset_mm";
 inline constexpr std::string_view kWheelRadiusMm = "wheel_radius_mm";
 inline constexpr std::string_view kStuckRunDeg = "stuck_run_deg";
+inline constexpr std::string_view kModelKnots = "model_knots";  // 0: chosen from the data
+inline constexpr std::string_view kModelAxialKnots = "model_axial_knots";
+inline constexpr std::string_view kModelRunoutKnots = "model_runout_knots";
+inline constexpr std::string_view kModelProfileStepMm = "model_profile_step_mm";
+inline constexpr std::string_view kModel = "model";  // "on" or "off"
 inline constexpr std::string_view kDespikeMethod = "despike_method";
 inline constexpr std::string_view kRpmSource = "rpm_source";
 inline constexpr std::string_view kFitSpan = "fit_span";

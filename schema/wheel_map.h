@@ -11,7 +11,7 @@
 namespace arcwheel::schema::wheel_map {
 
 inline constexpr int kMajorVersion = 1;
-inline constexpr int kMinorVersion = 0;
+inline constexpr int kMinorVersion = 1;  // 1.1: /model
 inline constexpr Version kVersion{kMajorVersion, kMinorVersion};
 inline constexpr std::string_view kFileName = "wheel_map.h5";
 
@@ -43,6 +43,22 @@ inline constexpr std::string_view kAxialRunoutUm = "/axial/runout_um";
 inline constexpr std::string_view kAxialRoundnessUm = "/axial/roundness_um";
 
 // Attributes of the root group "/".
+// The wheel model (fitting/wheel_model.h), on the map's phase nodes; absent with --no-model.
+inline constexpr std::string_view kModelGroup = "/model";
+inline constexpr std::string_view kModelArcRadiusMm = "/model/arc_radius_mm";  // [n_phase]
+inline constexpr std::string_view kModelArcRadiusSigmaMm = "/model/arc_radius_sigma_mm";
+inline constexpr std::string_view kModelCenterAxialMm = "/model/center_axial_mm";
+inline constexpr std::string_view kModelCenterAxialSigmaMm = "/model/center_axial_sigma_mm";
+inline constexpr std::string_view kModelCenterRadialMm = "/model/center_radial_mm";
+inline constexpr std::string_view kModelCenterRadialSigmaMm = "/model/center_radial_sigma_mm";
+inline constexpr std::string_view kModelProfileUMm = "/model/profile_u_mm";  // [n_u]
+inline constexpr std::string_view kModelProfileErrorUm = "/model/profile_error_um";
+inline constexpr std::string_view kModelProfileErrorSigmaUm = "/model/profile_error_sigma_um";
+inline constexpr std::string_view kModelResidualUm = "/model/residual_um";  // [n_phase, n_y], NaN: no sample
+// [Ra knots, a knots, b knots, p's B-spline coefficients] (mm) and their covariance (mm^2).
+inline constexpr std::string_view kModelCoefficients = "/model/coefficients";
+inline constexpr std::string_view kModelCovariance = "/model/covariance";  // [n, n]
+
 inline constexpr std::string_view kRoot = "/";
 inline constexpr std::string_view kSchemaVersionAttribute = "schema_version";  // "MAJOR.MINOR"
 inline constexpr std::string_view kArcwheelVersionAttribute = "arcwheel_version";

@@ -7,9 +7,11 @@
 #include <cmath>
 #include <limits>
 #include <numbers>
+#include <optional>
 
 #include "core/check.h"
 #include "core/error.h"
+#include "polishing/removal_fft.h"
 
 namespace arcwheel::polishing {
 namespace {
@@ -107,12 +109,38 @@ SparseMatrix RemovalMatrix(const ErrorMap& map, const Rows& rows, std::span<cons
                     removal.model());
 }
 
+// The removal matrix A as its two products: the sparse matrix (the reference), or FFT convolutions
+// when the dwell points lie on the map's grid (removal_fft.h).
+class Removal {
+ public:
+  Removal(const ErrorMap& map, const Rows& rows, std::span<const Eigen::Vector2d> path,
+          const RemovalFunction& removal, bool fft)
+      : points_(static_cast<Eigen::Index>(path.size())) {
+    if (fft) fft_ = internal::FftRemoval::Make(map, rows.node, path, removal);
+    if (!fft_) sparse_ = RemovalMatrix(map, rows, path, removal);
+  }
+  [[nodiscard]] Eigen::VectorXd operator*(const Eigen::VectorXd& dwell_s) const {
+    return fft_ ? fft_->Apply(dwell_s) : Eigen::VectorXd(sparse_ * dwell_s);
+  }
+  [[nodiscard]] Eigen::VectorXd Transposed(const Eigen::VectorXd& rows) const {
+    return fft_ ? fft_->ApplyTranspose(rows) : Eigen::VectorXd(sparse_.transpose() * rows);
+  }
+  [[nodiscard]] Eigen::Index cols() const { return points_; }
+  [[nodiscard]] long Nonzeros() const { return fft_ ? fft_->Nonzeros() : sparse_.nonZeros(); }
+  [[nodiscard]] bool UsesFft() const { return fft_.has_value(); }
+
+ private:
+  Eigen::Index points_;
+  std::optional<internal::FftRemoval> fft_;
+  SparseMatrix sparse_;
+};
+
 // Largest eigenvalue of A^T A by power iteration: the Lipschitz constant of the gradient.
-double GradientLipschitz(const SparseMatrix& a) {
+double GradientLipschitz(const Removal& a) {
   Eigen::VectorXd v = Eigen::VectorXd::Ones(a.cols()).normalized();
   double lambda = 0.0;
   for (int k = 0; k < 50; ++k) {
-    const Eigen::VectorXd w = a.transpose() * (a * v);
+    const Eigen::VectorXd w = a.Transposed(a * v);
     lambda = w.norm();
     if (!(lambda > 0.0)) return 1.0;
     v = w / lambda;
@@ -146,7 +174,7 @@ Bounds DwellBounds(std::span<const double> chord_mm, const DwellOptions& o) {
   return b;
 }
 
-void CheckReachable(const SparseMatrix& a, const Rows& rows, const ErrorMap& map, const Bounds& b,
+void CheckReachable(const Removal& a, const Rows& rows, const ErrorMap& map, const Bounds& b,
                     const DwellOptions& o) {
   const Eigen::VectorXd excess = a * b.lower - rows.target;
   Eigen::Index worst = 0;
@@ -259,7 +287,7 @@ struct Fit {
 // test only counts after kWarmStartIterations.
 constexpr int kWarmStartIterations = 100;
 
-Fit ProjectedGradient(const SparseMatrix& a, const Eigen::VectorXd& target, const Bounds& bounds, double step,
+Fit ProjectedGradient(const Removal& a, const Eigen::VectorXd& target, const Bounds& bounds, double step,
                       Eigen::VectorXd start, bool warm, const DwellOptions& options) {
   auto project = [&](const Eigen::VectorXd& t) {
     return t.cwiseMax(bounds.lower).cwiseMin(bounds.upper).eval();
@@ -274,7 +302,7 @@ Fit ProjectedGradient(const SparseMatrix& a, const Eigen::VectorXd& target, cons
       fit.converged = true;
       break;
     }
-    const Eigen::VectorXd gradient = a.transpose() * residual;
+    const Eigen::VectorXd gradient = a.Transposed(residual);
     previous = t;
     t = project(y - step * gradient);
     const double change = (t - previous).norm();
@@ -386,13 +414,13 @@ DwellSolution SolveDwell(const ErrorMap& target, const surfaces::Aperture& apert
   if (path.size() < 2) Invalid(fmt::format("the path has {} point(s); it needs two or more", path.size()));
   CheckChords(chord_mm, path.size());
   const Rows rows = ApertureRows(target, aperture);
-  const SparseMatrix a = RemovalMatrix(target, rows, path, removal);
+  const Removal a(target, rows, path, removal, options.fft_products);
   Bounds bounds = DwellBounds(chord_mm, options);
   CheckReachable(a, rows, target, bounds, options);
   AddLeastDwell(bounds, path, options);
 
   // Start from the correlation A^T b scaled to fit best: the right shape at low frequencies.
-  Eigen::VectorXd start = a.transpose() * rows.target;
+  Eigen::VectorXd start = a.Transposed(rows.target);
   const Eigen::VectorXd at = a * start;
   start *= at.squaredNorm() > 0.0 ? at.dot(rows.target) / at.squaredNorm() : 0.0;
   const double step = 1.0 / GradientLipschitz(a);
@@ -423,7 +451,8 @@ DwellSolution SolveDwell(const ErrorMap& target, const surfaces::Aperture& apert
   }
 
   const Eigen::VectorXd removed = a * t;
-  solution.nonzeros = static_cast<int>(a.nonZeros());
+  solution.nonzeros = a.Nonzeros();
+  solution.fft_products = a.UsesFft();
   solution.dwell_s.assign(t.data(), t.data() + t.size());
   solution.chord_mm.assign(chord_mm.begin(), chord_mm.end());
   solution.speed_mm_s = Speeds(t, bounds.chord_mm, options);

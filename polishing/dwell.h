@@ -16,8 +16,10 @@
 // function (surface extension); residuals are counted inside the aperture only.
 //
 // A is sparse (the Gaussian is truncated at 3.5 sigma, 0.2 % of the peak; a table ends at its
-// edge); the problem is solved by accelerated projected gradient (FISTA with adaptive restart) on
-// sparse matrix products.
+// edge); the problem is solved by accelerated projected gradient (FISTA with adaptive restart),
+// whose cost is the products A t and A^T r. The removal function is the same at every point, so
+// when the dwell points lie on the map's grid these products are 2-D convolutions, computed with
+// FFTs (removal_fft.h); otherwise (a circle's raster lines, a spiral) with the sparse matrix.
 //
 // With an acceleration limit the speeds are shaped as a motion planner does: a forward and a
 // backward pass cap each speed by what its neighbour allows, v_k <= sqrt(v_(k-1)^2 + 2 a L_k) and
@@ -85,6 +87,10 @@ struct DwellOptions {
   // A round settles when shaping its dwell adds at most this depth (peak rate x added dwell) at
   // any point, um, > 0 (1 nm: below what the solve itself resolves on a polished map).
   double shaping_tolerance_um = 1e-3;
+  // Compute the removal products as FFT convolutions when every dwell point lies on a node of the
+  // target map's grid (removal_fft.h): the same products, far faster on large maps. false: always
+  // the sparse matrix, the reference the FFT products are tested against.
+  bool fft_products = true;
   // Empty when valid, else one line per violation with its value, named by the job key
   // ("machine.max_speed_mm_s = -3 violates > 0"). least_dwell_s is checked against the path by
   // SolveDwell.
@@ -104,7 +110,8 @@ struct DwellSolution {
   int iterations = 0;                   // projected-gradient iterations, all rounds
   int shaping_rounds = 0;               // re-solves after shaping the speeds (0: none needed)
   bool converged = false;
-  int nonzeros = 0;  // entries of the sparse removal matrix
+  long nonzeros = 0;          // entries of the removal matrix (rate > 0), whichever way its products ran
+  bool fft_products = false;  // the products ran as FFT convolutions (DwellOptions::fft_products)
 };
 
 // Solves the dwell for a removal target (RemovalTarget) along a path whose contact points are

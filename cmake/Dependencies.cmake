@@ -30,3 +30,5 @@ endif()
 # cairo draws the report plots to SVG, PNG and PDF from one drawing code (reports/).
 find_package(PkgConfig REQUIRED)
 pkg_check_modules(CAIRO REQUIRED IMPORTED_TARGET cairo)
+# FFTW: the dwell solve's removal products as FFT convolutions (polishing/removal_fft.h).
+pkg_check_modules(FFTW3 REQUIRED IMPORTED_TARGET fftw3)

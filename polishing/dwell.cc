@@ -7,9 +7,11 @@
 #include <cmath>
 #include <limits>
 #include <numbers>
+#include <optional>
 
 #include "core/check.h"
 #include "core/error.h"
+#include "polishing/removal_fft.h"
 
 namespace arcwheel::polishing {
 namespace {
@@ -101,12 +103,38 @@ SparseMatrix RemovalMatrix(const ErrorMap& map, const Rows& rows, std::span<cons
                     removal.model());
 }
 
+// The removal matrix A as its two products: the sparse matrix (the reference), or FFT convolutions
+// when the dwell points lie on the map's grid (removal_fft.h).
+class Removal {
+ public:
+  Removal(const ErrorMap& map, const Rows& rows, std::span<const Eigen::Vector2d> path,
+          const RemovalFunction& removal, bool fft)
+      : points_(static_cast<Eigen::Index>(path.size())) {
+    if (fft) fft_ = internal::FftRemoval::Make(map, rows.node, path, removal);
+    if (!fft_) sparse_ = RemovalMatrix(map, rows, path, removal);
+  }
+  [[nodiscard]] Eigen::VectorXd operator*(const Eigen::VectorXd& dwell_s) const {
+    return fft_ ? fft_->Apply(dwell_s) : Eigen::VectorXd(sparse_ * dwell_s);
+  }
+  [[nodiscard]] Eigen::VectorXd Transposed(const Eigen::VectorXd& rows) const {
+    return fft_ ? fft_->ApplyTranspose(rows) : Eigen::VectorXd(sparse_.transpose() * rows);
+  }
+  [[nodiscard]] Eigen::Index cols() const { return points_; }
+  [[nodiscard]] long Nonzeros() const { return fft_ ? fft_->Nonzeros() : sparse_.nonZeros(); }
+  [[nodiscard]] bool UsesFft() const { return fft_.has_value(); }
+
+ private:
+  Eigen::Index points_;
+  std::optional<internal::FftRemoval> fft_;
+  SparseMatrix sparse_;
+};
+
 // Largest eigenvalue of A^T A by power iteration: the Lipschitz constant of the gradient.
-double GradientLipschitz(const SparseMatrix& a) {
+double GradientLipschitz(const Removal& a) {
   Eigen::VectorXd v = Eigen::VectorXd::Ones(a.cols()).normalized();
   double lambda = 0.0;
   for (int k = 0; k < 50; ++k) {
-    const Eigen::VectorXd w = a.transpose() * (a * v);
+    const Eigen::VectorXd w = a.Transposed(a * v);
     lambda = w.norm();
     if (!(lambda > 0.0)) return 1.0;
     v = w / lambda;
@@ -115,23 +143,32 @@ double GradientLipschitz(const SparseMatrix& a) {
 }
 
 struct Bounds {
-  Eigen::VectorXd lower, upper, segment_mm;
+  Eigen::VectorXd lower, upper, chord_mm;
 };
 
-Bounds DwellBounds(std::span<const Eigen::Vector2d> path, const DwellOptions& o) {
-  const auto n = static_cast<Eigen::Index>(path.size());
+// The chords come from the caller's geometry: a wrong one is our bug, not the user's input.
+void CheckChords(std::span<const double> chord_mm, std::size_t points) {
+  ARCWHEEL_CHECK(chord_mm.size() == points) << chord_mm.size() << " chords for " << points << " points";
+  for (std::size_t k = 0; k < chord_mm.size(); ++k) {
+    ARCWHEEL_CHECK(std::isfinite(chord_mm[k]) && chord_mm[k] >= 0.0 && (k > 0 || chord_mm[k] == 0.0))
+        << "chord_mm[" << k << "] = " << chord_mm[k];
+  }
+}
+
+// A point's dwell is the time of the TCP chord into it: chord / max_speed <= t <= chord / min_speed.
+Bounds DwellBounds(std::span<const double> chord_mm, const DwellOptions& o) {
+  const auto n = static_cast<Eigen::Index>(chord_mm.size());
   Bounds b{Eigen::VectorXd::Zero(n), Eigen::VectorXd::Constant(n, std::numeric_limits<double>::infinity()),
-           Eigen::VectorXd::Zero(n)};
+           Eigen::Map<const Eigen::VectorXd>(chord_mm.data(), n)};
   b.upper[0] = 0.0;  // the first point is the approach: no dwell
   for (Eigen::Index k = 1; k < n; ++k) {
-    b.segment_mm[k] = (path[k] - path[k - 1]).norm();
-    b.lower[k] = std::max(b.segment_mm[k] / o.max_speed_mm_s, o.min_dwell_s);
-    if (o.min_speed_mm_s > 0.0) b.upper[k] = b.segment_mm[k] / o.min_speed_mm_s;
+    b.lower[k] = std::max(b.chord_mm[k] / o.max_speed_mm_s, o.min_dwell_s);
+    if (o.min_speed_mm_s > 0.0) b.upper[k] = b.chord_mm[k] / o.min_speed_mm_s;
   }
   return b;
 }
 
-void CheckReachable(const SparseMatrix& a, const Rows& rows, const ErrorMap& map, const Bounds& b,
+void CheckReachable(const Removal& a, const Rows& rows, const ErrorMap& map, const Bounds& b,
                     const DwellOptions& o) {
   const Eigen::VectorXd excess = a * b.lower - rows.target;
   Eigen::Index worst = 0;
@@ -184,52 +221,51 @@ bool Stalled(double residual_norm, int iteration, const DwellOptions& o, std::ve
   return earlier - history.back() <= o.stall_improvement * history.front();
 }
 
-// Largest acceleration the speeds need: |v_k^2 - v_(k-1)^2| / (2 length_k) over k >= 2 (the
+// Largest acceleration the speeds need: |v_k^2 - v_(k-1)^2| / (2 chord_k) over k >= 2 (the
 // first point is the approach, reached at whatever speed the robot brings).
-double MaxAcceleration(const std::vector<double>& speed, const Eigen::VectorXd& segment_mm) {
+double MaxAcceleration(const std::vector<double>& speed, const Eigen::VectorXd& chord_mm) {
   double most = 0.0;
   for (std::size_t k = 2; k < speed.size(); ++k) {
-    const double length = segment_mm[static_cast<Eigen::Index>(k)];
+    const double length = chord_mm[static_cast<Eigen::Index>(k)];
     if (!(length > 0.0)) continue;
     most = std::max(most, std::abs(speed[k] * speed[k] - speed[k - 1] * speed[k - 1]) / (2.0 * length));
   }
   return most;
 }
 
-std::vector<double> Speeds(const Eigen::VectorXd& t, const Eigen::VectorXd& segment_mm,
-                           const DwellOptions& o) {
+std::vector<double> Speeds(const Eigen::VectorXd& t, const Eigen::VectorXd& chord_mm, const DwellOptions& o) {
   std::vector<double> speed(static_cast<std::size_t>(t.size()));
   for (Eigen::Index k = 0; k < t.size(); ++k) {
     speed[static_cast<std::size_t>(k)] =
-        k == 0 || !(t[k] > 0.0) ? o.max_speed_mm_s : std::min(o.max_speed_mm_s, segment_mm[k] / t[k]);
+        k == 0 || !(t[k] > 0.0) ? o.max_speed_mm_s : std::min(o.max_speed_mm_s, chord_mm[k] / t[k]);
   }
   return speed;
 }
 
 // The forward and backward passes of a motion planner: each speed capped by what its neighbour
-// allows over the segment between them. Only lowers speeds; afterwards every pair satisfies the limit.
-std::vector<double> ShapedSpeeds(std::vector<double> v, const Eigen::VectorXd& segment_mm, double a_mm_s2) {
+// allows over the TCP chord between them. Only lowers speeds; afterwards every pair satisfies the limit.
+std::vector<double> ShapedSpeeds(std::vector<double> v, const Eigen::VectorXd& chord_mm, double a_mm_s2) {
   const std::size_t n = v.size();
   for (std::size_t k = 2; k < n; ++k) {
-    const double length = segment_mm[static_cast<Eigen::Index>(k)];
+    const double length = chord_mm[static_cast<Eigen::Index>(k)];
     if (length > 0.0) v[k] = std::min(v[k], std::sqrt(v[k - 1] * v[k - 1] + 2.0 * a_mm_s2 * length));
   }
   for (std::size_t k = n - 1; k >= 2; --k) {
-    const double length = segment_mm[static_cast<Eigen::Index>(k)];
+    const double length = chord_mm[static_cast<Eigen::Index>(k)];
     if (length > 0.0) v[k - 1] = std::min(v[k - 1], std::sqrt(v[k] * v[k] + 2.0 * a_mm_s2 * length));
   }
   return v;
 }
 
 // The dwell that runs the shaped speeds: longer where a speed was lowered, unchanged elsewhere.
-Eigen::VectorXd ShapedDwell(const Eigen::VectorXd& t, const Eigen::VectorXd& segment_mm,
+Eigen::VectorXd ShapedDwell(const Eigen::VectorXd& t, const Eigen::VectorXd& chord_mm,
                             const DwellOptions& o) {
-  const std::vector<double> speed = Speeds(t, segment_mm, o);
-  const std::vector<double> shaped = ShapedSpeeds(speed, segment_mm, o.max_acceleration_mm_s2);
+  const std::vector<double> speed = Speeds(t, chord_mm, o);
+  const std::vector<double> shaped = ShapedSpeeds(speed, chord_mm, o.max_acceleration_mm_s2);
   Eigen::VectorXd out = t;
   for (Eigen::Index k = 1; k < t.size(); ++k) {
     const auto i = static_cast<std::size_t>(k);
-    if (shaped[i] < speed[i]) out[k] = std::max(t[k], segment_mm[k] / shaped[i]);
+    if (shaped[i] < speed[i]) out[k] = std::max(t[k], chord_mm[k] / shaped[i]);
   }
   return out;
 }
@@ -245,7 +281,7 @@ struct Fit {
 // test only counts after kWarmStartIterations.
 constexpr int kWarmStartIterations = 100;
 
-Fit ProjectedGradient(const SparseMatrix& a, const Eigen::VectorXd& target, const Bounds& bounds, double step,
+Fit ProjectedGradient(const Removal& a, const Eigen::VectorXd& target, const Bounds& bounds, double step,
                       Eigen::VectorXd start, bool warm, const DwellOptions& options) {
   auto project = [&](const Eigen::VectorXd& t) {
     return t.cwiseMax(bounds.lower).cwiseMin(bounds.upper).eval();
@@ -260,7 +296,7 @@ Fit ProjectedGradient(const SparseMatrix& a, const Eigen::VectorXd& target, cons
       fit.converged = true;
       break;
     }
-    const Eigen::VectorXd gradient = a.transpose() * residual;
+    const Eigen::VectorXd gradient = a.Transposed(residual);
     previous = t;
     t = project(y - step * gradient);
     const double change = (t - previous).norm();
@@ -345,19 +381,34 @@ std::vector<Eigen::Vector2d> RasterPath(const surfaces::Aperture& aperture, cons
   return path;
 }
 
+std::vector<double> PlanarChordsMm(std::span<const Eigen::Vector2d> path_xy_mm) {
+  std::vector<double> chord_mm(path_xy_mm.size(), 0.0);
+  for (std::size_t k = 1; k < path_xy_mm.size(); ++k)
+    chord_mm[k] = (path_xy_mm[k] - path_xy_mm[k - 1]).norm();
+  return chord_mm;
+}
+
 DwellSolution SolveDwell(const ErrorMap& target, const surfaces::Aperture& aperture,
                          std::span<const Eigen::Vector2d> path, const RemovalFunction& removal,
                          const DwellOptions& options) {
+  const std::vector<double> chord_mm = PlanarChordsMm(path);
+  return SolveDwell(target, aperture, path, chord_mm, removal, options);
+}
+
+DwellSolution SolveDwell(const ErrorMap& target, const surfaces::Aperture& aperture,
+                         std::span<const Eigen::Vector2d> path, std::span<const double> chord_mm,
+                         const RemovalFunction& removal, const DwellOptions& options) {
   CheckOptions(removal, options, path.size());
   if (path.size() < 2) Invalid(fmt::format("the path has {} point(s); it needs two or more", path.size()));
+  CheckChords(chord_mm, path.size());
   const Rows rows = ApertureRows(target, aperture);
-  const SparseMatrix a = RemovalMatrix(target, rows, path, removal);
-  Bounds bounds = DwellBounds(path, options);
+  const Removal a(target, rows, path, removal, options.fft_products);
+  Bounds bounds = DwellBounds(chord_mm, options);
   CheckReachable(a, rows, target, bounds, options);
   AddLeastDwell(bounds, path, options);
 
   // Start from the correlation A^T b scaled to fit best: the right shape at low frequencies.
-  Eigen::VectorXd start = a.transpose() * rows.target;
+  Eigen::VectorXd start = a.Transposed(rows.target);
   const Eigen::VectorXd at = a * start;
   start *= at.squaredNorm() > 0.0 ? at.dot(rows.target) / at.squaredNorm() : 0.0;
   const double step = 1.0 / GradientLipschitz(a);
@@ -369,7 +420,7 @@ DwellSolution SolveDwell(const ErrorMap& target, const surfaces::Aperture& apert
   if (options.max_acceleration_mm_s2 > 0.0) {
     const double peak = removal.PeakRateUmPerS();
     for (;;) {
-      const Eigen::VectorXd shaped = ShapedDwell(t, bounds.segment_mm, options);
+      const Eigen::VectorXd shaped = ShapedDwell(t, bounds.chord_mm, options);
       Eigen::Index worst = 0;
       const double added_um = peak * (shaped - t).maxCoeff(&worst);
       // The lengthened dwells become lower bounds; the other points stay free.
@@ -388,12 +439,13 @@ DwellSolution SolveDwell(const ErrorMap& target, const surfaces::Aperture& apert
   }
 
   const Eigen::VectorXd removed = a * t;
-  solution.nonzeros = static_cast<int>(a.nonZeros());
+  solution.nonzeros = a.Nonzeros();
+  solution.fft_products = a.UsesFft();
   solution.dwell_s.assign(t.data(), t.data() + t.size());
-  solution.segment_mm.assign(bounds.segment_mm.data(), bounds.segment_mm.data() + bounds.segment_mm.size());
-  solution.speed_mm_s = Speeds(t, bounds.segment_mm, options);
+  solution.chord_mm.assign(chord_mm.begin(), chord_mm.end());
+  solution.speed_mm_s = Speeds(t, bounds.chord_mm, options);
   solution.total_time_s = t.sum();
-  solution.max_acceleration_mm_s2 = MaxAcceleration(solution.speed_mm_s, bounds.segment_mm);
+  solution.max_acceleration_mm_s2 = MaxAcceleration(solution.speed_mm_s, bounds.chord_mm);
   solution.predicted_removal_um = Scatter(target, rows, removed);
   solution.residual_um = Scatter(target, rows, rows.target - removed);
   solution.before = StatisticsInAperture(target, aperture);

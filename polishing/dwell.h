@@ -7,14 +7,19 @@
 // part's (x, y) projection. Dwell points lie anywhere along
 // the path (not on the map's grid). The dwell solves the bounded linear least-squares problem
 //     minimise || A t - target ||^2  over the clear-aperture nodes,   t_min_k <= t_k <= t_max_k,
-// where the bounds come from the speed limits (a point stands for the path segment that ends at
-// it: t_k = length_k / speed_k). The path runs beyond the aperture by an extension so that the
-// edge can be reached by the whole removal function (surface extension); residuals are counted
-// inside the aperture only.
+// where the bounds come from the speed limits. The dwell model (docs/polishing.md, "Dwell model"):
+// the robot runs a straight TCP chord into each point (MoveL, at that point's speed), and a
+// point's dwell is the time of the chord that ends at it, t_k = chord_k / speed_k, with chord_k
+// the 3-D length of the TCP move (tool offset and precession included: the caller passes the
+// chords). The removal of that time is counted at the point's contact (x_k, y_k). The path runs
+// beyond the aperture by an extension so that the edge can be reached by the whole removal
+// function (surface extension); residuals are counted inside the aperture only.
 //
 // A is sparse (the Gaussian is truncated at 3.5 sigma, 0.2 % of the peak; a table ends at its
-// edge); the problem is solved by accelerated projected gradient (FISTA with adaptive restart) on
-// sparse matrix products.
+// edge); the problem is solved by accelerated projected gradient (FISTA with adaptive restart),
+// whose cost is the products A t and A^T r. The removal function is the same at every point, so
+// when the dwell points lie on the map's grid these products are 2-D convolutions, computed with
+// FFTs (removal_fft.h); otherwise (a circle's raster lines, a spiral) with the sparse matrix.
 //
 // With an acceleration limit the speeds are shaped as a motion planner does: a forward and a
 // backward pass cap each speed by what its neighbour allows, v_k <= sqrt(v_(k-1)^2 + 2 a L_k) and
@@ -63,7 +68,7 @@ struct DwellOptions {
   double min_speed_mm_s = 0.0;    // slowest TCP speed, [0, max]; 0 = no bound on dwell
   double min_dwell_s = 0.0;       // least dwell of every point after the first (controller), >= 0
   // Largest TCP acceleration, mm/s^2; 0 = no limit. The speed changes from v_(k-1) to v_k over
-  // the segment into point k, which takes |v_k^2 - v_(k-1)^2| / (2 length_k); the speeds are
+  // the TCP chord into point k, which takes |v_k^2 - v_(k-1)^2| / (2 chord_k); the speeds are
   // shaped to it (see above).
   double max_acceleration_mm_s2 = 0.0;
   // Per-point least dwell (s), one per path point (the first, the approach, must be 0), each
@@ -82,6 +87,10 @@ struct DwellOptions {
   // A round settles when shaping its dwell adds at most this depth (peak rate x added dwell) at
   // any point, um, > 0 (1 nm: below what the solve itself resolves on a polished map).
   double shaping_tolerance_um = 1e-3;
+  // Compute the removal products as FFT convolutions when every dwell point lies on a node of the
+  // target map's grid (removal_fft.h): the same products, far faster on large maps. false: always
+  // the sparse matrix, the reference the FFT products are tested against.
+  bool fft_products = true;
   // Empty when valid, else one line per violation with its value, named by the job key
   // ("machine.max_speed_mm_s = -3 violates > 0"). least_dwell_s is checked against the path by
   // SolveDwell.
@@ -91,7 +100,7 @@ struct DwellOptions {
 struct DwellSolution {
   std::vector<double> dwell_s;     // one per path point
   std::vector<double> speed_mm_s;  // TCP speed into each point (the first: max speed, no dwell)
-  std::vector<double> segment_mm;  // length of the segment ending at each point (first: 0)
+  std::vector<double> chord_mm;    // length of the TCP chord ending at each point (first: 0)
   ErrorMap predicted_removal_um;   // over the aperture nodes; NaN elsewhere
   ErrorMap residual_um;            // target - removal over the aperture; NaN elsewhere
   MapStatistics before;            // of the target (= the error) in the aperture
@@ -101,10 +110,14 @@ struct DwellSolution {
   int iterations = 0;                   // projected-gradient iterations, all rounds
   int shaping_rounds = 0;               // re-solves after shaping the speeds (0: none needed)
   bool converged = false;
-  int nonzeros = 0;  // entries of the sparse removal matrix
+  long nonzeros = 0;          // entries of the removal matrix (rate > 0), whichever way its products ran
+  bool fft_products = false;  // the products ran as FFT convolutions (DwellOptions::fft_products)
 };
 
-// Solves the dwell for a removal target (RemovalTarget) along `path_xy_mm`.
+// Solves the dwell for a removal target (RemovalTarget) along a path whose contact points are
+// `path_xy_mm` (where the removal function is centred) and whose TCP moves into each point are
+// straight chords of `chord_mm` (one per point, >= 0 and finite; chord_mm[0] = 0, the approach):
+// dwell_s[k] * speed_mm_s[k] = chord_mm[k] wherever the speed is below the maximum.
 // Throws Error{kInvalidOption, "polishing.dwell"} for options out of range (a Gaussian's too) or
 // speeds that cannot be met (min > max, a least_dwell_s above the point's longest dwell);
 // Error{kBadInput, "polishing.removal"} for a malformed table; Error{kBadInput,
@@ -115,6 +128,16 @@ struct DwellSolution {
 // point that still needed shaping).
 [[nodiscard]] DwellSolution SolveDwell(const ErrorMap& target, const surfaces::Aperture& aperture,
                                        std::span<const Eigen::Vector2d> path_xy_mm,
+                                       std::span<const double> chord_mm, const RemovalFunction& removal,
+                                       const DwellOptions& options);
+
+// The same for a path that the TCP runs in the plane of its contact points (a flat part without
+// precession): the chords are the (x, y) steps between the points.
+[[nodiscard]] DwellSolution SolveDwell(const ErrorMap& target, const surfaces::Aperture& aperture,
+                                       std::span<const Eigen::Vector2d> path_xy_mm,
                                        const RemovalFunction& removal, const DwellOptions& options);
+
+// The (x, y) steps between consecutive points (first: 0): the chords of a path in a plane.
+[[nodiscard]] std::vector<double> PlanarChordsMm(std::span<const Eigen::Vector2d> path_xy_mm);
 
 }  // namespace arcwheel::polishing

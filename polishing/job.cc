@@ -262,7 +262,9 @@ PolishRunReport RunPolishJob(const PolishJob& job, const std::filesystem::path& 
   CheckOnSurface(job, path);
   const ErrorMap target = RemovalTarget(job.error_map, job.aperture, job.target);
   PolishRunReport report;
-  report.dwell = SolveDwell(target, job.aperture, path, job.removal, job.dwell);
+  // The dwell is the time the robot takes on each TCP chord, precession included.
+  const std::vector<double> chord_mm = TcpChordsMm(TcpPositionsMm(*job.surface, path, job.precession));
+  report.dwell = SolveDwell(target, job.aperture, path, chord_mm, job.removal, job.dwell);
   const std::vector<PolishingPoint> points =
       BuildPolishingPath(*job.surface, path, report.dwell, job.robot_side, job.precession);
   report.points = points.size();

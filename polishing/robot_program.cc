@@ -8,6 +8,7 @@
 #include <iterator>
 #include <numbers>
 
+#include "core/check.h"
 #include "core/error.h"
 #include "core/version.h"
 #include "schema/polish_outputs.h"
@@ -19,12 +20,7 @@ std::string Quaternion9(const AbbQuaternion& q) {
   return fmt::format("[{:.9f},{:.9f},{:.9f},{:.9f}]", q.q1, q.q2, q.q3, q.q4);
 }
 
-}  // namespace
-
-std::vector<PolishingPoint> BuildPolishingPath(const surfaces::Surface& surface,
-                                               std::span<const Eigen::Vector2d> path_xy_mm,
-                                               const DwellSolution& dwell, RobotSide side,
-                                               const PathPrecession& precession) {
+void CheckPrecession(const PathPrecession& precession) {
   if (precession.enabled &&
       (!(precession.tilt_deg >= 0.0 && precession.tilt_deg < 90.0) ||
        !std::isfinite(precession.precession_rate_rpm) || !(precession.bonnet_radius_mm >= 0.0))) {
@@ -34,14 +30,22 @@ std::vector<PolishingPoint> BuildPolishingPath(const surfaces::Surface& surface,
                     "bonnet_radius_mm = {} (>= 0)",
                     precession.tilt_deg, precession.precession_rate_rpm, precession.bonnet_radius_mm));
   }
-  double elapsed_s = 0.0;
-  if (dwell.dwell_s.size() != path_xy_mm.size() || dwell.speed_mm_s.size() != path_xy_mm.size()) {
-    throw Error(
-        ErrorCode::kInvalidOption, "polishing.path",
-        fmt::format("{} path points but a dwell solution for {}", path_xy_mm.size(), dwell.dwell_s.size()));
-  }
-  std::vector<PolishingPoint> points;
-  points.reserve(path_xy_mm.size());
+}
+
+// The outward (upward) unit normal: minus the tool's z, which points into the part.
+Eigen::Vector3d OutwardNormal(const surfaces::Surface& surface, const Eigen::Vector2d& p) {
+  const surfaces::SurfacePoint sp = surface.Evaluate(p.x(), p.y());
+  return Eigen::Vector3d(-sp.fx, -sp.fy, 1.0).normalized();
+}
+
+}  // namespace
+
+std::vector<Eigen::Vector3d> TcpPositionsMm(const surfaces::Surface& surface,
+                                            std::span<const Eigen::Vector2d> path_xy_mm,
+                                            const PathPrecession& precession) {
+  CheckPrecession(precession);
+  std::vector<Eigen::Vector3d> tcp;
+  tcp.reserve(path_xy_mm.size());
   for (std::size_t k = 0; k < path_xy_mm.size(); ++k) {
     const Eigen::Vector2d& p = path_xy_mm[k];
     if (!surface.InDomain(p.x(), p.y())) {
@@ -49,8 +53,47 @@ std::vector<PolishingPoint> BuildPolishingPath(const surfaces::Surface& surface,
                   fmt::format("path point {} ({}, {}) mm is off the surface {}", k, p.x(), p.y(),
                               surface.Describe()));
     }
+    Eigen::Vector3d position(p.x(), p.y(), surface.Evaluate(p.x(), p.y()).z_mm);
+    if (precession.enabled) position += precession.bonnet_radius_mm * OutwardNormal(surface, p);
+    tcp.push_back(position);
+  }
+  return tcp;
+}
+
+std::vector<double> TcpChordsMm(std::span<const Eigen::Vector3d> tcp_mm) {
+  std::vector<double> chord_mm(tcp_mm.size(), 0.0);
+  for (std::size_t k = 1; k < tcp_mm.size(); ++k) chord_mm[k] = (tcp_mm[k] - tcp_mm[k - 1]).norm();
+  return chord_mm;
+}
+
+std::vector<PolishingPoint> BuildPolishingPath(const surfaces::Surface& surface,
+                                               std::span<const Eigen::Vector2d> path_xy_mm,
+                                               const DwellSolution& dwell, RobotSide side,
+                                               const PathPrecession& precession) {
+  if (dwell.dwell_s.size() != path_xy_mm.size() || dwell.speed_mm_s.size() != path_xy_mm.size()) {
+    throw Error(
+        ErrorCode::kInvalidOption, "polishing.path",
+        fmt::format("{} path points but a dwell solution for {}", path_xy_mm.size(), dwell.dwell_s.size()));
+  }
+  const std::vector<Eigen::Vector3d> tcp = TcpPositionsMm(surface, path_xy_mm, precession);
+  if (!dwell.chord_mm.empty()) {
+    // A dwell solved on other chords (another precession, or the contact points' steps) would
+    // make the robot's times differ from the dwell the prediction assumed.
+    const std::vector<double> chord_mm = TcpChordsMm(tcp);
+    ARCWHEEL_CHECK(dwell.chord_mm.size() == chord_mm.size()) << dwell.chord_mm.size() << " chords";
+    for (std::size_t k = 0; k < chord_mm.size(); ++k) {
+      ARCWHEEL_CHECK(std::abs(dwell.chord_mm[k] - chord_mm[k]) <= 1e-12 * (1.0 + chord_mm[k]))
+          << "the dwell was solved for a TCP chord of " << dwell.chord_mm[k] << " mm into point " << k
+          << ", the robot runs " << chord_mm[k] << " mm";
+    }
+  }
+  double elapsed_s = 0.0;
+  std::vector<PolishingPoint> points;
+  points.reserve(path_xy_mm.size());
+  for (std::size_t k = 0; k < path_xy_mm.size(); ++k) {
+    const Eigen::Vector2d& p = path_xy_mm[k];
     PolishingPoint point;
-    point.position_mm = Eigen::Vector3d(p.x(), p.y(), surface.Evaluate(p.x(), p.y()).z_mm);
+    point.position_mm = tcp[k];
     Eigen::Matrix3d frame = ToolFrameAt(surface, p.x(), p.y(), side);
     elapsed_s += dwell.dwell_s[k];
     if (precession.enabled && path_xy_mm.size() > 1) {
@@ -65,7 +108,6 @@ std::vector<PolishingPoint> BuildPolishingPath(const surfaces::Surface& surface,
       const Eigen::Vector3d axis = std::sin(theta) * std::cos(alpha) * a +
                                    std::sin(theta) * std::sin(alpha) * c.cross(a) + std::cos(theta) * c;
       frame = Eigen::Quaterniond::FromTwoVectors(-c, -axis).toRotationMatrix() * frame;
-      point.position_mm += precession.bonnet_radius_mm * c;
     }
     point.orientation = AbbQuaternionFromRotation(frame);
     point.speed_mm_s = dwell.speed_mm_s[k];

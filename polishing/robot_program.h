@@ -39,9 +39,23 @@ struct PathPrecession {
   [[nodiscard]] std::vector<std::string> Problems() const;
 };
 
+// The TCP positions the robot runs through, part frame: the contact point on the surface, or with
+// precession the bonnet centre, contact + bonnet_radius_mm along the outward normal. The robot moves
+// between them on straight chords (MoveL); the removal-centre offset is in the tooldata
+// (ToolData::CorrectedTcpMm), so it moves no target. Throws Error{kBadInput, "polishing.path"}
+// naming the first point off the surface.
+[[nodiscard]] std::vector<Eigen::Vector3d> TcpPositionsMm(const surfaces::Surface& surface,
+                                                          std::span<const Eigen::Vector2d> path_xy_mm,
+                                                          const PathPrecession& precession = {});
+
+// The 3-D lengths of the TCP chords into each position (first: 0, the approach): what SolveDwell
+// divides by the speeds.
+[[nodiscard]] std::vector<double> TcpChordsMm(std::span<const Eigen::Vector3d> tcp_mm);
+
 // Places the tool on the surface at each path point (ToolFrameAt, or precessed) with the dwell
-// solution's speed and dwell. Throws Error{kBadInput, "polishing.path"} naming the first point
-// off the surface, Error{kInvalidOption} for precession options out of range.
+// solution's speed and dwell, which must have been solved on the chords of TcpPositionsMm for the
+// same precession (checked when the solution carries its chords). Throws Error{kBadInput, "polishing.path"}
+// naming the first point off the surface, Error{kInvalidOption} for precession options out of range.
 [[nodiscard]] std::vector<PolishingPoint> BuildPolishingPath(const surfaces::Surface& surface,
                                                              std::span<const Eigen::Vector2d> path_xy_mm,
                                                              const DwellSolution& dwell, RobotSide side,

@@ -140,6 +140,39 @@ TEST(BuildPolishingPath, PrecessesTheBonnetAxisAboutTheNormalAtTheTiltAndRate) {
                Error);
 }
 
+TEST(TcpChordsMm, AreTheBonnetCentreStepsWithPrecessionAndTheContactStepsWithout) {
+  const Fixture f;
+  const PathPrecession precession{.enabled = true, .bonnet_radius_mm = 40.0};
+  const std::vector<double> plain = TcpChordsMm(TcpPositionsMm(f.surface, f.path));
+  const std::vector<double> precessed = TcpChordsMm(TcpPositionsMm(f.surface, f.path, precession));
+  ASSERT_EQ(plain.size(), f.path.size());
+  ASSERT_EQ(precessed.size(), f.path.size());
+  EXPECT_EQ(plain[0], 0.0);
+  EXPECT_EQ(precessed[0], 0.0);
+  // Independent: the convex paraboloid z = -r^2 / 1200 and its outward normal.
+  auto contact = [](const Eigen::Vector2d& p) -> Eigen::Vector3d {
+    return Eigen::Vector3d(p.x(), p.y(), -p.squaredNorm() / 1200.0);
+  };
+  auto centre = [&](const Eigen::Vector2d& p) -> Eigen::Vector3d {
+    return contact(p) + 40.0 * Eigen::Vector3d(p.x() / 600.0, p.y() / 600.0, 1.0).normalized();
+  };
+  for (std::size_t k = 1; k < f.path.size(); ++k) {
+    EXPECT_NEAR(plain[k], (contact(f.path[k]) - contact(f.path[k - 1])).norm(), 1e-12);
+    EXPECT_NEAR(precessed[k], (centre(f.path[k]) - centre(f.path[k - 1])).norm(), 1e-12);
+    EXPECT_GT(precessed[k], plain[k]);  // the centres ride 40 mm further out on a convex part
+  }
+}
+
+TEST(BuildPolishingPath, RefusesADwellSolvedOnOtherChordsThanTheRobotRuns) {
+  Fixture f;
+  f.dwell.chord_mm = TcpChordsMm(TcpPositionsMm(f.surface, f.path));
+  EXPECT_NO_THROW((void)BuildPolishingPath(f.surface, f.path, f.dwell, RobotSide::kPlusX));
+  // The same dwell on the bonnet centres' longer chords would not take the times it predicts.
+  EXPECT_THROW((void)BuildPolishingPath(f.surface, f.path, f.dwell, RobotSide::kPlusX,
+                                        {.enabled = true, .bonnet_radius_mm = 40.0}),
+               Error);
+}
+
 TEST(BuildPolishingPath, RefusesAPointOffTheSurface) {
   Fixture f;
   const surfaces::EvenAsphere small({.vertex_radius_mm = 35.0});

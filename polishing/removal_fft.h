@@ -1,0 +1,60 @@
+#pragma once
+// The dwell solve's removal products as 2-D FFT convolutions (dwell.h, "FFT products").
+//
+// The removal at map node n is  sum_k R(X_n - P_k) t_k.  When every dwell point P_k lies on a node
+// of the map's grid (extended beyond the map as far as the path goes), X_n - P_k is a whole number
+// of grid steps, so the sum is the 2-D convolution of the removal function sampled at those steps
+// with the dwell placed on the grid: the same products as the sparse removal matrix, computed with
+// FFTW in O(N log N) instead of O(N x footprint). The removal function is the same at every
+// point (it is defined in the part's (x, y) projection), so the convolution holds over the whole
+// part, curved or not. A point counts as on the grid when it lies within kGridTolerance of a
+// grid step from a node; the kernel is sampled at the exact steps, so such a point's removal
+// differs from the sparse matrix's by at most that shift times the rate's slope (1e-9 of the
+// step: below 1e-9 of the peak rate over the footprint, for a footprint wider than one step).
+
+#include <Eigen/Core>
+#include <memory>
+#include <optional>
+#include <span>
+#include <vector>
+
+#include "polishing/removal_function.h"
+#include "polishing/removal_target.h"
+
+namespace arcwheel::polishing::internal {
+
+// Largest distance of a dwell point from a grid node, in grid steps, for the FFT products.
+inline constexpr double kGridTolerance = 1e-9;
+
+class FftRemoval {
+ public:
+  // The products for the map nodes `row_nodes` (indices j * nx + i into `map`) and the dwell points
+  // `path_xy_mm`; nothing when a point lies off the map's grid, or when the rate jumps within the
+  // grid tolerance of a sampled offset (a table's edge or the Gaussian's truncation circle on the
+  // grid: there the sparse matrix's entries depend on the rounding of each point's coordinates).
+  [[nodiscard]] static std::optional<FftRemoval> Make(const ErrorMap& map, std::span<const int> row_nodes,
+                                                      std::span<const Eigen::Vector2d> path_xy_mm,
+                                                      const RemovalFunction& removal);
+  // Removal (um) at the row nodes for a dwell (s) per point: A t.
+  [[nodiscard]] Eigen::VectorXd Apply(const Eigen::VectorXd& dwell_s) const;
+  // A^T r: for each point, the sum over the row nodes of the rate times r.
+  [[nodiscard]] Eigen::VectorXd ApplyTranspose(const Eigen::VectorXd& rows) const;
+  // Entries of the sparse matrix that these products stand for: (row, point) pairs with a rate > 0.
+  [[nodiscard]] long Nonzeros() const { return nonzeros_; }
+
+ private:
+  struct Workspace;  // FFTW plans and arrays
+  FftRemoval() = default;
+  // The work grid convolved with the removal function, or correlated with it (A^T), in place.
+  void Convolve(bool correlate) const;
+  [[nodiscard]] double* ClearedGrid() const;
+
+  int origin_i_ = 0, origin_j_ = 0;  // map index of FFT cell (0, 0)
+  std::vector<int> row_cell_;        // FFT cell of each row node
+  std::vector<int> point_cell_;      // FFT cell of each dwell point
+  int rows_ = 0, columns_ = 0;       // FFT size
+  long nonzeros_ = 0;
+  std::shared_ptr<Workspace> work_;  // one FftRemoval serves one thread at a time
+};
+
+}  // namespace arcwheel::polishing::internal

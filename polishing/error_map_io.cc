@@ -313,18 +313,20 @@ void RasterTriangle(std::span<const ScatteredPoint> points, const Triangle& tri,
   if (den == 0.0) return;
   const double lo_x = std::min({a.x_mm, b.x_mm, c.x_mm}), hi_x = std::max({a.x_mm, b.x_mm, c.x_mm});
   const double lo_y = std::min({a.y_mm, b.y_mm, c.y_mm}), hi_y = std::max({a.y_mm, b.y_mm, c.y_mm});
-  const int i0 = std::max(0, static_cast<int>(std::ceil((lo_x - map.x0_mm) / map.dx_mm - 1e-9)));
-  const int i1 = std::min(map.nx - 1, static_cast<int>(std::floor((hi_x - map.x0_mm) / map.dx_mm + 1e-9)));
-  const int j0 = std::max(0, static_cast<int>(std::ceil((lo_y - map.y0_mm) / map.dy_mm - 1e-9)));
-  const int j1 = std::min(map.ny - 1, static_cast<int>(std::floor((hi_y - map.y0_mm) / map.dy_mm + 1e-9)));
+  const int i0 = std::max(0, static_cast<int>(std::ceil((lo_x - map.grid.x0_mm) / map.grid.dx_mm - 1e-9)));
+  const int i1 = std::min(map.grid.nx - 1,
+                          static_cast<int>(std::floor((hi_x - map.grid.x0_mm) / map.grid.dx_mm + 1e-9)));
+  const int j0 = std::max(0, static_cast<int>(std::ceil((lo_y - map.grid.y0_mm) / map.grid.dy_mm - 1e-9)));
+  const int j1 = std::min(map.grid.ny - 1,
+                          static_cast<int>(std::floor((hi_y - map.grid.y0_mm) / map.grid.dy_mm + 1e-9)));
   // Barycentric weights may dip this far below 0 for a node on an edge (rounding).
   constexpr double kEdge = 1e-9;
   for (int j = j0; j <= j1; ++j) {
-    const double y = map.Y(j);
+    const double y = map.grid.Y(j);
     for (int i = i0; i <= i1; ++i) {
-      double& node = map.error_um[static_cast<std::size_t>(j) * map.nx + i];
+      double& node = map.error_um[static_cast<std::size_t>(j) * map.grid.nx + i];
       if (!std::isnan(node)) continue;
-      const double x = map.X(i);
+      const double x = map.grid.X(i);
       const double la = ((b.y_mm - c.y_mm) * (x - c.x_mm) + (c.x_mm - b.x_mm) * (y - c.y_mm)) / den;
       const double lb = ((c.y_mm - a.y_mm) * (x - c.x_mm) + (a.x_mm - c.x_mm) * (y - c.y_mm)) / den;
       const double lc = 1.0 - la - lb;
@@ -393,28 +395,28 @@ ErrorMap PlaceInPartFrame(const PixelMap& pixels, const MapPlacement& placement,
   };
   const bool swapped = quarter_turns % 2 == 1;
   ErrorMap map;
-  map.nx = swapped ? pixels.height : pixels.width;
-  map.ny = swapped ? pixels.width : pixels.height;
-  map.dx_mm = swapped ? py : px;
-  map.dy_mm = swapped ? px : py;
-  map.x0_mm = std::numeric_limits<double>::infinity();
-  map.y0_mm = std::numeric_limits<double>::infinity();
+  map.grid.nx = swapped ? pixels.height : pixels.width;
+  map.grid.ny = swapped ? pixels.width : pixels.height;
+  map.grid.dx_mm = swapped ? py : px;
+  map.grid.dy_mm = swapped ? px : py;
+  map.grid.x0_mm = std::numeric_limits<double>::infinity();
+  map.grid.y0_mm = std::numeric_limits<double>::infinity();
   for (const int i : {0, pixels.width - 1}) {
     for (const int j : {0, pixels.height - 1}) {
       const auto p = place(i, j);
-      map.x0_mm = std::min(map.x0_mm, p[0]);
-      map.y0_mm = std::min(map.y0_mm, p[1]);
+      map.grid.x0_mm = std::min(map.grid.x0_mm, p[0]);
+      map.grid.y0_mm = std::min(map.grid.y0_mm, p[1]);
     }
   }
-  map.error_um.assign(static_cast<std::size_t>(map.nx) * static_cast<std::size_t>(map.ny), kNaN);
+  map.error_um.assign(static_cast<std::size_t>(map.grid.nx) * static_cast<std::size_t>(map.grid.ny), kNaN);
   for (int j = 0; j < pixels.height; ++j) {
     for (int i = 0; i < pixels.width; ++i) {
       const double h = pixels.height_um[static_cast<std::size_t>(j) * pixels.width + i];
       if (!std::isfinite(h)) continue;
       const auto p = place(i, j);
-      const auto I = static_cast<std::size_t>(std::lround((p[0] - map.x0_mm) / map.dx_mm));
-      const auto J = static_cast<std::size_t>(std::lround((p[1] - map.y0_mm) / map.dy_mm));
-      map.error_um[J * static_cast<std::size_t>(map.nx) + I] = placement.scale * h;
+      const auto I = static_cast<std::size_t>(std::lround((p[0] - map.grid.x0_mm) / map.grid.dx_mm));
+      const auto J = static_cast<std::size_t>(std::lround((p[1] - map.grid.y0_mm) / map.grid.dy_mm));
+      map.error_um[J * static_cast<std::size_t>(map.grid.nx) + I] = placement.scale * h;
     }
   }
   return map;
@@ -559,14 +561,16 @@ ErrorMap ReadErrorMapHdf5(const hdf5::File& file) {
       Fail(name, fmt::format("root attribute '{}' is {}", key, v ? "not finite" : "missing"));
     return *v;
   };
-  map.x0_mm = attribute("x0_mm");
-  map.y0_mm = attribute("y0_mm");
-  map.dx_mm = attribute("dx_mm");
-  map.dy_mm = attribute("dy_mm");
-  if (!(map.dx_mm > 0.0)) Fail(name, fmt::format("root attribute 'dx_mm' = {} must be > 0", map.dx_mm));
-  if (!(map.dy_mm > 0.0)) Fail(name, fmt::format("root attribute 'dy_mm' = {} must be > 0", map.dy_mm));
-  map.ny = static_cast<int>(shape[0]);
-  map.nx = static_cast<int>(shape[1]);
+  map.grid.x0_mm = attribute("x0_mm");
+  map.grid.y0_mm = attribute("y0_mm");
+  map.grid.dx_mm = attribute("dx_mm");
+  map.grid.dy_mm = attribute("dy_mm");
+  if (!(map.grid.dx_mm > 0.0))
+    Fail(name, fmt::format("root attribute 'dx_mm' = {} must be > 0", map.grid.dx_mm));
+  if (!(map.grid.dy_mm > 0.0))
+    Fail(name, fmt::format("root attribute 'dy_mm' = {} must be > 0", map.grid.dy_mm));
+  map.grid.ny = static_cast<int>(shape[0]);
+  map.grid.nx = static_cast<int>(shape[1]);
   map.error_um = file.ReadDoubles("/error_um");
   for (double& v : map.error_um) {
     if (!std::isfinite(v)) v = kNaN;
@@ -585,11 +589,11 @@ void WriteErrorMapHdf5(const ErrorMap& map, const std::filesystem::path& path) {
   {
     hdf5::File file = hdf5::File::Create(temporary);
     file.WriteDoubles("/error_um", map.error_um,
-                      {static_cast<hsize_t>(map.ny), static_cast<hsize_t>(map.nx)});
-    file.WriteAttribute("/", "x0_mm", map.x0_mm);
-    file.WriteAttribute("/", "y0_mm", map.y0_mm);
-    file.WriteAttribute("/", "dx_mm", map.dx_mm);
-    file.WriteAttribute("/", "dy_mm", map.dy_mm);
+                      {static_cast<hsize_t>(map.grid.ny), static_cast<hsize_t>(map.grid.nx)});
+    file.WriteAttribute("/", "x0_mm", map.grid.x0_mm);
+    file.WriteAttribute("/", "y0_mm", map.grid.y0_mm);
+    file.WriteAttribute("/", "dx_mm", map.grid.dx_mm);
+    file.WriteAttribute("/", "dy_mm", map.grid.dy_mm);
   }
   outputs.Commit();
 }
@@ -597,12 +601,12 @@ void WriteErrorMapHdf5(const ErrorMap& map, const std::filesystem::path& path) {
 ErrorMap ReadErrorMapCsv(const std::filesystem::path& path) {
   CsvGrid grid = ReadCsvGrid(path, "error_um", kStage);
   ErrorMap map;
-  map.x0_mm = grid.x0_mm;
-  map.y0_mm = grid.y0_mm;
-  map.dx_mm = grid.dx_mm;
-  map.dy_mm = grid.dy_mm;
-  map.nx = grid.nx;
-  map.ny = grid.ny;
+  map.grid.x0_mm = grid.x0_mm;
+  map.grid.y0_mm = grid.y0_mm;
+  map.grid.dx_mm = grid.dx_mm;
+  map.grid.dy_mm = grid.dy_mm;
+  map.grid.nx = grid.nx;
+  map.grid.ny = grid.ny;
   map.error_um = std::move(grid.values);
   return map;
 }
@@ -647,12 +651,12 @@ ErrorMap InterpolateScattered(std::span<const ScatteredPoint> points, double gri
              d, x_min, x_max, y_min, y_max, nodes, most_nodes, points.size()));
   }
   ErrorMap map;
-  map.dx_mm = map.dy_mm = d;
-  map.x0_mm = k_x0 * d;
-  map.y0_mm = k_y0 * d;
-  map.nx = static_cast<int>(k_x1 - k_x0 + 1.0);
-  map.ny = static_cast<int>(k_y1 - k_y0 + 1.0);
-  map.error_um.assign(static_cast<std::size_t>(map.nx) * static_cast<std::size_t>(map.ny), kNaN);
+  map.grid.dx_mm = map.grid.dy_mm = d;
+  map.grid.x0_mm = k_x0 * d;
+  map.grid.y0_mm = k_y0 * d;
+  map.grid.nx = static_cast<int>(k_x1 - k_x0 + 1.0);
+  map.grid.ny = static_cast<int>(k_y1 - k_y0 + 1.0);
+  map.error_um.assign(static_cast<std::size_t>(map.grid.nx) * static_cast<std::size_t>(map.grid.ny), kNaN);
   for (const Triangle& tri : t.triangles) RasterTriangle(points, tri, map);
   return map;
 }

@@ -35,12 +35,12 @@ bool Contains(const std::string& text, const std::string& part) {
 // The grid placement of `map` (size, origin, spacing) against `expected`'s, exactly: the
 // readers copy these numbers, or take them as differences of numbers exact in binary.
 void ExpectPlacement(const ErrorMap& map, const ErrorMap& expected) {
-  EXPECT_EQ(map.nx, expected.nx);
-  EXPECT_EQ(map.ny, expected.ny);
-  EXPECT_EQ(map.x0_mm, expected.x0_mm);
-  EXPECT_EQ(map.y0_mm, expected.y0_mm);
-  EXPECT_EQ(map.dx_mm, expected.dx_mm);
-  EXPECT_EQ(map.dy_mm, expected.dy_mm);
+  EXPECT_EQ(map.grid.nx, expected.grid.nx);
+  EXPECT_EQ(map.grid.ny, expected.grid.ny);
+  EXPECT_EQ(map.grid.x0_mm, expected.grid.x0_mm);
+  EXPECT_EQ(map.grid.y0_mm, expected.grid.y0_mm);
+  EXPECT_EQ(map.grid.dx_mm, expected.grid.dx_mm);
+  EXPECT_EQ(map.grid.dy_mm, expected.grid.dy_mm);
 }
 
 // ------------------------------------------------------------------------------------------------
@@ -57,8 +57,8 @@ TEST(ReadErrorMapCsv, PlacesScatteredRowsOnTheirGridAndLeavesGapsWithoutData) {
   std::ofstream(dir / "map.csv")
       << "# comment\nx_mm,y_mm,error_um\n2.5,-1,0.25\n-2.5,-1,1\n0,1,nan\n2.5,1,-3\n";
   const ErrorMap map = ReadErrorMapCsv(dir / "map.csv");
-  ExpectPlacement(
-      map, {.x0_mm = -2.5, .y0_mm = -1.0, .dx_mm = 2.5, .dy_mm = 2.0, .nx = 3, .ny = 2, .error_um = {}});
+  ExpectPlacement(map, {.grid = {.x0_mm = -2.5, .y0_mm = -1.0, .dx_mm = 2.5, .dy_mm = 2.0, .nx = 3, .ny = 2},
+                        .error_um = {}});
   EXPECT_DOUBLE_EQ(map.At(0, 0), 1.0);
   EXPECT_TRUE(std::isnan(map.At(1, 0)));  // never given
   EXPECT_DOUBLE_EQ(map.At(2, 0), 0.25);
@@ -193,16 +193,16 @@ TEST(PlaceInPartFrame, PutsEachPixelAtItsLateralPositionWithRowsRunningDownTheCa
   const ErrorMap map = PlaceInPartFrame(pixels, {}, "part.dat");
   const double p = static_cast<double>(spec.lateral_res_m) * 1e3;
   // Valid data span all columns 0..6 and rows 0..4: the centre pixel (3, 2) lands on the origin.
-  EXPECT_EQ(map.nx, 7);
-  EXPECT_EQ(map.ny, 5);
-  EXPECT_DOUBLE_EQ(map.dx_mm, p);
+  EXPECT_EQ(map.grid.nx, 7);
+  EXPECT_EQ(map.grid.ny, 5);
+  EXPECT_DOUBLE_EQ(map.grid.dx_mm, p);
   for (int j = 0; j < spec.height; ++j) {
     for (int i = 0; i < spec.width; ++i) {
       const double x = (i - 3) * p, y = (2 - j) * p;  // row 0 is the top: highest y
-      const int I = static_cast<int>(std::lround((x - map.x0_mm) / map.dx_mm));
-      const int J = static_cast<int>(std::lround((y - map.y0_mm) / map.dy_mm));
-      ASSERT_NEAR(map.X(I), x, 1e-12);
-      ASSERT_NEAR(map.Y(J), y, 1e-12);
+      const int I = static_cast<int>(std::lround((x - map.grid.x0_mm) / map.grid.dx_mm));
+      const int J = static_cast<int>(std::lround((y - map.grid.y0_mm) / map.grid.dy_mm));
+      ASSERT_NEAR(map.grid.X(I), x, 1e-12);
+      ASSERT_NEAR(map.grid.Y(J), y, 1e-12);
       const double expected = pixels.height_um[static_cast<std::size_t>(j) * spec.width + i];
       if (std::isnan(expected)) {
         EXPECT_TRUE(std::isnan(map.At(I, J)));
@@ -237,11 +237,11 @@ TEST(PlaceInPartFrame, RotatesFlipsScalesAndTranslatesAsTheRigidMotionItNames) {
           if (flip == MapPlacement::Flip::kY) v = -v;
           const double x = std::cos(a) * u - std::sin(a) * v + 10.0,
                        y = std::sin(a) * u + std::cos(a) * v - 4.0;
-          const int I = static_cast<int>(std::lround((x - map.x0_mm) / map.dx_mm));
-          const int J = static_cast<int>(std::lround((y - map.y0_mm) / map.dy_mm));
-          ASSERT_TRUE(I >= 0 && I < map.nx && J >= 0 && J < map.ny);
-          EXPECT_NEAR(map.X(I), x, 1e-12);
-          EXPECT_NEAR(map.Y(J), y, 1e-12);
+          const int I = static_cast<int>(std::lround((x - map.grid.x0_mm) / map.grid.dx_mm));
+          const int J = static_cast<int>(std::lround((y - map.grid.y0_mm) / map.grid.dy_mm));
+          ASSERT_TRUE(I >= 0 && I < map.grid.nx && J >= 0 && J < map.grid.ny);
+          EXPECT_NEAR(map.grid.X(I), x, 1e-12);
+          EXPECT_NEAR(map.grid.Y(J), y, 1e-12);
           EXPECT_EQ(map.At(I, J), -2.0 * (j * 4 + i + 1.0)) << rotation << " deg";
         }
       }
@@ -258,7 +258,7 @@ TEST(PlaceInPartFrame, NeedsALateralResolutionFromTheFileOrTheJob) {
   const std::string message = ErrorMessageOf([&] { (void)PlaceInPartFrame(pixels, {}, "nores.dat"); });
   EXPECT_TRUE(Contains(message, "'nores.dat'") && Contains(message, "pixel_mm")) << message;
   const ErrorMap map = PlaceInPartFrame(pixels, {.pixel_mm = 0.2}, "nores.dat");
-  EXPECT_DOUBLE_EQ(map.dx_mm, 0.2);
+  EXPECT_DOUBLE_EQ(map.grid.dx_mm, 0.2);
 }
 
 TEST(ParseMetroProDat, RefusesCorruptHeadersNamingTheFileAndTheField) {
@@ -523,7 +523,8 @@ TEST(ReadZygoDatx, RefusesAReferenceToAMissingOrLongerHeapObject) {
 
 TEST(ErrorMapHdf5, RoundTripsEveryNodeAndTheGridPlacement) {
   arcwheel::testing::TempDir dir;
-  ErrorMap map{.x0_mm = -12.5, .y0_mm = 3.0, .dx_mm = 0.25, .dy_mm = 0.5, .nx = 5, .ny = 3, .error_um = {}};
+  ErrorMap map{.grid = {.x0_mm = -12.5, .y0_mm = 3.0, .dx_mm = 0.25, .dy_mm = 0.5, .nx = 5, .ny = 3},
+               .error_um = {}};
   for (int k = 0; k < 15; ++k) map.error_um.push_back(k == 7 ? kNaN : 0.1 * k - 0.3);
   WriteErrorMapHdf5(map, dir / "grid.h5");
   const ErrorMap read = ReadErrorMapHdf5(dir / "grid.h5");
@@ -607,29 +608,29 @@ TEST(InterpolateScattered, ReproducesAPlaneExactlyAndLeavesNodesOutsideTheHullWi
   auto plane = [](double x, double y) { return 0.3 * x - 0.7 * y + 2.0; };
   const std::vector<ScatteredPoint> points = RandomPoints(300, plane, 20240611);
   const ErrorMap map = InterpolateScattered(points, 0.5, "cmm.csv");
-  EXPECT_EQ(map.dx_mm, 0.5);
+  EXPECT_EQ(map.grid.dx_mm, 0.5);
   std::vector<P2> xy;
   for (const ScatteredPoint& p : points) xy.push_back({p.x_mm, p.y_mm});
   const std::vector<P2> hull = Hull(xy);
   int inside = 0;
-  for (int j = 0; j < map.ny; ++j) {
-    for (int i = 0; i < map.nx; ++i) {
-      const double d = InsideBy(hull, map.X(i), map.Y(j));
+  for (int j = 0; j < map.grid.ny; ++j) {
+    for (int i = 0; i < map.grid.nx; ++i) {
+      const double d = InsideBy(hull, map.grid.X(i), map.grid.Y(j));
       if (d > 1e-9) {
         ++inside;
         ASSERT_TRUE(std::isfinite(map.At(i, j)))
-            << "node (" << map.X(i) << ", " << map.Y(j) << ") inside the hull by " << d;
-        EXPECT_NEAR(map.At(i, j), plane(map.X(i), map.Y(j)), 1e-12);
+            << "node (" << map.grid.X(i) << ", " << map.grid.Y(j) << ") inside the hull by " << d;
+        EXPECT_NEAR(map.At(i, j), plane(map.grid.X(i), map.grid.Y(j)), 1e-12);
       } else if (d < -1e-9) {
         EXPECT_TRUE(std::isnan(map.At(i, j)))
-            << "node (" << map.X(i) << ", " << map.Y(j) << ") outside the hull";
+            << "node (" << map.grid.X(i) << ", " << map.grid.Y(j) << ") outside the hull";
       }
     }
   }
   EXPECT_GT(inside, 1000);
   // Nodes sit at whole multiples of the spacing.
-  EXPECT_NEAR(std::remainder(map.x0_mm, 0.5), 0.0, 1e-12);
-  EXPECT_NEAR(std::remainder(map.y0_mm, 0.5), 0.0, 1e-12);
+  EXPECT_NEAR(std::remainder(map.grid.x0_mm, 0.5), 0.0, 1e-12);
+  EXPECT_NEAR(std::remainder(map.grid.y0_mm, 0.5), 0.0, 1e-12);
 }
 
 TEST(InterpolateScattered, StaysWithinTheLinearInterpolationBoundOfAQuadratic) {
@@ -653,11 +654,11 @@ TEST(InterpolateScattered, StaysWithinTheLinearInterpolationBoundOfAQuadratic) {
   const ErrorMap map = InterpolateScattered(points, 0.37, "quad.csv");
   const double r_max = h / std::sqrt(2.0) + 0.3 * std::sqrt(2.0) * h;
   int checked = 0;
-  for (int j = 0; j < map.ny; ++j) {
-    for (int i = 0; i < map.nx; ++i) {
-      if (std::max(std::abs(map.X(i)), std::abs(map.Y(j))) > 10 * h - r_max - h) continue;
+  for (int j = 0; j < map.grid.ny; ++j) {
+    for (int i = 0; i < map.grid.nx; ++i) {
+      if (std::max(std::abs(map.grid.X(i)), std::abs(map.grid.Y(j))) > 10 * h - r_max - h) continue;
       ASSERT_TRUE(std::isfinite(map.At(i, j)));
-      const double error = map.At(i, j) - (map.X(i) * map.X(i) + map.Y(j) * map.Y(j));
+      const double error = map.At(i, j) - (map.grid.X(i) * map.grid.X(i) + map.grid.Y(j) * map.grid.Y(j));
       EXPECT_GE(error, -1e-9);
       EXPECT_LE(error, r_max * r_max);
       ++checked;
@@ -680,7 +681,7 @@ TEST(InterpolateScattered, DefaultsTheSpacingToTheMedianNearestNeighbourDistance
   }
   std::sort(nearest.begin(), nearest.end());
   EXPECT_DOUBLE_EQ(MedianNearestNeighbourMm(points, "p.csv"), nearest[50]);
-  EXPECT_DOUBLE_EQ(InterpolateScattered(points, 0.0, "p.csv").dx_mm, nearest[50]);
+  EXPECT_DOUBLE_EQ(InterpolateScattered(points, 0.0, "p.csv").grid.dx_mm, nearest[50]);
 }
 
 TEST(ReadScatteredCsv, RefusesTooFewCollinearOrCoincidentPointsNamingTheFile) {
@@ -732,9 +733,9 @@ TEST(PolishJobErrorMap, ReadsEachFormatByItsExtensionAndAppliesThePlacementKeys)
       ReadJob(dir, R"({"file": "map.dat", "rotation_deg": 90, "scale": -1, "centre_mm": [1, 2]})");
   const ErrorMap expected = PlaceInPartFrame(
       pixels, {.centre_x_mm = 1, .centre_y_mm = 2, .rotation_deg = 90, .scale = -1}, "map.dat");
-  EXPECT_EQ(job.error_map.nx, 5);
-  EXPECT_EQ(job.error_map.ny, 7);
-  EXPECT_EQ(job.error_map.x0_mm, expected.x0_mm);
+  EXPECT_EQ(job.error_map.grid.nx, 5);
+  EXPECT_EQ(job.error_map.grid.ny, 7);
+  EXPECT_EQ(job.error_map.grid.x0_mm, expected.grid.x0_mm);
   for (std::size_t k = 0; k < expected.error_um.size(); ++k) {
     EXPECT_TRUE(job.error_map.error_um[k] == expected.error_um[k] ||
                 (std::isnan(job.error_map.error_um[k]) && std::isnan(expected.error_um[k])));
@@ -745,15 +746,10 @@ TEST(PolishJobErrorMap, ReadsEachFormatByItsExtensionAndAppliesThePlacementKeys)
 
   std::ofstream(dir / "pts.csv") << "x_mm,y_mm,error_um\n-10,-10,1\n10,-10,1\n0,10,1\n";
   job = ReadJob(dir, R"({"file": "pts.csv", "layout": "scattered", "grid_spacing_mm": 0.5})");
-  EXPECT_EQ(job.error_map.dx_mm, 0.5);
+  EXPECT_EQ(job.error_map.grid.dx_mm, 0.5);
   EXPECT_NEAR(job.error_map.At(20, 20), 1.0, 1e-12);  // (0, 0) lies inside the triangle
 
-  ErrorMap grid{.x0_mm = -10,
-                .y0_mm = -10,
-                .dx_mm = 1,
-                .dy_mm = 1,
-                .nx = 21,
-                .ny = 21,
+  ErrorMap grid{.grid = {.x0_mm = -10, .y0_mm = -10, .dx_mm = 1, .dy_mm = 1, .nx = 21, .ny = 21},
                 .error_um = std::vector<double>(441, 0.5)};
   WriteErrorMapHdf5(grid, dir / "grid.h5");
   job = ReadJob(dir, R"({"file": "grid.h5", "scale": 2})");
@@ -790,7 +786,7 @@ TEST(ErrorMapSeeds, SmallSamplesOfEachFormatReadBack) {
   std::ofstream(dir / "map_small.dat", std::ios::binary)
       .write(reinterpret_cast<const char*>(dat.data()), static_cast<std::streamsize>(dat.size()));
   WriteDatx(dir / "map_small.datx", DatxSpec{}, 6, 4, DatxHeightNm);
-  ErrorMap grid{.x0_mm = -2, .y0_mm = -1, .dx_mm = 1, .dy_mm = 1, .nx = 5, .ny = 3, .error_um = {}};
+  ErrorMap grid{.grid = {.x0_mm = -2, .y0_mm = -1, .dx_mm = 1, .dy_mm = 1, .nx = 5, .ny = 3}, .error_um = {}};
   for (int k = 0; k < 15; ++k) grid.error_um.push_back(k == 4 ? kNaN : 0.05 * k);
   WriteErrorMapHdf5(grid, dir / "map_small_grid.h5");
   {
@@ -803,9 +799,9 @@ TEST(ErrorMapSeeds, SmallSamplesOfEachFormatReadBack) {
   }
   EXPECT_EQ(ReadMetroProDat(dir / "map_small.dat").width, 7);
   EXPECT_EQ(ReadZygoDatx(dir / "map_small.datx").width, 6);
-  EXPECT_EQ(ReadErrorMapHdf5(dir / "map_small_grid.h5").nx, 5);
-  EXPECT_GT(InterpolateScattered(ReadScatteredCsv(dir / "map_scattered.csv"), 0.0, "map_scattered.csv").nx,
-            1);
+  EXPECT_EQ(ReadErrorMapHdf5(dir / "map_small_grid.h5").grid.nx, 5);
+  EXPECT_GT(
+      InterpolateScattered(ReadScatteredCsv(dir / "map_scattered.csv"), 0.0, "map_scattered.csv").grid.nx, 1);
   if (const char* folder = std::getenv("ARCWHEEL_WRITE_SEEDS")) {
     for (const char* name : {"map_small.dat", "map_small.datx", "map_small_grid.h5", "map_scattered.csv"}) {
       std::filesystem::copy_file(dir / name, std::filesystem::path(folder) / name,

@@ -132,7 +132,7 @@ ErrorMap ReadErrorMapSection(JsonSection& s, const std::filesystem::path& file) 
   }
   if (!pixels) {
     ErrorMap map = ReadErrorMap(file, options);
-    if (options.layout == ErrorMapLayout::kScattered) s.SetResolved("grid_spacing_mm", map.dx_mm);
+    if (options.layout == ErrorMapLayout::kScattered) s.SetResolved("grid_spacing_mm", map.grid.dx_mm);
     return map;
   }
   const PixelMap raw = options.format == ErrorMapFormat::kDat ? ReadMetroProDat(file) : ReadZygoDatx(file);
@@ -218,13 +218,14 @@ namespace {
 
 void CheckOnSurface(const PolishJob& job, std::span<const Eigen::Vector2d> path) {
   const ErrorMap& m = job.error_map;
-  for (int j = 0; j < m.ny; ++j) {
-    for (int i = 0; i < m.nx; ++i) {
-      if (!std::isfinite(m.At(i, j)) || !job.aperture.Contains(m.X(i), m.Y(j))) continue;
-      if (!job.surface->InDomain(m.X(i), m.Y(j))) {
-        throw Error(ErrorCode::kBadInput, kStage,
-                    fmt::format("map off the surface: '{}' node ({}, {}) mm lies outside {}",
-                                job.error_map_file.string(), m.X(i), m.Y(j), job.surface->Describe()));
+  for (int j = 0; j < m.grid.ny; ++j) {
+    for (int i = 0; i < m.grid.nx; ++i) {
+      if (!std::isfinite(m.At(i, j)) || !job.aperture.Contains(m.grid.X(i), m.grid.Y(j))) continue;
+      if (!job.surface->InDomain(m.grid.X(i), m.grid.Y(j))) {
+        throw Error(
+            ErrorCode::kBadInput, kStage,
+            fmt::format("map off the surface: '{}' node ({}, {}) mm lies outside {}",
+                        job.error_map_file.string(), m.grid.X(i), m.grid.Y(j), job.surface->Describe()));
       }
     }
   }
@@ -242,11 +243,11 @@ void CheckOnSurface(const PolishJob& job, std::span<const Eigen::Vector2d> path)
 std::string ResidualCsv(const ErrorMap& target, const DwellSolution& d) {
   fmt::memory_buffer out;
   fmt::format_to(std::back_inserter(out), "{}\n", fmt::join(schema::polish::residual_map::kColumns, ","));
-  for (int j = 0; j < target.ny; ++j) {
-    for (int i = 0; i < target.nx; ++i) {
-      const std::size_t k = static_cast<std::size_t>(j) * target.nx + i;
+  for (int j = 0; j < target.grid.ny; ++j) {
+    for (int i = 0; i < target.grid.nx; ++i) {
+      const std::size_t k = static_cast<std::size_t>(j) * target.grid.nx + i;
       if (!std::isfinite(d.residual_um.error_um[k])) continue;
-      fmt::format_to(std::back_inserter(out), "{},{},{},{},{}\n", target.X(i), target.Y(j),
+      fmt::format_to(std::back_inserter(out), "{},{},{},{},{}\n", target.grid.X(i), target.grid.Y(j),
                      target.error_um[k], d.predicted_removal_um.error_um[k], d.residual_um.error_um[k]);
     }
   }

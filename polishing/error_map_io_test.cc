@@ -6,11 +6,13 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <fstream>
 #include <functional>
 #include <iterator>
+#include <memory>
 #include <nlohmann/json.hpp>
 #include <random>
 #include <string>
@@ -76,6 +78,15 @@ TEST(ReadErrorMapCsv, NamesTheFileAndLineOfMalformedInput) {
             std::string::npos);
   EXPECT_NE(CsvError("x_mm,y_mm,error_um\n0,0,1\n1,0,2\n1,0,3\n").find("line 4: (1, 0) mm appears twice"),
             std::string::npos);
+}
+
+TEST(ReadErrorMapCsv, RefusesAnInfinityNamingTheLineButReadsNanAsNoData) {
+  for (const char* infinity : {"inf", "-inf", "Infinity", "1e999"}) {
+    const std::string message =
+        CsvError(std::string("x_mm,y_mm,error_um\n0,0,nan\n1,0,") + infinity + "\n2,0,1\n");
+    EXPECT_NE(message.find("map.csv' line 3: error_um = "), std::string::npos) << message;
+    EXPECT_NE(message.find("is not finite"), std::string::npos) << message;
+  }
 }
 
 // ------------------------------------------------------------------------------------------------
@@ -462,6 +473,111 @@ TEST(ReadZygoDatx, RefusesAFileWithoutTheSurfaceDatasetOrAHeightUnit) {
       << message;
 }
 
+// .datx files as h5py writes them in the layouts instruments use (tests/foreign/write_datx.py):
+// MetroPro's /Data/Surface/{GUID} found through /MetaData, /Measurement/Surface, and a lone
+// dataset under /Data/Surface. The script computes every height itself from what it wrote.
+class DatxLayouts : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    dir_ = std::make_unique<arcwheel::testing::TempDir>();
+    const std::string command =
+        "/usr/bin/python3 " + (arcwheel::testing::SourceDir() / "tests/foreign/write_datx.py").string() +
+        " " + dir_->path().string() + " > " + (*dir_ / "writer.log").string() + " 2>&1";
+    ASSERT_EQ(std::system(command.c_str()), 0) << command << "\n"
+                                               << arcwheel::testing::ReadText(*dir_ / "writer.log");
+    expected_ = nlohmann::json::parse(arcwheel::testing::ReadText(*dir_ / "expected.json"));
+  }
+  static void TearDownTestSuite() { dir_.reset(); }
+  static std::unique_ptr<arcwheel::testing::TempDir> dir_;
+  static nlohmann::json expected_;
+};
+std::unique_ptr<arcwheel::testing::TempDir> DatxLayouts::dir_;
+nlohmann::json DatxLayouts::expected_;
+
+// Valid pixels, PV and RMS about the mean of a pixel map, in the map's unit.
+struct PixelFigures {
+  std::size_t valid = 0;
+  double pv = 0.0;
+  double rms = 0.0;
+};
+PixelFigures FiguresOf(const std::vector<double>& heights) {
+  std::vector<double> valid;
+  std::copy_if(heights.begin(), heights.end(), std::back_inserter(valid),
+               [](double h) { return !std::isnan(h); });
+  PixelFigures f{.valid = valid.size()};
+  if (valid.empty()) return f;
+  const auto [low, high] = std::minmax_element(valid.begin(), valid.end());
+  f.pv = *high - *low;
+  double mean = 0.0, square = 0.0;
+  for (const double h : valid) mean += h / static_cast<double>(valid.size());
+  for (const double h : valid) square += (h - mean) * (h - mean) / static_cast<double>(valid.size());
+  f.rms = std::sqrt(square);
+  return f;
+}
+
+TEST_F(DatxLayouts, ReadsEveryLayoutToThePixelsTheWriterComputed) {
+  for (const auto& [file, want] : expected_["good"].items()) {
+    SCOPED_TRACE(file);
+    const PixelMap map = ReadZygoDatx(*dir_ / "good" / file);
+    ASSERT_EQ(map.width, want["width"].get<int>());
+    ASSERT_EQ(map.height, want["height"].get<int>());
+    EXPECT_DOUBLE_EQ(map.pixel_x_mm, want["pixel_mm"].get<double>());
+    EXPECT_DOUBLE_EQ(map.pixel_y_mm, want["pixel_mm"].get<double>());
+    for (int j = 0; j < map.height; ++j) {
+      for (int i = 0; i < map.width; ++i) {
+        const nlohmann::json& h = want["height_um"][j][i];
+        const double read = map.height_um[static_cast<std::size_t>(j) * map.width + i];
+        if (h.is_null()) {
+          EXPECT_TRUE(std::isnan(read)) << "[" << j << "][" << i << "]";
+        } else {
+          // The same product in another order: a few units in the last place.
+          EXPECT_NEAR(read, h.get<double>(), 1e-14 * std::abs(h.get<double>()))
+              << "[" << j << "][" << i << "]";
+        }
+      }
+    }
+    const PixelFigures figures = FiguresOf(map.height_um);
+    EXPECT_EQ(figures.valid, want["valid_pixels"].get<std::size_t>());
+    EXPECT_NEAR(figures.pv, want["pv_um"].get<double>(), 1e-13);
+    EXPECT_NEAR(figures.rms, want["rms_um"].get<double>(), 1e-13);
+  }
+}
+
+TEST_F(DatxLayouts, RefusesAnAmbiguousOrMissingSurfaceAndAnInfinityNamingTheFile) {
+  ASSERT_FALSE(expected_["bad"].empty());
+  for (const auto& [file, reason] : expected_["bad"].items()) {
+    const std::string message = ErrorMessageOf([&] { (void)ReadZygoDatx(*dir_ / "bad" / file); });
+    EXPECT_TRUE(Contains(message, file + "'") && Contains(message, reason.get<std::string>()))
+        << file << ": " << message;
+  }
+}
+
+// Real instrument files from public repositories (not part of the project: they are third-party
+// data). With ARCWHEEL_ZYGO_REAL_DIR set to a folder holding them, each must read to the figures
+// that its source project's own reader gives (valid pixels, PV nm, RMS nm about the mean; the
+// figures are given to 1e-6 nm).
+TEST(RealZygoFiles, ReadToTheirSourceProjectsFigures) {
+  const char* folder = std::getenv("ARCWHEEL_ZYGO_REAL_DIR");
+  if (folder == nullptr) GTEST_SKIP() << "set ARCWHEEL_ZYGO_REAL_DIR to the folder of the real Zygo files";
+  struct Real {
+    const char* file;
+    std::size_t valid;
+    double pv_nm, rms_nm;
+  };
+  for (const Real& real : {Real{"prysm_valid_zygo_dat_file.dat", 136359, 330.700173, 44.591409},
+                           Real{"surftopo_metropro-1.dat", 307200, 1363.056329, 75.288222},
+                           Real{"monolithic_zygo_test.datx", 7771, 453.030479, 80.817653}}) {
+    const std::filesystem::path path = std::filesystem::path(folder) / real.file;
+    const PixelMap map = path.extension() == ".datx" ? ReadZygoDatx(path) : ReadMetroProDat(path);
+    const PixelFigures figures = FiguresOf(map.height_um);
+    EXPECT_EQ(figures.valid, real.valid) << real.file;
+    EXPECT_NEAR(figures.pv * 1e3, real.pv_nm, 1e-6) << real.file;
+    EXPECT_NEAR(figures.rms * 1e3, real.rms_nm, 1e-6) << real.file;
+    std::printf("%s: %zu valid pixels, PV %.6f nm, RMS %.6f nm\n", real.file, figures.valid, figures.pv * 1e3,
+                figures.rms * 1e3);
+  }
+}
+
 // libhdf5 1.10 steps through a global heap collection by each object's size and never returns from
 // a zero-size object. Zeroing the body of the collection that holds the converters' strings makes
 // its first object exactly that; the reader must refuse the file instead of handing it on.
@@ -536,6 +652,19 @@ TEST(ErrorMapHdf5, RoundTripsEveryNodeAndTheGridPlacement) {
       EXPECT_EQ(read.error_um[k], map.error_um[k]);
     }
   }
+}
+
+TEST(ErrorMapHdf5, RefusesAnInfinityNamingTheDatasetAndItsIndex) {
+  arcwheel::testing::TempDir dir;
+  ErrorMap map{.grid = {.nx = 4, .ny = 3}, .error_um = std::vector<double>(12, 0.5)};
+  map.error_um[1] = kNaN;  // no data: read as such
+  map.error_um[6] = -std::numeric_limits<double>::infinity();
+  map.error_um[9] = std::numeric_limits<double>::infinity();
+  WriteErrorMapHdf5(map, dir / "inf.h5");
+  const std::string message = ErrorMessageOf([&] { (void)ReadErrorMapHdf5(dir / "inf.h5"); });
+  EXPECT_TRUE(Contains(message, "inf.h5'") && Contains(message, "dataset 'error_um' value [1][2] = -inf") &&
+              Contains(message, "not finite"))
+      << message;
 }
 
 TEST(ErrorMapHdf5, RefusesAMissingAttributeOrDatasetByName) {

@@ -9,6 +9,8 @@
 #include <iterator>
 #include <limits>
 #include <map>
+#include <numbers>
+#include <optional>
 #include <sstream>
 #include <utility>
 
@@ -16,6 +18,7 @@
 #include "core/error.h"
 #include "core/json_job.h"
 #include "core/json_text.h"
+#include "core/memory_budget.h"
 #include "core/version.h"
 #include "schema/polish_outputs.h"
 #include "surfaces/surface_json.h"
@@ -210,8 +213,45 @@ PolishJob ReadPolishJob(const std::filesystem::path& path) {
     problems.insert(problems.end(), more.begin(), more.end());
   }
   s.ThrowIfProblems(problems);
+  s.ThrowIfProblems(SizeProblems(job));
   job.resolved_json = s.resolved().dump();
   return job;
+}
+
+double PathPointCount(const surfaces::Aperture& aperture, const RasterOptions& o, PathPattern pattern) {
+  const bool circle = aperture.shape == surfaces::Aperture::Shape::kCircle;
+  const double half_x = aperture.HalfX() + o.extension_mm, half_y = aperture.HalfY() + o.extension_mm;
+  if (pattern == PathPattern::kSpiral) {
+    // As SpiralPath: the arc length of r = b theta out to the grown aperture's radius, in steps.
+    const double radius = circle ? half_y : std::hypot(half_x, half_y);
+    const double b = o.line_spacing_mm / (2.0 * std::numbers::pi), theta = radius / b;
+    const double length = 0.5 * b * (theta * std::sqrt(1.0 + theta * theta) + std::asinh(theta));
+    return std::max(1.0, std::ceil(length / o.point_spacing_mm - 1e-9)) + 1.0;
+  }
+  // As RasterPath: lines across the grown height, each at most the grown width long.
+  const double lines = std::ceil(2.0 * half_y / o.line_spacing_mm - 1e-9) + 1.0;
+  const double widest = circle ? half_y : half_x;
+  return lines * (std::max(1.0, std::ceil(2.0 * widest / o.point_spacing_mm - 1e-9)) + 1.0);
+}
+
+std::vector<std::string> SizeProblems(const PolishJob& job) {
+  // Each dwell point holds a column of the removal matrix, reserved as the removal function's
+  // footprint box on the map's grid.
+  const FootprintBox box = job.removal.Footprint();
+  const surfaces::GridSpec& grid = job.error_map.grid;
+  const double box_x_mm = box.max_x_mm - box.min_x_mm, box_y_mm = box.max_y_mm - box.min_y_mm;
+  const double entries = std::ceil(box_x_mm / grid.dx_mm + 1.0) * std::ceil(box_y_mm / grid.dy_mm + 1.0);
+  const double points = PathPointCount(job.aperture, job.path, job.path_pattern);
+  std::optional<std::string> problem = MemoryBudgetProblem(
+      fmt::format("path.line_spacing_mm = {}, path.point_spacing_mm = {}", job.path.line_spacing_mm,
+                  job.path.point_spacing_mm),
+      points, "dwell points", kBytesPerDwellPoint + kBytesPerRemovalMatrixEntry * entries);
+  if (!problem) return {};
+  return {*problem +
+          fmt::format(" (a dwell point holds {:.3g} B and {:.3g} removal-matrix entries of {:g} B: the "
+                      "removal function's {:g} x {:g} mm footprint on the map's {:g} x {:g} mm grid)",
+                      kBytesPerDwellPoint, entries, kBytesPerRemovalMatrixEntry, box_x_mm, box_y_mm,
+                      grid.dx_mm, grid.dy_mm)};
 }
 
 namespace {
@@ -298,8 +338,8 @@ PolishRunReport RunPolishJob(const PolishJob& job, const std::filesystem::path& 
         {key::solver::kNonzeros, report.dwell.nonzeros},
         {key::solver::kShapingRounds, report.dwell.shaping_rounds}}}};
 
-  EnsureDirectory(output_folder);
   OutputSet outputs;
+  outputs.CreateFolder(output_folder);
   auto write = [&](std::string_view name, const std::string& text) {
     const std::filesystem::path temporary = outputs.Stage(output_folder / name);
     std::ofstream out(temporary, std::ios::binary);

@@ -24,11 +24,15 @@ void BM_SolveDwell(benchmark::State& state) {
   const std::vector<Eigen::Vector2d> path =
       RasterPath(aperture, {.line_spacing_mm = 1.0, .point_spacing_mm = 1.0, .extension_mm = extension_mm});
   const int nodes = static_cast<int>(side_mm) + 1;
-  ErrorMap error{
-      .x0_mm = -side_mm / 2, .y0_mm = -side_mm / 2, .dx_mm = 1.0, .dy_mm = 1.0, .nx = nodes, .ny = nodes};
+  ErrorMap error{.grid = {.x0_mm = -side_mm / 2,
+                          .y0_mm = -side_mm / 2,
+                          .dx_mm = 1.0,
+                          .dy_mm = 1.0,
+                          .nx = nodes,
+                          .ny = nodes}};
   for (int j = 0; j < nodes; ++j) {
     for (int i = 0; i < nodes; ++i) {
-      const double x = error.X(i) / side_mm, y = error.Y(j) / side_mm;
+      const double x = error.grid.X(i) / side_mm, y = error.grid.Y(j) / side_mm;
       error.error_um.push_back(0.3 * (x * x - y * y) + 0.2 * std::cos(9.0 * x) * std::sin(7.0 * y));
     }
   }

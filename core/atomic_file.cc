@@ -19,6 +19,21 @@ OutputSet::~OutputSet() {
     std::error_code ignored;
     fs::remove(entry.temporary, ignored);
   }
+  for (const fs::path& folder : created_folders_) {
+    std::error_code ignored;
+    fs::remove(folder, ignored);  // removes a folder only while it is empty
+  }
+}
+
+void OutputSet::CreateFolder(const fs::path& directory) {
+  std::vector<fs::path> missing;
+  std::error_code error;
+  for (fs::path p = directory; !p.empty() && !fs::exists(p, error); p = p.parent_path()) {
+    missing.push_back(p);
+    if (p == p.parent_path()) break;
+  }
+  EnsureDirectory(directory);
+  created_folders_.insert(created_folders_.end(), missing.begin(), missing.end());
 }
 
 fs::path OutputSet::Stage(const fs::path& final_path) {

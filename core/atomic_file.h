@@ -19,6 +19,10 @@ class OutputSet {
   OutputSet& operator=(const OutputSet&) = delete;
   ~OutputSet();
 
+  // Creates `directory` and any missing parents; Error{kIo} naming it if that fails. The folders
+  // this had to create are removed again (those still empty) when the set is destroyed without
+  // Commit(): a failed run leaves no new folder behind, as it leaves no file.
+  void CreateFolder(const std::filesystem::path& directory);
   // Reserves `final_path` and returns the temporary path (same folder) to write it to.
   [[nodiscard]] std::filesystem::path Stage(const std::filesystem::path& final_path);
   // Renames every staged file into place. Throws Error{kIo} naming the file that failed.
@@ -30,6 +34,7 @@ class OutputSet {
     std::filesystem::path final;
   };
   std::vector<Entry> entries_;
+  std::vector<std::filesystem::path> created_folders_;  // innermost first
   bool committed_ = false;
 };
 

@@ -29,6 +29,29 @@ TEST(OutputSet, LeavesEarlierFileIntactWhenNotCommitted) {
   EXPECT_EQ(testing::ListFolder(dir.path()), "summary.json\n");
 }
 
+TEST(OutputSet, RemovesTheFoldersItCreatedWhenNotCommitted) {
+  testing::TempDir dir;
+  std::filesystem::create_directory(dir / "kept");
+  {
+    OutputSet outputs;
+    outputs.CreateFolder(dir / "kept");
+    outputs.CreateFolder(dir / "new" / "deeper");
+    ASSERT_TRUE(std::filesystem::is_directory(dir / "new" / "deeper"));
+    std::ofstream(outputs.Stage(dir / "new" / "deeper" / "a.txt")) << "the run fails before commit";
+  }
+  // The folder that was there stays; the two made for the run go with their temporary file.
+  EXPECT_EQ(testing::ListFolder(dir.path()), "kept\n");
+}
+
+TEST(OutputSet, KeepsTheFoldersItCreatedOnCommit) {
+  testing::TempDir dir;
+  OutputSet outputs;
+  outputs.CreateFolder(dir / "out");
+  std::ofstream(outputs.Stage(dir / "out" / "a.txt")) << "A";
+  outputs.Commit();
+  EXPECT_EQ(Slurp(dir / "out" / "a.txt"), "A");
+}
+
 TEST(OutputSet, CommitReplacesEveryStagedFile) {
   testing::TempDir dir;
   OutputSet outputs;

@@ -481,6 +481,28 @@ std::optional<MemberReader> MakeMemberReader(hid_t member_type, const char* memb
   return reader;
 }
 
+// The text of a string member read by `reader` into `element` (fixed: up to its first NUL).
+std::string MemberString(const MemberReader& reader, const unsigned char* element) {
+  if (reader.kind == MemberReader::Kind::kVariableString) {
+    const char* text = *reinterpret_cast<char* const*>(element);
+    return text == nullptr ? std::string() : std::string(text);
+  }
+  const auto* text = reinterpret_cast<const char*>(element);
+  return std::string(text, strnlen(text, reader.element_size));
+}
+
+bool IsVariableLength(const MemberReader& reader) {
+  return reader.kind == MemberReader::Kind::kVariableString ||
+         reader.kind == MemberReader::Kind::kVariableNumbers;
+}
+
+// max_align_t storage for `elements` values of a member: pointers (variable-length) and doubles.
+std::vector<std::max_align_t> MemberBuffer(const MemberReader& reader, hssize_t elements) {
+  return std::vector<std::max_align_t>(
+      (static_cast<size_t>(elements) * reader.element_size + sizeof(std::max_align_t) - 1) /
+      sizeof(std::max_align_t));
+}
+
 // libhdf5 1.10.8 converts a compound by moving each member from its stored offset, trusting the
 // stored layout: a damaged type whose member lies past the end of the compound makes it copy from
 // outside its buffer. A layout written by the library has members inside the compound and apart.
@@ -542,30 +564,20 @@ std::optional<File::Compound> File::ReadAttributeCompound(const std::string& obj
     const Handle member_type(H5Tget_member_type(type.id(), static_cast<unsigned>(m)), H5Tclose);
     const std::optional<MemberReader> reader = MakeMemberReader(member_type.id(), member.c_str());
     if (!reader) continue;
-    if (reader->kind == MemberReader::Kind::kVariableString ||
-        reader->kind == MemberReader::Kind::kVariableNumbers) {
+    if (IsVariableLength(*reader)) {
       CheckHeapReferences(attribute.id(), member_type.id(), "member '" + member + "' of " + where,
                           member.c_str());
     }
-    // max_align_t storage: the buffer holds pointers (variable-length members) and doubles.
-    std::vector<std::max_align_t> buffer(
-        (static_cast<size_t>(elements) * reader->element_size + sizeof(std::max_align_t) - 1) /
-        sizeof(std::max_align_t));
+    std::vector<std::max_align_t> buffer = MemberBuffer(*reader, elements);
     if (H5Aread(attribute.id(), reader->memory_type.id(), buffer.data()) < 0) {
       throw Error(ErrorCode::kBadInput, kStage, "cannot read member '" + member + "' of " + where);
     }
     const auto* first = reinterpret_cast<const unsigned char*>(buffer.data());
     switch (reader->kind) {
-      case MemberReader::Kind::kString: {
-        const auto* text = reinterpret_cast<const char*>(first);
-        result.strings[member] = std::string(text, strnlen(text, reader->element_size));
+      case MemberReader::Kind::kString:
+      case MemberReader::Kind::kVariableString:
+        result.strings[member] = MemberString(*reader, first);
         break;
-      }
-      case MemberReader::Kind::kVariableString: {
-        const char* text = *reinterpret_cast<char* const*>(first);
-        result.strings[member] = text == nullptr ? std::string() : std::string(text);
-        break;
-      }
       case MemberReader::Kind::kNumber: {
         const auto* values = reinterpret_cast<const double*>(first);
         result.numbers[member] = std::vector<double>(values, values + reader->count);
@@ -579,12 +591,96 @@ std::optional<File::Compound> File::ReadAttributeCompound(const std::string& obj
         break;
       }
     }
-    if (reader->kind == MemberReader::Kind::kVariableString ||
-        reader->kind == MemberReader::Kind::kVariableNumbers) {
+    if (IsVariableLength(*reader)) {
       H5Dvlen_reclaim(reader->memory_type.id(), space.id(), H5P_DEFAULT, buffer.data());
     }
   }
   return result;
+}
+
+std::vector<std::vector<std::string>> File::ReadStringTable(const std::string& dataset,
+                                                            const std::vector<std::string>& columns) const {
+  const std::string where = Where(dataset);
+  const Handle data = OpenDataset(dataset);
+  const Handle type(H5Dget_type(data.id()), H5Tclose);
+  if (!type.valid() || H5Tget_class(type.id()) != H5T_COMPOUND) {
+    throw Error(ErrorCode::kBadInput, kStage, where + " is not a table (a compound dataset)");
+  }
+  const Handle space(H5Dget_space(data.id()), H5Sclose);
+  const hssize_t rows = H5Sget_simple_extent_npoints(space.id());
+  if (H5Sget_simple_extent_ndims(space.id()) != 1 || rows < 0 || rows > (1 << 16)) {
+    throw Error(ErrorCode::kBadInput, kStage,
+                where + " must be a one-dimensional table of at most 65536 rows (damaged?)");
+  }
+  CheckCompoundLayout(type.id(), where);
+  std::vector<std::vector<std::string>> table(static_cast<size_t>(rows),
+                                              std::vector<std::string>(columns.size()));
+  for (size_t c = 0; c < columns.size(); ++c) {
+    const std::string column = "column '" + columns[c] + "' of " + where;
+    const int index = H5Tget_member_index(type.id(), columns[c].c_str());
+    if (index < 0) throw Error(ErrorCode::kBadInput, kStage, where + " has no column '" + columns[c] + "'");
+    const Handle member_type(H5Tget_member_type(type.id(), static_cast<unsigned>(index)), H5Tclose);
+    const std::optional<MemberReader> reader = MakeMemberReader(member_type.id(), columns[c].c_str());
+    if (!reader || (reader->kind != MemberReader::Kind::kString &&
+                    reader->kind != MemberReader::Kind::kVariableString)) {
+      throw Error(ErrorCode::kBadInput, kStage, column + " is not text");
+    }
+    if (IsVariableLength(*reader))
+      CheckHeapReferences(data.id(), member_type.id(), column, columns[c].c_str());
+    std::vector<std::max_align_t> buffer = MemberBuffer(*reader, rows);
+    if (rows > 0 &&
+        H5Dread(data.id(), reader->memory_type.id(), H5S_ALL, H5S_ALL, H5P_DEFAULT, buffer.data()) < 0) {
+      throw Error(ErrorCode::kBadInput, kStage, "cannot read " + column);
+    }
+    const auto* first = reinterpret_cast<const unsigned char*>(buffer.data());
+    for (size_t r = 0; r < table.size(); ++r)
+      table[r][c] = MemberString(*reader, first + r * reader->element_size);
+    if (IsVariableLength(*reader) && rows > 0) {
+      H5Dvlen_reclaim(reader->memory_type.id(), space.id(), H5P_DEFAULT, buffer.data());
+    }
+  }
+  return table;
+}
+
+namespace {
+
+struct LinkNames {
+  std::vector<std::string> names;
+  bool too_many = false;
+};
+
+herr_t CollectLinkName(hid_t, const char* name, const H5L_info_t*, void* data) {
+  auto* links = static_cast<LinkNames*>(data);
+  if (links->names.size() >= (1u << 16)) {
+    links->too_many = true;
+    return 1;  // stop
+  }
+  links->names.emplace_back(name);
+  return 0;
+}
+
+}  // namespace
+
+std::vector<std::string> File::DatasetNames(const std::string& group) const {
+  if (group != "/" && !HasObject(group)) return {};
+  const Handle handle(H5Gopen2(handle_.id(), group.c_str(), H5P_DEFAULT), H5Gclose);
+  if (!handle.valid()) return {};
+  LinkNames links;
+  hsize_t position = 0;
+  if (H5Literate(handle.id(), H5_INDEX_NAME, H5_ITER_INC, &position, CollectLinkName, &links) < 0 ||
+      links.too_many) {
+    throw Error(ErrorCode::kBadInput, kStage,
+                "cannot list the members of " + Where(group) + (links.too_many ? " (more than 65536)" : ""));
+  }
+  std::vector<std::string> datasets;
+  for (const std::string& name : links.names) {
+    H5O_info_t info;
+    if (H5Oget_info_by_name2(handle.id(), name.c_str(), &info, H5O_INFO_BASIC, H5P_DEFAULT) >= 0 &&
+        info.type == H5O_TYPE_DATASET) {
+      datasets.push_back(name);
+    }
+  }
+  return datasets;
 }
 
 void File::WriteAttribute(const std::string& object, const std::string& name, double value) {

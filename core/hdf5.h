@@ -91,6 +91,15 @@ class File {
   };
   [[nodiscard]] std::optional<Compound> ReadAttributeCompound(const std::string& object,
                                                               const std::string& name) const;
+  // The string columns `columns` of a one-dimensional compound dataset, row by row (e.g. the
+  // /MetaData table of a Zygo .datx: Source, Link, Destination); each column a fixed or
+  // variable-length string. Throws Error{kBadInput} naming the dataset if it is not such a table,
+  // lacks a column, or holds more than 65536 rows.
+  [[nodiscard]] std::vector<std::vector<std::string>> ReadStringTable(
+      const std::string& dataset, const std::vector<std::string>& columns) const;
+  // The names of the datasets directly in `group`, in name order; empty if there is no such group.
+  // Throws Error{kBadInput} if the group cannot be listed or holds more than 65536 members.
+  [[nodiscard]] std::vector<std::string> DatasetNames(const std::string& group) const;
   void WriteAttribute(const std::string& object, const std::string& name, double value);
   void WriteAttribute(const std::string& object, const std::string& name, const std::string& value);
 
@@ -104,10 +113,10 @@ class File {
   [[nodiscard]] std::string Where(const std::string& object) const;
   // "attribute 'name' on <Where(object)>", for messages.
   [[nodiscard]] std::string AttributeWhere(const std::string& object, const std::string& name) const;
-  // Before libhdf5 reads a variable-length attribute (or `member` of a compound one) of
+  // Before libhdf5 reads a variable-length attribute or dataset (or `member` of a compound one) of
   // `stored_type`: throws Error{kBadInput} unless every global heap object it refers to is one the
   // library can read safely (see hdf5_heap.cc).
-  void CheckHeapReferences(hid_t attribute, hid_t stored_type, const std::string& what,
+  void CheckHeapReferences(hid_t object, hid_t stored_type, const std::string& what,
                            const char* member = nullptr) const;
   // `size` bytes at `address` (relative to the HDF5 base address); shorter at the end of the file.
   [[nodiscard]] std::string ReadRawBytes(uint64_t address, uint64_t size) const;

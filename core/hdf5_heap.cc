@@ -3,7 +3,7 @@
 // trusts both sides: a collection holding an object of size 0 makes it loop for ever while
 // loading the collection, an index the collection does not hold makes it read through a null
 // pointer, and an object larger than the reference says overruns the buffer it is copied into.
-// So before the library reads a variable-length attribute, the references are read as stored
+// So before the library reads a variable-length attribute or dataset, the references are read as stored
 // (a conversion registered below leaves them unfollowed), and each is checked
 // against the collection it names, walked the way the library walks it.
 
@@ -148,7 +148,7 @@ std::string File::ReadRawBytes(uint64_t address, uint64_t size) const {
   return bytes;
 }
 
-void File::CheckHeapReferences(hid_t attribute, hid_t stored_type, const std::string& what,
+void File::CheckHeapReferences(hid_t object, hid_t stored_type, const std::string& what,
                                const char* member) const {
   RegisterKeepStoredReference();
   size_t address_size = 0;
@@ -159,7 +159,8 @@ void File::CheckHeapReferences(hid_t attribute, hid_t stored_type, const std::st
     throw Error(ErrorCode::kBadInput, kStage,
                 "'" + path_.string() + "' declares invalid address or length sizes");
   }
-  const Handle space(H5Aget_space(attribute), H5Sclose);
+  const bool dataset = H5Iget_type(object) == H5I_DATASET;
+  const Handle space(dataset ? H5Dget_space(object) : H5Aget_space(object), H5Sclose);
   const hssize_t elements = H5Sget_simple_extent_npoints(space.id());
   if (elements < 1 || elements > (1 << 16)) {
     throw Error(ErrorCode::kBadInput, kStage, what + " holds " + std::to_string(elements) + " elements");
@@ -175,7 +176,11 @@ void File::CheckHeapReferences(hid_t attribute, hid_t stored_type, const std::st
     memory_type = Handle(H5Tcopy(opaque.id()), H5Tclose);
   }
   std::vector<unsigned char> stored(static_cast<size_t>(elements) * stored_bytes);
-  if (!memory_type.valid() || H5Aread(attribute, memory_type.id(), stored.data()) < 0) {
+  const auto read = [&] {
+    return dataset ? H5Dread(object, memory_type.id(), H5S_ALL, H5S_ALL, H5P_DEFAULT, stored.data())
+                   : H5Aread(object, memory_type.id(), stored.data());
+  };
+  if (!memory_type.valid() || read() < 0) {
     throw Error(ErrorCode::kBadInput, kStage, "cannot read the stored references of " + what);
   }
   const size_t element_bytes = StoredElementBytes(stored_type);

@@ -13,8 +13,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   try {
     const auto file = arcwheel::hdf5::File::OpenImage(data, size, "fuzz_map.h5");
     const auto map = arcwheel::polishing::ReadErrorMapHdf5(file);
-    if (map.nx <= 0 || map.ny <= 0 || map.error_um.size() != static_cast<size_t>(map.nx) * map.ny)
-      __builtin_trap();
+    if (map.grid.nx <= 0 || map.grid.ny <= 0 || map.error_um.size() != map.grid.Nodes()) __builtin_trap();
   } catch (const arcwheel::Error&) {
   }
   return 0;

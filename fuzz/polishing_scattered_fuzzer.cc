@@ -14,8 +14,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     const auto points =
         arcwheel::polishing::ReadScatteredCsv(arcwheel::fuzz::WriteInput(data, size, "points.csv"));
     const auto map = arcwheel::polishing::InterpolateScattered(points, 0.0, "points.csv");
-    if (map.nx <= 0 || map.ny <= 0 || map.error_um.size() != static_cast<size_t>(map.nx) * map.ny)
-      __builtin_trap();
+    if (map.grid.nx <= 0 || map.grid.ny <= 0 || map.error_um.size() != map.grid.Nodes()) __builtin_trap();
   } catch (const arcwheel::Error&) {
   }
   return 0;

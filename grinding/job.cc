@@ -2,6 +2,7 @@
 
 #include <fmt/core.h>
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <limits>
@@ -10,6 +11,8 @@
 #include "core/error.h"
 #include "core/json_job.h"
 #include "core/json_text.h"
+#include "core/memory_budget.h"
+#include "core/parallel.h"
 #include "surfaces/surface_json.h"
 
 namespace arcwheel::grinding {
@@ -17,6 +20,13 @@ namespace arcwheel::grinding {
 namespace {
 
 constexpr const char* kStage = "grinding.job";
+
+// Peak resident memory of `arcwheel toolpath` per item, measured on the trial part (docs/grinding.md
+// "Sizes"): a control point of a row in flight, with its CSV, G-code and PMAC text (360 B); a
+// planned row; a node of the predicted form-error map (30 B).
+constexpr double kBytesPerControlPoint = 400.0;
+constexpr double kBytesPerRow = 8.0;
+constexpr double kBytesPerPredictionNode = 40.0;
 
 // Wheel from the job's own numbers or from a summary.json.
 struct WheelSource {
@@ -143,12 +153,52 @@ void ReadPrediction(JsonSection& s, const std::optional<WheelSummary>& summary, 
   p.spindle_rpm = rpm.value_or(0.0);
   // Whole numbers only: 2.5 must be refused, not used as 2, and a huge count never cast to int.
   const std::vector<double> nodes = s.Numbers("map_nodes", {201, 201});
+  // Checked before the counts become ints: [1e10, 1e10] is no int, and no map that fits.
+  if (const auto problem =
+          MemoryBudgetProblem(fmt::format("prediction.map_nodes = [{}, {}]", nodes[0], nodes[1]),
+                              nodes[0] * nodes[1], "map nodes", kBytesPerPredictionNode)) {
+    s.ThrowIfProblems({*problem});
+  }
   for (const double n : nodes) {
     if (n != std::floor(n) || std::abs(n) > std::numeric_limits<int>::max())
       s.Expected("map_nodes", "two whole numbers");
   }
   p.nodes_x = static_cast<int>(nodes[0]);
   p.nodes_y = static_cast<int>(nodes[1]);
+}
+
+// Sizes the toolpath implies, against the wheel and the memory budget (core/memory_budget.h),
+// from the job alone: the rows are planned and the points solved only after this.
+std::vector<std::string> SizeProblems(const Job& job) {
+  const ToolpathOptions& o = job.path;
+  const Wheel& w = job.wheel;
+  std::vector<std::string> problems;
+  if (o.step_over_mm > 2.0 * w.half_width_mm) {
+    problems.push_back(
+        fmt::format("path.step_over_mm = {} violates <= wheel.width_mm = {}: rows farther apart than "
+                    "the wheel is wide leave bands it never touches",
+                    o.step_over_mm, 2.0 * w.half_width_mm));
+  }
+  // Wheel-centre Y of the contacts lies within Ra of the contact (|Yw - Y| = Ra |fy| / N3), and
+  // wheel-centre X within Ra + Rb of it: bounds of the rows and of a row's length.
+  const double rows = (2.0 * job.aperture.HalfY() + 2.0 * w.arc_radius_mm) / o.step_over_mm + 2.0;
+  if (const auto problem = MemoryBudgetProblem(fmt::format("path.step_over_mm = {}", o.step_over_mm), rows,
+                                               "rows", kBytesPerRow)) {
+    problems.push_back(*problem);
+  }
+  const double row_mm =
+      2.0 * job.aperture.HalfX() + o.lead_in_mm + o.lead_out_mm + 2.0 * (w.arc_radius_mm + w.base_radius_mm);
+  const double points_per_row = row_mm / o.point_spacing_mm + 2.0;
+  const double rows_at_once =
+      std::min(rows, static_cast<double>(kRowsInFlightPerWorker * WorkerCount(o.threads)));
+  if (const auto problem = MemoryBudgetProblem(
+          fmt::format("path.point_spacing_mm = {}", o.point_spacing_mm), rows_at_once * points_per_row,
+          fmt::format("control points held at once ({:g} rows of up to {:.3g})", rows_at_once,
+                      points_per_row),
+          kBytesPerControlPoint)) {
+    problems.push_back(*problem);
+  }
+  return problems;
 }
 
 // Every range problem of the options at once, then the aperture against the surface.
@@ -160,6 +210,7 @@ void Validate(const JsonSection& root, const Job& job) {
     for (std::string& p : job.prediction.Problems()) problems.push_back(std::move(p));
   }
   root.ThrowIfProblems(problems);
+  root.ThrowIfProblems(SizeProblems(job));
   // Contacts run lead_in / lead_out past the aperture and up to Ra |fy| / N3 < half width
   // across it; the surface must exist there.
   try {

@@ -109,8 +109,11 @@ TEST(ParseJob, RefusesMapNodesThatAreNotWholeNumbers) {
   job["prediction"]["map_nodes"] = {31.5, 21};
   EXPECT_THAT(ExpectRefused(job),
               HasSubstr("key 'prediction.map_nodes' expected two whole numbers, got [31.5,21]"));
+  // A count beyond an int is a whole number, but no map that fits: the memory budget refuses it
+  // before any cast (RefusesSizesBeyondTheMemoryBudget...).
   job["prediction"]["map_nodes"] = {31, 1e12};
-  EXPECT_THAT(ExpectRefused(job), HasSubstr("key 'prediction.map_nodes' expected two whole numbers"));
+  EXPECT_THAT(ExpectRefused(job),
+              HasSubstr("prediction.map_nodes = [31, 1000000000000] violates the memory budget"));
 }
 
 TEST(ParseJob, RefusesAnApertureOffTheSurfacesDomainNamingThePoint) {
@@ -240,7 +243,44 @@ TEST(ToolpathCommand, RefusesAWheelThatCannotReachTheCurvatureAndWritesNothing) 
       testing::RunArcwheel("toolpath " + (dir / "job.json").string() + " -o " + (dir / "out").string());
   EXPECT_EQ(run.exit_status, 3) << run.output;
   EXPECT_THAT(run.output, HasSubstr("cannot reach the curvature at contact ("));
-  EXPECT_EQ(testing::ListFolder(dir / "out"), "");
+  // The run fails while the rows are written: the output folder it made goes too.
+  EXPECT_FALSE(std::filesystem::exists(dir / "out"));
+}
+
+TEST(ParseJob, RefusesSizesBeyondTheMemoryBudgetAndAStepOverWiderThanTheWheel) {
+  json job = SmallJob();
+  job["path"]["point_spacing_mm"] = 1e-6;
+  EXPECT_THAT(ExpectRefused(job),
+              HasSubstr("path.point_spacing_mm = 1e-06 violates the memory budget: it implies"));
+  EXPECT_THAT(ExpectRefused(job), HasSubstr("control points held at once"));
+  EXPECT_THAT(ExpectRefused(job), HasSubstr("over the 4 GiB (4294967296 B) of one run"));
+  job = SmallJob();
+  job["path"]["step_over_mm"] = 1e-9;
+  EXPECT_THAT(ExpectRefused(job),
+              HasSubstr("path.step_over_mm = 1e-09 violates the memory budget: it implies"));
+  job = SmallJob();
+  job["path"]["step_over_mm"] = 1e308;
+  EXPECT_THAT(ExpectRefused(job), HasSubstr("path.step_over_mm = 1e+308 violates <= wheel.width_mm = 20"));
+  job["path"]["step_over_mm"] = 20.0;  // the wheel's width: the widest step that leaves no band
+  EXPECT_NO_THROW((void)ParseJob(job.dump(), "job.json", std::nullopt));
+  job = SmallJob();
+  job["prediction"]["map_nodes"] = {1e10, 1e10};
+  EXPECT_THAT(ExpectRefused(job),
+              HasSubstr("prediction.map_nodes = [10000000000, 10000000000] violates the memory "
+                        "budget: it implies 1e+20 map nodes"));
+}
+
+TEST(ToolpathCommand, RefusesATinyStepUpFrontAndWritesNothing) {
+  // A 1e-6 mm step used to end in std::bad_alloc and leave an empty output folder.
+  const testing::TempDir dir;
+  json job = SmallJob();
+  job["path"]["point_spacing_mm"] = 1e-6;
+  WriteText(dir / "job.json", job.dump());
+  const testing::CommandResult run =
+      testing::RunArcwheel("toolpath " + (dir / "job.json").string() + " -o " + (dir / "out").string());
+  EXPECT_EQ(run.exit_status, 3) << run.output;
+  EXPECT_THAT(run.output, HasSubstr("path.point_spacing_mm = 1e-06 violates the memory budget"));
+  EXPECT_FALSE(std::filesystem::exists(dir / "out"));
 }
 
 TEST(ToolpathCommand, RefusesAnUnknownKeyWithExitStatusThree) {

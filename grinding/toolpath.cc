@@ -410,7 +410,7 @@ ToolpathSummary GenerateToolpath(const Surface& surface, const Aperture& apertur
   const std::vector<double> rows = PlanRows(surface, aperture, wheel, options.step_over_mm);
   const RowBuilder builder(surface, aperture, wheel, options, static_cast<int>(rows.size()));
   const int threads = WorkerCount(options.threads);
-  const int block = 8 * threads;
+  const int block = kRowsInFlightPerWorker * threads;
   ToolpathSummary summary;
   summary.passes = options.passes;
   summary.rows_per_pass = static_cast<int>(rows.size());

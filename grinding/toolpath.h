@@ -144,6 +144,9 @@ struct ToolpathSummary {
   double min_local_clearance_per_mm = 0.0;
 };
 
+// Rows are built in blocks of this many per worker thread; a block's rows are held at once.
+inline constexpr int kRowsInFlightPerWorker = 8;
+
 // Generates the toolpath row by row and hands each row to `sink`. Throws
 // Error{kBadInput, "grinding.toolpath"} naming the point where the wheel cannot reach the surface,
 // would leave its usable arc, or would gouge; Error{kInvalidOption} for invalid options.

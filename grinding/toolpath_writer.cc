@@ -229,8 +229,8 @@ std::vector<std::string> ToolpathHeaderLines(const Job& job) {
 }
 
 ToolpathRunReport RunToolpathJob(const Job& job, const std::filesystem::path& output_folder) {
-  EnsureDirectory(output_folder);
   OutputSet outputs;
+  outputs.CreateFolder(output_folder);
   std::vector<std::string> files;
   const auto stage = [&](const std::string& name, bool wanted) -> std::optional<std::filesystem::path> {
     if (!wanted) return std::nullopt;

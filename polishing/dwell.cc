@@ -48,10 +48,11 @@ Rows ApertureRows(const ErrorMap& target, const surfaces::Aperture& aperture) {
   Rows rows;
   rows.row_of_node.assign(target.error_um.size(), -1);
   std::vector<double> values;
-  for (int j = 0; j < target.ny; ++j) {
-    for (int i = 0; i < target.nx; ++i) {
-      const int index = j * target.nx + i;
-      if (!std::isfinite(target.error_um[index]) || !aperture.Contains(target.X(i), target.Y(j))) continue;
+  for (int j = 0; j < target.grid.ny; ++j) {
+    for (int i = 0; i < target.grid.nx; ++i) {
+      const int index = j * target.grid.nx + i;
+      if (!std::isfinite(target.error_um[index]) || !aperture.Contains(target.grid.X(i), target.grid.Y(j)))
+        continue;
       rows.row_of_node[index] = static_cast<int>(rows.node.size());
       rows.node.push_back(index);
       values.push_back(target.error_um[index]);
@@ -72,22 +73,26 @@ template <class Model>
 SparseMatrix RemovalMatrix(const ErrorMap& map, const Rows& rows, std::span<const Eigen::Vector2d> path,
                            const Model& removal, const FootprintBox& box) {
   SparseMatrix a(static_cast<Eigen::Index>(rows.node.size()), static_cast<Eigen::Index>(path.size()));
-  const int per_column = static_cast<int>(std::ceil((box.max_x_mm - box.min_x_mm) / map.dx_mm + 1) *
-                                          std::ceil((box.max_y_mm - box.min_y_mm) / map.dy_mm + 1));
+  const int per_column = static_cast<int>(std::ceil((box.max_x_mm - box.min_x_mm) / map.grid.dx_mm + 1) *
+                                          std::ceil((box.max_y_mm - box.min_y_mm) / map.grid.dy_mm + 1));
   a.reserve(Eigen::VectorXi::Constant(static_cast<Eigen::Index>(path.size()), per_column));
   for (std::size_t k = 0; k < path.size(); ++k) {
     const Eigen::Vector2d& p = path[k];
-    const int i0 = std::max(0, static_cast<int>(std::ceil((p.x() + box.min_x_mm - map.x0_mm) / map.dx_mm)));
+    const int i0 =
+        std::max(0, static_cast<int>(std::ceil((p.x() + box.min_x_mm - map.grid.x0_mm) / map.grid.dx_mm)));
     const int i1 =
-        std::min(map.nx - 1, static_cast<int>(std::floor((p.x() + box.max_x_mm - map.x0_mm) / map.dx_mm)));
-    const int j0 = std::max(0, static_cast<int>(std::ceil((p.y() + box.min_y_mm - map.y0_mm) / map.dy_mm)));
+        std::min(map.grid.nx - 1,
+                 static_cast<int>(std::floor((p.x() + box.max_x_mm - map.grid.x0_mm) / map.grid.dx_mm)));
+    const int j0 =
+        std::max(0, static_cast<int>(std::ceil((p.y() + box.min_y_mm - map.grid.y0_mm) / map.grid.dy_mm)));
     const int j1 =
-        std::min(map.ny - 1, static_cast<int>(std::floor((p.y() + box.max_y_mm - map.y0_mm) / map.dy_mm)));
+        std::min(map.grid.ny - 1,
+                 static_cast<int>(std::floor((p.y() + box.max_y_mm - map.grid.y0_mm) / map.grid.dy_mm)));
     for (int j = j0; j <= j1; ++j) {
       for (int i = i0; i <= i1; ++i) {
-        const int row = rows.row_of_node[j * map.nx + i];
+        const int row = rows.row_of_node[j * map.grid.nx + i];
         if (row < 0) continue;
-        const double rate = removal.RateUmPerS(map.X(i) - p.x(), map.Y(j) - p.y());
+        const double rate = removal.RateUmPerS(map.grid.X(i) - p.x(), map.grid.Y(j) - p.y());
         if (rate > 0.0) a.insert(row, static_cast<Eigen::Index>(k)) = rate;
       }
     }
@@ -179,8 +184,8 @@ void CheckReachable(const Removal& a, const Rows& rows, const ErrorMap& map, con
               fmt::format("unreachable speeds: at max_speed_mm_s = {} the path already removes {:.4f} um "
                           "at ({:.3f}, {:.3f}) mm where the target is {:.4f} um; add a uniform layer of "
                           "at least {:.4f} um (removal_target.uniform_layer_um) or raise the maximum speed",
-                          o.max_speed_mm_s, most + rows.target[worst], map.X(node % map.nx),
-                          map.Y(node / map.nx), rows.target[worst], most));
+                          o.max_speed_mm_s, most + rows.target[worst], map.grid.X(node % map.grid.nx),
+                          map.grid.Y(node / map.grid.nx), rows.target[worst], most));
 }
 
 // The caller's per-point least dwell, kept even where it removes more than the target.

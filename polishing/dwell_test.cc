@@ -27,19 +27,22 @@ ErrorMap SimulatedErrorMap(unsigned seed, double step_mm = 1.0) {
   const double bx = 25.0 * u(rng), by = 25.0 * u(rng), cx = 25.0 * u(rng), cy = 25.0 * u(rng);
   const int nodes = 2 * static_cast<int>(std::ceil(52.0 / step_mm)) + 1;
   const double half_width_mm = (nodes - 1) / 2 * step_mm;
-  ErrorMap map{.x0_mm = -half_width_mm,
-               .y0_mm = -half_width_mm,
-               .dx_mm = step_mm,
-               .dy_mm = step_mm,
-               .nx = nodes,
-               .ny = nodes};
-  for (int j = 0; j < map.ny; ++j) {
-    for (int i = 0; i < map.nx; ++i) {
-      const double x = map.X(i) / 50.0, y = map.Y(j) / 50.0, r2 = x * x + y * y;
-      map.error_um.push_back(
-          astig * (x * x - y * y) + ring * std::cos(3.0 * std::numbers::pi * r2) +
-          0.5 * std::exp(-((map.X(i) - bx) * (map.X(i) - bx) + (map.Y(j) - by) * (map.Y(j) - by)) / 200.0) -
-          0.4 * std::exp(-((map.X(i) - cx) * (map.X(i) - cx) + (map.Y(j) - cy) * (map.Y(j) - cy)) / 300.0));
+  ErrorMap map{.grid = {.x0_mm = -half_width_mm,
+                        .y0_mm = -half_width_mm,
+                        .dx_mm = step_mm,
+                        .dy_mm = step_mm,
+                        .nx = nodes,
+                        .ny = nodes}};
+  for (int j = 0; j < map.grid.ny; ++j) {
+    for (int i = 0; i < map.grid.nx; ++i) {
+      const double x = map.grid.X(i) / 50.0, y = map.grid.Y(j) / 50.0, r2 = x * x + y * y;
+      map.error_um.push_back(astig * (x * x - y * y) + ring * std::cos(3.0 * std::numbers::pi * r2) +
+                             0.5 * std::exp(-((map.grid.X(i) - bx) * (map.grid.X(i) - bx) +
+                                              (map.grid.Y(j) - by) * (map.grid.Y(j) - by)) /
+                                            200.0) -
+                             0.4 * std::exp(-((map.grid.X(i) - cx) * (map.grid.X(i) - cx) +
+                                              (map.grid.Y(j) - cy) * (map.grid.Y(j) - cy)) /
+                                            300.0));
     }
   }
   return map;
@@ -62,7 +65,8 @@ Eigen::MatrixXd AxisGaussian(int nodes, double first_mm, double step_mm,
 // Independent prediction: the untruncated Gaussian summed over every dwell point, at every node of
 // `grid` (row j, column i). The Gaussian is separable, so the sum over points k of
 // exp(-dx^2 / 2s^2) exp(-dy^2 / 2s^2) dwell_k is the product Gy diag(dwell) Gx^T.
-Eigen::MatrixXd FullGaussianRemovalUm(const ErrorMap& grid, const std::vector<Eigen::Vector2d>& path,
+Eigen::MatrixXd FullGaussianRemovalUm(const surfaces::GridSpec& grid,
+                                      const std::vector<Eigen::Vector2d>& path,
                                       const std::vector<double>& dwell_s, double peak, double fwhm) {
   const double sigma = fwhm / std::sqrt(8.0 * std::log(2.0));
   const Eigen::Map<const Eigen::VectorXd> dwell(dwell_s.data(), static_cast<Eigen::Index>(dwell_s.size()));
@@ -75,12 +79,12 @@ Eigen::MatrixXd FullGaussianRemovalUm(const ErrorMap& grid, const std::vector<Ei
 // Gaussian from the solution's dwell.
 double ResidualRmsUm(const ErrorMap& target, const std::vector<Eigen::Vector2d>& path,
                      const std::vector<double>& dwell_s, double peak, double fwhm) {
-  const Eigen::MatrixXd removal = FullGaussianRemovalUm(target, path, dwell_s, peak, fwhm);
+  const Eigen::MatrixXd removal = FullGaussianRemovalUm(target.grid, path, dwell_s, peak, fwhm);
   double sum = 0.0, sum2 = 0.0;
   int n = 0;
-  for (int j = 0; j < target.ny; ++j) {
-    for (int i = 0; i < target.nx; ++i) {
-      const double x = target.X(i), y = target.Y(j);
+  for (int j = 0; j < target.grid.ny; ++j) {
+    for (int i = 0; i < target.grid.nx; ++i) {
+      const double x = target.grid.X(i), y = target.grid.Y(j);
       if (x * x + y * y > 50.0 * 50.0) continue;
       const double r = target.At(i, j) - removal(j, i);
       sum += r, sum2 += r * r, ++n;
@@ -110,9 +114,9 @@ TEST(SolveDwell, CutsTheResidualRmsTenfoldWithNonNegativeDwellWithinSpeedLimits)
     // Residual recomputed independently, with the whole Gaussian, over the aperture.
     double before_sum = 0.0, before_sum2 = 0.0;
     int n = 0;
-    for (int j = 0; j < error.ny; ++j) {
-      for (int i = 0; i < error.nx; ++i) {
-        const double x = error.X(i), y = error.Y(j), e = error.At(i, j);
+    for (int j = 0; j < error.grid.ny; ++j) {
+      for (int i = 0; i < error.grid.nx; ++i) {
+        const double x = error.grid.X(i), y = error.grid.Y(j), e = error.At(i, j);
         if (x * x + y * y > 50.0 * 50.0) continue;
         before_sum += e, before_sum2 += e * e, ++n;
       }
@@ -145,7 +149,7 @@ TEST(SolveDwell, AMeasuredGaussianRemovesAsTheAnalyticOneWithinTheInterpolationB
   // within the interpolation bound; outside it the table gives 0 for the Gaussian's value. So the
   // bound at a node is the sum over points of dwell * (inside ? interpolation bound : Gaussian),
   // and "inside" (|dx|, |dy| <= half width) is separable like the Gaussian.
-  const Eigen::MatrixXd analytic = FullGaussianRemovalUm(target, path, solution.dwell_s, peak, fwhm);
+  const Eigen::MatrixXd analytic = FullGaussianRemovalUm(target.grid, path, solution.dwell_s, peak, fwhm);
   const auto inside_along = [&](int nodes, double first_mm, double step_mm, int axis) {
     Eigen::MatrixXd in(nodes, static_cast<Eigen::Index>(path.size()));
     for (int i = 0; i < nodes; ++i) {
@@ -155,22 +159,24 @@ TEST(SolveDwell, AMeasuredGaussianRemovesAsTheAnalyticOneWithinTheInterpolationB
     }
     return in;
   };
-  const Eigen::MatrixXd in_x = inside_along(target.nx, target.x0_mm, target.dx_mm, 0);
-  const Eigen::MatrixXd in_y = inside_along(target.ny, target.y0_mm, target.dy_mm, 1);
-  const Eigen::MatrixXd gx = AxisGaussian(target.nx, target.x0_mm, target.dx_mm, path, 0, sigma);
-  const Eigen::MatrixXd gy = AxisGaussian(target.ny, target.y0_mm, target.dy_mm, path, 1, sigma);
+  const Eigen::MatrixXd in_x = inside_along(target.grid.nx, target.grid.x0_mm, target.grid.dx_mm, 0);
+  const Eigen::MatrixXd in_y = inside_along(target.grid.ny, target.grid.y0_mm, target.grid.dy_mm, 1);
+  const Eigen::MatrixXd gx =
+      AxisGaussian(target.grid.nx, target.grid.x0_mm, target.grid.dx_mm, path, 0, sigma);
+  const Eigen::MatrixXd gy =
+      AxisGaussian(target.grid.ny, target.grid.y0_mm, target.grid.dy_mm, path, 1, sigma);
   const Eigen::Map<const Eigen::VectorXd> dwell(solution.dwell_s.data(),
                                                 static_cast<Eigen::Index>(solution.dwell_s.size()));
   const Eigen::MatrixXd inside_dwell = in_y * dwell.asDiagonal() * in_x.transpose();
   const Eigen::MatrixXd inside_gaussian =
       peak * (in_y.cwiseProduct(gy) * dwell.asDiagonal() * in_x.cwiseProduct(gx).transpose());
   const Eigen::MatrixXd bound = interpolation_bound * inside_dwell + (analytic - inside_gaussian);
-  for (int j = 0; j < target.ny; ++j) {
-    for (int i = 0; i < target.nx; ++i) {
+  for (int j = 0; j < target.grid.ny; ++j) {
+    for (int i = 0; i < target.grid.nx; ++i) {
       const double removal = solution.predicted_removal_um.At(i, j);
       if (std::isnan(removal)) continue;
       EXPECT_LE(std::abs(removal - analytic(j, i)), bound(j, i) + 1e-12)
-          << target.X(i) << ", " << target.Y(j);
+          << target.grid.X(i) << ", " << target.grid.Y(j);
     }
   }
   const double rms_after = ResidualRmsUm(target, path, solution.dwell_s, peak, fwhm);
@@ -197,11 +203,11 @@ TEST(SolveDwell, PredictsTheRemovalOfAnOffsetEllipticFootprintAsABruteForceConvo
   // 0.5 mm table: the interpolation is visible at the map's 1 mm nodes.
   const TabulatedRemovalFunction table = SampledGaussian(3.0, 2.0, -1.0, 3.0, 1.5, -6.0, -6.0, 0.5, 33, 21);
   const surfaces::Aperture square{.width_x_mm = 30.0, .width_y_mm = 30.0};
-  ErrorMap error{.x0_mm = -15.0, .y0_mm = -15.0, .dx_mm = 1.0, .dy_mm = 1.0, .nx = 31, .ny = 31};
-  for (int j = 0; j < error.ny; ++j) {
-    for (int i = 0; i < error.nx; ++i) {
-      error.error_um.push_back(0.2 * std::cos(error.X(i) / 6.0) * std::sin(error.Y(j) / 5.0) +
-                               0.003 * error.X(i));
+  ErrorMap error{.grid = {.x0_mm = -15.0, .y0_mm = -15.0, .dx_mm = 1.0, .dy_mm = 1.0, .nx = 31, .ny = 31}};
+  for (int j = 0; j < error.grid.ny; ++j) {
+    for (int i = 0; i < error.grid.nx; ++i) {
+      error.error_um.push_back(0.2 * std::cos(error.grid.X(i) / 6.0) * std::sin(error.grid.Y(j) / 5.0) +
+                               0.003 * error.grid.X(i));
     }
   }
   const ErrorMap target = RemovalTarget(error, square, {.uniform_layer_um = 0.5});
@@ -210,15 +216,15 @@ TEST(SolveDwell, PredictsTheRemovalOfAnOffsetEllipticFootprintAsABruteForceConvo
   const DwellSolution solution =
       SolveDwell(target, square, path, table, {.max_speed_mm_s = 500.0, .max_iterations = 1000});
   double most = 0.0;
-  for (int j = 0; j < target.ny; ++j) {
-    for (int i = 0; i < target.nx; ++i) {
+  for (int j = 0; j < target.grid.ny; ++j) {
+    for (int i = 0; i < target.grid.nx; ++i) {
       double removal = 0.0;
       for (std::size_t k = 0; k < path.size(); ++k) {
-        removal +=
-            solution.dwell_s[k] * BruteForceRate(table, target.X(i) - path[k].x(), target.Y(j) - path[k].y());
+        removal += solution.dwell_s[k] *
+                   BruteForceRate(table, target.grid.X(i) - path[k].x(), target.grid.Y(j) - path[k].y());
       }
       EXPECT_NEAR(solution.predicted_removal_um.At(i, j), removal, 1e-9)
-          << target.X(i) << ", " << target.Y(j);
+          << target.grid.X(i) << ", " << target.grid.Y(j);
       most = std::max(most, removal);
     }
   }
@@ -233,15 +239,15 @@ TEST(SolveDwell, RecoversAKnownDwellToWithinTheConditioningOfTheProblem) {
   const surfaces::Aperture square{.width_x_mm = 40.0, .width_y_mm = 40.0};
   const std::vector<Eigen::Vector2d> path =
       RasterPath(square, {.line_spacing_mm = 2.0, .point_spacing_mm = 2.0, .extension_mm = 8.0});
-  ErrorMap target{.x0_mm = -20.0, .y0_mm = -20.0, .dx_mm = 1.0, .dy_mm = 1.0, .nx = 41, .ny = 41};
+  ErrorMap target{.grid = {.x0_mm = -20.0, .y0_mm = -20.0, .dx_mm = 1.0, .dy_mm = 1.0, .nx = 41, .ny = 41}};
   std::vector<double> dwell(path.size(), 0.0);
   for (std::size_t k = 1; k < path.size(); ++k)
     dwell[k] = 0.1 + 0.05 * std::cos(path[k].x() / 9.0) * std::sin(path[k].y() / 7.0);
-  for (int j = 0; j < target.ny; ++j) {
-    for (int i = 0; i < target.nx; ++i) {
+  for (int j = 0; j < target.grid.ny; ++j) {
+    for (int i = 0; i < target.grid.nx; ++i) {
       double sum = 0.0;
       for (std::size_t k = 0; k < path.size(); ++k)
-        sum += tool.RateUmPerS(target.X(i) - path[k].x(), target.Y(j) - path[k].y()) * dwell[k];
+        sum += tool.RateUmPerS(target.grid.X(i) - path[k].x(), target.grid.Y(j) - path[k].y()) * dwell[k];
       target.error_um.push_back(sum);
     }
   }
@@ -325,13 +331,13 @@ TEST(SolveDwell, ShapesTheSpeedsToTheAccelerationLimitAndStillCutsTheResidualTen
     }
     EXPECT_NEAR(solution.max_acceleration_mm_s2, LargestAcceleration(path, solution), 1e-9 * limit);
     // The prediction is of the final dwell (same truncated model, summed here point by point).
-    for (int j = 0; j < target.ny; j += 3) {
-      for (int i = 0; i < target.nx; i += 3) {
+    for (int j = 0; j < target.grid.ny; j += 3) {
+      for (int i = 0; i < target.grid.nx; i += 3) {
         if (std::isnan(solution.predicted_removal_um.At(i, j))) continue;
         double removal = 0.0;
         for (std::size_t k = 0; k < path.size(); ++k) {
-          removal +=
-              tool.RateUmPerS(target.X(i) - path[k].x(), target.Y(j) - path[k].y()) * solution.dwell_s[k];
+          removal += tool.RateUmPerS(target.grid.X(i) - path[k].x(), target.grid.Y(j) - path[k].y()) *
+                     solution.dwell_s[k];
         }
         EXPECT_NEAR(solution.predicted_removal_um.At(i, j), removal, 1e-9);
       }
@@ -396,7 +402,7 @@ TEST(SolveDwell, HoldsThePerPointLeastDwellAndRefusesOneOutOfRange) {
 }
 
 TEST(SolveDwell, RefusesAnEmptyAperture) {
-  const ErrorMap target{.x0_mm = 500.0, .y0_mm = 500.0, .nx = 2, .ny = 2, .error_um = {1, 2, 3, 4}};
+  const ErrorMap target{.grid = {.x0_mm = 500.0, .y0_mm = 500.0, .nx = 2, .ny = 2}, .error_um = {1, 2, 3, 4}};
   const std::vector<Eigen::Vector2d> path = {{0.0, 0.0}, {1.0, 0.0}};
   EXPECT_THROW((void)SolveDwell(target, kDisc, path, {}, {}), Error);
 }

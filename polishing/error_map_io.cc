@@ -11,6 +11,7 @@
 #include <fstream>
 #include <iterator>
 #include <opencv2/imgproc.hpp>
+#include <optional>
 #include <set>
 #include <sstream>
 #include <tuple>
@@ -18,6 +19,7 @@
 
 #include "core/atomic_file.h"
 #include "core/error.h"
+#include "core/memory_budget.h"
 #include "polishing/grid_csv.h"
 
 namespace arcwheel::polishing {
@@ -27,9 +29,21 @@ constexpr const char* kStage = "polishing.map";
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 // Largest grid any reader builds (8e8 bytes of doubles).
 constexpr double kMaxNodes = 1e8;
+// An error map marks a node without data with NaN; an infinity is a damaged value, never "no data".
+constexpr const char* kInfinityIsDamage =
+    "is not finite: a map marks no data with nan, and an infinity is a damaged value (docs/polishing.md)";
 
 [[noreturn]] void Fail(const std::string& name, const std::string& what) {
   throw Error(ErrorCode::kBadInput, kStage, fmt::format("'{}': {}", name, what));
+}
+
+// Refuses a grid of `rows` x `columns` nodes (as `what` in the file `name` declares it) that would
+// not fit the memory budget of a polish run.
+void CheckMapNodes(const std::string& name, const std::string& what, double rows, double columns) {
+  if (const auto problem = MemoryBudgetProblem(fmt::format("'{}': {} [{}][{}]", name, what, rows, columns),
+                                               rows * columns, "map nodes", kBytesPerMapNode)) {
+    throw Error(ErrorCode::kBadInput, kStage, *problem);
+  }
 }
 
 [[noreturn]] void LineFail(const std::filesystem::path& path, std::size_t line, const std::string& what) {
@@ -120,7 +134,69 @@ double PositiveFinite(const BigEndian& in, const MetroProField& f, const std::st
 // Zygo Mx .datx. Layout as read by ContactEngineering SurfaceTopography (IO/DATX.py) and prysm
 // (io.read_zygo_datx): a surface dataset with attributes `No Data`, `Unit`, `X Converter`,
 // `Y Converter`, `Z Converter`; a converter is a compound {Category, BaseUnit, Parameters}.
-constexpr const char* kDatxSurface = "/Measurement/Surface";
+// Where the surface dataset is: see DatxSurfacePath.
+constexpr const char* kDatxMetaData = "/MetaData";
+constexpr const char* kDatxMeasurementSurface = "/Measurement/Surface";
+constexpr const char* kDatxDataSurface = "/Data/Surface";
+
+// The destination of the /MetaData row (source, link), or nothing. Two rows that disagree are
+// refused: which surface is meant would be a guess.
+std::optional<std::string> MetaDataLink(const std::vector<std::vector<std::string>>& rows,
+                                        const std::string& source, const std::string& link,
+                                        const std::string& name) {
+  std::optional<std::string> destination;
+  for (const std::vector<std::string>& row : rows) {
+    if (row[0] != source || row[1] != link) continue;
+    if (destination && *destination != row[2]) {
+      Fail(name, fmt::format("{} links '{}' -> '{}' to both '{}' and '{}'", kDatxMetaData, source, link,
+                             *destination, row[2]));
+    }
+    destination = row[2];
+  }
+  return destination;
+}
+
+// The surface's path as the /MetaData table names it (Root -> Measurement -> Surface -> Path, as
+// MetroPro writes it and SurfaceTopography reads it), or nothing if the table does not name one.
+std::optional<std::string> DatxSurfaceFromMetaData(const hdf5::File& file) {
+  const std::string name = file.path().string();
+  const std::vector<std::vector<std::string>> rows =
+      file.ReadStringTable(kDatxMetaData, {"Source", "Link", "Destination"});
+  std::string node = "Root";
+  for (const char* link : {"Measurement", "Surface", "Path"}) {
+    const std::optional<std::string> next = MetaDataLink(rows, node, link, name);
+    if (!next) return std::nullopt;
+    node = *next;
+  }
+  return node;
+}
+
+// Where the surface dataset of a .datx is: the path /MetaData names (MetroPro's files put the
+// surface at /Data/Surface/{GUID}); else /Measurement/Surface; else the only dataset under
+// /Data/Surface (as prysm takes it). A path that /MetaData names but the file lacks is refused.
+std::string DatxSurfacePath(const hdf5::File& file) {
+  const std::string name = file.path().string();
+  if (file.HasObject(kDatxMetaData)) {
+    if (const std::optional<std::string> path = DatxSurfaceFromMetaData(file)) {
+      if (path->empty() || path->front() != '/' || !file.HasObject(*path)) {
+        Fail(name, fmt::format("{} names the surface dataset '{}', which the file does not hold",
+                               kDatxMetaData, *path));
+      }
+      return *path;
+    }
+  }
+  if (file.HasObject(kDatxMeasurementSurface)) return kDatxMeasurementSurface;
+  const std::vector<std::string> datasets = file.DatasetNames(kDatxDataSurface);
+  if (datasets.size() == 1) return std::string(kDatxDataSurface) + "/" + datasets.front();
+  if (datasets.size() > 1) {
+    Fail(name, fmt::format("'{}' holds {} datasets and no {} table says which is the surface",
+                           kDatxDataSurface, datasets.size(), kDatxMetaData));
+  }
+  Fail(name,
+       fmt::format("no surface dataset: neither a {} table naming one, nor '{}', nor a dataset under '{}' "
+                   "(not a Zygo Mx .datx surface measurement?)",
+                   kDatxMetaData, kDatxMeasurementSurface, kDatxDataSurface));
+}
 
 // Micrometres per base unit of a height, or NaN for a unit that is not a length.
 double MicrometresPer(const std::string& unit) {
@@ -132,44 +208,44 @@ double MicrometresPer(const std::string& unit) {
   return kNaN;
 }
 
-double DatxAttribute(const hdf5::File& file, const std::string& attribute) {
-  const std::optional<double> v = file.ReadAttributeDouble(kDatxSurface, attribute);
+double DatxAttribute(const hdf5::File& file, const std::string& surface, const std::string& attribute) {
+  const std::optional<double> v = file.ReadAttributeDouble(surface, attribute);
   if (!v || !std::isfinite(*v) || *v == 0.0) {
-    Fail(file.path().string(),
-         fmt::format("{} attribute '{}' is {} (needed for heights in Fringes)", kDatxSurface, attribute,
-                     v ? fmt::format("{}", *v) : std::string("missing")));
+    Fail(file.path().string(), fmt::format("{} attribute '{}' is {} (needed for heights in Fringes)", surface,
+                                           attribute, v ? fmt::format("{}", *v) : std::string("missing")));
   }
   return *v;
 }
 
 // Micrometres per stored height value, from the Z converter.
-double DatxHeightScaleUm(const hdf5::File& file) {
+double DatxHeightScaleUm(const hdf5::File& file, const std::string& surface) {
   const std::string name = file.path().string();
-  const auto z = file.ReadAttributeCompound(kDatxSurface, "Z Converter");
-  if (!z) Fail(name, fmt::format("{} has no attribute 'Z Converter' (the height unit)", kDatxSurface));
+  const auto z = file.ReadAttributeCompound(surface, "Z Converter");
+  if (!z) Fail(name, fmt::format("{} has no attribute 'Z Converter' (the height unit)", surface));
   const std::string category = z->strings.count("Category") ? z->strings.at("Category") : "";
   const std::string unit = z->strings.count("BaseUnit") ? z->strings.at("BaseUnit") : "";
   if (category != "HeightCat") {
-    Fail(name, fmt::format("{} attribute 'Z Converter' Category = '{}' is not 'HeightCat'", kDatxSurface,
-                           category));
+    Fail(name,
+         fmt::format("{} attribute 'Z Converter' Category = '{}' is not 'HeightCat'", surface, category));
   }
   if (unit == "Fringes") {
     // As prysm: fringes * wavelength * interferometric scale factor * obliquity factor = height.
-    return 1e6 * DatxAttribute(file, "Wavelength") * DatxAttribute(file, "Interferometric Scale Factor") *
-           DatxAttribute(file, "Obliquity Factor");
+    return 1e6 * DatxAttribute(file, surface, "Wavelength") *
+           DatxAttribute(file, surface, "Interferometric Scale Factor") *
+           DatxAttribute(file, surface, "Obliquity Factor");
   }
   const double um = MicrometresPer(unit);
   if (std::isnan(um)) {
     Fail(name, fmt::format("{} attribute 'Z Converter' BaseUnit = '{}' is not a length (Meters, MilliMeters, "
                            "MicroMeters, NanoMeters, Angstroms) or Fringes",
-                           kDatxSurface, unit));
+                           surface, unit));
   }
   return um;
 }
 
 // mm per pixel from an X or Y converter (Parameters[1] in m), NaN if absent or not lateral.
-double DatxPixelMm(const hdf5::File& file, const std::string& converter) {
-  const auto c = file.ReadAttributeCompound(kDatxSurface, converter);
+double DatxPixelMm(const hdf5::File& file, const std::string& surface, const std::string& converter) {
+  const auto c = file.ReadAttributeCompound(surface, converter);
   if (!c || !c->strings.count("Category") || c->strings.at("Category") != "LateralCat" ||
       !c->numbers.count("Parameters")) {
     return kNaN;
@@ -313,18 +389,20 @@ void RasterTriangle(std::span<const ScatteredPoint> points, const Triangle& tri,
   if (den == 0.0) return;
   const double lo_x = std::min({a.x_mm, b.x_mm, c.x_mm}), hi_x = std::max({a.x_mm, b.x_mm, c.x_mm});
   const double lo_y = std::min({a.y_mm, b.y_mm, c.y_mm}), hi_y = std::max({a.y_mm, b.y_mm, c.y_mm});
-  const int i0 = std::max(0, static_cast<int>(std::ceil((lo_x - map.x0_mm) / map.dx_mm - 1e-9)));
-  const int i1 = std::min(map.nx - 1, static_cast<int>(std::floor((hi_x - map.x0_mm) / map.dx_mm + 1e-9)));
-  const int j0 = std::max(0, static_cast<int>(std::ceil((lo_y - map.y0_mm) / map.dy_mm - 1e-9)));
-  const int j1 = std::min(map.ny - 1, static_cast<int>(std::floor((hi_y - map.y0_mm) / map.dy_mm + 1e-9)));
+  const int i0 = std::max(0, static_cast<int>(std::ceil((lo_x - map.grid.x0_mm) / map.grid.dx_mm - 1e-9)));
+  const int i1 = std::min(map.grid.nx - 1,
+                          static_cast<int>(std::floor((hi_x - map.grid.x0_mm) / map.grid.dx_mm + 1e-9)));
+  const int j0 = std::max(0, static_cast<int>(std::ceil((lo_y - map.grid.y0_mm) / map.grid.dy_mm - 1e-9)));
+  const int j1 = std::min(map.grid.ny - 1,
+                          static_cast<int>(std::floor((hi_y - map.grid.y0_mm) / map.grid.dy_mm + 1e-9)));
   // Barycentric weights may dip this far below 0 for a node on an edge (rounding).
   constexpr double kEdge = 1e-9;
   for (int j = j0; j <= j1; ++j) {
-    const double y = map.Y(j);
+    const double y = map.grid.Y(j);
     for (int i = i0; i <= i1; ++i) {
-      double& node = map.error_um[static_cast<std::size_t>(j) * map.nx + i];
+      double& node = map.error_um[static_cast<std::size_t>(j) * map.grid.nx + i];
       if (!std::isnan(node)) continue;
-      const double x = map.X(i);
+      const double x = map.grid.X(i);
       const double la = ((b.y_mm - c.y_mm) * (x - c.x_mm) + (c.x_mm - b.x_mm) * (y - c.y_mm)) / den;
       const double lb = ((c.y_mm - a.y_mm) * (x - c.x_mm) + (a.x_mm - c.x_mm) * (y - c.y_mm)) / den;
       const double lc = 1.0 - la - lb;
@@ -393,28 +471,28 @@ ErrorMap PlaceInPartFrame(const PixelMap& pixels, const MapPlacement& placement,
   };
   const bool swapped = quarter_turns % 2 == 1;
   ErrorMap map;
-  map.nx = swapped ? pixels.height : pixels.width;
-  map.ny = swapped ? pixels.width : pixels.height;
-  map.dx_mm = swapped ? py : px;
-  map.dy_mm = swapped ? px : py;
-  map.x0_mm = std::numeric_limits<double>::infinity();
-  map.y0_mm = std::numeric_limits<double>::infinity();
+  map.grid.nx = swapped ? pixels.height : pixels.width;
+  map.grid.ny = swapped ? pixels.width : pixels.height;
+  map.grid.dx_mm = swapped ? py : px;
+  map.grid.dy_mm = swapped ? px : py;
+  map.grid.x0_mm = std::numeric_limits<double>::infinity();
+  map.grid.y0_mm = std::numeric_limits<double>::infinity();
   for (const int i : {0, pixels.width - 1}) {
     for (const int j : {0, pixels.height - 1}) {
       const auto p = place(i, j);
-      map.x0_mm = std::min(map.x0_mm, p[0]);
-      map.y0_mm = std::min(map.y0_mm, p[1]);
+      map.grid.x0_mm = std::min(map.grid.x0_mm, p[0]);
+      map.grid.y0_mm = std::min(map.grid.y0_mm, p[1]);
     }
   }
-  map.error_um.assign(static_cast<std::size_t>(map.nx) * static_cast<std::size_t>(map.ny), kNaN);
+  map.error_um.assign(static_cast<std::size_t>(map.grid.nx) * static_cast<std::size_t>(map.grid.ny), kNaN);
   for (int j = 0; j < pixels.height; ++j) {
     for (int i = 0; i < pixels.width; ++i) {
       const double h = pixels.height_um[static_cast<std::size_t>(j) * pixels.width + i];
       if (!std::isfinite(h)) continue;
       const auto p = place(i, j);
-      const auto I = static_cast<std::size_t>(std::lround((p[0] - map.x0_mm) / map.dx_mm));
-      const auto J = static_cast<std::size_t>(std::lround((p[1] - map.y0_mm) / map.dy_mm));
-      map.error_um[J * static_cast<std::size_t>(map.nx) + I] = placement.scale * h;
+      const auto I = static_cast<std::size_t>(std::lround((p[0] - map.grid.x0_mm) / map.grid.dx_mm));
+      const auto J = static_cast<std::size_t>(std::lround((p[1] - map.grid.y0_mm) / map.grid.dy_mm));
+      map.error_um[J * static_cast<std::size_t>(map.grid.nx) + I] = placement.scale * h;
     }
   }
   return map;
@@ -486,6 +564,7 @@ PixelMap ParseMetroProDat(std::span<const unsigned char> bytes, const std::strin
              "the {}-byte file (truncated?)",
              map.width, map.height, phase_bytes, phase_offset, bytes.size()));
   }
+  CheckMapNodes(name, "phase data 'cn_height' x 'cn_width'", map.height, map.width);
   const std::uint16_t phase_res = in.U16(kPhaseRes);
   static constexpr std::array<double, 3> kResolution = {4096.0, 32768.0, 131072.0};
   if (phase_res >= kResolution.size())
@@ -513,28 +592,44 @@ PixelMap ReadMetroProDat(const std::filesystem::path& path) {
 
 PixelMap ReadZygoDatx(const hdf5::File& file) {
   const std::string name = file.path().string();
-  if (!file.HasObject(kDatxSurface)) {
-    Fail(name,
-         fmt::format("dataset '{}' is missing (not a Zygo Mx .datx surface measurement?)", kDatxSurface));
-  }
-  const std::vector<hsize_t> shape = file.Shape(kDatxSurface);
+  const std::string surface = DatxSurfacePath(file);
+  const std::vector<hsize_t> shape = file.Shape(surface);
   if (shape.size() != 2 || shape[0] == 0 || shape[1] == 0 || shape[0] > 1u << 20 || shape[1] > 1u << 20) {
     std::string dims;
     for (const hsize_t d : shape) dims += (dims.empty() ? "" : " x ") + std::to_string(d);
-    Fail(name, fmt::format("dataset '{}' has shape [{}], needs [rows][columns]", kDatxSurface, dims));
+    Fail(name, fmt::format("dataset '{}' has shape [{}], needs [rows][columns]", surface, dims));
   }
-  const H5T_class_t element = file.ElementClass(kDatxSurface);
+  CheckMapNodes(name, fmt::format("dataset '{}'", surface), static_cast<double>(shape[0]),
+                static_cast<double>(shape[1]));
+  const H5T_class_t element = file.ElementClass(surface);
   if (element != H5T_FLOAT && element != H5T_INTEGER)
-    Fail(name, fmt::format("dataset '{}' is not numeric", kDatxSurface));
-  const double um = DatxHeightScaleUm(file);
-  const std::optional<double> no_data = file.ReadAttributeDouble(kDatxSurface, "No Data");
+    Fail(name, fmt::format("dataset '{}' is not numeric", surface));
+  const double um = DatxHeightScaleUm(file, surface);
+  const std::optional<double> no_data = file.ReadAttributeDouble(surface, "No Data");
   PixelMap map;
   map.height = static_cast<int>(shape[0]);
   map.width = static_cast<int>(shape[1]);
-  map.pixel_x_mm = DatxPixelMm(file, "X Converter");
-  map.pixel_y_mm = DatxPixelMm(file, "Y Converter");
-  map.height_um = file.ReadDoubles(kDatxSurface);
-  for (double& v : map.height_um) v = (!std::isfinite(v) || (no_data && v == *no_data)) ? kNaN : v * um;
+  map.pixel_x_mm = DatxPixelMm(file, surface, "X Converter");
+  map.pixel_y_mm = DatxPixelMm(file, surface, "Y Converter");
+  map.height_um = file.ReadDoubles(surface);
+  // No data: the file's `No Data` value (MetroPro writes the largest double; a file whose
+  // marker is infinity marks its gaps with it) or NaN. Any other value that is not finite, or
+  // whose height overflows, is damage.
+  for (std::size_t k = 0; k < map.height_um.size(); ++k) {
+    double& v = map.height_um[k];
+    if (std::isnan(v) || (no_data && v == *no_data)) {
+      v = kNaN;
+      continue;
+    }
+    const double height_um = v * um;
+    if (!std::isfinite(height_um)) {
+      Fail(name,
+           fmt::format("dataset '{}' value [{}][{}] = {} is not a finite height (its No Data value is {})",
+                       surface, k / shape[1], k % shape[1], v,
+                       no_data ? fmt::format("{}", *no_data) : std::string("not given")));
+    }
+    v = height_um;
+  }
   return map;
 }
 
@@ -552,6 +647,7 @@ ErrorMap ReadErrorMapHdf5(const hdf5::File& file) {
       static_cast<double>(shape[0]) * static_cast<double>(shape[1]) > kMaxNodes) {
     Fail(name, "dataset 'error_um' must be [ny][nx] with 1 .. 1e8 nodes");
   }
+  CheckMapNodes(name, "dataset 'error_um'", static_cast<double>(shape[0]), static_cast<double>(shape[1]));
   ErrorMap map;
   auto attribute = [&](const char* key) {
     const std::optional<double> v = file.ReadAttributeDouble("/", key);
@@ -559,17 +655,22 @@ ErrorMap ReadErrorMapHdf5(const hdf5::File& file) {
       Fail(name, fmt::format("root attribute '{}' is {}", key, v ? "not finite" : "missing"));
     return *v;
   };
-  map.x0_mm = attribute("x0_mm");
-  map.y0_mm = attribute("y0_mm");
-  map.dx_mm = attribute("dx_mm");
-  map.dy_mm = attribute("dy_mm");
-  if (!(map.dx_mm > 0.0)) Fail(name, fmt::format("root attribute 'dx_mm' = {} must be > 0", map.dx_mm));
-  if (!(map.dy_mm > 0.0)) Fail(name, fmt::format("root attribute 'dy_mm' = {} must be > 0", map.dy_mm));
-  map.ny = static_cast<int>(shape[0]);
-  map.nx = static_cast<int>(shape[1]);
+  map.grid.x0_mm = attribute("x0_mm");
+  map.grid.y0_mm = attribute("y0_mm");
+  map.grid.dx_mm = attribute("dx_mm");
+  map.grid.dy_mm = attribute("dy_mm");
+  if (!(map.grid.dx_mm > 0.0))
+    Fail(name, fmt::format("root attribute 'dx_mm' = {} must be > 0", map.grid.dx_mm));
+  if (!(map.grid.dy_mm > 0.0))
+    Fail(name, fmt::format("root attribute 'dy_mm' = {} must be > 0", map.grid.dy_mm));
+  map.grid.ny = static_cast<int>(shape[0]);
+  map.grid.nx = static_cast<int>(shape[1]);
   map.error_um = file.ReadDoubles("/error_um");
-  for (double& v : map.error_um) {
-    if (!std::isfinite(v)) v = kNaN;
+  for (std::size_t k = 0; k < map.error_um.size(); ++k) {
+    if (std::isinf(map.error_um[k])) {
+      Fail(name, fmt::format("dataset 'error_um' value [{}][{}] = {} {}", k / shape[1], k % shape[1],
+                             map.error_um[k], kInfinityIsDamage));
+    }
   }
   return map;
 }
@@ -585,24 +686,29 @@ void WriteErrorMapHdf5(const ErrorMap& map, const std::filesystem::path& path) {
   {
     hdf5::File file = hdf5::File::Create(temporary);
     file.WriteDoubles("/error_um", map.error_um,
-                      {static_cast<hsize_t>(map.ny), static_cast<hsize_t>(map.nx)});
-    file.WriteAttribute("/", "x0_mm", map.x0_mm);
-    file.WriteAttribute("/", "y0_mm", map.y0_mm);
-    file.WriteAttribute("/", "dx_mm", map.dx_mm);
-    file.WriteAttribute("/", "dy_mm", map.dy_mm);
+                      {static_cast<hsize_t>(map.grid.ny), static_cast<hsize_t>(map.grid.nx)});
+    file.WriteAttribute("/", "x0_mm", map.grid.x0_mm);
+    file.WriteAttribute("/", "y0_mm", map.grid.y0_mm);
+    file.WriteAttribute("/", "dx_mm", map.grid.dx_mm);
+    file.WriteAttribute("/", "dy_mm", map.grid.dy_mm);
   }
   outputs.Commit();
 }
 
 ErrorMap ReadErrorMapCsv(const std::filesystem::path& path) {
   CsvGrid grid = ReadCsvGrid(path, "error_um", kStage);
+  CheckMapNodes(path.string(), "the grid of its rows", grid.ny, grid.nx);
+  for (std::size_t k = 0; k < grid.values.size(); ++k) {
+    if (std::isinf(grid.values[k]))
+      LineFail(path, grid.lines[k], fmt::format("error_um = {} {}", grid.values[k], kInfinityIsDamage));
+  }
   ErrorMap map;
-  map.x0_mm = grid.x0_mm;
-  map.y0_mm = grid.y0_mm;
-  map.dx_mm = grid.dx_mm;
-  map.dy_mm = grid.dy_mm;
-  map.nx = grid.nx;
-  map.ny = grid.ny;
+  map.grid.x0_mm = grid.x0_mm;
+  map.grid.y0_mm = grid.y0_mm;
+  map.grid.dx_mm = grid.dx_mm;
+  map.grid.dy_mm = grid.dy_mm;
+  map.grid.nx = grid.nx;
+  map.grid.ny = grid.ny;
   map.error_um = std::move(grid.values);
   return map;
 }
@@ -646,13 +752,14 @@ ErrorMap InterpolateScattered(std::span<const ScatteredPoint> points, double gri
              "points (a stray point? or set error_map.grid_spacing_mm)",
              d, x_min, x_max, y_min, y_max, nodes, most_nodes, points.size()));
   }
+  CheckMapNodes(name, fmt::format("the grid of spacing {} mm", d), k_y1 - k_y0 + 1.0, k_x1 - k_x0 + 1.0);
   ErrorMap map;
-  map.dx_mm = map.dy_mm = d;
-  map.x0_mm = k_x0 * d;
-  map.y0_mm = k_y0 * d;
-  map.nx = static_cast<int>(k_x1 - k_x0 + 1.0);
-  map.ny = static_cast<int>(k_y1 - k_y0 + 1.0);
-  map.error_um.assign(static_cast<std::size_t>(map.nx) * static_cast<std::size_t>(map.ny), kNaN);
+  map.grid.dx_mm = map.grid.dy_mm = d;
+  map.grid.x0_mm = k_x0 * d;
+  map.grid.y0_mm = k_y0 * d;
+  map.grid.nx = static_cast<int>(k_x1 - k_x0 + 1.0);
+  map.grid.ny = static_cast<int>(k_y1 - k_y0 + 1.0);
+  map.error_um.assign(static_cast<std::size_t>(map.grid.nx) * static_cast<std::size_t>(map.grid.ny), kNaN);
   for (const Triangle& tri : t.triangles) RasterTriangle(points, tri, map);
   return map;
 }

@@ -33,6 +33,12 @@
 
 namespace arcwheel::polishing {
 
+// Bytes a polish run holds per node of its error map (the map, the target, the predicted removal
+// and residual, the residual CSV; measured, docs/polishing.md "Sizes"). Every reader refuses a grid
+// whose nodes would need more than the memory budget (core/memory_budget.h), from the file's header
+// or shape, before the values are read.
+inline constexpr double kBytesPerMapNode = 160.0;
+
 // Heights per camera pixel: height_um[j * width + i] for column i, row j (row 0 = top of the
 // camera image), NaN = no data. Pixel sizes are NaN when the file does not give them.
 struct PixelMap {
@@ -78,15 +84,19 @@ struct MapPlacement {
 [[nodiscard]] PixelMap ParseMetroProDat(std::span<const unsigned char> bytes, const std::string& name);
 [[nodiscard]] PixelMap ReadMetroProDat(const std::filesystem::path& path);
 
-// Zygo Mx `.datx` (HDF5): the dataset /Measurement/Surface [rows][columns], its `No Data` value,
+// Zygo Mx `.datx` (HDF5): the surface dataset [rows][columns], its `No Data` value,
 // `Z Converter` (HeightCat; base unit Meters, MilliMeters, MicroMeters, NanoMeters or Angstroms,
 // or Fringes with the dataset's `Wavelength` (m), `Interferometric Scale Factor` and
 // `Obliquity Factor`), and `X Converter` / `Y Converter` (LateralCat, Parameters[1] = m/pixel).
+// The surface is the dataset the /MetaData table names (Root -> Measurement -> Surface -> Path,
+// as MetroPro writes it), else /Measurement/Surface, else the only dataset under /Data/Surface.
+// NaN and the `No Data` value have no data; any other non-finite value is refused, naming its
+// [row][column].
 [[nodiscard]] PixelMap ReadZygoDatx(const hdf5::File& file);
 [[nodiscard]] PixelMap ReadZygoDatx(const std::filesystem::path& path);
 
 // arcwheel's own HDF5 grid (docs/polishing.md): dataset `error_um` [ny][nx] (float64, NaN = no
-// data) and root attributes `x0_mm`, `y0_mm`, `dx_mm`, `dy_mm`: node (i, j) lies at
+// data, an infinity refused) and root attributes `x0_mm`, `y0_mm`, `dx_mm`, `dy_mm`: node (i, j) lies at
 // (x0 + i dx, y0 + j dy).
 [[nodiscard]] ErrorMap ReadErrorMapHdf5(const hdf5::File& file);
 [[nodiscard]] ErrorMap ReadErrorMapHdf5(const std::filesystem::path& path);
@@ -95,7 +105,7 @@ void WriteErrorMapHdf5(const ErrorMap& map, const std::filesystem::path& path);
 
 // Reads an error map CSV: a header `x_mm,y_mm,error_um`, then one node of a regular grid per row
 // (any order; missing nodes and `nan` have no data). Throws Error{kIo} if unreadable and
-// Error{kBadInput, "polishing.map"} naming the file and line of anything malformed.
+// Error{kBadInput, "polishing.map"} naming the file and line of anything malformed or infinite.
 [[nodiscard]] ErrorMap ReadErrorMapCsv(const std::filesystem::path& path);
 
 struct ScatteredPoint {

@@ -6,11 +6,13 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <fstream>
 #include <functional>
 #include <iterator>
+#include <memory>
 #include <nlohmann/json.hpp>
 #include <random>
 #include <string>
@@ -36,12 +38,12 @@ bool Contains(const std::string& text, const std::string& part) {
 // The grid placement of `map` (size, origin, spacing) against `expected`'s, exactly: the
 // readers copy these numbers, or take them as differences of numbers exact in binary.
 void ExpectPlacement(const ErrorMap& map, const ErrorMap& expected) {
-  EXPECT_EQ(map.nx, expected.nx);
-  EXPECT_EQ(map.ny, expected.ny);
-  EXPECT_EQ(map.x0_mm, expected.x0_mm);
-  EXPECT_EQ(map.y0_mm, expected.y0_mm);
-  EXPECT_EQ(map.dx_mm, expected.dx_mm);
-  EXPECT_EQ(map.dy_mm, expected.dy_mm);
+  EXPECT_EQ(map.grid.nx, expected.grid.nx);
+  EXPECT_EQ(map.grid.ny, expected.grid.ny);
+  EXPECT_EQ(map.grid.x0_mm, expected.grid.x0_mm);
+  EXPECT_EQ(map.grid.y0_mm, expected.grid.y0_mm);
+  EXPECT_EQ(map.grid.dx_mm, expected.grid.dx_mm);
+  EXPECT_EQ(map.grid.dy_mm, expected.grid.dy_mm);
 }
 
 // ------------------------------------------------------------------------------------------------
@@ -58,8 +60,8 @@ TEST(ReadErrorMapCsv, PlacesScatteredRowsOnTheirGridAndLeavesGapsWithoutData) {
   std::ofstream(dir / "map.csv")
       << "# comment\nx_mm,y_mm,error_um\n2.5,-1,0.25\n-2.5,-1,1\n0,1,nan\n2.5,1,-3\n";
   const ErrorMap map = ReadErrorMapCsv(dir / "map.csv");
-  ExpectPlacement(
-      map, {.x0_mm = -2.5, .y0_mm = -1.0, .dx_mm = 2.5, .dy_mm = 2.0, .nx = 3, .ny = 2, .error_um = {}});
+  ExpectPlacement(map, {.grid = {.x0_mm = -2.5, .y0_mm = -1.0, .dx_mm = 2.5, .dy_mm = 2.0, .nx = 3, .ny = 2},
+                        .error_um = {}});
   EXPECT_DOUBLE_EQ(map.At(0, 0), 1.0);
   EXPECT_TRUE(std::isnan(map.At(1, 0)));  // never given
   EXPECT_DOUBLE_EQ(map.At(2, 0), 0.25);
@@ -77,6 +79,15 @@ TEST(ReadErrorMapCsv, NamesTheFileAndLineOfMalformedInput) {
             std::string::npos);
   EXPECT_NE(CsvError("x_mm,y_mm,error_um\n0,0,1\n1,0,2\n1,0,3\n").find("line 4: (1, 0) mm appears twice"),
             std::string::npos);
+}
+
+TEST(ReadErrorMapCsv, RefusesAnInfinityNamingTheLineButReadsNanAsNoData) {
+  for (const char* infinity : {"inf", "-inf", "Infinity", "1e999"}) {
+    const std::string message =
+        CsvError(std::string("x_mm,y_mm,error_um\n0,0,nan\n1,0,") + infinity + "\n2,0,1\n");
+    EXPECT_NE(message.find("map.csv' line 3: error_um = "), std::string::npos) << message;
+    EXPECT_NE(message.find("is not finite"), std::string::npos) << message;
+  }
 }
 
 // ------------------------------------------------------------------------------------------------
@@ -201,16 +212,16 @@ TEST(PlaceInPartFrame, PutsEachPixelAtItsLateralPositionWithRowsRunningDownTheCa
   const ErrorMap map = PlaceInPartFrame(pixels, {}, "part.dat");
   const double p = static_cast<double>(spec.lateral_res_m) * 1e3;
   // Valid data span all columns 0..6 and rows 0..4: the centre pixel (3, 2) lands on the origin.
-  EXPECT_EQ(map.nx, 7);
-  EXPECT_EQ(map.ny, 5);
-  EXPECT_DOUBLE_EQ(map.dx_mm, p);
+  EXPECT_EQ(map.grid.nx, 7);
+  EXPECT_EQ(map.grid.ny, 5);
+  EXPECT_DOUBLE_EQ(map.grid.dx_mm, p);
   for (int j = 0; j < spec.height; ++j) {
     for (int i = 0; i < spec.width; ++i) {
       const double x = (i - 3) * p, y = (2 - j) * p;  // row 0 is the top: highest y
-      const int I = static_cast<int>(std::lround((x - map.x0_mm) / map.dx_mm));
-      const int J = static_cast<int>(std::lround((y - map.y0_mm) / map.dy_mm));
-      ASSERT_NEAR(map.X(I), x, 1e-12);
-      ASSERT_NEAR(map.Y(J), y, 1e-12);
+      const int I = static_cast<int>(std::lround((x - map.grid.x0_mm) / map.grid.dx_mm));
+      const int J = static_cast<int>(std::lround((y - map.grid.y0_mm) / map.grid.dy_mm));
+      ASSERT_NEAR(map.grid.X(I), x, 1e-12);
+      ASSERT_NEAR(map.grid.Y(J), y, 1e-12);
       const double expected = pixels.height_um[static_cast<std::size_t>(j) * spec.width + i];
       if (std::isnan(expected)) {
         EXPECT_TRUE(std::isnan(map.At(I, J)));
@@ -245,11 +256,11 @@ TEST(PlaceInPartFrame, RotatesFlipsScalesAndTranslatesAsTheRigidMotionItNames) {
           if (flip == MapPlacement::Flip::kY) v = -v;
           const double x = std::cos(a) * u - std::sin(a) * v + 10.0,
                        y = std::sin(a) * u + std::cos(a) * v - 4.0;
-          const int I = static_cast<int>(std::lround((x - map.x0_mm) / map.dx_mm));
-          const int J = static_cast<int>(std::lround((y - map.y0_mm) / map.dy_mm));
-          ASSERT_TRUE(I >= 0 && I < map.nx && J >= 0 && J < map.ny);
-          EXPECT_NEAR(map.X(I), x, 1e-12);
-          EXPECT_NEAR(map.Y(J), y, 1e-12);
+          const int I = static_cast<int>(std::lround((x - map.grid.x0_mm) / map.grid.dx_mm));
+          const int J = static_cast<int>(std::lround((y - map.grid.y0_mm) / map.grid.dy_mm));
+          ASSERT_TRUE(I >= 0 && I < map.grid.nx && J >= 0 && J < map.grid.ny);
+          EXPECT_NEAR(map.grid.X(I), x, 1e-12);
+          EXPECT_NEAR(map.grid.Y(J), y, 1e-12);
           EXPECT_EQ(map.At(I, J), -2.0 * (j * 4 + i + 1.0)) << rotation << " deg";
         }
       }
@@ -266,7 +277,7 @@ TEST(PlaceInPartFrame, NeedsALateralResolutionFromTheFileOrTheJob) {
   const std::string message = ErrorMessageOf([&] { (void)PlaceInPartFrame(pixels, {}, "nores.dat"); });
   EXPECT_TRUE(Contains(message, "'nores.dat'") && Contains(message, "pixel_mm")) << message;
   const ErrorMap map = PlaceInPartFrame(pixels, {.pixel_mm = 0.2}, "nores.dat");
-  EXPECT_DOUBLE_EQ(map.dx_mm, 0.2);
+  EXPECT_DOUBLE_EQ(map.grid.dx_mm, 0.2);
 }
 
 TEST(ParseMetroProDat, RefusesCorruptHeadersNamingTheFileAndTheField) {
@@ -470,6 +481,111 @@ TEST(ReadZygoDatx, RefusesAFileWithoutTheSurfaceDatasetOrAHeightUnit) {
       << message;
 }
 
+// .datx files as h5py writes them in the layouts instruments use (tests/foreign/write_datx.py):
+// MetroPro's /Data/Surface/{GUID} found through /MetaData, /Measurement/Surface, and a lone
+// dataset under /Data/Surface. The script computes every height itself from what it wrote.
+class DatxLayouts : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    dir_ = std::make_unique<arcwheel::testing::TempDir>();
+    const std::string command =
+        "/usr/bin/python3 " + (arcwheel::testing::SourceDir() / "tests/foreign/write_datx.py").string() +
+        " " + dir_->path().string() + " > " + (*dir_ / "writer.log").string() + " 2>&1";
+    ASSERT_EQ(std::system(command.c_str()), 0) << command << "\n"
+                                               << arcwheel::testing::ReadText(*dir_ / "writer.log");
+    expected_ = nlohmann::json::parse(arcwheel::testing::ReadText(*dir_ / "expected.json"));
+  }
+  static void TearDownTestSuite() { dir_.reset(); }
+  static std::unique_ptr<arcwheel::testing::TempDir> dir_;
+  static nlohmann::json expected_;
+};
+std::unique_ptr<arcwheel::testing::TempDir> DatxLayouts::dir_;
+nlohmann::json DatxLayouts::expected_;
+
+// Valid pixels, PV and RMS about the mean of a pixel map, in the map's unit.
+struct PixelFigures {
+  std::size_t valid = 0;
+  double pv = 0.0;
+  double rms = 0.0;
+};
+PixelFigures FiguresOf(const std::vector<double>& heights) {
+  std::vector<double> valid;
+  std::copy_if(heights.begin(), heights.end(), std::back_inserter(valid),
+               [](double h) { return !std::isnan(h); });
+  PixelFigures f{.valid = valid.size()};
+  if (valid.empty()) return f;
+  const auto [low, high] = std::minmax_element(valid.begin(), valid.end());
+  f.pv = *high - *low;
+  double mean = 0.0, square = 0.0;
+  for (const double h : valid) mean += h / static_cast<double>(valid.size());
+  for (const double h : valid) square += (h - mean) * (h - mean) / static_cast<double>(valid.size());
+  f.rms = std::sqrt(square);
+  return f;
+}
+
+TEST_F(DatxLayouts, ReadsEveryLayoutToThePixelsTheWriterComputed) {
+  for (const auto& [file, want] : expected_["good"].items()) {
+    SCOPED_TRACE(file);
+    const PixelMap map = ReadZygoDatx(*dir_ / "good" / file);
+    ASSERT_EQ(map.width, want["width"].get<int>());
+    ASSERT_EQ(map.height, want["height"].get<int>());
+    EXPECT_DOUBLE_EQ(map.pixel_x_mm, want["pixel_mm"].get<double>());
+    EXPECT_DOUBLE_EQ(map.pixel_y_mm, want["pixel_mm"].get<double>());
+    for (int j = 0; j < map.height; ++j) {
+      for (int i = 0; i < map.width; ++i) {
+        const nlohmann::json& h = want["height_um"][j][i];
+        const double read = map.height_um[static_cast<std::size_t>(j) * map.width + i];
+        if (h.is_null()) {
+          EXPECT_TRUE(std::isnan(read)) << "[" << j << "][" << i << "]";
+        } else {
+          // The same product in another order: a few units in the last place.
+          EXPECT_NEAR(read, h.get<double>(), 1e-14 * std::abs(h.get<double>()))
+              << "[" << j << "][" << i << "]";
+        }
+      }
+    }
+    const PixelFigures figures = FiguresOf(map.height_um);
+    EXPECT_EQ(figures.valid, want["valid_pixels"].get<std::size_t>());
+    EXPECT_NEAR(figures.pv, want["pv_um"].get<double>(), 1e-13);
+    EXPECT_NEAR(figures.rms, want["rms_um"].get<double>(), 1e-13);
+  }
+}
+
+TEST_F(DatxLayouts, RefusesAnAmbiguousOrMissingSurfaceAndAnInfinityNamingTheFile) {
+  ASSERT_FALSE(expected_["bad"].empty());
+  for (const auto& [file, reason] : expected_["bad"].items()) {
+    const std::string message = ErrorMessageOf([&] { (void)ReadZygoDatx(*dir_ / "bad" / file); });
+    EXPECT_TRUE(Contains(message, file + "'") && Contains(message, reason.get<std::string>()))
+        << file << ": " << message;
+  }
+}
+
+// Real instrument files from public repositories (not part of the project: they are third-party
+// data). With ARCWHEEL_ZYGO_REAL_DIR set to a folder holding them, each must read to the figures
+// that its source project's own reader gives (valid pixels, PV nm, RMS nm about the mean; the
+// figures are given to 1e-6 nm).
+TEST(RealZygoFiles, ReadToTheirSourceProjectsFigures) {
+  const char* folder = std::getenv("ARCWHEEL_ZYGO_REAL_DIR");
+  if (folder == nullptr) GTEST_SKIP() << "set ARCWHEEL_ZYGO_REAL_DIR to the folder of the real Zygo files";
+  struct Real {
+    const char* file;
+    std::size_t valid;
+    double pv_nm, rms_nm;
+  };
+  for (const Real& real : {Real{"prysm_valid_zygo_dat_file.dat", 136359, 330.700173, 44.591409},
+                           Real{"surftopo_metropro-1.dat", 307200, 1363.056329, 75.288222},
+                           Real{"monolithic_zygo_test.datx", 7771, 453.030479, 80.817653}}) {
+    const std::filesystem::path path = std::filesystem::path(folder) / real.file;
+    const PixelMap map = path.extension() == ".datx" ? ReadZygoDatx(path) : ReadMetroProDat(path);
+    const PixelFigures figures = FiguresOf(map.height_um);
+    EXPECT_EQ(figures.valid, real.valid) << real.file;
+    EXPECT_NEAR(figures.pv * 1e3, real.pv_nm, 1e-6) << real.file;
+    EXPECT_NEAR(figures.rms * 1e3, real.rms_nm, 1e-6) << real.file;
+    std::printf("%s: %zu valid pixels, PV %.6f nm, RMS %.6f nm\n", real.file, figures.valid, figures.pv * 1e3,
+                figures.rms * 1e3);
+  }
+}
+
 // libhdf5 1.10 steps through a global heap collection by each object's size and never returns from
 // a zero-size object. Zeroing the body of the collection that holds the converters' strings makes
 // its first object exactly that; the reader must refuse the file instead of handing it on.
@@ -531,7 +647,8 @@ TEST(ReadZygoDatx, RefusesAReferenceToAMissingOrLongerHeapObject) {
 
 TEST(ErrorMapHdf5, RoundTripsEveryNodeAndTheGridPlacement) {
   arcwheel::testing::TempDir dir;
-  ErrorMap map{.x0_mm = -12.5, .y0_mm = 3.0, .dx_mm = 0.25, .dy_mm = 0.5, .nx = 5, .ny = 3, .error_um = {}};
+  ErrorMap map{.grid = {.x0_mm = -12.5, .y0_mm = 3.0, .dx_mm = 0.25, .dy_mm = 0.5, .nx = 5, .ny = 3},
+               .error_um = {}};
   for (int k = 0; k < 15; ++k) map.error_um.push_back(k == 7 ? kNaN : 0.1 * k - 0.3);
   WriteErrorMapHdf5(map, dir / "grid.h5");
   const ErrorMap read = ReadErrorMapHdf5(dir / "grid.h5");
@@ -543,6 +660,19 @@ TEST(ErrorMapHdf5, RoundTripsEveryNodeAndTheGridPlacement) {
       EXPECT_EQ(read.error_um[k], map.error_um[k]);
     }
   }
+}
+
+TEST(ErrorMapHdf5, RefusesAnInfinityNamingTheDatasetAndItsIndex) {
+  arcwheel::testing::TempDir dir;
+  ErrorMap map{.grid = {.nx = 4, .ny = 3}, .error_um = std::vector<double>(12, 0.5)};
+  map.error_um[1] = kNaN;  // no data: read as such
+  map.error_um[6] = -std::numeric_limits<double>::infinity();
+  map.error_um[9] = std::numeric_limits<double>::infinity();
+  WriteErrorMapHdf5(map, dir / "inf.h5");
+  const std::string message = ErrorMessageOf([&] { (void)ReadErrorMapHdf5(dir / "inf.h5"); });
+  EXPECT_TRUE(Contains(message, "inf.h5'") && Contains(message, "dataset 'error_um' value [1][2] = -inf") &&
+              Contains(message, "not finite"))
+      << message;
 }
 
 TEST(ErrorMapHdf5, RefusesAMissingAttributeOrDatasetByName) {
@@ -615,29 +745,29 @@ TEST(InterpolateScattered, ReproducesAPlaneExactlyAndLeavesNodesOutsideTheHullWi
   auto plane = [](double x, double y) { return 0.3 * x - 0.7 * y + 2.0; };
   const std::vector<ScatteredPoint> points = RandomPoints(300, plane, 20240611);
   const ErrorMap map = InterpolateScattered(points, 0.5, "cmm.csv");
-  EXPECT_EQ(map.dx_mm, 0.5);
+  EXPECT_EQ(map.grid.dx_mm, 0.5);
   std::vector<P2> xy;
   for (const ScatteredPoint& p : points) xy.push_back({p.x_mm, p.y_mm});
   const std::vector<P2> hull = Hull(xy);
   int inside = 0;
-  for (int j = 0; j < map.ny; ++j) {
-    for (int i = 0; i < map.nx; ++i) {
-      const double d = InsideBy(hull, map.X(i), map.Y(j));
+  for (int j = 0; j < map.grid.ny; ++j) {
+    for (int i = 0; i < map.grid.nx; ++i) {
+      const double d = InsideBy(hull, map.grid.X(i), map.grid.Y(j));
       if (d > 1e-9) {
         ++inside;
         ASSERT_TRUE(std::isfinite(map.At(i, j)))
-            << "node (" << map.X(i) << ", " << map.Y(j) << ") inside the hull by " << d;
-        EXPECT_NEAR(map.At(i, j), plane(map.X(i), map.Y(j)), 1e-12);
+            << "node (" << map.grid.X(i) << ", " << map.grid.Y(j) << ") inside the hull by " << d;
+        EXPECT_NEAR(map.At(i, j), plane(map.grid.X(i), map.grid.Y(j)), 1e-12);
       } else if (d < -1e-9) {
         EXPECT_TRUE(std::isnan(map.At(i, j)))
-            << "node (" << map.X(i) << ", " << map.Y(j) << ") outside the hull";
+            << "node (" << map.grid.X(i) << ", " << map.grid.Y(j) << ") outside the hull";
       }
     }
   }
   EXPECT_GT(inside, 1000);
   // Nodes sit at whole multiples of the spacing.
-  EXPECT_NEAR(std::remainder(map.x0_mm, 0.5), 0.0, 1e-12);
-  EXPECT_NEAR(std::remainder(map.y0_mm, 0.5), 0.0, 1e-12);
+  EXPECT_NEAR(std::remainder(map.grid.x0_mm, 0.5), 0.0, 1e-12);
+  EXPECT_NEAR(std::remainder(map.grid.y0_mm, 0.5), 0.0, 1e-12);
 }
 
 TEST(InterpolateScattered, StaysWithinTheLinearInterpolationBoundOfAQuadratic) {
@@ -661,11 +791,11 @@ TEST(InterpolateScattered, StaysWithinTheLinearInterpolationBoundOfAQuadratic) {
   const ErrorMap map = InterpolateScattered(points, 0.37, "quad.csv");
   const double r_max = h / std::sqrt(2.0) + 0.3 * std::sqrt(2.0) * h;
   int checked = 0;
-  for (int j = 0; j < map.ny; ++j) {
-    for (int i = 0; i < map.nx; ++i) {
-      if (std::max(std::abs(map.X(i)), std::abs(map.Y(j))) > 10 * h - r_max - h) continue;
+  for (int j = 0; j < map.grid.ny; ++j) {
+    for (int i = 0; i < map.grid.nx; ++i) {
+      if (std::max(std::abs(map.grid.X(i)), std::abs(map.grid.Y(j))) > 10 * h - r_max - h) continue;
       ASSERT_TRUE(std::isfinite(map.At(i, j)));
-      const double error = map.At(i, j) - (map.X(i) * map.X(i) + map.Y(j) * map.Y(j));
+      const double error = map.At(i, j) - (map.grid.X(i) * map.grid.X(i) + map.grid.Y(j) * map.grid.Y(j));
       EXPECT_GE(error, -1e-9);
       EXPECT_LE(error, r_max * r_max);
       ++checked;
@@ -688,7 +818,7 @@ TEST(InterpolateScattered, DefaultsTheSpacingToTheMedianNearestNeighbourDistance
   }
   std::sort(nearest.begin(), nearest.end());
   EXPECT_DOUBLE_EQ(MedianNearestNeighbourMm(points, "p.csv"), nearest[50]);
-  EXPECT_DOUBLE_EQ(InterpolateScattered(points, 0.0, "p.csv").dx_mm, nearest[50]);
+  EXPECT_DOUBLE_EQ(InterpolateScattered(points, 0.0, "p.csv").grid.dx_mm, nearest[50]);
 }
 
 TEST(ReadScatteredCsv, RefusesTooFewCollinearOrCoincidentPointsNamingTheFile) {
@@ -737,9 +867,9 @@ TEST(PolishJobErrorMap, ReadsEachFormatByItsExtensionAndAppliesThePlacementKeys)
       ReadJob(dir, R"({"file": "map.dat", "rotation_deg": 90, "scale": -1, "centre_mm": [1, 2]})");
   const ErrorMap expected = PlaceInPartFrame(
       pixels, {.centre_x_mm = 1, .centre_y_mm = 2, .rotation_deg = 90, .scale = -1}, "map.dat");
-  EXPECT_EQ(job.error_map.nx, 5);
-  EXPECT_EQ(job.error_map.ny, 7);
-  EXPECT_EQ(job.error_map.x0_mm, expected.x0_mm);
+  EXPECT_EQ(job.error_map.grid.nx, 5);
+  EXPECT_EQ(job.error_map.grid.ny, 7);
+  EXPECT_EQ(job.error_map.grid.x0_mm, expected.grid.x0_mm);
   for (std::size_t k = 0; k < expected.error_um.size(); ++k) {
     EXPECT_TRUE(job.error_map.error_um[k] == expected.error_um[k] ||
                 (std::isnan(job.error_map.error_um[k]) && std::isnan(expected.error_um[k])));
@@ -750,15 +880,10 @@ TEST(PolishJobErrorMap, ReadsEachFormatByItsExtensionAndAppliesThePlacementKeys)
 
   std::ofstream(dir / "pts.csv") << "x_mm,y_mm,error_um\n-10,-10,1\n10,-10,1\n0,10,1\n";
   job = ReadJob(dir, R"({"file": "pts.csv", "layout": "scattered", "grid_spacing_mm": 0.5})");
-  EXPECT_EQ(job.error_map.dx_mm, 0.5);
+  EXPECT_EQ(job.error_map.grid.dx_mm, 0.5);
   EXPECT_NEAR(job.error_map.At(20, 20), 1.0, 1e-12);  // (0, 0) lies inside the triangle
 
-  ErrorMap grid{.x0_mm = -10,
-                .y0_mm = -10,
-                .dx_mm = 1,
-                .dy_mm = 1,
-                .nx = 21,
-                .ny = 21,
+  ErrorMap grid{.grid = {.x0_mm = -10, .y0_mm = -10, .dx_mm = 1, .dy_mm = 1, .nx = 21, .ny = 21},
                 .error_um = std::vector<double>(441, 0.5)};
   WriteErrorMapHdf5(grid, dir / "grid.h5");
   job = ReadJob(dir, R"({"file": "grid.h5", "scale": 2})");
@@ -792,7 +917,7 @@ TEST(ErrorMapSeeds, SmallSamplesOfEachFormatReadBack) {
   const std::vector<unsigned char> dat = TestMetroProImage();
   WriteText(dir / "map_small.dat", std::string(dat.begin(), dat.end()));
   WriteDatx(dir / "map_small.datx", DatxSpec{}, 6, 4, DatxHeightNm);
-  ErrorMap grid{.x0_mm = -2, .y0_mm = -1, .dx_mm = 1, .dy_mm = 1, .nx = 5, .ny = 3, .error_um = {}};
+  ErrorMap grid{.grid = {.x0_mm = -2, .y0_mm = -1, .dx_mm = 1, .dy_mm = 1, .nx = 5, .ny = 3}, .error_um = {}};
   for (int k = 0; k < 15; ++k) grid.error_um.push_back(k == 4 ? kNaN : 0.05 * k);
   WriteErrorMapHdf5(grid, dir / "map_small_grid.h5");
   {
@@ -805,9 +930,9 @@ TEST(ErrorMapSeeds, SmallSamplesOfEachFormatReadBack) {
   }
   EXPECT_EQ(ReadMetroProDat(dir / "map_small.dat").width, 7);
   EXPECT_EQ(ReadZygoDatx(dir / "map_small.datx").width, 6);
-  EXPECT_EQ(ReadErrorMapHdf5(dir / "map_small_grid.h5").nx, 5);
-  EXPECT_GT(InterpolateScattered(ReadScatteredCsv(dir / "map_scattered.csv"), 0.0, "map_scattered.csv").nx,
-            1);
+  EXPECT_EQ(ReadErrorMapHdf5(dir / "map_small_grid.h5").grid.nx, 5);
+  EXPECT_GT(
+      InterpolateScattered(ReadScatteredCsv(dir / "map_scattered.csv"), 0.0, "map_scattered.csv").grid.nx, 1);
   if (const char* folder = std::getenv("ARCWHEEL_WRITE_SEEDS")) {
     for (const char* name : {"map_small.dat", "map_small.datx", "map_small_grid.h5", "map_scattered.csv"}) {
       std::filesystem::copy_file(dir / name, std::filesystem::path(folder) / name,

@@ -9,6 +9,8 @@
 #include <iterator>
 #include <limits>
 #include <map>
+#include <numbers>
+#include <optional>
 #include <sstream>
 #include <utility>
 
@@ -16,6 +18,7 @@
 #include "core/error.h"
 #include "core/json_job.h"
 #include "core/json_text.h"
+#include "core/memory_budget.h"
 #include "core/version.h"
 #include "schema/polish_outputs.h"
 #include "surfaces/surface_json.h"
@@ -132,7 +135,7 @@ ErrorMap ReadErrorMapSection(JsonSection& s, const std::filesystem::path& file) 
   }
   if (!pixels) {
     ErrorMap map = ReadErrorMap(file, options);
-    if (options.layout == ErrorMapLayout::kScattered) s.SetResolved("grid_spacing_mm", map.dx_mm);
+    if (options.layout == ErrorMapLayout::kScattered) s.SetResolved("grid_spacing_mm", map.grid.dx_mm);
     return map;
   }
   const PixelMap raw = options.format == ErrorMapFormat::kDat ? ReadMetroProDat(file) : ReadZygoDatx(file);
@@ -210,21 +213,59 @@ PolishJob ReadPolishJob(const std::filesystem::path& path) {
     problems.insert(problems.end(), more.begin(), more.end());
   }
   s.ThrowIfProblems(problems);
+  s.ThrowIfProblems(SizeProblems(job));
   job.resolved_json = s.resolved().dump();
   return job;
+}
+
+double PathPointCount(const surfaces::Aperture& aperture, const RasterOptions& o, PathPattern pattern) {
+  const bool circle = aperture.shape == surfaces::Aperture::Shape::kCircle;
+  const double half_x = aperture.HalfX() + o.extension_mm, half_y = aperture.HalfY() + o.extension_mm;
+  if (pattern == PathPattern::kSpiral) {
+    // As SpiralPath: the arc length of r = b theta out to the grown aperture's radius, in steps.
+    const double radius = circle ? half_y : std::hypot(half_x, half_y);
+    const double b = o.line_spacing_mm / (2.0 * std::numbers::pi), theta = radius / b;
+    const double length = 0.5 * b * (theta * std::sqrt(1.0 + theta * theta) + std::asinh(theta));
+    return std::max(1.0, std::ceil(length / o.point_spacing_mm - 1e-9)) + 1.0;
+  }
+  // As RasterPath: lines across the grown height, each at most the grown width long.
+  const double lines = std::ceil(2.0 * half_y / o.line_spacing_mm - 1e-9) + 1.0;
+  const double widest = circle ? half_y : half_x;
+  return lines * (std::max(1.0, std::ceil(2.0 * widest / o.point_spacing_mm - 1e-9)) + 1.0);
+}
+
+std::vector<std::string> SizeProblems(const PolishJob& job) {
+  // Each dwell point holds a column of the removal matrix, reserved as the removal function's
+  // footprint box on the map's grid.
+  const FootprintBox box = job.removal.Footprint();
+  const surfaces::GridSpec& grid = job.error_map.grid;
+  const double box_x_mm = box.max_x_mm - box.min_x_mm, box_y_mm = box.max_y_mm - box.min_y_mm;
+  const double entries = std::ceil(box_x_mm / grid.dx_mm + 1.0) * std::ceil(box_y_mm / grid.dy_mm + 1.0);
+  const double points = PathPointCount(job.aperture, job.path, job.path_pattern);
+  std::optional<std::string> problem = MemoryBudgetProblem(
+      fmt::format("path.line_spacing_mm = {}, path.point_spacing_mm = {}", job.path.line_spacing_mm,
+                  job.path.point_spacing_mm),
+      points, "dwell points", kBytesPerDwellPoint + kBytesPerRemovalMatrixEntry * entries);
+  if (!problem) return {};
+  return {*problem +
+          fmt::format(" (a dwell point holds {:.3g} B and {:.3g} removal-matrix entries of {:g} B: the "
+                      "removal function's {:g} x {:g} mm footprint on the map's {:g} x {:g} mm grid)",
+                      kBytesPerDwellPoint, entries, kBytesPerRemovalMatrixEntry, box_x_mm, box_y_mm,
+                      grid.dx_mm, grid.dy_mm)};
 }
 
 namespace {
 
 void CheckOnSurface(const PolishJob& job, std::span<const Eigen::Vector2d> path) {
   const ErrorMap& m = job.error_map;
-  for (int j = 0; j < m.ny; ++j) {
-    for (int i = 0; i < m.nx; ++i) {
-      if (!std::isfinite(m.At(i, j)) || !job.aperture.Contains(m.X(i), m.Y(j))) continue;
-      if (!job.surface->InDomain(m.X(i), m.Y(j))) {
-        throw Error(ErrorCode::kBadInput, kStage,
-                    fmt::format("map off the surface: '{}' node ({}, {}) mm lies outside {}",
-                                job.error_map_file.string(), m.X(i), m.Y(j), job.surface->Describe()));
+  for (int j = 0; j < m.grid.ny; ++j) {
+    for (int i = 0; i < m.grid.nx; ++i) {
+      if (!std::isfinite(m.At(i, j)) || !job.aperture.Contains(m.grid.X(i), m.grid.Y(j))) continue;
+      if (!job.surface->InDomain(m.grid.X(i), m.grid.Y(j))) {
+        throw Error(
+            ErrorCode::kBadInput, kStage,
+            fmt::format("map off the surface: '{}' node ({}, {}) mm lies outside {}",
+                        job.error_map_file.string(), m.grid.X(i), m.grid.Y(j), job.surface->Describe()));
       }
     }
   }
@@ -242,11 +283,11 @@ void CheckOnSurface(const PolishJob& job, std::span<const Eigen::Vector2d> path)
 std::string ResidualCsv(const ErrorMap& target, const DwellSolution& d) {
   fmt::memory_buffer out;
   fmt::format_to(std::back_inserter(out), "{}\n", fmt::join(schema::polish::residual_map::kColumns, ","));
-  for (int j = 0; j < target.ny; ++j) {
-    for (int i = 0; i < target.nx; ++i) {
-      const std::size_t k = static_cast<std::size_t>(j) * target.nx + i;
+  for (int j = 0; j < target.grid.ny; ++j) {
+    for (int i = 0; i < target.grid.nx; ++i) {
+      const std::size_t k = static_cast<std::size_t>(j) * target.grid.nx + i;
       if (!std::isfinite(d.residual_um.error_um[k])) continue;
-      fmt::format_to(std::back_inserter(out), "{},{},{},{},{}\n", target.X(i), target.Y(j),
+      fmt::format_to(std::back_inserter(out), "{},{},{},{},{}\n", target.grid.X(i), target.grid.Y(j),
                      target.error_um[k], d.predicted_removal_um.error_um[k], d.residual_um.error_um[k]);
     }
   }
@@ -299,8 +340,8 @@ PolishRunReport RunPolishJob(const PolishJob& job, const std::filesystem::path& 
         {key::solver::kNonzeros, report.dwell.nonzeros},
         {key::solver::kShapingRounds, report.dwell.shaping_rounds}}}};
 
-  EnsureDirectory(output_folder);
   OutputSet outputs;
+  outputs.CreateFolder(output_folder);
   auto write = [&](std::string_view name, const std::string& text) {
     const std::filesystem::path temporary = outputs.Stage(output_folder / name);
     std::ofstream out(temporary, std::ios::binary);

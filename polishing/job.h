@@ -5,6 +5,7 @@
 #include <filesystem>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "polishing/dwell.h"
 #include "polishing/error_map_io.h"
@@ -38,6 +39,24 @@ struct PolishJob {
 // Reads and validates a job; the error map's "file" is relative to the job's folder.
 // Throws Error{kIo} or Error{kBadInput, "polishing.job"} naming the file and the dotted key.
 [[nodiscard]] PolishJob ReadPolishJob(const std::filesystem::path& path);
+
+// Bytes a polish run holds per item, measured as the peak resident memory of `arcwheel polish`
+// over jobs of 845 to 1.3e6 dwell points and 4e3 to 1.6e6 map nodes (docs/polishing.md, "Sizes"):
+// a dwell point with its bounds, solver vectors, tool frame, CSV and RAPID text (525 B at most);
+// an entry the removal matrix reserves for it (a footprint box of map nodes per point, 16.5 - 17.8
+// B each); a map node with its copies (target, prediction, residual, residual CSV: 155 B).
+inline constexpr double kBytesPerDwellPoint = 550.0;
+inline constexpr double kBytesPerRemovalMatrixEntry = 18.0;
+
+// The dwell points a path of `pattern` over the aperture will hold: exact for a spiral and a
+// rectangle's raster, an upper bound for a circle's raster. Computed in doubles: a spacing far too
+// small gives a huge (or infinite) count, never an overflow.
+[[nodiscard]] double PathPointCount(const surfaces::Aperture& aperture, const RasterOptions& options,
+                                    PathPattern pattern);
+
+// The sizes a valid job implies against the memory budget (core/memory_budget.h), one line per
+// problem in the "key = value violates rule" form; empty when it fits.
+[[nodiscard]] std::vector<std::string> SizeProblems(const PolishJob& job);
 
 struct PolishRunReport {
   DwellSolution dwell;

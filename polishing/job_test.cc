@@ -9,6 +9,7 @@
 
 #include "core/error.h"
 #include "core/testing/testing.h"
+#include "polishing/dwell.h"
 #include "polishing/removal_function.h"
 #include "polishing/removal_target.h"
 #include "polishing/robot_program.h"
@@ -73,6 +74,31 @@ TEST(PolishingOptions, DefaultsAreValidAndEachViolationNamesItsKeyAndValue) {
   ToolData tool;
   tool.mass_kg = -5.0;
   EXPECT_EQ(tool.Problems(), std::vector<std::string>{"tool.mass_kg = -5 violates > 0"});
+}
+
+// The size check counts the points before the path is made: the count must match the paths
+// RasterPath and SpiralPath then make (a circle's raster: at most 4/pi times too many).
+TEST(PathPointCount, MatchesThePathsMadeOrBoundsACirclesRaster) {
+  const surfaces::Aperture disc{.shape = surfaces::Aperture::Shape::kCircle, .diameter_mm = 61.3};
+  const surfaces::Aperture plate{.width_x_mm = 47.0, .width_y_mm = 22.5};
+  for (const RasterOptions& o :
+       {RasterOptions{.line_spacing_mm = 2.0, .point_spacing_mm = 2.0, .extension_mm = 6.0},
+        RasterOptions{.line_spacing_mm = 0.7, .point_spacing_mm = 0.3, .extension_mm = 1.1},
+        RasterOptions{.line_spacing_mm = 5.0, .point_spacing_mm = 9.0, .extension_mm = 0.0}}) {
+    SCOPED_TRACE(o.line_spacing_mm);
+    for (const surfaces::Aperture& a : {disc, plate}) {
+      EXPECT_EQ(PathPointCount(a, o, PathPattern::kSpiral), static_cast<double>(SpiralPath(a, o).size()));
+    }
+    EXPECT_EQ(PathPointCount(plate, o, PathPattern::kRaster),
+              static_cast<double>(RasterPath(plate, o).size()));
+    const double made = static_cast<double>(RasterPath(disc, o).size());
+    EXPECT_GE(PathPointCount(disc, o, PathPattern::kRaster), made);
+    EXPECT_LE(PathPointCount(disc, o, PathPattern::kRaster), 1.5 * made + 10.0);
+  }
+  // Far too fine: a huge count, not an overflow.
+  const RasterOptions tiny{.line_spacing_mm = 1e-300, .point_spacing_mm = 1e-300};
+  EXPECT_FALSE(PathPointCount(disc, tiny, PathPattern::kRaster) < 1e300);
+  EXPECT_FALSE(PathPointCount(disc, tiny, PathPattern::kSpiral) < 1e300);
 }
 
 }  // namespace

@@ -1,6 +1,7 @@
 // End-to-end tests of `arcwheel polish JOB -o OUTDIR`.
 #include <fmt/core.h>
 #include <gtest/gtest.h>
+#include <hdf5.h>
 
 #include <cmath>
 #include <cstdlib>
@@ -122,7 +123,7 @@ void ExpectRefused(const std::string& job, const std::string& message, bool shif
   const auto result = PolishJobIn(dir);
   EXPECT_EQ(result.exit_status, 3) << result.output;
   EXPECT_NE(result.output.find(message), std::string::npos) << result.output;
-  EXPECT_FALSE(std::filesystem::exists(dir / "out"));
+  EXPECT_FALSE(std::filesystem::exists(dir / "out")) << "a refused run leaves no output folder";
 }
 
 std::string WithSurface(const std::string& surface) {
@@ -221,6 +222,75 @@ TEST(PolishCommand, RefusesAMapOffTheSurface) {
 }
 
 TEST(PolishCommand, RefusesAnEmptyAperture) { ExpectRefused(Job(), "empty aperture", /*shifted_map=*/true); }
+
+TEST(PolishCommand, RefusesAPathSpacingBeyondTheMemoryBudgetUpFront) {
+  // 1e-4 mm over the 72 mm grown disc: a raster bound of (72 / 1e-4 + 1)^2 = 5.18e11 dwell points
+  // (this used to run a minute, take 17 GB and end in std::bad_alloc).
+  std::string job = Job();
+  const std::string spacing = R"("line_spacing_mm": 2.0, "point_spacing_mm": 2.0)";
+  job.replace(job.find(spacing), spacing.size(), R"("line_spacing_mm": 1e-4, "point_spacing_mm": 1e-4)");
+  ExpectRefused(
+      job,
+      "path.line_spacing_mm = 0.0001, path.point_spacing_mm = 0.0001 violates the memory budget: it "
+      "implies 5.18e+11 dwell points");
+  ExpectRefused(job, "over the 4 GiB (4294967296 B) of one run");
+}
+
+TEST(PolishCommand, RefusesAnInfinityInTheMapNamingItsLine) {
+  TempDir dir;
+  WriteMap(dir / "map.csv");
+  std::string map = arcwheel::testing::ReadText(dir / "map.csv");
+  // Row of node (0, 0): line 3 (comment, header) + 32 rows of 65 + 32 nodes.
+  const std::size_t start = map.find("\n0,0,") + 1;
+  map.replace(start, map.find('\n', start) - start, "0,0,inf");
+  WriteText(dir / "map.csv", map);
+  WriteText(dir / "job.json", Job());
+  const auto result =
+      RunArcwheel(fmt::format("polish {} -o {}", (dir / "job.json").string(), (dir / "out").string()));
+  EXPECT_EQ(result.exit_status, 3) << result.output;
+  EXPECT_NE(result.output.find("map.csv' line 2115: error_um = inf is not finite"), std::string::npos)
+      << result.output;
+  EXPECT_FALSE(std::filesystem::exists(dir / "out"));
+}
+
+TEST(PolishCommand, RefusesAnErrorMapGridBeyondTheMemoryBudgetBeforeReadingIt) {
+  TempDir dir;
+  {
+    // 8192 x 8192 nodes declared, none stored: a chunked dataset that was never written takes no
+    // room in the file, so only its declared shape can stop the read.
+    const hid_t file = H5Fcreate((dir / "map.h5").c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT);
+    const hsize_t shape[2] = {8192, 8192}, chunk[2] = {256, 256};
+    const hid_t space = H5Screate_simple(2, shape, nullptr);
+    const hid_t creation = H5Pcreate(H5P_DATASET_CREATE);
+    H5Pset_chunk(creation, 2, chunk);
+    const hid_t data =
+        H5Dcreate2(file, "error_um", H5T_IEEE_F64LE, space, H5P_DEFAULT, creation, H5P_DEFAULT);
+    for (const char* key : {"x0_mm", "y0_mm", "dx_mm", "dy_mm"}) {
+      const double value = key[1] == '0' ? -40.0 : 0.01;
+      const hid_t scalar = H5Screate(H5S_SCALAR);
+      const hid_t attribute = H5Acreate2(file, key, H5T_IEEE_F64LE, scalar, H5P_DEFAULT, H5P_DEFAULT);
+      H5Awrite(attribute, H5T_NATIVE_DOUBLE, &value);
+      H5Aclose(attribute);
+      H5Sclose(scalar);
+    }
+    H5Dclose(data);
+    H5Pclose(creation);
+    H5Sclose(space);
+    H5Fclose(file);
+  }
+  std::string job = Job();
+  job.replace(job.find("map.csv"), 7, "map.h5");
+  WriteText(dir / "job.json", job);
+  const auto result =
+      RunArcwheel(fmt::format("polish {} -o {}", (dir / "job.json").string(), (dir / "out").string()));
+  EXPECT_EQ(result.exit_status, 3) << result.output;
+  EXPECT_NE(
+      result.output.find("map.h5': dataset 'error_um' [8192][8192] violates the memory budget: it implies "
+                         "6.71e+07 map nodes x 160 B"),
+      std::string::npos)
+      << result.output;
+  EXPECT_FALSE(std::filesystem::exists(dir / "out"));
+}
 
 }  // namespace
 }  // namespace arcwheel::polishing

@@ -114,8 +114,8 @@ std::optional<FftRemoval> FftRemoval::Make(const ErrorMap& map, std::span<const 
   point_i.reserve(path_xy_mm.size());
   point_j.reserve(path_xy_mm.size());
   for (const Eigen::Vector2d& p : path_xy_mm) {
-    const std::optional<int> i = GridIndex(p.x(), map.x0_mm, map.dx_mm);
-    const std::optional<int> j = GridIndex(p.y(), map.y0_mm, map.dy_mm);
+    const std::optional<int> i = GridIndex(p.x(), map.grid.x0_mm, map.grid.dx_mm);
+    const std::optional<int> j = GridIndex(p.y(), map.grid.y0_mm, map.grid.dy_mm);
     if (!i || !j) return std::nullopt;
     point_i.push_back(*i);
     point_j.push_back(*j);
@@ -125,15 +125,15 @@ std::optional<FftRemoval> FftRemoval::Make(const ErrorMap& map, std::span<const 
   f.origin_i_ = std::min(0, *std::min_element(point_i.begin(), point_i.end()));
   f.origin_j_ = std::min(0, *std::min_element(point_j.begin(), point_j.end()));
   const int cells_x =
-      std::max(map.nx - 1, *std::max_element(point_i.begin(), point_i.end())) - f.origin_i_ + 1;
+      std::max(map.grid.nx - 1, *std::max_element(point_i.begin(), point_i.end())) - f.origin_i_ + 1;
   const int cells_y =
-      std::max(map.ny - 1, *std::max_element(point_j.begin(), point_j.end())) - f.origin_j_ + 1;
+      std::max(map.grid.ny - 1, *std::max_element(point_j.begin(), point_j.end())) - f.origin_j_ + 1;
   // One step more each side than the footprint's box: the rate itself is zero outside it.
   const FootprintBox box = removal.Footprint();
-  const Span kx{static_cast<int>(std::floor(box.min_x_mm / map.dx_mm)) - 1,
-                static_cast<int>(std::ceil(box.max_x_mm / map.dx_mm)) + 1};
-  const Span ky{static_cast<int>(std::floor(box.min_y_mm / map.dy_mm)) - 1,
-                static_cast<int>(std::ceil(box.max_y_mm / map.dy_mm)) + 1};
+  const Span kx{static_cast<int>(std::floor(box.min_x_mm / map.grid.dx_mm)) - 1,
+                static_cast<int>(std::ceil(box.max_x_mm / map.grid.dx_mm)) + 1};
+  const Span ky{static_cast<int>(std::floor(box.min_y_mm / map.grid.dy_mm)) - 1,
+                static_cast<int>(std::ceil(box.max_y_mm / map.grid.dy_mm)) + 1};
   f.columns_ = FftLength(cells_x, kx);
   f.rows_ = FftLength(cells_y, ky);
   f.work_ = std::make_shared<Workspace>(f.rows_, f.columns_);
@@ -141,7 +141,7 @@ std::optional<FftRemoval> FftRemoval::Make(const ErrorMap& map, std::span<const 
 
   auto cell = [&f](int i, int j) { return (j - f.origin_j_) * f.columns_ + (i - f.origin_i_); };
   for (std::size_t k = 0; k < point_i.size(); ++k) f.point_cell_.push_back(cell(point_i[k], point_j[k]));
-  for (const int node : row_nodes) f.row_cell_.push_back(cell(node % map.nx, node / map.nx));
+  for (const int node : row_nodes) f.row_cell_.push_back(cell(node % map.grid.nx, node / map.grid.nx));
 
   // The kernel with offset (0, 0) at cell (0, 0), negative offsets wrapped to the far end; and its
   // support, for the entry count.
@@ -150,8 +150,8 @@ std::optional<FftRemoval> FftRemoval::Make(const ErrorMap& map, std::span<const 
   double* kernel = f.ClearedGrid();
   for (int b = ky.first; b <= ky.last; ++b) {
     for (int a = kx.first; a <= kx.last; ++a) {
-      const double rate = removal.RateUmPerS(a * map.dx_mm, b * map.dy_mm);
-      if (!SteadyAround(removal, a * map.dx_mm, b * map.dy_mm, rate, map.dx_mm, map.dy_mm))
+      const double rate = removal.RateUmPerS(a * map.grid.dx_mm, b * map.grid.dy_mm);
+      if (!SteadyAround(removal, a * map.grid.dx_mm, b * map.grid.dy_mm, rate, map.grid.dx_mm, map.grid.dy_mm))
         return std::nullopt;
       if (!(rate > 0.0)) continue;
       const std::size_t c = static_cast<std::size_t>(wrap(b, f.rows_)) * f.columns_ + wrap(a, f.columns_);

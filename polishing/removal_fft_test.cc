@@ -21,13 +21,13 @@ ErrorMap SmoothMap(double x0_mm, double y0_mm, double step_mm, int nx, int ny, u
   std::mt19937 rng(seed);
   std::uniform_real_distribution<double> u(-1.0, 1.0);
   const double astig = 0.3 * u(rng), coma = 0.2 * u(rng), bx = 10.0 * u(rng), by = 10.0 * u(rng);
-  ErrorMap map{.x0_mm = x0_mm, .y0_mm = y0_mm, .dx_mm = step_mm, .dy_mm = step_mm, .nx = nx, .ny = ny};
+  ErrorMap map{.grid = {.x0_mm = x0_mm, .y0_mm = y0_mm, .dx_mm = step_mm, .dy_mm = step_mm, .nx = nx, .ny = ny}};
   for (int j = 0; j < ny; ++j) {
     for (int i = 0; i < nx; ++i) {
-      const double x = map.X(i) / 20.0, y = map.Y(j) / 20.0;
+      const double x = map.grid.X(i) / 20.0, y = map.grid.Y(j) / 20.0;
       map.error_um.push_back(astig * (x * x - y * y) + coma * x * (x * x + y * y) +
                              0.3 *
-                                 std::exp(-(std::pow(map.X(i) - bx, 2) + std::pow(map.Y(j) - by, 2)) / 60.0));
+                                 std::exp(-(std::pow(map.grid.X(i) - bx, 2) + std::pow(map.grid.Y(j) - by, 2)) / 60.0));
     }
   }
   return map;
@@ -36,9 +36,9 @@ ErrorMap SmoothMap(double x0_mm, double y0_mm, double step_mm, int nx, int ny, u
 // Points on the map's grid, some beyond it (as a path's extension is), in no particular order.
 std::vector<Eigen::Vector2d> GridPoints(const ErrorMap& map, int count, unsigned seed) {
   std::mt19937 rng(seed);
-  std::uniform_int_distribution<int> i(-6, map.nx + 5), j(-6, map.ny + 5);
+  std::uniform_int_distribution<int> i(-6, map.grid.nx + 5), j(-6, map.grid.ny + 5);
   std::vector<Eigen::Vector2d> points;
-  for (int k = 0; k < count; ++k) points.emplace_back(map.X(i(rng)), map.Y(j(rng)));
+  for (int k = 0; k < count; ++k) points.emplace_back(map.grid.X(i(rng)), map.grid.Y(j(rng)));
   return points;
 }
 
@@ -52,12 +52,12 @@ struct Products {
 Products BruteForce(const ErrorMap& map, const std::vector<Eigen::Vector2d>& points,
                     const RemovalFunction& removal) {
   Products p;
-  p.dense.resize(map.nx * map.ny, static_cast<Eigen::Index>(points.size()));
-  for (int n = 0; n < map.nx * map.ny; ++n) {
+  p.dense.resize(map.grid.nx * map.grid.ny, static_cast<Eigen::Index>(points.size()));
+  for (int n = 0; n < map.grid.nx * map.grid.ny; ++n) {
     p.nodes.push_back(n);
     for (std::size_t k = 0; k < points.size(); ++k) {
       const double rate =
-          removal.RateUmPerS(map.X(n % map.nx) - points[k].x(), map.Y(n / map.nx) - points[k].y());
+          removal.RateUmPerS(map.grid.X(n % map.grid.nx) - points[k].x(), map.grid.Y(n / map.grid.nx) - points[k].y());
       p.dense(n, static_cast<Eigen::Index>(k)) = rate;
       p.nonzeros += rate > 0.0 ? 1 : 0;
     }
@@ -72,7 +72,7 @@ void ExpectProductsAsBruteForce(const ErrorMap& map, const std::vector<Eigen::Ve
   ASSERT_TRUE(fft.has_value());
   std::mt19937 rng(7);
   std::uniform_real_distribution<double> u(0.0, 1.0);
-  Eigen::VectorXd dwell(static_cast<Eigen::Index>(points.size())), rows(map.nx * map.ny);
+  Eigen::VectorXd dwell(static_cast<Eigen::Index>(points.size())), rows(map.grid.nx * map.grid.ny);
   for (auto& t : dwell) t = u(rng);
   for (auto& r : rows) r = u(rng) - 0.5;
   const Eigen::VectorXd removal_um = brute.dense * dwell, transposed = brute.dense.transpose() * rows;

@@ -14,12 +14,12 @@ namespace {
 constexpr const char* kStage = "polishing.target";
 
 void CheckGrid(const ErrorMap& map) {
-  if (map.nx < 1 || map.ny < 1 || !(map.dx_mm > 0.0) || !(map.dy_mm > 0.0) ||
-      map.error_um.size() != static_cast<std::size_t>(map.nx) * map.ny) {
+  if (map.grid.nx < 1 || map.grid.ny < 1 || !(map.grid.dx_mm > 0.0) || !(map.grid.dy_mm > 0.0) ||
+      map.error_um.size() != static_cast<std::size_t>(map.grid.nx) * map.grid.ny) {
     throw Error(ErrorCode::kInvalidOption, kStage,
                 fmt::format("error map grid {} x {} nodes, spacing {} x {} mm with {} values is "
                             "malformed",
-                            map.nx, map.ny, map.dx_mm, map.dy_mm, map.error_um.size()));
+                            map.grid.nx, map.grid.ny, map.grid.dx_mm, map.grid.dy_mm, map.error_um.size()));
   }
 }
 
@@ -28,10 +28,10 @@ void CheckGrid(const ErrorMap& map) {
 MapStatistics StatisticsInAperture(const ErrorMap& map, const surfaces::Aperture& aperture) {
   double lo = std::numeric_limits<double>::infinity(), hi = -lo, sum = 0.0, sum2 = 0.0;
   int n = 0;
-  for (int j = 0; j < map.ny; ++j) {
-    for (int i = 0; i < map.nx; ++i) {
+  for (int j = 0; j < map.grid.ny; ++j) {
+    for (int i = 0; i < map.grid.nx; ++i) {
       const double v = map.At(i, j);
-      if (!std::isfinite(v) || !aperture.Contains(map.X(i), map.Y(j))) continue;
+      if (!std::isfinite(v) || !aperture.Contains(map.grid.X(i), map.grid.Y(j))) continue;
       lo = std::min(lo, v);
       hi = std::max(hi, v);
       sum += v;
@@ -40,10 +40,11 @@ MapStatistics StatisticsInAperture(const ErrorMap& map, const surfaces::Aperture
   }
   if (n == 0) return {};
   const double mean = sum / n;
-  for (int j = 0; j < map.ny; ++j) {
-    for (int i = 0; i < map.nx; ++i) {
+  for (int j = 0; j < map.grid.ny; ++j) {
+    for (int i = 0; i < map.grid.nx; ++i) {
       const double v = map.At(i, j);
-      if (std::isfinite(v) && aperture.Contains(map.X(i), map.Y(j))) sum2 += (v - mean) * (v - mean);
+      if (std::isfinite(v) && aperture.Contains(map.grid.X(i), map.grid.Y(j)))
+        sum2 += (v - mean) * (v - mean);
     }
   }
   return {hi - lo, std::sqrt(sum2 / n), n};
@@ -57,9 +58,9 @@ ErrorMap RemovalTarget(const ErrorMap& error, const surfaces::Aperture& aperture
                 fmt::format("uniform_layer_um = {} violates >= 0", options.uniform_layer_um));
   }
   double minimum = std::numeric_limits<double>::infinity();
-  for (int j = 0; j < error.ny; ++j) {
-    for (int i = 0; i < error.nx; ++i) {
-      if (std::isfinite(error.At(i, j)) && aperture.Contains(error.X(i), error.Y(j))) {
+  for (int j = 0; j < error.grid.ny; ++j) {
+    for (int i = 0; i < error.grid.nx; ++i) {
+      if (std::isfinite(error.At(i, j)) && aperture.Contains(error.grid.X(i), error.grid.Y(j))) {
         minimum = std::min(minimum, error.At(i, j));
       }
     }
@@ -70,10 +71,10 @@ ErrorMap RemovalTarget(const ErrorMap& error, const surfaces::Aperture& aperture
         fmt::format("empty aperture: no error-map node with data lies inside {}", aperture.Describe()));
   }
   ErrorMap target = error;
-  for (int j = 0; j < error.ny; ++j) {
-    for (int i = 0; i < error.nx; ++i) {
-      double& v = target.error_um[static_cast<std::size_t>(j) * error.nx + i];
-      v = std::isfinite(v) && aperture.Contains(error.X(i), error.Y(j))
+  for (int j = 0; j < error.grid.ny; ++j) {
+    for (int i = 0; i < error.grid.nx; ++i) {
+      double& v = target.error_um[static_cast<std::size_t>(j) * error.grid.nx + i];
+      v = std::isfinite(v) && aperture.Contains(error.grid.X(i), error.grid.Y(j))
               ? v - minimum + options.uniform_layer_um
               : std::numeric_limits<double>::quiet_NaN();
     }

@@ -11,22 +11,16 @@
 #include <string>
 #include <vector>
 
+#include "surfaces/grid_spec.h"
 #include "surfaces/surface.h"
 
 namespace arcwheel::polishing {
 
-// error_um[j * nx + i] is the error at (x0 + i dx, y0 + j dy); NaN where there is no data.
+// error_um[grid.Index(i, j)] is the error at (grid.X(i), grid.Y(j)); NaN where there is no data.
 struct ErrorMap {
-  double x0_mm = 0.0;
-  double y0_mm = 0.0;
-  double dx_mm = 1.0;
-  double dy_mm = 1.0;
-  int nx = 0;
-  int ny = 0;
+  surfaces::GridSpec grid{};
   std::vector<double> error_um{};
-  [[nodiscard]] double X(int i) const { return x0_mm + i * dx_mm; }
-  [[nodiscard]] double Y(int j) const { return y0_mm + j * dy_mm; }
-  [[nodiscard]] double At(int i, int j) const { return error_um[static_cast<std::size_t>(j) * nx + i]; }
+  [[nodiscard]] double At(int i, int j) const { return error_um[grid.Index(i, j)]; }
 };
 
 // PV (max - min) and RMS about the mean of the finite values of a map inside the aperture.

@@ -40,10 +40,11 @@ TEST(RemovalTarget, ClosestSphereOfTheLensNeeds14Point2Micrometres) {
   // Error of a 1767.657 mm sphere tangent at the vertex against the asphere, on a 2D grid of the
   // 460 mm aperture (rotational symmetry: radius r = sqrt(x^2 + y^2)).
   const surfaces::Aperture aperture{.shape = surfaces::Aperture::Shape::kCircle, .diameter_mm = 460.0};
-  ErrorMap error{.x0_mm = -230.0, .y0_mm = -230.0, .dx_mm = 2.5, .dy_mm = 2.5, .nx = 185, .ny = 185};
-  for (int j = 0; j < error.ny; ++j) {
-    for (int i = 0; i < error.nx; ++i) {
-      const double r = std::hypot(error.X(i), error.Y(j));
+  ErrorMap error{
+      .grid = {.x0_mm = -230.0, .y0_mm = -230.0, .dx_mm = 2.5, .dy_mm = 2.5, .nx = 185, .ny = 185}};
+  for (int j = 0; j < error.grid.ny; ++j) {
+    for (int i = 0; i < error.grid.nx; ++i) {
+      const double r = std::hypot(error.grid.X(i), error.grid.Y(j));
       error.error_um.push_back(r <= 230.0
                                    ? 1e3 * (SphereSagMm(1767.657, r) - PolynomialProfileSagMm(kLens, r))
                                    : std::numeric_limits<double>::quiet_NaN());
@@ -68,12 +69,7 @@ TEST(RemovalTarget, ClosestSphereOfTheLensNeeds14Point2Micrometres) {
 TEST(RemovalTarget, AddsTheUniformLayerAndBlanksOutsideTheAperture) {
   const surfaces::Aperture aperture{
       .shape = surfaces::Aperture::Shape::kRectangle, .width_x_mm = 2.0, .width_y_mm = 2.0};
-  const ErrorMap error{.x0_mm = -2.0,
-                       .y0_mm = 0.0,
-                       .dx_mm = 1.0,
-                       .dy_mm = 1.0,
-                       .nx = 5,
-                       .ny = 1,
+  const ErrorMap error{.grid = {.x0_mm = -2.0, .y0_mm = 0.0, .dx_mm = 1.0, .dy_mm = 1.0, .nx = 5, .ny = 1},
                        .error_um = {9.0, -1.0, 3.0, 2.0, -7.0}};
   const ErrorMap target = RemovalTarget(error, aperture, {.uniform_layer_um = 0.5});
   EXPECT_TRUE(std::isnan(target.error_um[0]));
@@ -85,7 +81,7 @@ TEST(RemovalTarget, AddsTheUniformLayerAndBlanksOutsideTheAperture) {
 
 TEST(RemovalTarget, RefusesAnEmptyAperture) {
   const surfaces::Aperture aperture{.shape = surfaces::Aperture::Shape::kCircle, .diameter_mm = 1.0};
-  const ErrorMap error{.x0_mm = 10.0, .y0_mm = 10.0, .nx = 2, .ny = 1, .error_um = {1.0, 2.0}};
+  const ErrorMap error{.grid = {.x0_mm = 10.0, .y0_mm = 10.0, .nx = 2, .ny = 1}, .error_um = {1.0, 2.0}};
   try {
     (void)RemovalTarget(error, aperture, {});
     FAIL() << "accepted";

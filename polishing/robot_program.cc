@@ -172,9 +172,12 @@ std::string RapidModule(std::span<const PolishingPoint> points, const ToolData& 
     line(fmt::format("    [{:.4f},500,5000,1000]{}", points[k].speed_mm_s,
                      k + 1 < points.size() ? "," : "];"));
   }
+  // Fly-by (z1) through every point but the last, so that the TCP keeps its speed from segment
+  // to segment; the last move is a stop point (fine), so that the program ends with the tool
+  // exactly on the last target. Each target is moved to once: no zero-length repeat of the last.
   line("  PROC main()");
   line("    ConfL \\Off;");
-  line("    FOR i FROM 1 TO nPoints DO");
+  line("    FOR i FROM 1 TO nPoints - 1 DO");
   line("      MoveL pPath{i}, vPath{i}, z1, tPolish \\WObj:=wPart;");
   line("    ENDFOR");
   line("    MoveL pPath{nPoints}, vPath{nPoints}, fine, tPolish \\WObj:=wPart;");

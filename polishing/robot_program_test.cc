@@ -105,7 +105,19 @@ TEST(RapidModule, DeclaresTargetsSpeedsToolAndWorkObjectAndMovesThroughEveryPoin
   }
   EXPECT_EQ(k, points.size());
   EXPECT_NE(text.find("    [67.5000,500,5000,1000],"), std::string::npos);
-  EXPECT_NE(text.find("MoveL pPath{i}, vPath{i}, z1, tPolish \\WObj:=wPart;"), std::string::npos);
+  // The targets in the order main() moves to them: fly-by through 1 .. N-1, a stop point on N, and
+  // no target twice (a repeat of the last would be a zero-length move).
+  const std::size_t main_at = text.find("  PROC main()");
+  ASSERT_NE(main_at, std::string::npos);
+  EXPECT_EQ(text.substr(main_at),
+            "  PROC main()\n"
+            "    ConfL \\Off;\n"
+            "    FOR i FROM 1 TO nPoints - 1 DO\n"
+            "      MoveL pPath{i}, vPath{i}, z1, tPolish \\WObj:=wPart;\n"
+            "    ENDFOR\n"
+            "    MoveL pPath{nPoints}, vPath{nPoints}, fine, tPolish \\WObj:=wPart;\n"
+            "  ENDPROC\n"
+            "ENDMODULE\n");
 }
 
 TEST(BuildPolishingPath, PrecessesTheBonnetAxisAboutTheNormalAtTheTiltAndRate) {

@@ -175,15 +175,15 @@ std::string XyPolynomial::Describe() const {
 
 // ---------------------------------------------------------------------------------------------
 HeightGrid::HeightGrid(HeightGridParameters parameters) : p_(std::move(parameters)) {
-  if (p_.nx < 4 || p_.ny < 4) {
+  if (p_.grid.nx < 4 || p_.grid.ny < 4) {
     throw Error(ErrorCode::kBadInput, kStage,
-                fmt::format("height grid of {} x {} nodes: at least 4 x 4 needed", p_.nx, p_.ny));
+                fmt::format("height grid of {} x {} nodes: at least 4 x 4 needed", p_.grid.nx, p_.grid.ny));
   }
-  if (!(p_.dx_mm > 0.0) || !(p_.dy_mm > 0.0)) {
+  if (!(p_.grid.dx_mm > 0.0) || !(p_.grid.dy_mm > 0.0)) {
     throw Error(ErrorCode::kBadInput, kStage,
-                fmt::format("height grid spacing ({}, {}) mm must be > 0", p_.dx_mm, p_.dy_mm));
+                fmt::format("height grid spacing ({}, {}) mm must be > 0", p_.grid.dx_mm, p_.grid.dy_mm));
   }
-  const size_t nx = static_cast<size_t>(p_.nx), ny = static_cast<size_t>(p_.ny);
+  const size_t nx = static_cast<size_t>(p_.grid.nx), ny = static_cast<size_t>(p_.grid.ny);
   if (p_.heights_mm.size() != nx * ny) {
     throw Error(ErrorCode::kBadInput, kStage,
                 fmt::format("height grid holds {} heights, {} x {} = {} expected", p_.heights_mm.size(), nx,
@@ -202,15 +202,15 @@ HeightGrid::HeightGrid(HeightGridParameters parameters) : p_(std::move(parameter
   for (size_t j = 0; j < ny; ++j) {
     line.assign(p_.heights_mm.begin() + static_cast<std::ptrdiff_t>(j * nx),
                 p_.heights_mm.begin() + static_cast<std::ptrdiff_t>((j + 1) * nx));
-    const std::vector<double> m = SplineSlopes(line, p_.dx_mm);
+    const std::vector<double> m = SplineSlopes(line, p_.grid.dx_mm);
     std::copy(m.begin(), m.end(), slope_x_.begin() + static_cast<std::ptrdiff_t>(j * nx));
   }
   line.resize(ny);
   for (size_t i = 0; i < nx; ++i) {
     for (size_t j = 0; j < ny; ++j) line[j] = p_.heights_mm[j * nx + i];
-    const std::vector<double> my = SplineSlopes(line, p_.dy_mm);
+    const std::vector<double> my = SplineSlopes(line, p_.grid.dy_mm);
     for (size_t j = 0; j < ny; ++j) line[j] = slope_x_[j * nx + i];
-    const std::vector<double> mxy = SplineSlopes(line, p_.dy_mm);
+    const std::vector<double> mxy = SplineSlopes(line, p_.grid.dy_mm);
     for (size_t j = 0; j < ny; ++j) {
       slope_y_[j * nx + i] = my[j];
       slope_xy_[j * nx + i] = mxy[j];
@@ -219,24 +219,24 @@ HeightGrid::HeightGrid(HeightGridParameters parameters) : p_(std::move(parameter
 }
 
 bool HeightGrid::InDomain(double x_mm, double y_mm) const {
-  const double x_end = p_.x0_mm + (p_.nx - 1) * p_.dx_mm;
-  const double y_end = p_.y0_mm + (p_.ny - 1) * p_.dy_mm;
-  return x_mm >= p_.x0_mm && x_mm <= x_end && y_mm >= p_.y0_mm && y_mm <= y_end;
+  const double x_end = p_.grid.x0_mm + (p_.grid.nx - 1) * p_.grid.dx_mm;
+  const double y_end = p_.grid.y0_mm + (p_.grid.ny - 1) * p_.grid.dy_mm;
+  return x_mm >= p_.grid.x0_mm && x_mm <= x_end && y_mm >= p_.grid.y0_mm && y_mm <= y_end;
 }
 
 SurfacePoint HeightGrid::Evaluate(double x_mm, double y_mm) const {
-  const double gx = (x_mm - p_.x0_mm) / p_.dx_mm;
-  const double gy = (y_mm - p_.y0_mm) / p_.dy_mm;
-  const int i = std::clamp(static_cast<int>(std::floor(gx)), 0, p_.nx - 2);
-  const int j = std::clamp(static_cast<int>(std::floor(gy)), 0, p_.ny - 2);
+  const double gx = (x_mm - p_.grid.x0_mm) / p_.grid.dx_mm;
+  const double gy = (y_mm - p_.grid.y0_mm) / p_.grid.dy_mm;
+  const int i = std::clamp(static_cast<int>(std::floor(gx)), 0, p_.grid.nx - 2);
+  const int j = std::clamp(static_cast<int>(std::floor(gy)), 0, p_.grid.ny - 2);
   const HermiteBasis bx = Hermite(gx - i);
   const HermiteBasis by = Hermite(gy - j);
-  const double hx = p_.dx_mm, hy = p_.dy_mm;
+  const double hx = p_.grid.dx_mm, hy = p_.grid.dy_mm;
   SurfacePoint p;
   // Corner a (0 or 1) in x and b in y; Hermite slots: 0/1 values, 2/3 slopes.
   for (int a = 0; a < 2; ++a) {
     for (int b = 0; b < 2; ++b) {
-      const size_t k = static_cast<size_t>((j + b) * p_.nx + (i + a));
+      const size_t k = static_cast<size_t>((j + b) * p_.grid.nx + (i + a));
       const double v = p_.heights_mm[k], sx = slope_x_[k] * hx, sy = slope_y_[k] * hy,
                    sxy = slope_xy_[k] * hx * hy;
       const auto combine = [&](const std::array<double, 4>& ux, const std::array<double, 4>& uy) {
@@ -256,7 +256,7 @@ SurfacePoint HeightGrid::Evaluate(double x_mm, double y_mm) const {
 
 std::string HeightGrid::Describe() const {
   return fmt::format("height grid, {} x {} nodes from ({}, {}) mm, spacing ({}, {}) mm, bicubic spline",
-                     p_.nx, p_.ny, p_.x0_mm, p_.y0_mm, p_.dx_mm, p_.dy_mm);
+                     p_.grid.nx, p_.grid.ny, p_.grid.x0_mm, p_.grid.y0_mm, p_.grid.dx_mm, p_.grid.dy_mm);
 }
 
 // ---------------------------------------------------------------------------------------------

@@ -14,6 +14,8 @@
 #include <string>
 #include <vector>
 
+#include "surfaces/grid_spec.h"
+
 namespace arcwheel::surfaces {
 
 // Height and derivatives of a surface at one (x, y).
@@ -97,14 +99,9 @@ class XyPolynomial final : public Surface {
   int max_y_power_ = 0;
 };
 
-// Heights on a regular grid: heights_mm[j * nx + i] is z at (x0 + i dx, y0 + j dy).
+// Heights on a regular grid: heights_mm[grid.Index(i, j)] is z at (grid.X(i), grid.Y(j)).
 struct HeightGridParameters {
-  double x0_mm = 0.0;
-  double y0_mm = 0.0;
-  double dx_mm = 1.0;
-  double dy_mm = 1.0;
-  int nx = 0;
-  int ny = 0;
+  GridSpec grid{};
   std::vector<double> heights_mm{};
 };
 

@@ -48,22 +48,22 @@ std::shared_ptr<const Surface> ReadXyPolynomial(JsonSection& s) {
 
 std::shared_ptr<const Surface> ReadHeightGrid(JsonSection& s) {
   HeightGridParameters g;
-  g.x0_mm = s.RequiredNumber("x0_mm");
-  g.y0_mm = s.RequiredNumber("y0_mm");
-  g.dx_mm = s.RequiredNumber("dx_mm");
-  if (!(g.dx_mm > 0.0)) s.Expected("dx_mm", "a spacing > 0");
-  g.dy_mm = s.RequiredNumber("dy_mm");
-  if (!(g.dy_mm > 0.0)) s.Expected("dy_mm", "a spacing > 0");
+  g.grid.x0_mm = s.RequiredNumber("x0_mm");
+  g.grid.y0_mm = s.RequiredNumber("y0_mm");
+  g.grid.dx_mm = s.RequiredNumber("dx_mm");
+  if (!(g.grid.dx_mm > 0.0)) s.Expected("dx_mm", "a spacing > 0");
+  g.grid.dy_mm = s.RequiredNumber("dy_mm");
+  if (!(g.grid.dy_mm > 0.0)) s.Expected("dy_mm", "a spacing > 0");
   const std::string rows_expected = "an array of rows (one per y, each an array of heights along x)";
   if (!s.Has("heights_mm") || !s.Raw("heights_mm").is_array()) s.Expected("heights_mm", rows_expected);
   const nlohmann::json& rows = s.Raw("heights_mm");
-  g.ny = static_cast<int>(rows.size());
+  g.grid.ny = static_cast<int>(rows.size());
   for (std::size_t j = 0; j < rows.size(); ++j) {
     const std::string key = fmt::format("heights_mm[{}]", j);
     if (!rows[j].is_array()) s.Fail(key, fmt::format("expected an array of heights, got {}", rows[j].dump()));
-    if (j == 0) g.nx = static_cast<int>(rows[j].size());
-    if (static_cast<int>(rows[j].size()) != g.nx) {
-      s.Fail(key, fmt::format("expected {} heights (as row 0), got {}", g.nx, rows[j].size()));
+    if (j == 0) g.grid.nx = static_cast<int>(rows[j].size());
+    if (static_cast<int>(rows[j].size()) != g.grid.nx) {
+      s.Fail(key, fmt::format("expected {} heights (as row 0), got {}", g.grid.nx, rows[j].size()));
     }
     for (const nlohmann::json& h : rows[j]) {
       if (!h.is_number() || !std::isfinite(h.get<double>())) {

@@ -151,10 +151,11 @@ double Bicubic(double x, double y) {
 }
 
 TEST(HeightGrid, ReproducesABicubicPolynomialWithItsDerivatives) {
-  HeightGridParameters g{.x0_mm = -20.0, .y0_mm = -15.0, .dx_mm = 2.5, .dy_mm = 3.0, .nx = 17, .ny = 11};
-  for (int j = 0; j < g.ny; ++j) {
-    for (int i = 0; i < g.nx; ++i)
-      g.heights_mm.push_back(Bicubic(g.x0_mm + i * g.dx_mm, g.y0_mm + j * g.dy_mm));
+  HeightGridParameters g{
+      .grid = {.x0_mm = -20.0, .y0_mm = -15.0, .dx_mm = 2.5, .dy_mm = 3.0, .nx = 17, .ny = 11}};
+  for (int j = 0; j < g.grid.ny; ++j) {
+    for (int i = 0; i < g.grid.nx; ++i)
+      g.heights_mm.push_back(Bicubic(g.grid.x0_mm + i * g.grid.dx_mm, g.grid.y0_mm + j * g.grid.dy_mm));
   }
   const HeightGrid grid(g);
   std::mt19937 rng(7);
@@ -176,10 +177,11 @@ TEST(HeightGrid, InterpolatesASmoothSurfaceToSplineAccuracy) {
   // A sphere of radius 500 sampled every 5 mm: the cubic spline's error is of order
   // 5/384 h^4 max|f''''| (up to the clamped ends), with f'''' ~ 3 / R^3 growing to ~1e-7 / mm^3
   // at r = 140 mm: about 1e-6 mm.
-  HeightGridParameters g{.x0_mm = -100.0, .y0_mm = -100.0, .dx_mm = 5.0, .dy_mm = 5.0, .nx = 41, .ny = 41};
+  HeightGridParameters g{
+      .grid = {.x0_mm = -100.0, .y0_mm = -100.0, .dx_mm = 5.0, .dy_mm = 5.0, .nx = 41, .ny = 41}};
   const EvenAsphere sphere({.vertex_radius_mm = 500.0, .conic = 0.0});
-  for (int j = 0; j < g.ny; ++j) {
-    for (int i = 0; i < g.nx; ++i)
+  for (int j = 0; j < g.grid.ny; ++j) {
+    for (int i = 0; i < g.grid.nx; ++i)
       g.heights_mm.push_back(sphere.Evaluate(-100 + 5.0 * i, -100 + 5.0 * j).z_mm);
   }
   const HeightGrid grid(g);
@@ -192,10 +194,10 @@ TEST(HeightGrid, InterpolatesASmoothSurfaceToSplineAccuracy) {
 }
 
 TEST(HeightGrid, RefusesTooFewNodesAndSizeMismatch) {
-  HeightGridParameters g{
-      .dx_mm = 1.0, .dy_mm = 1.0, .nx = 3, .ny = 5, .heights_mm = std::vector<double>(15, 0.0)};
+  HeightGridParameters g{.grid = {.dx_mm = 1.0, .dy_mm = 1.0, .nx = 3, .ny = 5},
+                         .heights_mm = std::vector<double>(15, 0.0)};
   EXPECT_THROW(HeightGrid{g}, Error);
-  g.nx = 4;
+  g.grid.nx = 4;
   try {
     HeightGrid grid(g);
     FAIL();

@@ -151,7 +151,8 @@ std::optional<FftRemoval> FftRemoval::Make(const ErrorMap& map, std::span<const 
   for (int b = ky.first; b <= ky.last; ++b) {
     for (int a = kx.first; a <= kx.last; ++a) {
       const double rate = removal.RateUmPerS(a * map.grid.dx_mm, b * map.grid.dy_mm);
-      if (!SteadyAround(removal, a * map.grid.dx_mm, b * map.grid.dy_mm, rate, map.grid.dx_mm, map.grid.dy_mm))
+      if (!SteadyAround(removal, a * map.grid.dx_mm, b * map.grid.dy_mm, rate, map.grid.dx_mm,
+                        map.grid.dy_mm))
         return std::nullopt;
       if (!(rate > 0.0)) continue;
       const std::size_t c = static_cast<std::size_t>(wrap(b, f.rows_)) * f.columns_ + wrap(a, f.columns_);

@@ -21,13 +21,14 @@ ErrorMap SmoothMap(double x0_mm, double y0_mm, double step_mm, int nx, int ny, u
   std::mt19937 rng(seed);
   std::uniform_real_distribution<double> u(-1.0, 1.0);
   const double astig = 0.3 * u(rng), coma = 0.2 * u(rng), bx = 10.0 * u(rng), by = 10.0 * u(rng);
-  ErrorMap map{.grid = {.x0_mm = x0_mm, .y0_mm = y0_mm, .dx_mm = step_mm, .dy_mm = step_mm, .nx = nx, .ny = ny}};
+  ErrorMap map{
+      .grid = {.x0_mm = x0_mm, .y0_mm = y0_mm, .dx_mm = step_mm, .dy_mm = step_mm, .nx = nx, .ny = ny}};
   for (int j = 0; j < ny; ++j) {
     for (int i = 0; i < nx; ++i) {
       const double x = map.grid.X(i) / 20.0, y = map.grid.Y(j) / 20.0;
-      map.error_um.push_back(astig * (x * x - y * y) + coma * x * (x * x + y * y) +
-                             0.3 *
-                                 std::exp(-(std::pow(map.grid.X(i) - bx, 2) + std::pow(map.grid.Y(j) - by, 2)) / 60.0));
+      map.error_um.push_back(
+          astig * (x * x - y * y) + coma * x * (x * x + y * y) +
+          0.3 * std::exp(-(std::pow(map.grid.X(i) - bx, 2) + std::pow(map.grid.Y(j) - by, 2)) / 60.0));
     }
   }
   return map;
@@ -56,8 +57,8 @@ Products BruteForce(const ErrorMap& map, const std::vector<Eigen::Vector2d>& poi
   for (int n = 0; n < map.grid.nx * map.grid.ny; ++n) {
     p.nodes.push_back(n);
     for (std::size_t k = 0; k < points.size(); ++k) {
-      const double rate =
-          removal.RateUmPerS(map.grid.X(n % map.grid.nx) - points[k].x(), map.grid.Y(n / map.grid.nx) - points[k].y());
+      const double rate = removal.RateUmPerS(map.grid.X(n % map.grid.nx) - points[k].x(),
+                                             map.grid.Y(n / map.grid.nx) - points[k].y());
       p.dense(n, static_cast<Eigen::Index>(k)) = rate;
       p.nonzeros += rate > 0.0 ? 1 : 0;
     }

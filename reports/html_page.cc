@@ -16,6 +16,7 @@ body { margin: 0 auto; padding: 12px; max-width: 980px; color: #222; background:
        font: 15px/1.45 "DejaVu Sans", "Helvetica Neue", Arial, sans-serif; }
 h1 { font-size: 1.35em; margin: 0.3em 0; }
 h2 { font-size: 1.1em; margin: 1.2em 0 0.4em; border-bottom: 1px solid #ccc; }
+h3 { font-size: 1em; margin: 0.9em 0 0.3em; }
 table { border-collapse: collapse; width: 100%; margin: 0.3em 0; }
 th, td { text-align: left; padding: 4px 6px; border-bottom: 1px solid #e4e4e4; vertical-align: top; }
 td.value { overflow-wrap: anywhere; font-variant-numeric: tabular-nums; }

@@ -645,6 +645,8 @@ std::string FormatTick(double value, double step) {
   const int decimals = std::max(0, static_cast<int>(-std::floor(std::log10(step) + 1e-9)));
   std::string text = fmt::format("{:.{}f}", value, decimals);
   if (text.find_first_not_of("-0.") == std::string::npos) text = fmt::format("{:.{}f}", 0.0, decimals);
+  // The typographic minus: a hyphen reads as a dash.
+  if (text.front() == '-') text.replace(0, 1, "−");
   return text;
 }
 

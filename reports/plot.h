@@ -34,7 +34,8 @@ struct Rgb {
 [[nodiscard]] std::vector<double> NiceTicks(double low, double high, int max_ticks);
 // The step NiceTicks uses for the same arguments.
 [[nodiscard]] double NiceStep(double low, double high, int max_ticks);
-// Tick label with as many decimals as `step` needs ("0.25" for step 0.05 -> "0.25").
+// Tick label with as many decimals as `step` needs ("0.25" for step 0.05 -> "0.25"), negative
+// values with the minus sign U+2212 ("−0.25").
 [[nodiscard]] std::string FormatTick(double value, double step);
 
 struct Axis {

@@ -90,6 +90,11 @@ TEST(FormatTick, UsesAsManyDecimalsAsTheStepNeeds) {
   EXPECT_EQ(FormatTick(-1e-17, 0.5), "0.0");
 }
 
+TEST(FormatTick, WritesNegativeValuesWithTheMinusSign) {
+  EXPECT_EQ(FormatTick(-0.25, 0.05), "−0.25");
+  EXPECT_EQ(FormatTick(-150.0, 50.0), "−150");
+}
+
 TEST(Viridis, MatchesThePublishedEndAndMiddleColours) {
   EXPECT_EQ(Packed(Viridis(0.0)), 0x440154u);
   EXPECT_EQ(Packed(Viridis(1.0)), 0xFDE725u);

@@ -105,6 +105,17 @@ TEST(ReportCommand, ReportsASimulatedAndProcessedScanWithTheSummaryNumbers) {
   }
   EXPECT_THAT(text, HasSubstr(summary["input"]["sha256"].get<std::string>()));
   EXPECT_THAT(text, HasSubstr("Overall: PASS"));
+  // The wheel model, which `process` fits by default, as summary.json has it.
+  const nlohmann::json& model = summary.at("model");
+  EXPECT_THAT(text, HasSubstr(fmt::format("{:.5f} ± {:.5f} mm", model["mean_arc_radius_mm"].get<double>(),
+                                          model["mean_arc_radius_sigma_mm"].get<double>())));
+  EXPECT_THAT(text, HasSubstr(fmt::format("{:.4f} ± {:.4f} mm", model["arc_radius_range_mm"].get<double>(),
+                                          model["arc_radius_range_sigma_mm"].get<double>())));
+  EXPECT_THAT(text, HasSubstr(fmt::format("{} (χ² = {:.1f} with {} dof",
+                                          model["radius_variation_significant"].get<bool>() ? "yes" : "no",
+                                          model["radius_variation_chi2"].get<double>(),
+                                          model["radius_variation_dof"].get<int>())));
+  EXPECT_THAT(text, HasSubstr(fmt::format("{:.2f} µm", model["profile_pv_um"].get<double>())));
   const std::string html = ReadText(dir / "out" / "report.html");
   EXPECT_THAT(html, HasSubstr(fmt::format("{:.2f} µm", summary["max_runout_um"].get<double>())));
 }

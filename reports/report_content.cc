@@ -201,7 +201,46 @@ ReportFigure RadiusPlot(const PhaseSeries& p) {
   return {"Arc radius of each axial section, with its 1-sigma band.", plot, 0.42};
 }
 
-ReportFigure CentrePlot(const PhaseSeries& p) {
+// A model function as a line with its 1-sigma band, each value drawn as (value - offset) * scale.
+plot::Series ModelSeries(const std::string& label, const std::vector<double>& x,
+                         const std::vector<double>& value, const std::vector<double>& sigma, double offset,
+                         double scale, plot::Rgb colour, bool dashed = false) {
+  plot::Series series{label, x, {}, {}, {}, colour, false, dashed};
+  for (std::size_t i = 0; i < x.size(); ++i) {
+    series.y.push_back((value[i] - offset) * scale);
+    series.band_low.push_back((value[i] - sigma[i] - offset) * scale);
+    series.band_high.push_back((value[i] + sigma[i] - offset) * scale);
+  }
+  return series;
+}
+
+double FiniteMedian(std::vector<double> values) {
+  std::erase_if(values, [](double v) { return !std::isfinite(v); });
+  if (values.empty()) return kNaN;
+  const auto middle = values.begin() + static_cast<std::ptrdiff_t>(values.size() / 2);
+  std::nth_element(values.begin(), middle, values.end());
+  return *middle;
+}
+
+// With the model, the per-phase radii become dots (their 1-sigma band would hide the model's) and
+// Ra(c) is drawn over them with its own band.
+ReportFigure RadiusPlotWithModel(const PhaseSeries& p, const ModelCurves& model) {
+  plot::Series per_phase{"per-phase fits",      p.phase_deg, UsableOnly(p.arc_radius_mm, p.usable), {}, {},
+                         plot::SeriesColour(0), true};
+  plot::LinePlot plot{"Arc radius vs phase: per-phase fits and the wheel model (shaded: ± 1σ)",
+                      kPhaseAxis,
+                      FreeAxis("arc radius Ra (mm)"),
+                      {per_phase, ModelSeries("model Ra(c)", p.phase_deg, model.arc_radius_mm,
+                                              model.arc_radius_sigma_mm, 0.0, 1.0, plot::SeriesColour(1))},
+                      {}};
+  const double median_sigma_um = FiniteMedian(UsableOnly(p.arc_radius_sigma_mm, p.usable)) * 1000.0;
+  return {fmt::format("Arc radius of each axial section (dots; median 1σ {} µm), and the wheel model's Ra(c) "
+                      "fitted to every sample, with its 1-sigma band.",
+                      FormatNumber(median_sigma_um, 2)),
+          plot, 0.42};
+}
+
+ReportFigure CentrePlot(const PhaseSeries& p, const ModelCurves* model) {
   auto deviation_um = [&p](const std::vector<double>& values) {
     std::vector<double> usable = UsableOnly(values, p.usable);
     const double mean = FiniteMean(usable);
@@ -210,15 +249,37 @@ ReportFigure CentrePlot(const PhaseSeries& p) {
   };
   const auto [axial, mean_axial] = deviation_um(p.center_axial_mm);
   const auto [radial, mean_radial] = deviation_um(p.center_radial_mm);
-  plot::LinePlot plot{"Arc centre vs phase (deviation from its mean)",
-                      kPhaseAxis,
-                      FreeAxis("centre deviation (µm)"),
-                      {{"axial a − mean", p.phase_deg, axial, {}, {}, plot::SeriesColour(0)},
-                       {"radial b − mean", p.phase_deg, radial, {}, {}, plot::SeriesColour(1), false, true}},
-                      {}};
-  return {fmt::format("Arc centre position by phase: axial a (mean {} mm) and radial b (mean {} mm).",
-                      FormatNumber(mean_axial, 4), FormatNumber(mean_radial, 4)),
-          plot, 0.42};
+  if (model == nullptr) {
+    plot::LinePlot plot{
+        "Arc centre vs phase (deviation from its mean)",
+        kPhaseAxis,
+        FreeAxis("centre deviation (µm)"),
+        {{"axial a − mean", p.phase_deg, axial, {}, {}, plot::SeriesColour(0)},
+         {"radial b − mean", p.phase_deg, radial, {}, {}, plot::SeriesColour(1), false, true}},
+        {}};
+    return {fmt::format("Arc centre position by phase: axial a (mean {} mm) and radial b (mean {} mm).",
+                        FormatNumber(mean_axial, 4), FormatNumber(mean_radial, 4)),
+            plot, 0.42};
+  }
+  // The model's a(c) and b(c) against the same means, so that they lie over the per-phase points.
+  const double axial_offset = std::isfinite(mean_axial) ? mean_axial : FiniteMean(model->center_axial_mm);
+  const double radial_offset = std::isfinite(mean_radial) ? mean_radial : FiniteMean(model->center_radial_mm);
+  plot::LinePlot plot{
+      "Arc centre vs phase (deviation from the per-phase mean; shaded: model ± 1σ)",
+      kPhaseAxis,
+      FreeAxis("centre deviation (µm)"),
+      {{"axial a, per phase", p.phase_deg, axial, {}, {}, plot::SeriesColour(0), true},
+       {"radial b, per phase", p.phase_deg, radial, {}, {}, plot::SeriesColour(1), true},
+       ModelSeries("model a(c)", p.phase_deg, model->center_axial_mm, model->center_axial_sigma_mm,
+                   axial_offset, 1000.0, plot::SeriesColour(0)),
+       ModelSeries("model b(c)", p.phase_deg, model->center_radial_mm, model->center_radial_sigma_mm,
+                   radial_offset, 1000.0, plot::SeriesColour(1), true)},
+      {}};
+  return {
+      fmt::format("Arc centre position by phase: axial a (per-phase mean {} mm) and radial b (per-phase mean "
+                  "{} mm); dots: per-phase fits, lines: the wheel model with its 1-sigma band.",
+                  FormatNumber(mean_axial, 4), FormatNumber(mean_radial, 4)),
+      plot, 0.42};
 }
 
 ReportFigure ArcErrorPlot(const PhaseSeries& p) {
@@ -322,6 +383,42 @@ std::vector<ReportFigure> SectionFigures(const ReportInputs& inputs) {
       {"Geometric residuals of the same two sections inside the band, in micrometres.", residuals, 0.42}};
 }
 
+ReportFigure ProfileErrorPlot(const ModelCurves& model) {
+  plot::LinePlot plot{"Profile error p(u) common to all phases (shaded: ± 1σ)",
+                      FreeAxis("distance from the arc centre u = y − a(c) (mm)"),
+                      FreeAxis("profile error p (µm)"),
+                      {ModelSeries("p(u)", model.profile_u_mm, model.profile_error_um,
+                                   model.profile_error_sigma_um, 0.0, 1.0, plot::SeriesColour(1))},
+                      {}};
+  return {
+      "The wheel model's profile error: the departure from an arc that every phase shares, held to zero "
+      "mean, slope and curvature over the band (those belong to b, a and Ra), with its 1-sigma band.",
+      plot, 0.42};
+}
+
+ReportFigure ModelResidualMap(const ReportInputs& inputs) {
+  plot::HeatMap map;
+  map.title = "Wheel model residual (measured minus model)";
+  map.x = FreeAxis("phase c (deg)");
+  // The model is fitted inside the band only; outside it every cell would be grey.
+  map.y = kAxialAxis;
+  if (inputs.summary.band_high_mm > inputs.summary.band_low_mm) {
+    map.y.min = inputs.summary.band_low_mm;
+    map.y.max = inputs.summary.band_high_mm;
+  }
+  map.n_x = inputs.map.n_phase();
+  map.n_y = inputs.map.n_y();
+  map.values = inputs.map.model->residual_um;
+  map.x_nodes = inputs.map.phase_deg;
+  map.y_nodes = inputs.map.y_mm;
+  map.colour_bar_label = "model residual (µm)";
+  return {
+      "Mean residual of the samples in each map cell against the wheel model, inside the band (colour "
+      "range: 0.5 to 99.5 percentile; grey: no sample). Grit texture and local damage stay here; a pattern "
+      "that repeats over phases is profile or radius variation the model does not describe.",
+      map, 0.5};
+}
+
 ReportFigure CoverageMap(const WheelMapData& map) {
   plot::CategoryMap coverage;
   coverage.title = "Coverage and despiking";
@@ -345,7 +442,83 @@ ReportFigure CoverageMap(const WheelMapData& map) {
       coverage, 0.5};
 }
 
+std::string WithSigma(double value, double sigma, int decimals, const char* unit) {
+  return FormatSigned(value, decimals) + " ± " + FormatNumber(sigma, decimals) + " " + unit;
+}
+
+// p-values below 0.001 as "p < 0.001": the test's decision needs no more digits.
+std::string PValueText(double p_value) {
+  if (std::isfinite(p_value) && p_value < 0.001) return "p < 0.001";
+  return "p = " + FormatNumber(p_value, 3);
+}
+
+std::string VariesText(const ModelSummary& m) {
+  return fmt::format("{} (χ² = {} with {} dof, {}; significance level {})",
+                     m.variation_significant ? "yes" : "no", FormatNumber(m.variation_chi2, 1),
+                     m.variation_dof, PValueText(m.variation_p_value),
+                     fmt::format("{}", m.significance_level));
+}
+
+std::string KnotsText(const ModelSummary& m) {
+  auto knots = [](int count) { return count == 1 ? std::string("1 (constant)") : fmt::format("{}", count); };
+  const std::string how = m.knots_chosen_by == "bic" ? "chosen by the Bayesian information criterion"
+                          : m.knots_chosen_by == "given"
+                              ? "as given (--model-knots, --model-axial-knots, --model-runout-knots)"
+                              : "chosen by " + m.knots_chosen_by;
+  return fmt::format("Ra(c) {}, a(c) {}, b(c) {} per turn; {}", knots(m.radius_knots), knots(m.axial_knots),
+                     knots(m.runout_knots), how);
+}
+
+std::string ResidualText(const ModelSummary& m) {
+  const double ratio = m.residual_rms_um / m.noise_sigma_um;
+  return fmt::format("{} µm against a noise estimate of {} µm (ratio {})", FormatNumber(m.residual_rms_um, 3),
+                     FormatNumber(m.noise_sigma_um, 3), FormatNumber(ratio, 2));
+}
+
+// One line on why a summary has no model, from what it records.
+std::string NoModelNote(const Summary& s) {
+  const auto setting = s.processing.find(key::processing::kModel);
+  if (setting != s.processing.end() && *setting == "off")
+    return "Wheel model: not fitted (processed with --no-model).";
+  if (s.schema_version.empty() || s.schema_version == "1.0")
+    return "Wheel model: not in this summary (schema " +
+           (s.schema_version.empty() ? "1.0" : s.schema_version) + ", written before the model).";
+  return "Wheel model: not in this summary (it could not be fitted; see Warnings).";
+}
+
+ModelReport ModelPart(const Summary& s) {
+  ModelReport part;
+  if (!s.model) {
+    part.note = NoModelNote(s);
+    return part;
+  }
+  const ModelSummary& m = *s.model;
+  part.shown = true;
+  part.rows = {
+      {"Mean arc radius (± 1σ)", WithSigma(m.mean_arc_radius_mm, m.mean_arc_radius_sigma_mm, 5, "mm")},
+      {"Arc radius range, max − min of Ra(c) (± 1σ)",
+       WithSigma(m.arc_radius_range_mm, m.arc_radius_range_sigma_mm, 4, "mm") +
+           (m.radius_knots == 1 ? " (Ra(c) fitted as a constant)" : "")},
+      {"Radius varies with phase", VariesText(m)},
+      {"Knots", KnotsText(m)},
+      {"Residual RMS", ResidualText(m)},
+      {"Profile error p(u), peak-to-valley", FormatNumber(m.profile_pv_um, 2) + " µm"},
+  };
+  for (const ModelHarmonic& h : m.radius_harmonics) {
+    part.harmonics.push_back({fmt::format("{}", h.order),
+                              WithSigma(h.amplitude_um, h.amplitude_sigma_um, 2, "µm"),
+                              WithSigma(h.phase_deg, h.phase_sigma_deg, 1, "deg")});
+  }
+  return part;
+}
+
 }  // namespace
+
+std::string FormatSigned(double value, int decimals) {
+  std::string text = FormatNumber(value, decimals);
+  if (!text.empty() && text.front() == '-') text.replace(0, 1, "−");
+  return text;
+}
 
 std::string FormatNumber(double value, int decimals) {
   if (!std::isfinite(value)) return "n/a";
@@ -395,8 +568,16 @@ ReportContent ComposeReport(const ReportInputs& inputs, const Tolerances& tolera
   content.provenance = Provenance(inputs);
   content.headline = HeadlineRows(s, tolerances);
   content.overall = Overall(content.headline);
-  content.figures = {FormErrorMap(inputs), RadiusPlot(s.phases), CentrePlot(s.phases), ArcErrorPlot(s.phases),
-                     RunoutPlot(s)};
+  content.model = ModelPart(s);
+  // ReadReportInputs guarantees the map's /model when the summary has one.
+  const ModelCurves* model = content.model.shown && inputs.map.model ? &*inputs.map.model : nullptr;
+  content.figures = {FormErrorMap(inputs)};
+  if (model != nullptr && !model->residual_um.empty()) content.figures.push_back(ModelResidualMap(inputs));
+  content.figures.push_back(model != nullptr ? RadiusPlotWithModel(s.phases, *model) : RadiusPlot(s.phases));
+  content.figures.push_back(CentrePlot(s.phases, model));
+  if (model != nullptr) content.figures.push_back(ProfileErrorPlot(*model));
+  content.figures.push_back(ArcErrorPlot(s.phases));
+  content.figures.push_back(RunoutPlot(s));
   for (ReportFigure& figure : SectionFigures(inputs)) content.figures.push_back(std::move(figure));
   content.figures.push_back(CoverageMap(inputs.map));
   if (!s.processing.empty()) Flatten(s.processing, "", content.processing);

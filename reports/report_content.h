@@ -33,11 +33,23 @@ struct ReportFigure {
   double height_over_width = 0.45;  // aspect ratio the renderers keep
 };
 
+// The wheel model's part of the report (docs/wheel_model.md): a table and the harmonics of Ra(c);
+// its curves are drawn into ReportContent::figures. Numbers at fixed precision: mm as the
+// headline table (5 decimals for the mean radius, 4 for the range), um with 2 (3 for the residual
+// RMS and the noise, as the provenance prints the noise), degrees with 1, chi-square with 1.
+struct ModelReport {
+  bool shown = false;
+  std::string note;            // when not shown: one line saying why
+  std::vector<KeyValue> rows;  // mean radius, range, "radius varies", knots, residual, profile PV
+  std::vector<std::vector<std::string>> harmonics;  // order, amplitude ± 1σ, phase ± 1σ
+};
+
 struct ReportContent {
   std::string title;                        // "Wheel inspection report: WHEEL-ID"
   std::vector<KeyValue> provenance;         // wheel, scan settings, input file and SHA-256, versions
   std::vector<HeadlineRow> headline;        // in kHeadlineKeys order
   Verdict overall = Verdict::kNoTolerance;  // kFail if any row fails, kPass if some pass and none fail
+  ModelReport model;
   std::vector<ReportFigure> figures;
   std::vector<KeyValue> processing;  // summary.json "processing", flattened to dotted keys
   std::vector<std::string> warnings;
@@ -55,6 +67,9 @@ struct ReportContent {
 
 // `value` with `decimals` decimals, or "n/a" when not finite.
 [[nodiscard]] std::string FormatNumber(double value, int decimals);
+
+// As FormatNumber, with "−" (U+2212) for a minus sign, as tables print it.
+[[nodiscard]] std::string FormatSigned(double value, int decimals);
 
 // Geometric residuals |p - centre| - Ra, in um, of the section at map phase row `phase_index`
 // against the circle (center_axial_mm, center_radial_mm, arc_radius_mm) of that phase, for the

@@ -47,6 +47,11 @@ double FixtureArcRadius_mm(double phase_deg) { return 75.0 + 0.003 * std::sin(2.
 double FixtureCenterAxial_mm(double phase_deg) { return 10.0 + 0.002 * std::cos(phase_deg * kDegToRad); }
 double FixtureCenterRadial_mm(double phase_deg) { return 25.0 + 0.001 * std::sin(phase_deg * kDegToRad); }
 
+double FixtureModelResidual_um(double phase_deg, double y_mm, bool has_samples) {
+  if (!has_samples || y_mm < 2.0 || y_mm > 18.0) return kNaN;
+  return 0.1 * std::sin(3.0 * phase_deg * kDegToRad) * std::cos(y_mm);
+}
+
 namespace {
 
 namespace parameter = schema::summary::processing;
@@ -144,6 +149,73 @@ fitting::WheelFit FixtureFit(const FixtureOptions& options, const processing::Wh
   return fit;
 }
 
+// The model's numbers; their printed forms are "75.00003 ± 0.00002 mm", "0.0060 ± 0.0003 mm",
+// "yes (χ² = 912.3 with 7 dof, p < 0.001; significance level 0.01)", "0.313 µm against a noise
+// estimate of 0.310 µm (ratio 1.01)", "0.84 µm", and the harmonics (order, amplitude, phase)
+// "1", "0.04 ± 0.11 µm", "12.5 ± 160.0 deg"; "2", "3.00 ± 0.12 µm", "−90.0 ± 2.3 deg".
+fitting::WheelModel FixtureModel(const processing::WheelMap& map) {
+  fitting::WheelModel model;
+  model.fitted = true;
+  model.radius_knots = 8;
+  model.axial_knots = 4;
+  model.runout_knots = 16;
+  model.profile_coefficients = 30;
+  model.knots_chosen = true;
+  model.band_low_mm = 2.0;
+  model.band_high_mm = 18.0;
+  model.center_axial_reference_mm = 10.0;
+  model.samples = 1280000;
+  model.parameters = 55;
+  model.iterations = 4;
+  model.residual_rms_um = 0.3127;
+  model.noise_sigma_um = 0.31;
+  model.mean_arc_radius_mm = 75.00003;
+  model.mean_arc_radius_sigma_mm = 0.00002;
+  model.arc_radius_range_mm = 0.0060;
+  model.arc_radius_range_sigma_mm = 0.0003;
+  model.variation_chi2 = 912.345;
+  model.variation_dof = 7;
+  model.variation_p_value = 1e-12;
+  model.significance_level = 0.01;
+  model.variation_significant = true;
+  model.radius_harmonics = {{.order = 1,
+                             .amplitude_um = 0.04,
+                             .amplitude_sigma_um = 0.11,
+                             .phase_deg = 12.5,
+                             .phase_sigma_deg = 160.0},
+                            {.order = 2,
+                             .amplitude_um = 3.0,
+                             .amplitude_sigma_um = 0.12,
+                             .phase_deg = -90.0,
+                             .phase_sigma_deg = 2.3}};
+  model.profile_pv_um = 0.84;
+  model.phase_deg = map.phase_deg;
+  for (const double c : map.phase_deg) {
+    model.arc_radius_mm.push_back(FixtureArcRadius_mm(c));
+    model.arc_radius_sigma_mm.push_back(0.0002);
+    model.center_axial_mm.push_back(FixtureCenterAxial_mm(c));
+    model.center_axial_sigma_mm.push_back(0.0001);
+    model.center_radial_mm.push_back(FixtureCenterRadial_mm(c));
+    model.center_radial_sigma_mm.push_back(0.00015);
+  }
+  for (int k = 0; k <= 160; ++k) {
+    const double u = -8.0 + 0.1 * k;
+    model.profile_u_mm.push_back(u);
+    model.profile_error_um.push_back(0.42 * std::cos(M_PI * u / 8.0));
+    model.profile_error_sigma_um.push_back(0.02);
+  }
+  for (std::size_t i = 0; i < map.n_phase(); ++i) {
+    for (std::size_t j = 0; j < map.n_y(); ++j) {
+      const bool has_samples = map.sample_count[i * map.n_y() + j] > 0;
+      model.residual_um.push_back(FixtureModelResidual_um(map.phase_deg[i], map.y_mm[j], has_samples));
+    }
+  }
+  // Coefficients and covariance as the writer stores them; the report does not read them.
+  model.coefficients.assign(3, 0.0);
+  model.covariance.assign(9, 0.0);
+  return model;
+}
+
 fitting::RunRecord FixtureRecord(const FixtureOptions& options) {
   fitting::RunRecord record;
   record.input_path = "/data/scans/wheel_W17.h5";
@@ -164,7 +236,8 @@ fitting::RunRecord FixtureRecord(const FixtureOptions& options) {
                                {std::string(parameter::kBandHalfWidthMm), 8.0},
                                {std::string(parameter::kDespikeWindowHalfWidth), 5.0},
                                {std::string(parameter::kDespikeThresholdUm), 5.0}};
-  record.text_parameters = {{std::string(parameter::kFitSpan), "band"}};
+  record.text_parameters = {{std::string(parameter::kFitSpan), "band"},
+                            {std::string(parameter::kModel), options.with_model ? "on" : "off"}};
   return record;
 }
 
@@ -172,8 +245,9 @@ fitting::RunRecord FixtureRecord(const FixtureOptions& options) {
 
 nlohmann::json FixtureSummary(const FixtureOptions& options) {
   const processing::ProcessedScan scan = FixtureScan(options);
-  return nlohmann::json::parse(
-      fitting::SummaryJson(FixtureRecord(options), scan, FixtureFit(options, scan.map)));
+  const fitting::WheelModel model = FixtureModel(scan.map);
+  return nlohmann::json::parse(fitting::SummaryJson(
+      FixtureRecord(options), scan, FixtureFit(options, scan.map), options.with_model ? &model : nullptr));
 }
 
 void WriteFixture(const std::filesystem::path& outdir, const FixtureOptions& options,
@@ -184,7 +258,9 @@ void WriteFixture(const std::filesystem::path& outdir, const FixtureOptions& opt
 
 void WriteFixture(const std::filesystem::path& outdir, const FixtureOptions& options) {
   const processing::ProcessedScan scan = FixtureScan(options);
-  fitting::WriteProcessOutputs(outdir, FixtureRecord(options), scan, FixtureFit(options, scan.map));
+  const fitting::WheelModel model = FixtureModel(scan.map);
+  fitting::WriteProcessOutputs(outdir, FixtureRecord(options), scan, FixtureFit(options, scan.map),
+                               options.with_model ? &model : nullptr);
 }
 
 }  // namespace arcwheel::reports::testing

@@ -12,6 +12,7 @@ using internal::HtmlPageEnd;
 using internal::HtmlPageStart;
 using internal::KeyValueTable;
 using internal::kFigureWidth_pt;
+using internal::Table;
 
 std::string VerdictClass(Verdict verdict) {
   return verdict == Verdict::kPass ? "pass" : verdict == Verdict::kFail ? "fail" : "none";
@@ -35,6 +36,14 @@ std::string HeadlineTable(const ReportContent& content) {
   return html + "</table></div>\n";
 }
 
+std::string ModelSection(const ModelReport& model) {
+  if (!model.shown) return "<p>" + Escape(model.note) + "</p>\n";
+  std::string html = KeyValueTable(model.rows);
+  html += "<h3>Radius harmonics of Ra(c)</h3>\n";
+  if (model.harmonics.empty()) return html + "<p>None: Ra(c) is modelled as a constant.</p>\n";
+  return html + Table({"Order", "Amplitude", "Phase"}, model.harmonics);
+}
+
 std::string Figures(const ReportContent& content) {
   std::string html;
   for (std::size_t i = 0; i < content.figures.size(); ++i) {
@@ -56,6 +65,7 @@ std::string RenderHtml(const ReportContent& content) {
   std::string html = HtmlPageStart(content.title);
   html += "<h2>Scan and provenance</h2>\n" + KeyValueTable(content.provenance);
   html += "<h2>Headline numbers</h2>\n" + HeadlineTable(content);
+  html += "<h2>Wheel model</h2>\n" + ModelSection(content.model);
   html += "<h2>Plots</h2>\n" + Figures(content);
   html += "<h2>Warnings</h2>\n" + Warnings(content.warnings);
   html += "<h2>Processing parameters</h2>\n";

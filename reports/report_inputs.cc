@@ -73,6 +73,21 @@ std::int64_t RequireCount(const json& object, const JsonWhere& parent, std::stri
   return value.get<std::int64_t>();
 }
 
+int RequireInt(const json& object, const JsonWhere& parent, std::string_view name) {
+  const json& value = RequireKey(object, parent, name);
+  if (!value.is_number_integer() || value.get<std::int64_t>() < 0 || value.get<std::int64_t>() > 1000000) {
+    BadSummary(parent.Child(name), "is not a non-negative integer (found " + value.dump() + ")");
+  }
+  return value.get<int>();
+}
+
+bool RequireBool(const json& object, const JsonWhere& parent, std::string_view name) {
+  const json& value = RequireKey(object, parent, name);
+  if (!value.is_boolean())
+    BadSummary(parent.Child(name), "is not true or false (found " + value.dump() + ")");
+  return value.get<bool>();
+}
+
 std::string RequireString(const json& object, const JsonWhere& parent, std::string_view name) {
   const json& value = RequireKey(object, parent, name);
   if (!value.is_string()) BadSummary(parent.Child(name), "is not a string (found " + value.dump() + ")");
@@ -149,6 +164,53 @@ AxialSeries ParseAxial(const json& root, const JsonWhere& top) {
   series.runout_um = RequireNumberArray(axial, where, key::axial::kRunoutUm, series.y_mm.size());
   series.roundness_um = RequireNumberArray(axial, where, key::axial::kRoundnessUm, series.y_mm.size());
   return series;
+}
+
+std::vector<ModelHarmonic> ParseHarmonics(const json& model, const JsonWhere& parent) {
+  namespace hk = key::model::harmonic;
+  const JsonWhere where = parent.Child(key::model::kRadiusHarmonics);
+  const json& list = RequireKey(model, parent, key::model::kRadiusHarmonics);
+  if (!list.is_array()) BadSummary(where, "is not an array");
+  std::vector<ModelHarmonic> harmonics;
+  for (std::size_t i = 0; i < list.size(); ++i) {
+    const JsonWhere item = where.Child(std::to_string(i));
+    if (!list[i].is_object()) BadSummary(item, "is not a JSON object");
+    harmonics.push_back({.order = RequireInt(list[i], item, hk::kOrder),
+                         .amplitude_um = RequireNumber(list[i], item, hk::kAmplitudeUm),
+                         .amplitude_sigma_um = RequireNumber(list[i], item, hk::kAmplitudeSigmaUm),
+                         .phase_deg = RequireNumber(list[i], item, hk::kPhaseDeg),
+                         .phase_sigma_deg = RequireNumber(list[i], item, hk::kPhaseSigmaDeg)});
+  }
+  return harmonics;
+}
+
+// "model" is optional (schema 1.0, --no-model, a model that could not be fitted); when present,
+// every key the report shows is required.
+std::optional<ModelSummary> ParseModel(const json& root, const JsonWhere& top) {
+  const auto it = root.find(key::kModel);
+  if (it == root.end() || it->is_null()) return std::nullopt;
+  namespace mk = key::model;
+  const JsonWhere where = top.Child(key::kModel);
+  const json& m = RequireObject(root, top, key::kModel);
+  ModelSummary model;
+  model.radius_knots = RequireInt(m, where, mk::kRadiusKnots);
+  model.axial_knots = RequireInt(m, where, mk::kAxialKnots);
+  model.runout_knots = RequireInt(m, where, mk::kRunoutKnots);
+  model.knots_chosen_by = RequireString(m, where, mk::kKnotsChosenBy);
+  model.residual_rms_um = RequireNumber(m, where, mk::kResidualRmsUm);
+  model.noise_sigma_um = RequireNumber(m, where, mk::kNoiseSigmaUm);
+  model.mean_arc_radius_mm = RequireNumber(m, where, mk::kMeanArcRadiusMm);
+  model.mean_arc_radius_sigma_mm = RequireNumber(m, where, mk::kMeanArcRadiusSigmaMm);
+  model.arc_radius_range_mm = RequireNumber(m, where, mk::kArcRadiusRangeMm);
+  model.arc_radius_range_sigma_mm = RequireNumber(m, where, mk::kArcRadiusRangeSigmaMm);
+  model.variation_chi2 = RequireNumber(m, where, mk::kVariationChi2);
+  model.variation_dof = RequireInt(m, where, mk::kVariationDof);
+  model.variation_p_value = RequireNumber(m, where, mk::kVariationPValue);
+  model.significance_level = RequireNumber(m, where, mk::kSignificanceLevel);
+  model.variation_significant = RequireBool(m, where, mk::kVariationSignificant);
+  model.profile_pv_um = RequireNumber(m, where, mk::kProfilePvUm);
+  model.radius_harmonics = ParseHarmonics(m, where);
+  return model;
 }
 
 void ParseBand(const json& root, const JsonWhere& top, Summary& summary) {
@@ -243,6 +305,27 @@ std::vector<double> ReadAxisDataset(const hdf5::File& file, std::string_view dat
   return nodes;
 }
 
+// /model's datasets, when the group is there; each of the shape the writer gives it.
+std::optional<ModelCurves> ReadModelCurves(const hdf5::File& file, std::size_t n_phase, std::size_t n_y) {
+  if (!file.HasObject(std::string(h5::kModelGroup))) return std::nullopt;
+  const std::vector<hsize_t> phases = {n_phase};
+  ModelCurves model;
+  model.arc_radius_mm = ReadDataset(file, h5::kModelArcRadiusMm, phases);
+  model.arc_radius_sigma_mm = ReadDataset(file, h5::kModelArcRadiusSigmaMm, phases);
+  model.center_axial_mm = ReadDataset(file, h5::kModelCenterAxialMm, phases);
+  model.center_axial_sigma_mm = ReadDataset(file, h5::kModelCenterAxialSigmaMm, phases);
+  model.center_radial_mm = ReadDataset(file, h5::kModelCenterRadialMm, phases);
+  model.center_radial_sigma_mm = ReadDataset(file, h5::kModelCenterRadialSigmaMm, phases);
+  model.profile_u_mm = ReadAxisDataset(file, h5::kModelProfileUMm);
+  const std::vector<hsize_t> profile = {model.profile_u_mm.size()};
+  model.profile_error_um = ReadDataset(file, h5::kModelProfileErrorUm, profile);
+  model.profile_error_sigma_um = ReadDataset(file, h5::kModelProfileErrorSigmaUm, profile);
+  // The writer leaves the residual map out when it could not make one of the map's shape.
+  if (file.HasObject(std::string(h5::kModelResidualUm)))
+    model.residual_um = ReadDataset(file, h5::kModelResidualUm, {n_phase, n_y});
+  return model;
+}
+
 }  // namespace
 
 Summary ParseSummary(const std::string& text, const std::string& name) {
@@ -253,6 +336,7 @@ Summary ParseSummary(const std::string& text, const std::string& name) {
   CheckSummaryVersion(root, top);
   Summary summary;
   summary.arcwheel_version = RequireString(root, top, key::kArcwheelVersion);
+  summary.schema_version = OptionalString(root, top, key::kSchemaVersion);
   summary.input = ParseInput(root, top);
   ParseHeadline(root, top, summary);
   ParseBand(root, top, summary);
@@ -264,6 +348,7 @@ Summary ParseSummary(const std::string& text, const std::string& name) {
     summary.scan = *it;
   }
   summary.warnings = ParseWarnings(root, top);
+  summary.model = ParseModel(root, top);
   return summary;
 }
 
@@ -293,6 +378,7 @@ WheelMapData ReadWheelMap(const std::filesystem::path& path) {
   map.form_error_um = ReadDataset(file, h5::kMapFormErrorUm, grid);
   map.sample_count = ReadDataset(file, h5::kMapSampleCount, grid);
   map.despiked_count = ReadDataset(file, h5::kMapDespikedCount, grid);
+  map.model = ReadModelCurves(file, map.n_phase(), map.n_y());
   map.arcwheel_version =
       file.ReadAttributeString(root, std::string(h5::kArcwheelVersionAttribute)).value_or("");
   map.input_sha256 = file.ReadAttributeString(root, std::string(h5::kInputSha256Attribute)).value_or("");
@@ -329,6 +415,13 @@ ReportInputs ReadReportInputs(const std::filesystem::path& outdir) {
                               inputs.summary_path.string(), key::kPhases, key::phases::kPhaseDeg, i,
                               summary.phases.phase_deg[i]));
     }
+  }
+  if (summary.model && !inputs.map.model) {
+    throw Error(
+        ErrorCode::kBadInput, kMapStage,
+        fmt::format("'{}' group '{}' is missing, but '{}' has key '{}': the two files come from "
+                    "different runs",
+                    inputs.map_path.string(), h5::kModelGroup, inputs.summary_path.string(), key::kModel));
   }
   return inputs;
 }

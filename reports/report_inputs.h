@@ -46,8 +46,41 @@ struct AxialSeries {
   std::vector<double> roundness_um;
 };
 
+// One radius harmonic of the wheel model: amplitude_um * cos(order * c + phase_deg), with 1-sigma.
+struct ModelHarmonic {
+  int order = 0;
+  double amplitude_um = 0.0;
+  double amplitude_sigma_um = 0.0;
+  double phase_deg = 0.0;
+  double phase_sigma_deg = 0.0;
+};
+
+// summary.json "model": the wheel model's numbers (docs/wheel_model.md). Optional in the file:
+// absent in schema 1.0 files, with --no-model, or when the model could not be fitted.
+struct ModelSummary {
+  int radius_knots = 0;         // knots per turn of Ra(c); 1 = constant
+  int axial_knots = 0;          // of a(c)
+  int runout_knots = 0;         // of b(c)
+  std::string knots_chosen_by;  // "bic" or "given"
+  double residual_rms_um = 0.0;
+  double noise_sigma_um = 0.0;
+  double mean_arc_radius_mm = 0.0;
+  double mean_arc_radius_sigma_mm = 0.0;
+  double arc_radius_range_mm = 0.0;
+  double arc_radius_range_sigma_mm = 0.0;
+  double variation_chi2 = 0.0;
+  int variation_dof = 0;
+  double variation_p_value = 0.0;
+  double significance_level = 0.0;
+  bool variation_significant = false;
+  double profile_pv_um = 0.0;
+  std::vector<ModelHarmonic> radius_harmonics;
+};
+
 struct Summary {
   std::string arcwheel_version;
+  // "schema_version" as recorded; "" in files written before versions were recorded.
+  std::string schema_version;
   InputProvenance input;
   double spindle_rpm_nominal = 0.0;
   double spindle_rpm_estimated = 0.0;
@@ -76,6 +109,19 @@ struct Summary {
   double noise_sigma_um = 0.0;
   double map_sigma_um = 0.0;
   std::string spindle_rpm_source;
+  // "model" when the file has one.
+  std::optional<ModelSummary> model;
+};
+
+// wheel_map.h5 "/model": the wheel model's functions. Ra(c), a(c), b(c) and their 1-sigma on the
+// map's phase nodes; p(u) on its own nodes; the residual map on the map's grid (empty when the
+// file has none).
+struct ModelCurves {
+  std::vector<double> arc_radius_mm, arc_radius_sigma_mm;
+  std::vector<double> center_axial_mm, center_axial_sigma_mm;
+  std::vector<double> center_radial_mm, center_radial_sigma_mm;
+  std::vector<double> profile_u_mm, profile_error_um, profile_error_sigma_um;
+  std::vector<double> residual_um;  // [n_phase, n_y], NaN where a cell holds no sample
 };
 
 // wheel_map.h5: the regular map rho(c, y) and its diagnostics. Grids are row-major
@@ -87,6 +133,7 @@ struct WheelMapData {
   std::vector<double> form_error_um;   // /map/form_error_um
   std::vector<double> sample_count;    // /map/sample_count
   std::vector<double> despiked_count;  // /map/despiked_count
+  std::optional<ModelCurves> model;    // /model, when the file has it
   // Root attributes, empty when absent.
   std::string arcwheel_version;
   std::string input_sha256;
@@ -113,7 +160,9 @@ struct ReportInputs {
 };
 
 // Reads OUTDIR/summary.json and OUTDIR/wheel_map.h5 and checks that they describe the same scan
-// (same input SHA-256 when the map records one, same number of phases). Throws as above.
+// (same input SHA-256 when the map records one, same number of phases) and that the map holds
+// /model when the summary holds "model" (a map's /model without one in the summary is ignored).
+// Throws as above.
 [[nodiscard]] ReportInputs ReadReportInputs(const std::filesystem::path& outdir);
 
 }  // namespace arcwheel::reports

@@ -57,6 +57,56 @@ TEST(ReadReportInputs, ReadsBackTheFixtureValues) {
   EXPECT_EQ(map.input_sha256, s.input.sha256);
 }
 
+TEST(ReadReportInputs, ReadsBackTheFixtureModel) {
+  TempDir dir;
+  WriteFixture(dir.path(), {.n_phase = 36, .n_y = 41});
+  const ReportInputs inputs = ReadReportInputs(dir.path());
+  ASSERT_TRUE(inputs.summary.model.has_value());
+  const ModelSummary& m = *inputs.summary.model;
+  // The values FixtureModel (report_fixture.cc) gives the writer.
+  EXPECT_EQ(m.radius_knots, 8);
+  EXPECT_EQ(m.axial_knots, 4);
+  EXPECT_EQ(m.runout_knots, 16);
+  EXPECT_EQ(m.knots_chosen_by, "bic");
+  EXPECT_DOUBLE_EQ(m.mean_arc_radius_mm, 75.00003);
+  EXPECT_DOUBLE_EQ(m.arc_radius_range_sigma_mm, 0.0003);
+  EXPECT_DOUBLE_EQ(m.variation_chi2, 912.345);
+  EXPECT_EQ(m.variation_dof, 7);
+  EXPECT_TRUE(m.variation_significant);
+  EXPECT_DOUBLE_EQ(m.residual_rms_um, 0.3127);
+  ASSERT_EQ(m.radius_harmonics.size(), 2u);
+  EXPECT_EQ(m.radius_harmonics[1].order, 2);
+  EXPECT_DOUBLE_EQ(m.radius_harmonics[1].phase_deg, -90.0);
+  EXPECT_EQ(inputs.summary.schema_version, "1.1");
+
+  ASSERT_TRUE(inputs.map.model.has_value());
+  const ModelCurves& curves = *inputs.map.model;
+  ASSERT_EQ(curves.arc_radius_mm.size(), 36u);
+  EXPECT_DOUBLE_EQ(curves.arc_radius_mm[4], testing::FixtureArcRadius_mm(40.0));
+  EXPECT_DOUBLE_EQ(curves.center_radial_sigma_mm[4], 0.00015);
+  ASSERT_EQ(curves.profile_u_mm.size(), 161u);
+  EXPECT_NEAR(curves.profile_error_um[80], 0.42, 1e-12) << "p(0)";
+  ASSERT_EQ(curves.residual_um.size(), 36u * 41u);
+  EXPECT_NEAR(curves.residual_um[5 * 41 + 20], testing::FixtureModelResidual_um(50.0, 10.0, true), 1e-12);
+}
+
+TEST(ReadReportInputs, ReadsFilesWithoutAModel) {
+  TempDir dir;
+  WriteFixture(dir.path(), {.n_phase = 12, .n_y = 21, .with_model = false});
+  const ReportInputs inputs = ReadReportInputs(dir.path());
+  EXPECT_FALSE(inputs.summary.model.has_value());
+  EXPECT_FALSE(inputs.map.model.has_value());
+}
+
+TEST(ReadReportInputs, RefusesASummaryWithAModelBesideAMapWithout) {
+  TempDir dir;
+  WriteFixture(dir.path(), {.n_phase = 12, .n_y = 21, .with_model = false},
+               FixtureSummary({.n_phase = 12, .n_y = 21}));
+  const std::string message = ErrorMessageOf([&] { (void)ReadReportInputs(dir.path()); });
+  EXPECT_THAT(message, HasSubstr("wheel_map.h5' group '/model' is missing, but '"));
+  EXPECT_THAT(message, HasSubstr("summary.json' has key 'model'"));
+}
+
 TEST(ReadSummary, ReadsNullAsNaN) {
   nlohmann::json summary = FixtureSummary({});
   summary["max_roundness_um"] = nullptr;
@@ -154,6 +204,16 @@ INSTANTIATE_TEST_SUITE_P(
                           "key 'input.samples' is not a non-negative integer"},
         BrokenSummaryCase{"BadUsable", [](nlohmann::json& s) { s["phases"]["usable"][1] = 1; },
                           "key 'phases.usable.1' is not a boolean"},
+        BrokenSummaryCase{"MissingModelKey", [](nlohmann::json& s) { s["model"].erase("residual_rms_um"); },
+                          "key 'model.residual_rms_um' is missing"},
+        BrokenSummaryCase{"TextInHarmonic",
+                          [](nlohmann::json& s) { s["model"]["radius_harmonics"][1]["phase_deg"] = "x"; },
+                          "key 'model.radius_harmonics.1.phase_deg' is not a number"},
+        BrokenSummaryCase{"NumberForVerdict",
+                          [](nlohmann::json& s) { s["model"]["radius_variation_significant"] = 1; },
+                          "key 'model.radius_variation_significant' is not true or false (found 1)"},
+        BrokenSummaryCase{"FractionalKnots", [](nlohmann::json& s) { s["model"]["radius_knots"] = 8.5; },
+                          "key 'model.radius_knots' is not a non-negative integer (found 8.5)"},
         BrokenSummaryCase{"NotAnObject", [](nlohmann::json& s) { s = nlohmann::json::array(); },
                           "'out/summary.json' is not a JSON object"}),
     [](const ::testing::TestParamInfo<BrokenSummaryCase>& param_info) {
@@ -181,8 +241,10 @@ TEST(ReadWheelMap, RefusesAFileThatIsNotHdf5) {
 
 // Writes a 3 x 2 map; `rho_shape` may differ from it, and form_error_um may be left out. Without
 // `schema_version`, the map is one written before versions were recorded.
+// With `model_radius_shape`, the map also has /model/arc_radius_mm of that shape (and nothing else
+// in /model).
 void WriteMapWith(const std::filesystem::path& path, bool with_form_error, std::vector<hsize_t> rho_shape,
-                  const std::string& schema_version = "") {
+                  const std::string& schema_version = "", std::vector<hsize_t> model_radius_shape = {}) {
   hdf5::File file = hdf5::File::Create(path);
   if (!schema_version.empty()) file.WriteAttribute("/", "schema_version", schema_version);
   file.CreateGroup("/map");
@@ -193,6 +255,10 @@ void WriteMapWith(const std::filesystem::path& path, bool with_form_error, std::
   if (with_form_error) file.WriteDoubles("/map/form_error_um", std::vector<double>(6, 0.0), {3, 2});
   file.WriteInts("/map/sample_count", std::vector<int>(6, 1), {3, 2});
   file.WriteInts("/map/despiked_count", std::vector<int>(6, 0), {3, 2});
+  if (model_radius_shape.empty()) return;
+  file.CreateGroup("/model");
+  file.WriteDoubles("/model/arc_radius_mm", std::vector<double>(model_radius_shape[0], 75.0),
+                    model_radius_shape);
 }
 
 TEST(ReadWheelMap, RefusesAMissingDatasetNamingIt) {
@@ -207,6 +273,18 @@ TEST(ReadWheelMap, RefusesAGridOfTheWrongShape) {
   WriteMapWith(dir / "wheel_map.h5", true, {2, 3});
   const std::string message = WheelMapRefusal(dir);
   EXPECT_THAT(message, HasSubstr("dataset '/map/rho' has shape [2, 3], expected [3, 2]"));
+}
+
+TEST(ReadWheelMap, RefusesAModelCurveOfTheWrongShape) {
+  TempDir dir;
+  WriteMapWith(dir / "wheel_map.h5", true, {3, 2}, "1.1", {2});
+  EXPECT_THAT(WheelMapRefusal(dir), HasSubstr("dataset '/model/arc_radius_mm' has shape [2], expected [3]"));
+}
+
+TEST(ReadWheelMap, RefusesAModelGroupMissingACurve) {
+  TempDir dir;
+  WriteMapWith(dir / "wheel_map.h5", true, {3, 2}, "1.1", {3});
+  EXPECT_THAT(WheelMapRefusal(dir), HasSubstr("dataset '/model/arc_radius_sigma_mm' is missing"));
 }
 
 TEST(ReadWheelMap, ReadsAMapWrittenBeforeSchemaVersionsAndOneOfTheSameMajor) {

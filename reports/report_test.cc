@@ -12,6 +12,8 @@
 #include <regex>
 #include <set>
 #include <sstream>
+#include <stdexcept>
+#include <variant>
 
 #include "core/error.h"
 #include "core/testing/testing.h"
@@ -84,6 +86,192 @@ TEST(ComposeReport, ListsTheProcessingParametersByTheirKeys) {
   EXPECT_EQ(rows["band_half_width_mm"], "8.0");
   EXPECT_EQ(rows["fit_span"], "band");
   EXPECT_EQ(rows["axial_step_mm"], "0.1");
+}
+
+// ---- The wheel model (reports/report_fixture.h gives its known values). ----
+
+// The fixture model's numbers as the report must print them (report_fixture.cc, FixtureModel).
+const std::vector<std::string> kFixtureModelText = {
+    "75.00003 ± 0.00002 mm",
+    "0.0060 ± 0.0003 mm",
+    "yes (χ² = 912.3 with 7 dof, p < 0.001; significance level 0.01)",
+    "0.313 µm against a noise estimate of 0.310 µm (ratio 1.01)",
+    "0.84 µm",
+    "0.04 ± 0.11 µm",
+    "12.5 ± 160.0 deg",
+    "3.00 ± 0.12 µm",
+    "−90.0 ± 2.3 deg"};
+
+const plot::LinePlot& LinePlotTitled(const ReportContent& content, const std::string& title_start) {
+  for (const ReportFigure& figure : content.figures) {
+    const auto* plot = std::get_if<plot::LinePlot>(&figure.figure);
+    if (plot != nullptr && plot->title.rfind(title_start, 0) == 0) return *plot;
+  }
+  throw std::runtime_error("no line plot titled '" + title_start + "...'");
+}
+
+const plot::Series& SeriesLabelled(const plot::LinePlot& plot, const std::string& label) {
+  for (const plot::Series& series : plot.series) {
+    if (series.label == label) return series;
+  }
+  throw std::runtime_error("no series '" + label + "' in '" + plot.title + "'");
+}
+
+TEST(ComposeReport, ShowsTheWheelModelsNumbersRounded) {
+  TempDir dir;
+  WriteFixture(dir.path());
+  const ModelReport model = ComposeReport(ReadReportInputs(dir.path()), {}).model;
+  ASSERT_TRUE(model.shown);
+  std::vector<std::string> values;
+  for (const KeyValue& row : model.rows) values.push_back(row.value);
+  EXPECT_THAT(values, ::testing::ElementsAre(
+                          kFixtureModelText[0], kFixtureModelText[1], kFixtureModelText[2],
+                          "Ra(c) 8, a(c) 4, b(c) 16 per turn; chosen by the Bayesian information criterion",
+                          kFixtureModelText[3], kFixtureModelText[4]));
+  using Row = std::vector<std::string>;
+  EXPECT_THAT(model.harmonics, ::testing::ElementsAre(Row{"1", kFixtureModelText[5], kFixtureModelText[6]},
+                                                      Row{"2", kFixtureModelText[7], kFixtureModelText[8]}));
+}
+
+TEST(ComposeReport, SaysWhenTheModelsRadiusIsAConstant) {
+  TempDir dir;
+  WriteFixture(dir.path(), {.n_phase = 12, .n_y = 21});
+  ReportInputs inputs = ReadReportInputs(dir.path());
+  // As the writer records a radius the information criterion found constant.
+  inputs.summary.model->radius_knots = 1;
+  inputs.summary.model->arc_radius_range_mm = 0.0;
+  inputs.summary.model->arc_radius_range_sigma_mm = 0.0;
+  inputs.summary.model->radius_harmonics.clear();
+  const ReportContent content = ComposeReport(inputs, {});
+  EXPECT_EQ(content.model.rows[1].value, "0.0000 ± 0.0000 mm (Ra(c) fitted as a constant)");
+  EXPECT_THAT(content.model.rows[3].value, HasSubstr("Ra(c) 1 (constant), a(c) 4"));
+  EXPECT_TRUE(content.model.harmonics.empty());
+  EXPECT_THAT(RenderHtml(content), HasSubstr("None: Ra(c) is modelled as a constant."));
+}
+
+TEST(ComposeReport, DrawsTheModelRadiusWithItsBandOverThePerPhaseRadii) {
+  TempDir dir;
+  WriteFixture(dir.path(), {.n_phase = 36, .n_y = 41});
+  const ReportContent content = ComposeReport(ReadReportInputs(dir.path()), {});
+  const plot::LinePlot& radius = LinePlotTitled(content, "Arc radius vs phase");
+  const plot::Series& per_phase = SeriesLabelled(radius, "per-phase fits");
+  const plot::Series& model = SeriesLabelled(radius, "model Ra(c)");
+  EXPECT_TRUE(per_phase.markers) << "points under the model's line";
+  ASSERT_EQ(model.x.size(), 36u);
+  for (std::size_t i = 0; i < model.x.size(); ++i) {
+    const double ra = testing::FixtureArcRadius_mm(10.0 * static_cast<double>(i));
+    EXPECT_DOUBLE_EQ(model.x[i], 10.0 * static_cast<double>(i));
+    EXPECT_NEAR(model.y[i], ra, 1e-12);
+    EXPECT_NEAR(model.band_low[i], ra - 0.0002, 1e-12);
+    EXPECT_NEAR(model.band_high[i], ra + 0.0002, 1e-12);
+  }
+}
+
+TEST(ComposeReport, DrawsTheModelCentreAgainstThePerPhaseMeanInMicrometres) {
+  TempDir dir;
+  WriteFixture(dir.path(), {.n_phase = 36, .n_y = 41});
+  const ReportContent content = ComposeReport(ReadReportInputs(dir.path()), {});
+  const plot::LinePlot& centre = LinePlotTitled(content, "Arc centre vs phase");
+  const plot::Series& axial = SeriesLabelled(centre, "model a(c)");
+  const plot::Series& radial = SeriesLabelled(centre, "model b(c)");
+  // a = 10 + 0.002 cos c mm and b = 25 + 0.001 sin c mm: over whole turns the per-phase means are 10
+  // and 25 mm, so the deviations are 2 cos c and sin c um, with bands of 0.1 and 0.15 um.
+  for (std::size_t i = 0; i < axial.x.size(); ++i) {
+    const double c = 10.0 * static_cast<double>(i) * M_PI / 180.0;
+    EXPECT_NEAR(axial.y[i], 2.0 * std::cos(c), 1e-9);
+    EXPECT_NEAR(axial.band_high[i] - axial.y[i], 0.1, 1e-9);
+    EXPECT_NEAR(radial.y[i], std::sin(c), 1e-9);
+    EXPECT_NEAR(radial.y[i] - radial.band_low[i], 0.15, 1e-9);
+  }
+}
+
+TEST(ComposeReport, DrawsTheProfileErrorAndTheResidualMapOfTheModel) {
+  TempDir dir;
+  WriteFixture(dir.path(), {.n_phase = 36, .n_y = 41});
+  const ReportContent content = ComposeReport(ReadReportInputs(dir.path()), {});
+  const plot::Series& profile = SeriesLabelled(LinePlotTitled(content, "Profile error p(u)"), "p(u)");
+  ASSERT_EQ(profile.x.size(), 161u);
+  for (std::size_t k = 0; k < profile.x.size(); ++k) {
+    EXPECT_NEAR(profile.y[k], 0.42 * std::cos(M_PI * profile.x[k] / 8.0), 1e-12);
+    EXPECT_NEAR(profile.band_high[k] - profile.band_low[k], 0.04, 1e-12);
+  }
+  const plot::HeatMap* residual = nullptr;
+  for (const ReportFigure& figure : content.figures) {
+    const auto* map = std::get_if<plot::HeatMap>(&figure.figure);
+    if (map != nullptr && map->colour_bar_label == "model residual (µm)") residual = map;
+  }
+  ASSERT_NE(residual, nullptr);
+  EXPECT_EQ(residual->y.min, 2.0) << "the band, where the model has residuals";
+  EXPECT_EQ(residual->y.max, 18.0);
+  ASSERT_EQ(residual->values.size(), 36u * 41u);
+  for (std::size_t i = 0; i < 36; ++i) {
+    for (std::size_t j = 0; j < 41; ++j) {
+      const double expected =
+          testing::FixtureModelResidual_um(10.0 * static_cast<double>(i), 0.5 * static_cast<double>(j), true);
+      const double value = residual->values[i * 41 + j];
+      if (std::isnan(expected)) {
+        EXPECT_TRUE(std::isnan(value)) << i << ", " << j;
+      } else {
+        EXPECT_NEAR(value, expected, 1e-12) << i << ", " << j;
+      }
+    }
+  }
+}
+
+TEST(ComposeReport, SaysInOneLineWhyASummaryHasNoModel) {
+  TempDir dir;
+  WriteFixture(dir.path(), {.n_phase = 12, .n_y = 21, .with_model = false});
+  ReportInputs inputs = ReadReportInputs(dir.path());
+  const ReportContent off = ComposeReport(inputs, {});
+  EXPECT_FALSE(off.model.shown);
+  EXPECT_EQ(off.model.note, "Wheel model: not fitted (processed with --no-model).");
+  for (const ReportFigure& figure : off.figures) {
+    EXPECT_THAT(figure.caption, Not(HasSubstr("model"))) << "no model figure without a model";
+  }
+  inputs.summary.processing.erase("model");
+  inputs.summary.schema_version = "1.0";
+  EXPECT_EQ(ComposeReport(inputs, {}).model.note,
+            "Wheel model: not in this summary (schema 1.0, written before the model).");
+  inputs.summary.processing["model"] = "on";
+  inputs.summary.schema_version = "1.1";
+  EXPECT_EQ(ComposeReport(inputs, {}).model.note,
+            "Wheel model: not in this summary (it could not be fitted; see Warnings).");
+}
+
+TEST(WriteReports, PdfAndHtmlCarryTheWheelModelsNumbers) {
+  TempDir dir;
+  WriteFixture(dir.path());
+  const WrittenReports written = WriteReports(dir.path(), {});
+  ASSERT_EQ(
+      Shell("pdftotext -enc UTF-8 '" + written.pdf.string() + "' '" + (dir / "report.txt").string() + "'"),
+      0);
+  const std::string text = ReadText(dir / "report.txt");
+  const std::string html = ReadText(written.html);
+  for (const std::string& number : kFixtureModelText) {
+    EXPECT_THAT(text, HasSubstr(number));
+    EXPECT_THAT(html, HasSubstr(std::regex_replace(number, std::regex("<"), "&lt;")));
+  }
+  // A long cell wraps in the PDF; its parts come through.
+  EXPECT_THAT(text, HasSubstr("Ra(c) 8, a(c) 4, b(c) 16 per turn"));
+  EXPECT_THAT(text, HasSubstr("Bayesian information criterion"));
+  EXPECT_THAT(text, HasSubstr("model residual (µm)"));
+  EXPECT_THAT(text, HasSubstr("profile error p (µm)"));
+  EXPECT_THAT(text, HasSubstr("model Ra(c)"));
+  EXPECT_THAT(text, HasSubstr("−2")) << "a negative tick of the centre plot, with the minus sign";
+}
+
+TEST(WriteReports, ReportsASummaryWithoutModelAndSaysSo) {
+  TempDir dir;
+  WriteFixture(dir.path(), {.with_model = false});
+  const WrittenReports written = WriteReports(dir.path(), FixtureTolerances());
+  ASSERT_EQ(
+      Shell("pdftotext -enc UTF-8 '" + written.pdf.string() + "' '" + (dir / "report.txt").string() + "'"),
+      0);
+  const std::string text = ReadText(dir / "report.txt");
+  EXPECT_THAT(text, HasSubstr("Wheel model: not fitted (processed with --no-model)."));
+  EXPECT_THAT(text, Not(HasSubstr("model Ra(c)")));
+  for (const std::string& number : kFixtureHeadline) EXPECT_THAT(text, HasSubstr(number));
+  EXPECT_THAT(ReadText(written.html), HasSubstr("Wheel model: not fitted (processed with --no-model)."));
 }
 
 TEST(SectionResiduals, AreZeroForPointsOnTheCircle) {

@@ -163,6 +163,49 @@ double PhaseInTurn(double unwrapped_deg) {
   return c < 0.0 ? c + 360.0 : c;
 }
 
+// Neighbouring samples touch the same 16 coefficients (the phase crosses a knot every dozen
+// samples or so, u a profile knot every few turns): their Jacobian rows are summed into a small
+// fixed-size block, which is added into the normal equations only when the coefficients change.
+class BlockAccumulator {
+ public:
+  explicit BlockAccumulator(NormalEquations& into) : into_(into) {}
+  ~BlockAccumulator() { Flush(); }
+  BlockAccumulator(const BlockAccumulator&) = delete;
+  BlockAccumulator& operator=(const BlockAccumulator&) = delete;
+
+  void Add(const int column[16], const double value[16], double residual) {
+    if (!std::equal(column, column + 16, columns_)) {
+      Flush();
+      std::copy(column, column + 16, columns_);
+    }
+    const Eigen::Map<const Row> row(value);
+    block_.selfadjointView<Eigen::Lower>().rankUpdate(row);
+    rhs_.noalias() += residual * row;
+    pending_ = true;
+  }
+
+  void Flush() {
+    if (!pending_) return;
+    const Block full = block_.selfadjointView<Eigen::Lower>();
+    for (int r = 0; r < 16; ++r) {
+      into_.jtr[columns_[r]] += rhs_[r];
+      for (int c = 0; c < 16; ++c) into_.jtj(columns_[r], columns_[c]) += full(r, c);
+    }
+    block_.setZero();
+    rhs_.setZero();
+    pending_ = false;
+  }
+
+ private:
+  using Block = Eigen::Matrix<double, 16, 16>;
+  using Row = Eigen::Matrix<double, 16, 1>;
+  NormalEquations& into_;
+  int columns_[16] = {-1};
+  Block block_ = Block::Zero();
+  Row rhs_ = Row::Zero();
+  bool pending_ = false;
+};
+
 // One pass over the band's samples on every core.
 NormalEquations Accumulate(const Samples& samples, const Layout& layout, const VectorXd& theta) {
   const int n = layout.size();
@@ -175,6 +218,7 @@ NormalEquations Accumulate(const Samples& samples, const Layout& layout, const V
     part.jtr = VectorXd::Zero(n);
     const std::size_t begin = total * static_cast<std::size_t>(worker) / static_cast<std::size_t>(workers);
     const std::size_t end = total * static_cast<std::size_t>(worker + 1) / static_cast<std::size_t>(workers);
+    BlockAccumulator block(part);
     int column[16];
     double value[16];
     double residual = 0;
@@ -187,10 +231,7 @@ NormalEquations Accumulate(const Samples& samples, const Layout& layout, const V
                     residual)) {
         continue;
       }
-      for (int r = 0; r < 16; ++r) {
-        part.jtr[column[r]] += value[r] * residual;
-        for (int c = 0; c < 16; ++c) part.jtj(column[r], column[c]) += value[r] * value[c];
-      }
+      block.Add(column, value, residual);
       part.rss += residual * residual;
       ++part.samples;
     }

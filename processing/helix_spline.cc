@@ -67,9 +67,9 @@ HelixSpline::HelixSpline(std::span<const double> z, const HelixGeometry& geometr
   BandedSpd upper_normal(n);
   std::vector<double> upper_rhs(n, 0.0);
   std::vector<int> upper_counts(cells, 0);
-  RunOnWorkers(2, [&, end = last](int half) {
+  RunOnWorkers(2, [&, begin = first, end = last](int half) {
     if (half == 0) {
-      Accumulate(z, geometry, first, middle, normal_, rhs, cell_counts_);
+      Accumulate(z, geometry, begin, middle, normal_, rhs, cell_counts_);
     } else {
       Accumulate(z, geometry, middle, end, upper_normal, upper_rhs, upper_counts);
     }

@@ -12,29 +12,31 @@ namespace {
 
 constexpr const char* kStage = "polishing.precession";
 
-void CheckOptions(const PrecessionOptions& o) {
-  auto bad = [](const char* name, double value, const char* rule) {
-    throw Error(ErrorCode::kInvalidOption, kStage,
-                fmt::format("PrecessionOptions::{} = {} violates {}", name, value, rule));
-  };
-  if (!(o.tilt_deg >= 0.0 && o.tilt_deg < 90.0)) bad("tilt_deg", o.tilt_deg, "[0, 90)");
-  if (!std::isfinite(o.precession_rate_rpm)) bad("precession_rate_rpm", o.precession_rate_rpm, "finite");
-  if (!(o.feed_mm_per_s > 0.0)) bad("feed_mm_per_s", o.feed_mm_per_s, "> 0");
-  if (!(o.bonnet_radius_mm >= 0.0)) bad("bonnet_radius_mm", o.bonnet_radius_mm, ">= 0");
-  if (!(o.arm_length_mm >= 0.0)) bad("arm_length_mm", o.arm_length_mm, ">= 0");
-  if (!(o.time_step_s > 0.0)) bad("time_step_s", o.time_step_s, "> 0");
-}
-
 Eigen::Vector3d UpwardNormal(const surfaces::SurfacePoint& p) {
   return Eigen::Vector3d(-p.fx, -p.fy, 1.0).normalized();
 }
 
 }  // namespace
 
+std::vector<std::string> PrecessionOptions::Problems() const {
+  std::vector<std::string> problems;
+  const auto check = [&](const char* name, double value, bool ok, const char* rule) {
+    if (!ok) problems.push_back(fmt::format("PrecessionOptions::{} = {} violates {}", name, value, rule));
+  };
+  check("tilt_deg", tilt_deg, tilt_deg >= 0.0 && tilt_deg < 90.0, "[0, 90)");
+  check("precession_rate_rpm", precession_rate_rpm, std::isfinite(precession_rate_rpm), "finite");
+  check("feed_mm_per_s", feed_mm_per_s, feed_mm_per_s > 0.0 && std::isfinite(feed_mm_per_s), "> 0");
+  check("bonnet_radius_mm", bonnet_radius_mm, bonnet_radius_mm >= 0.0 && std::isfinite(bonnet_radius_mm),
+        ">= 0");
+  check("arm_length_mm", arm_length_mm, arm_length_mm >= 0.0 && std::isfinite(arm_length_mm), ">= 0");
+  check("time_step_s", time_step_s, time_step_s > 0.0 && std::isfinite(time_step_s), "> 0");
+  return problems;
+}
+
 std::vector<PrecessionSample> PrecessionTrajectory(const surfaces::Surface& surface,
                                                    std::span<const Eigen::Vector2d> path_xy_mm,
                                                    const PrecessionOptions& options) {
-  CheckOptions(options);
+  ThrowIfProblems(ErrorCode::kInvalidOption, kStage, options.Problems());
   // Cumulative length of the polyline in the part's (x, y) plane lifted onto the surface.
   std::vector<double> length_mm{0.0};
   for (std::size_t i = 0; i < path_xy_mm.size(); ++i) {

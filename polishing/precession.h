@@ -14,6 +14,7 @@
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 #include <span>
+#include <string>
 #include <vector>
 
 #include "surfaces/surface.h"
@@ -27,6 +28,7 @@ struct PrecessionOptions {
   double bonnet_radius_mm = 0.0;     // the bonnet centre sits this far above the contact, >= 0
   double arm_length_mm = 127.0;      // the traced point lies this far up the axis from the centre
   double time_step_s = 0.05;         // sampling interval of the trajectory, > 0
+  [[nodiscard]] std::vector<std::string> Problems() const;
 };
 
 struct PrecessionSample {

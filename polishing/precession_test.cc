@@ -13,6 +13,7 @@
 namespace arcwheel::polishing {
 namespace {
 
+using arcwheel::testing::ErrorMessageOf;
 using arcwheel::testing::ErrorOf;
 using ::testing::HasSubstr;
 
@@ -74,6 +75,17 @@ TEST(PrecessionTrajectory, RefusesATiltOf90DegreesAndAPathOffTheSurface) {
   EXPECT_THROW((void)PrecessionTrajectory(sphere, path, {.tilt_deg = 90.0}), Error);
   EXPECT_THAT(ErrorOf([&] { (void)PrecessionTrajectory(sphere, path, {}); }).what(),
               HasSubstr("path point 1 (60, 0) mm is off the surface"));
+}
+
+TEST(PrecessionOptions, EveryProblemIsReportedInOneErrorWithItsValue) {
+  const surfaces::EvenAsphere sphere({.vertex_radius_mm = 50.0});
+  const std::vector<Eigen::Vector2d> path = {{0.0, 0.0}, {1.0, 0.0}};
+  EXPECT_EQ(ErrorMessageOf(
+                [&] { (void)PrecessionTrajectory(sphere, path, {.tilt_deg = 95.0, .time_step_s = 0.0}); },
+                ErrorCode::kInvalidOption),
+            "polishing.precession: PrecessionOptions::tilt_deg = 95 violates [0, 90); "
+            "PrecessionOptions::time_step_s "
+            "= 0 violates > 0");
 }
 
 }  // namespace

@@ -107,14 +107,7 @@ std::string RemovalFunction::Describe() const {
 
 void RemovalFunction::Check() const {
   if (const auto* g = std::get_if<GaussianRemovalFunction>(&model_)) {
-    if (!(g->peak_rate_um_per_s > 0.0) || !std::isfinite(g->peak_rate_um_per_s)) {
-      throw Error(ErrorCode::kInvalidOption, "polishing.dwell",
-                  fmt::format("peak_rate_um_per_s = {} violates > 0", g->peak_rate_um_per_s));
-    }
-    if (!(g->fwhm_mm > 0.0) || !std::isfinite(g->fwhm_mm)) {
-      throw Error(ErrorCode::kInvalidOption, "polishing.dwell",
-                  fmt::format("fwhm_mm = {} violates > 0", g->fwhm_mm));
-    }
+    ThrowIfProblems(ErrorCode::kInvalidOption, "polishing.dwell", g->Problems());
     return;
   }
   std::get<TabulatedRemovalFunction>(model_).Check();
@@ -201,11 +194,11 @@ TabulatedRemovalFunction ReadRemovalFunctionHdf5(const std::filesystem::path& pa
 
 std::vector<std::string> GaussianRemovalFunction::Problems() const {
   std::vector<std::string> problems;
-  if (!(peak_rate_um_per_s > 0.0)) {
+  if (!(peak_rate_um_per_s > 0.0 && std::isfinite(peak_rate_um_per_s))) {
     problems.push_back(
         fmt::format("removal_function.peak_rate_um_per_s = {} violates > 0", peak_rate_um_per_s));
   }
-  if (!(fwhm_mm > 0.0))
+  if (!(fwhm_mm > 0.0 && std::isfinite(fwhm_mm)))
     problems.push_back(fmt::format("removal_function.fwhm_mm = {} violates > 0", fwhm_mm));
   return problems;
 }

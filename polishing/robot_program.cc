@@ -21,15 +21,7 @@ std::string Quaternion9(const AbbQuaternion& q) {
 }
 
 void CheckPrecession(const PathPrecession& precession) {
-  if (precession.enabled &&
-      (!(precession.tilt_deg >= 0.0 && precession.tilt_deg < 90.0) ||
-       !std::isfinite(precession.precession_rate_rpm) || !(precession.bonnet_radius_mm >= 0.0))) {
-    throw Error(
-        ErrorCode::kInvalidOption, "polishing.path",
-        fmt::format("precession tilt_deg = {} (needs [0, 90)), precession_rate_rpm = {} (finite), "
-                    "bonnet_radius_mm = {} (>= 0)",
-                    precession.tilt_deg, precession.precession_rate_rpm, precession.bonnet_radius_mm));
-  }
+  ThrowIfProblems(ErrorCode::kInvalidOption, "polishing.path", precession.Problems());
 }
 
 // The outward (upward) unit normal: minus the tool's z, which points into the part.

@@ -4,10 +4,12 @@
 
 #include <gtest/gtest.h>
 
+#include <functional>
 #include <string>
 #include <vector>
 
 #include "core/error.h"
+#include "core/testing/testing.h"
 #include "fitting/circle_fit.h"
 #include "fitting/wheel_fit.h"
 #include "processing/wheel_map.h"
@@ -18,16 +20,8 @@ namespace {
 using Problems = std::vector<std::string>;
 
 // The message of the Error{kInvalidOption} that `run` throws; fails the test if there is none.
-template <class Run>
-std::string InvalidOptionMessage(Run run) {
-  try {
-    run();
-  } catch (const Error& e) {
-    EXPECT_EQ(e.code(), ErrorCode::kInvalidOption) << e.what();
-    return e.what();
-  }
-  ADD_FAILURE() << "the options were accepted";
-  return "";
+std::string InvalidOptionMessage(const std::function<void()>& run) {
+  return arcwheel::testing::ErrorMessageOf(run, ErrorCode::kInvalidOption);
 }
 
 TEST(WheelFitOptions, DefaultsHaveNoProblems) {

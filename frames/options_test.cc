@@ -4,12 +4,14 @@
 
 #include <gtest/gtest.h>
 
+#include <functional>
 #include <limits>
 #include <random>
 #include <string>
 #include <vector>
 
 #include "core/error.h"
+#include "core/testing/testing.h"
 #include "frames/force_centre.h"
 #include "frames/force_record_io.h"
 #include "frames/program_transform.h"
@@ -24,16 +26,8 @@ using Problems = std::vector<std::string>;
 constexpr double kNan = std::numeric_limits<double>::quiet_NaN();
 
 // The message of the Error{kInvalidOption} that `run` throws; fails the test if there is none.
-template <class Run>
-std::string InvalidOptionMessage(Run run) {
-  try {
-    run();
-  } catch (const Error& e) {
-    EXPECT_EQ(e.code(), ErrorCode::kInvalidOption) << e.what();
-    return e.what();
-  }
-  ADD_FAILURE() << "the options were accepted";
-  return "";
+std::string InvalidOptionMessage(const std::function<void()>& run) {
+  return arcwheel::testing::ErrorMessageOf(run, ErrorCode::kInvalidOption);
 }
 
 TEST(FramesOptions, DefaultsHaveNoProblems) {

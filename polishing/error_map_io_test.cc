@@ -554,7 +554,8 @@ TEST_F(DatxLayouts, ReadsEveryLayoutToThePixelsTheWriterComputed) {
 TEST_F(DatxLayouts, RefusesAnAmbiguousOrMissingSurfaceAndAnInfinityNamingTheFile) {
   ASSERT_FALSE(expected_["bad"].empty());
   for (const auto& [file, reason] : expected_["bad"].items()) {
-    const std::string message = ErrorMessageOf([&] { (void)ReadZygoDatx(*dir_ / "bad" / file); });
+    const std::string message =
+        ErrorMessageOf([&, name = file] { (void)ReadZygoDatx(*dir_ / "bad" / name); });
     EXPECT_TRUE(Contains(message, file + "'") && Contains(message, reason.get<std::string>()))
         << file << ": " << message;
   }

@@ -13,6 +13,7 @@
 
 #include "core/error.h"
 #include "core/testing/testing.h"
+#include "polishing/testing.h"
 
 namespace arcwheel::polishing {
 namespace {
@@ -20,24 +21,7 @@ namespace {
 using arcwheel::testing::ErrorOf;
 using ::testing::HasSubstr;
 
-std::vector<std::vector<double>> ParseCsvRows(const std::string& text, std::string& header) {
-  std::istringstream in(text);
-  std::string line;
-  std::vector<std::vector<double>> rows;
-  while (std::getline(in, line)) {
-    if (line.rfind("# ", 0) == 0) continue;
-    if (header.empty()) {
-      header = line;
-      continue;
-    }
-    std::vector<double> row;
-    std::stringstream cells(line);
-    std::string cell;
-    while (std::getline(cells, cell, ',')) row.push_back(std::stod(cell));
-    rows.push_back(row);
-  }
-  return rows;
-}
+using testing::ParseCsvRows;
 
 struct Fixture {
   surfaces::EvenAsphere surface{{.vertex_radius_mm = 600.0, .conic = -1.0, .concave = false}};

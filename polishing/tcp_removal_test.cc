@@ -16,6 +16,7 @@
 
 #include "core/testing/testing.h"
 #include "polishing/job.h"
+#include "polishing/testing.h"
 
 namespace arcwheel::polishing {
 namespace {
@@ -25,21 +26,11 @@ using arcwheel::testing::TempDir;
 constexpr double kPeakUmPerS = 1.5;
 constexpr double kFwhmMm = 10.0;
 
-// Rows of a CSV written by the program: "# " comments, a header, then numbers.
+// Rows of a CSV written by the program, whose header must be `header`.
 std::vector<std::vector<double>> ReadCsvRows(const std::filesystem::path& path, const std::string& header) {
-  std::ifstream in(path);
-  std::string line;
-  while (std::getline(in, line) && line.rfind("# ", 0) == 0) {
-  }
-  EXPECT_EQ(line, header) << path;
-  std::vector<std::vector<double>> rows;
-  while (std::getline(in, line)) {
-    std::vector<double> row;
-    std::stringstream cells(line);
-    std::string cell;
-    while (std::getline(cells, cell, ',')) row.push_back(std::stod(cell));
-    rows.push_back(row);
-  }
+  std::string found;
+  std::vector<std::vector<double>> rows = testing::ParseCsvRows(arcwheel::testing::ReadText(path), found);
+  EXPECT_EQ(found, header) << path;
   return rows;
 }
 

@@ -2,6 +2,9 @@
 // Helpers shared by polishing's tests.
 
 #include <cmath>
+#include <sstream>
+#include <string>
+#include <vector>
 
 #include "polishing/removal_function.h"
 
@@ -19,6 +22,27 @@ inline TabulatedRemovalFunction SampledGaussian(double peak, double cx, double c
     }
   }
   return t;
+}
+
+// The rows of a CSV the program wrote: "# " comment lines, then a header line (returned in
+// `header`), then rows of numbers.
+inline std::vector<std::vector<double>> ParseCsvRows(const std::string& text, std::string& header) {
+  std::istringstream in(text);
+  std::string line;
+  std::vector<std::vector<double>> rows;
+  while (std::getline(in, line)) {
+    if (line.rfind("# ", 0) == 0) continue;
+    if (header.empty()) {
+      header = line;
+      continue;
+    }
+    std::vector<double> row;
+    std::stringstream cells(line);
+    std::string cell;
+    while (std::getline(cells, cell, ',')) row.push_back(std::stod(cell));
+    rows.push_back(row);
+  }
+  return rows;
 }
 
 }  // namespace arcwheel::polishing::testing

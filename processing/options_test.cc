@@ -4,12 +4,14 @@
 
 #include <gtest/gtest.h>
 
+#include <functional>
 #include <limits>
 #include <string>
 #include <vector>
 
 #include "acquisition/scan.h"
 #include "core/error.h"
+#include "core/testing/testing.h"
 #include "processing/despike.h"
 #include "processing/process_scan.h"
 #include "processing/spindle_speed.h"
@@ -21,16 +23,8 @@ namespace {
 using Problems = std::vector<std::string>;
 
 // The message of the Error{kInvalidOption} that `run` throws; fails the test if there is none.
-template <class Run>
-std::string InvalidOptionMessage(Run run) {
-  try {
-    run();
-  } catch (const Error& e) {
-    EXPECT_EQ(e.code(), ErrorCode::kInvalidOption) << e.what();
-    return e.what();
-  }
-  ADD_FAILURE() << "the options were accepted";
-  return "";
+std::string InvalidOptionMessage(const std::function<void()>& run) {
+  return arcwheel::testing::ErrorMessageOf(run, ErrorCode::kInvalidOption);
 }
 
 TEST(ProcessOptions, DefaultsHaveNoProblems) {

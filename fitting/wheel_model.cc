@@ -12,6 +12,7 @@
 #include "core/error.h"
 #include "core/interrupt.h"
 #include "core/parallel.h"
+#include "processing/uniform_cubic_bspline.h"
 
 namespace arcwheel::fitting {
 namespace {
@@ -22,31 +23,17 @@ constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 using Eigen::MatrixXd;
 using Eigen::VectorXd;
 
-// A uniform cubic B-spline's four weights (and their derivatives per knot interval) at fraction
-// f of an interval; they weigh the coefficients first .. first + 3.
-struct CubicWeights {
-  double w[4];
-  double dw[4];
-};
-
-CubicWeights WeightsAt(double f) {
-  const double g = 1.0 - f;
-  return {{g * g * g / 6.0, (3.0 * f * f * f - 6.0 * f * f + 4.0) / 6.0,
-           (-3.0 * f * f * f + 3.0 * f * f + 3.0 * f + 1.0) / 6.0, f * f * f / 6.0},
-          {-0.5 * g * g, 1.5 * f * f - 2.0 * f, -1.5 * f * f + f + 0.5, 0.5 * f * f}};
-}
-
 // Ra(c), a(c), b(c): `knots` coefficients spread evenly over a turn, wrapping around.
 struct PeriodicBasis {
   int knots = 0;
   void At(double phase_deg, int index[4], double weight[4]) const {
     const double t = phase_deg / 360.0 * knots;
     const double interval = std::floor(t);
-    const CubicWeights cw = WeightsAt(t - interval);
+    const processing::UniformCubicWeights cw = processing::UniformCubicBSplineWeights(t - interval);
     const int j = static_cast<int>(interval);
     for (int k = 0; k < 4; ++k) {
       index[k] = ((j - 1 + k) % knots + knots) % knots;
-      weight[k] = cw.w[k];
+      weight[k] = cw.w[static_cast<std::size_t>(k)];
     }
   }
   // Row r of the returned matrix holds every coefficient's weight at phases_deg[r].
@@ -71,10 +58,10 @@ struct ProfileBasis {
   int At(double u_mm, double weight[4], double slope[4]) const {
     const double t = std::clamp((u_mm - low_mm) / step_mm, 0.0, static_cast<double>(intervals));
     const int j = std::min(static_cast<int>(t), intervals - 1);
-    const CubicWeights cw = WeightsAt(t - j);
+    const processing::UniformCubicWeights cw = processing::UniformCubicBSplineWeights(t - j);
     for (int k = 0; k < 4; ++k) {
-      weight[k] = cw.w[k];
-      slope[k] = cw.dw[k] / step_mm;
+      weight[k] = cw.w[static_cast<std::size_t>(k)];
+      slope[k] = cw.dw[static_cast<std::size_t>(k)] / step_mm;
     }
     return j;
   }
@@ -340,23 +327,25 @@ Solution GaussNewton(const Samples& samples, const Layout& layout, const MatrixX
               fmt::format("the wheel model did not converge in {} Gauss-Newton iterations", max_iterations));
 }
 
-// The residual sum of squares that coarser knots would reach, from the fine fit's
-// normal equations linearised at its solution: RSS = |z - J T x|^2 minimised over x, z = r + J theta.
-double LinearisedRss(const Solution& fine, const MatrixXd& reduction) {
+// The fine fit's normal equations linearised at its solution, restricted to coarser knots
+// (theta = T x): the x minimising RSS = |z - J T x|^2 with z = r + J theta, that RSS, and T^T J^T J T.
+struct LinearisedFit {
+  VectorXd x;
+  double rss = 0.0;
+  MatrixXd reduced_jtj;
+};
+
+LinearisedFit Linearise(const Solution& fine, const MatrixXd& reduction) {
   const MatrixXd& jtj = fine.normal.jtj;
   const VectorXd jtz = fine.normal.jtr + jtj * fine.theta;
   const double ztz =
       fine.normal.rss + 2.0 * fine.theta.dot(fine.normal.jtr) + fine.theta.dot(jtj * fine.theta);
   const VectorXd rhs = reduction.transpose() * jtz;
-  const MatrixXd reduced = reduction.transpose() * jtj * reduction;
-  return std::max(ztz - rhs.dot(reduced.ldlt().solve(rhs)), 0.0);
-}
-
-// The reduced parameters minimising the linearised RSS, for a start at coarser knots.
-VectorXd LinearisedStart(const Solution& fine, const MatrixXd& reduction) {
-  const VectorXd jtz = fine.normal.jtr + fine.normal.jtj * fine.theta;
-  const MatrixXd reduced = reduction.transpose() * fine.normal.jtj * reduction;
-  return reduced.ldlt().solve(reduction.transpose() * jtz);
+  LinearisedFit fit;
+  fit.reduced_jtj = reduction.transpose() * jtj * reduction;
+  fit.x = fit.reduced_jtj.ldlt().solve(rhs);
+  fit.rss = std::max(ztz - rhs.dot(fit.x), 0.0);
+  return fit;
 }
 
 // The knot counts to choose from: the one given, else kKnotChoices, and for Ra and a also a
@@ -407,11 +396,11 @@ Variation VariationAtFineFit(const Solution& fine, const Layout& fine_layout, Kn
   knots.radius = std::max(knots.radius, 4);
   const MatrixXd t = Reduction(fine_layout, knots, null_space);
   const double n = static_cast<double>(fine.normal.samples);
-  const double sigma2 = LinearisedRss(fine, t) / (n - static_cast<double>(t.cols()));
-  const MatrixXd reduced = t.transpose() * fine.normal.jtj * t;
-  const VectorXd x = LinearisedStart(fine, t);
-  const MatrixXd covariance = sigma2 * reduced.inverse();
-  return WaldTestOfConstancy(x.head(knots.radius), covariance.topLeftCorner(knots.radius, knots.radius));
+  const LinearisedFit linear = Linearise(fine, t);
+  const double sigma2 = linear.rss / (n - static_cast<double>(t.cols()));
+  const MatrixXd covariance = sigma2 * linear.reduced_jtj.inverse();
+  return WaldTestOfConstancy(linear.x.head(knots.radius),
+                             covariance.topLeftCorner(knots.radius, knots.radius));
 }
 
 struct Fitted {
@@ -576,7 +565,7 @@ VectorXd StartingPoint(const Layout& layout, const WheelFit& fit) {
 double Bic(const Solution& fine, const Layout& fine_layout, const Knots& knots, const MatrixXd& null_space) {
   const MatrixXd t = Reduction(fine_layout, knots, null_space);
   const double n = static_cast<double>(fine.normal.samples);
-  return n * std::log(LinearisedRss(fine, t) / n) + static_cast<double>(t.cols()) * std::log(n);
+  return n * std::log(Linearise(fine, t).rss / n) + static_cast<double>(t.cols()) * std::log(n);
 }
 
 // Each function's knots in turn (Ra, then a, then b, twice over), the one with the least BIC
@@ -624,7 +613,7 @@ Fitted FitAndChoose(const Samples& samples, const WheelFit& fit, const WheelMode
   fitted.layout = MakeLayout(knots, half_width_mm, options.profile_knot_step_mm);
   fitted.variation = VariationAtFineFit(best, fine, knots, null_space);
   if (!(knots == fine.knots())) {
-    const VectorXd start_reduced = LinearisedStart(best, Reduction(fine, knots, null_space));
+    const VectorXd start_reduced = Linearise(best, Reduction(fine, knots, null_space)).x;
     const MatrixXd reduction = Reduction(fitted.layout, knots, null_space);
     const int iterations = best.iterations;
     best = GaussNewton(samples, fitted.layout, reduction, reduction * start_reduced, options.max_iterations);

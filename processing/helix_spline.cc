@@ -7,6 +7,7 @@
 #include "core/error.h"
 #include "core/interrupt.h"
 #include "core/parallel.h"
+#include "processing/uniform_cubic_bspline.h"
 
 namespace arcwheel::processing {
 namespace {
@@ -40,11 +41,8 @@ HelixSpline::Basis HelixSpline::BasisAt(double u) const {
   const double f = s - cell;
   Basis b;
   b.first = static_cast<std::size_t>(cell);
-  const double g = 1.0 - f;
-  b.w[0] = g * g * g / 6.0;
-  b.w[1] = (3.0 * f * f * f - 6.0 * f * f + 4.0) / 6.0;
-  b.w[2] = (-3.0 * f * f * f + 3.0 * f * f + 3.0 * f + 1.0) / 6.0;
-  b.w[3] = f * f * f / 6.0;
+  const UniformCubicWeights weights = UniformCubicBSplineWeights(f);
+  for (int k = 0; k < 4; ++k) b.w[k] = weights.w[static_cast<std::size_t>(k)];
   return b;
 }
 

@@ -2,7 +2,11 @@
 
 #include <cmath>
 #include <limits>
+#include <span>
 #include <string>
+#include <type_traits>
+#include <utility>
+#include <vector>
 
 #include "acquisition/scan_metadata_keys.h"
 #include "acquisition/scan_reader.h"
@@ -14,14 +18,13 @@ namespace {
 
 constexpr const char* kStage = "acquisition.hdf5";
 
-std::vector<double> ReadColumn(const hdf5::File& file, const std::string& name) {
+void CheckOneDimensional(const hdf5::File& file, const std::string& name) {
   const std::vector<hsize_t> shape = file.Shape(name);
   if (shape.size() != 1) {
     throw Error(ErrorCode::kBadInput, kStage,
                 "'" + file.path().string() + "' dataset " + name + " must be one-dimensional, has rank " +
                     std::to_string(shape.size()));
   }
-  return file.ReadDoubles(name);
 }
 
 // Every attribute on /scan, matched to formats.md's keys case-insensitively; the unused ones noted.
@@ -49,16 +52,25 @@ void ReadAttributes(const hdf5::File& file, ScanMetadata& metadata) {
   }
 }
 
-// z in mm. Integer z are sensor counts: they need the CF convention's `scale_factor` (mm per count)
-// and optional `add_offset` (mm) on /scan/z; invalid_value is then compared with the counts.
-std::vector<double> ReadZ(const hdf5::File& file, ScanMetadata& metadata, SentinelComparison& comparison) {
+// How /scan/z is stored: float32 or float64 millimetres, or integer sensor counts with the CF
+// convention's `scale_factor` (mm per count) and optional `add_offset` (mm); invalid_value is then
+// compared with the counts.
+struct ZLayout {
+  bool is_float = true;
+  bool is_float32 = false;
+  double scale = 1.0;
+  double offset = 0.0;
+};
+
+ZLayout ReadZLayout(const hdf5::File& file) {
   const std::string name = "/scan/z";
-  std::vector<double> z = ReadColumn(file, name);
-  const H5T_class_t type_class = file.ElementClass(name);
-  if (type_class == H5T_FLOAT) {
-    comparison = file.ElementSize(name) == 4 ? SentinelComparison::kAsFloat : SentinelComparison::kAsDouble;
-    return z;
+  CheckOneDimensional(file, name);
+  ZLayout layout;
+  if (file.ElementClass(name) == H5T_FLOAT) {
+    layout.is_float32 = file.ElementSize(name) == 4;
+    return layout;
   }
+  layout.is_float = false;
   const std::optional<double> scale = file.ReadAttributeDouble(name, "scale_factor");
   if (!scale) {
     throw Error(ErrorCode::kBadInput, kStage,
@@ -68,29 +80,53 @@ std::vector<double> ReadZ(const hdf5::File& file, ScanMetadata& metadata, Sentin
                     "on /scan/z, "
                     "or store z as float in mm");
   }
-  const double offset = file.ReadAttributeDouble(name, "add_offset").value_or(0.0);
-  if (!std::isfinite(*scale) || *scale == 0.0 || !std::isfinite(offset)) {
+  layout.scale = *scale;
+  layout.offset = file.ReadAttributeDouble(name, "add_offset").value_or(0.0);
+  if (!std::isfinite(layout.scale) || layout.scale == 0.0 || !std::isfinite(layout.offset)) {
     throw Error(
         ErrorCode::kBadInput, kStage,
         "'" + file.path().string() + "' /scan/z: scale_factor must be finite and not 0, add_offset finite");
   }
-  for (double& value : z) {
-    value = metadata.invalid_value && value == *metadata.invalid_value
-                ? std::numeric_limits<double>::quiet_NaN()
-                : value * *scale + offset;
+  return layout;
+}
+
+SentinelComparison ComparisonOf(const ZLayout& layout) {
+  if (!layout.is_float) return SentinelComparison::kDone;  // compared with the counts on reading
+  return layout.is_float32 ? SentinelComparison::kAsFloat : SentinelComparison::kAsDouble;
+}
+
+// The optional columns, as formats.md 2.1 names them.
+constexpr std::pair<const char*, std::vector<double> Scan::*> kColumns[] = {
+    {"/scan/t", &Scan::t_s}, {"/scan/angle", &Scan::angle_deg}, {"/scan/y", &Scan::y_mm}};
+
+// Where the columns' values go: the scan's own vectors, or arrays shared with a parent process.
+template <typename Allocator>
+void ReadColumns(const hdf5::File& file, const ScanMetadata& metadata, const ReadOptions& options,
+                 Allocator&& allocate) {
+  const ZLayout layout = ReadZLayout(file);
+  const std::string z = "/scan/z";
+  if (layout.is_float32 && options.keep_float32) {
+    file.ReadInto(z, allocate(z, file.NumericCount(z, sizeof(float)), float{}));
+  } else {
+    const std::span<double> values = allocate(z, file.NumericCount(z, sizeof(double)), double{});
+    file.ReadInto(z, values);
+    if (!layout.is_float) {
+      for (double& value : values) {
+        value = metadata.invalid_value && value == *metadata.invalid_value
+                    ? std::numeric_limits<double>::quiet_NaN()
+                    : value * layout.scale + layout.offset;
+      }
+    }
   }
-  comparison = SentinelComparison::kDone;
-  return z;
+  for (const auto& [name, member] : kColumns) {
+    if (!file.HasObject(name)) continue;
+    CheckOneDimensional(file, name);
+    file.ReadInto(name, allocate(name, file.NumericCount(name, sizeof(double)), double{}));
+  }
 }
 
-}  // namespace
-
-Scan ReadHdf5Scan(const std::filesystem::path& path) {
-  hdf5::ReadFirstInChildProcess(path, [&] { (void)ReadHdf5Scan(hdf5::File::OpenReadOnly(path)); });
-  return ReadHdf5Scan(hdf5::File::OpenReadOnly(path));
-}
-
-Scan ReadHdf5Scan(const hdf5::File& file) {
+// The group, its attributes and the presence of /scan/z: everything but the data.
+Scan ReadHeader(const hdf5::File& file) {
   const std::filesystem::path& path = file.path();
   if (!file.HasObject("/scan")) {
     throw Error(ErrorCode::kBadInput, kStage, "'" + path.string() + "' has no group /scan");
@@ -101,20 +137,72 @@ Scan ReadHdf5Scan(const hdf5::File& file) {
   if (!file.HasObject("/scan/z")) {
     throw Error(ErrorCode::kBadInput, kStage, "'" + path.string() + "' has no dataset /scan/z");
   }
-  SentinelComparison comparison = SentinelComparison::kAsDouble;
-  scan.z_mm = ReadZ(file, scan.metadata, comparison);
-  if (file.HasObject("/scan/t")) scan.t_s = ReadColumn(file, "/scan/t");
-  if (file.HasObject("/scan/angle")) scan.angle_deg = ReadColumn(file, "/scan/angle");
-  if (file.HasObject("/scan/y")) scan.y_mm = ReadColumn(file, "/scan/y");
-  ApplyInvalidMarkers(scan, comparison);
+  return scan;
+}
+
+// The vector of `scan` that holds the values of `name`.
+template <typename T>
+std::vector<T>& ColumnOf(Scan& scan, const std::string& name) {
+  if constexpr (std::is_same_v<T, float>) {
+    return scan.z_float_mm;
+  } else {
+    if (name == "/scan/z") return scan.z_mm;
+    for (const auto& [column, member] : kColumns) {
+      if (name == column) return scan.*member;
+    }
+    throw Error(ErrorCode::kInternal, kStage, "no scan column for " + name);
+  }
+}
+
+// Invalid markers, then formats.md 2.3.
+Scan Finish(Scan scan, const hdf5::File& file) {
+  ApplyInvalidMarkers(scan, ComparisonOf(ReadZLayout(file)));
   ValidateScan(scan);
   return scan;
 }
 
-Scan ReadScan(const std::filesystem::path& path) {
+}  // namespace
+
+Scan ReadHdf5Scan(const std::filesystem::path& path, const ReadOptions& options) {
+  // The data are read once, in the child process that guards against libhdf5 crashing on a
+  // damaged file; here only the header is read again (what the child has already read safely).
+  hdf5::SharedArrays arrays;
+  const bool handed = hdf5::ReadInChildProcess(path, arrays, [&](hdf5::SharedArrays& shared) {
+    const hdf5::File file = hdf5::File::OpenReadOnly(path);
+    const Scan header = ReadHeader(file);
+    ReadColumns(file, header.metadata, options, [&](const std::string& name, std::size_t count, auto type) {
+      return shared.Allocate<decltype(type)>(name, count);
+    });
+  });
+  const hdf5::File file = hdf5::File::OpenReadOnly(path);
+  if (!handed) return ReadHdf5Scan(file, options);
+  Scan scan = ReadHeader(file);
+  const auto take = [&](const std::string& name, auto type) {
+    using T = decltype(type);
+    if (std::optional<std::vector<T>> values = arrays.Take<T>(name))
+      ColumnOf<T>(scan, name) = std::move(*values);
+  };
+  take("/scan/z", float{});
+  take("/scan/z", double{});
+  for (const auto& [name, member] : kColumns) take(name, double{});
+  return Finish(std::move(scan), file);
+}
+
+Scan ReadHdf5Scan(const hdf5::File& file, const ReadOptions& options) {
+  Scan scan = ReadHeader(file);
+  ReadColumns(file, scan.metadata, options, [&](const std::string& name, std::size_t count, auto type) {
+    using T = decltype(type);
+    std::vector<T>& column = ColumnOf<T>(scan, name);
+    column.resize(count);
+    return std::span<T>(column);
+  });
+  return Finish(std::move(scan), file);
+}
+
+Scan ReadScan(const std::filesystem::path& path, const ReadOptions& options) {
   std::string extension = path.extension().string();
   for (char& c : extension) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  if (extension == ".h5" || extension == ".hdf5") return ReadHdf5Scan(path);
+  if (extension == ".h5" || extension == ".hdf5") return ReadHdf5Scan(path, options);
   if (extension == ".csv" || extension == ".txt") return ReadCsvScan(path);
   throw Error(ErrorCode::kBadInput, "acquisition",
               "'" + path.string() + "': unknown scan file type '" + extension +

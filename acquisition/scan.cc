@@ -23,9 +23,9 @@ std::string Number(double value) {
 
 void CheckColumn(const Scan& scan, const std::vector<double>& column, const char* name) {
   if (column.empty()) return;
-  if (column.size() != scan.z_mm.size()) {
+  if (column.size() != scan.size()) {
     Refuse(scan, std::string("column '") + name + "' has " + std::to_string(column.size()) +
-                     " values but 'z' has " + std::to_string(scan.z_mm.size()));
+                     " values but 'z' has " + std::to_string(scan.size()));
   }
   for (size_t i = 0; i < column.size(); ++i) {
     if (!std::isfinite(column[i])) {
@@ -52,13 +52,20 @@ void CheckPositive(const Scan& scan, const std::optional<double>& value, const c
 }  // namespace
 
 size_t Scan::CountValid() const {
-  return static_cast<size_t>(
-      std::count_if(z_mm.begin(), z_mm.end(), [](double z) { return std::isfinite(z); }));
+  return VisitReadings(*this, [](const auto& z) {
+    return static_cast<size_t>(std::count_if(z.begin(), z.end(), [](double v) { return std::isfinite(v); }));
+  });
+}
+
+void Scan::WidenToDouble() {
+  if (!holds_float()) return;
+  z_mm.assign(z_float_mm.begin(), z_float_mm.end());
+  z_float_mm = {};
 }
 
 void ValidateScan(const Scan& scan) {
   const ScanMetadata& meta = scan.metadata;
-  if (scan.z_mm.empty()) Refuse(scan, "holds no samples");
+  if (scan.size() == 0) Refuse(scan, "holds no samples");
   CheckColumn(scan, scan.t_s, "t");
   CheckColumn(scan, scan.angle_deg, "angle");
   CheckColumn(scan, scan.y_mm, "y");
@@ -73,13 +80,13 @@ void ValidateScan(const Scan& scan) {
   }
   CheckIncreasing(scan, scan.t_s, "t");
 
-  const auto first =
-      std::find_if(scan.z_mm.begin(), scan.z_mm.end(), [](double z) { return std::isfinite(z); });
-  if (first == scan.z_mm.end()) Refuse(scan, "has no valid samples");
-  const auto last =
-      std::find_if(scan.z_mm.rbegin(), scan.z_mm.rend(), [](double z) { return std::isfinite(z); });
-  const size_t i0 = static_cast<size_t>(first - scan.z_mm.begin());
-  const size_t i1 = scan.z_mm.size() - 1 - static_cast<size_t>(last - scan.z_mm.rbegin());
+  const auto [i0, i1] = VisitReadings(scan, [&](const auto& z) {
+    const auto first = std::find_if(z.begin(), z.end(), [](double v) { return std::isfinite(v); });
+    if (first == z.end()) Refuse(scan, "has no valid samples");
+    const auto last = std::find_if(z.rbegin(), z.rend(), [](double v) { return std::isfinite(v); });
+    return std::pair<size_t, size_t>(static_cast<size_t>(first - z.begin()),
+                                     z.size() - 1 - static_cast<size_t>(last - z.rbegin()));
+  });
 
   const auto time_at = [&](size_t i) {
     return scan.has_time() ? scan.t_s[i] : static_cast<double>(i) * *meta.sample_period_s;

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <iterator>
 #include <limits>
+#include <type_traits>
 
 #include "core/error.h"
 #include "core/text_encoding.h"
@@ -107,13 +108,17 @@ void ApplyInvalidMarkers(Scan& scan, SentinelComparison comparison) {
   const bool as_float = comparison == SentinelComparison::kAsFloat;
   const double sentinel = m.invalid_value.value_or(0.0);
   const float sentinel_float = static_cast<float>(sentinel);
-  for (double& z : scan.z_mm) {
-    const bool is_sentinel =
-        has_sentinel && (as_float ? static_cast<float>(z) == sentinel_float : z == sentinel);
-    // +-Inf is a float sensor's over-range reading: an invalid sample, like NaN.
-    if (is_sentinel || !std::isfinite(z) || !(z >= low && z <= high))
-      z = std::numeric_limits<double>::quiet_NaN();
-  }
+  VisitReadings(scan, [&](auto& readings) {
+    for (auto& z : readings) {
+      const bool is_sentinel =
+          has_sentinel && (as_float ? static_cast<float>(z) == sentinel_float : z == sentinel);
+      // +-Inf is a float sensor's over-range reading: an invalid sample, like NaN. The range
+      // limits are compared in double, as for readings held in double.
+      const double value = z;
+      if (is_sentinel || !std::isfinite(value) || !(value >= low && value <= high))
+        z = std::numeric_limits<std::remove_reference_t<decltype(z)>>::quiet_NaN();
+    }
+  });
 }
 
 }  // namespace arcwheel::acquisition

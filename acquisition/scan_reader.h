@@ -15,11 +15,18 @@
 
 namespace arcwheel::acquisition {
 
-// By extension: .h5/.hdf5 -> ReadHdf5Scan, .csv/.txt -> ReadCsvScan; else Error{kBadInput}.
-[[nodiscard]] Scan ReadScan(const std::filesystem::path& path);
+struct ReadOptions {
+  // float32 readings stay float32 (Scan::z_float_mm): half the memory, the same results.
+  bool keep_float32 = false;
+};
 
-// formats.md 2.1: group /scan, dataset /scan/z, optional /scan/t, /scan/angle, /scan/y.
-[[nodiscard]] Scan ReadHdf5Scan(const std::filesystem::path& path);
+// By extension: .h5/.hdf5 -> ReadHdf5Scan, .csv/.txt -> ReadCsvScan; else Error{kBadInput}.
+[[nodiscard]] Scan ReadScan(const std::filesystem::path& path, const ReadOptions& options = {});
+
+// formats.md 2.1: group /scan, dataset /scan/z, optional /scan/t, /scan/angle, /scan/y. The data
+// are read once, in a child process that guards against libhdf5 crashing on a damaged file
+// (hdf5::ReadInChildProcess).
+[[nodiscard]] Scan ReadHdf5Scan(const std::filesystem::path& path, const ReadOptions& options = {});
 
 // formats.md 2.2: `# key: value` lines, a header row, separators , ; or tab, decimal point.
 [[nodiscard]] Scan ReadCsvScan(const std::filesystem::path& path);
@@ -27,6 +34,6 @@ namespace arcwheel::acquisition {
 [[nodiscard]] Scan ParseCsvScan(std::string text, const std::string& name);
 
 // formats.md 2.1 from an open file (e.g. an in-memory image, hdf5::File::OpenImage).
-[[nodiscard]] Scan ReadHdf5Scan(const hdf5::File& file);
+[[nodiscard]] Scan ReadHdf5Scan(const hdf5::File& file, const ReadOptions& options = {});
 
 }  // namespace arcwheel::acquisition

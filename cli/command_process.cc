@@ -15,6 +15,7 @@
 #include "core/interrupt.h"
 #include "core/progress.h"
 #include "core/sha256.h"
+#include "core/stage_clock.h"
 #include "core/text_encoding.h"
 #include "fitting/outputs.h"
 #include "fitting/wheel_fit.h"
@@ -41,6 +42,7 @@ struct ProcessArgs {
   std::vector<std::string> report_formats;
   std::string tolerance_file;
   bool quiet = false;
+  bool timings = false;
 };
 
 fitting::RunRecord MakeRecord(const ProcessArgs& args, const acquisition::Scan& scan) {
@@ -114,7 +116,9 @@ std::optional<fitting::WheelModel> FitModelUnlessOff(const ProcessArgs& args, co
   if (args.no_model) return std::nullopt;
   try {
     const processing::HelixGeometry geometry(scan, processed.rpm_used);
-    return fitting::FitWheelModel(scan.z_mm, geometry, processed.map, fit, args.model);
+    return acquisition::VisitReadings(scan, [&](const auto& rho) {
+      return fitting::FitWheelModel(std::span(rho), geometry, processed.map, fit, args.model);
+    });
   } catch (const Error& e) {
     if (e.code() != ErrorCode::kFitFailed) throw;
     processed.warnings.push_back(std::string("no wheel model: ") + e.what());
@@ -128,6 +132,17 @@ void PrintModelHeadline(const fitting::WheelModel& m) {
   fmt::print("model radius varies  {} (chi-square {:.1f} on {} dof, p = {:.2g}); knots Ra/a/b {}/{}/{}\n",
              m.variation_significant ? "yes" : "no", m.variation_chi2, m.variation_dof, m.variation_p_value,
              m.radius_knots, m.axial_knots, m.runout_knots);
+}
+
+// One line per stage on stderr, so that the outputs and the headline stay as they are.
+void PrintTimings(const StageClock& clock) {
+  double total_s = 0.0;
+  for (const StageClock::Stage& stage : clock.stages()) {
+    fmt::print(stderr, "timing  {:<32} {:8.3f} s   peak memory {:7.1f} MiB\n", stage.name, stage.seconds,
+               stage.peak_memory_mib);
+    total_s += stage.seconds;
+  }
+  fmt::print(stderr, "timing  {:<32} {:8.3f} s\n", "total", total_s);
 }
 
 void Run(ProcessArgs& args) {
@@ -147,21 +162,32 @@ void Run(ProcessArgs& args) {
   // ReadScan forks (an HDF5 file is read first in a child process, core/hdf5_child.cc), and no
   // thread may be alive at fork(): the input's SHA-256 starts after it, on the second core while
   // the first one processes.
-  acquisition::Scan scan = acquisition::ReadScan(args.scan_path);
+  StageClock clock;
+  clock.Start("reading");
+  acquisition::Scan scan = acquisition::ReadScan(args.scan_path, {.keep_float32 = true});
+  clock.Stop();
   auto sha256 = std::async(std::launch::async, [path = args.scan_path] { return Sha256OfFile(path); });
   fitting::RunRecord record = MakeRecord(args, scan);
   ThrowIfInterrupted();
   progress.Update("processing", 0.3);
   processing::ProcessedScan processed = processing::ProcessScanInPlace(scan, args.processing);
+  clock.Append(processed.timings);
   progress.Update("fitting", 0.7);
+  clock.Start("per-phase fits");
   const fitting::WheelFit fit = fitting::FitWheel(processed.map, args.fit);
+  clock.Start("wheel model");
   const std::optional<fitting::WheelModel> model = FitModelUnlessOff(args, scan, processed, fit);
+  clock.Start("releasing the samples");
   scan = {};  // the samples are no longer needed
   progress.Update("writing", 0.9);
+  clock.Start("waiting for the SHA-256");
   record.input_sha256 = sha256.get();
   ThrowIfInterrupted();
+  clock.Start("writing");
   fitting::WriteProcessOutputs(args.outdir, record, processed, fit, model ? &*model : nullptr);
+  clock.Stop();
   progress.Done();
+  if (args.timings) PrintTimings(clock);
   if (!args.quiet) PrintHeadline(args, processed, fit);
   if (!args.quiet && model) PrintModelHeadline(*model);
   if (!args.report_formats.empty()) {
@@ -239,6 +265,7 @@ void AddProcessCommand(CLI::App& app) {
       ->capture_default_str();
   cmd->add_flag("--no-model", args->no_model, "skip the wheel model (docs/wheel_model.md)");
   cmd->add_flag("-q,--quiet", args->quiet, "no progress and no headline");
+  cmd->add_flag("--timings", args->timings, "print the wall time of each stage on stderr");
   cmd->callback([args] { Run(*args); });
 }
 

@@ -7,6 +7,7 @@
 #include <cstddef>
 #include <cstring>
 #include <set>
+#include <span>
 #include <utility>
 
 #include "core/error.h"
@@ -182,8 +183,10 @@ void CheckFiltersAvailable(const Handle& data, const std::string& where) {
   }
 }
 
-template <typename T>
-std::vector<T> ReadNumeric(hid_t file_id, const Handle& data, hid_t memory_type, const std::string& where) {
+// The number of values in a numeric dataset, refused when the header declares more than the file
+// could hold even compressed 64 to 1 (`value_bytes` each in memory), before anything is allocated.
+std::size_t NumericCount(hid_t file_id, const Handle& data, std::size_t value_bytes,
+                         const std::string& where) {
   const Handle type(H5Dget_type(data.id()), H5Tclose);
   const H5T_class_t type_class = H5Tget_class(type.id());
   if (type_class != H5T_FLOAT && type_class != H5T_INTEGER) {
@@ -193,25 +196,55 @@ std::vector<T> ReadNumeric(hid_t file_id, const Handle& data, hid_t memory_type,
   const Handle space(H5Dget_space(data.id()), H5Sclose);
   const hssize_t count = H5Sget_simple_extent_npoints(space.id());
   if (count < 0) throw Error(ErrorCode::kBadInput, kStage, "cannot read the size of " + where);
-  // A damaged header can declare any size: refuse more values than the file could hold even
-  // compressed 64 to 1, rather than trying to allocate them.
   hsize_t file_bytes = 0;
   H5Fget_filesize(file_id, &file_bytes);
-  const double declared_bytes = static_cast<double>(count) * static_cast<double>(sizeof(T));
+  const double declared_bytes = static_cast<double>(count) * static_cast<double>(value_bytes);
   if (declared_bytes > 64.0 * std::max<double>(static_cast<double>(file_bytes), 1 << 20)) {
     throw Error(ErrorCode::kBadInput, kStage,
                 where + " declares " + std::to_string(count) + " values, more than the " +
                     std::to_string(file_bytes) + "-byte file can hold (damaged?)");
   }
-  std::vector<T> values(static_cast<size_t>(count));
-  if (count > 0 && H5Dread(data.id(), memory_type, H5S_ALL, H5S_ALL, H5P_DEFAULT, values.data()) < 0) {
+  return static_cast<std::size_t>(count);
+}
+
+void ReadNumericInto(const Handle& data, hid_t memory_type, void* values, std::size_t count,
+                     const std::string& where) {
+  if (count > 0 && H5Dread(data.id(), memory_type, H5S_ALL, H5S_ALL, H5P_DEFAULT, values) < 0) {
     CheckFiltersAvailable(data, where);
     throw Error(ErrorCode::kBadInput, kStage, "cannot read " + where + " (file truncated or damaged?)");
   }
+}
+
+template <typename T>
+std::vector<T> ReadNumeric(hid_t file_id, const Handle& data, hid_t memory_type, const std::string& where) {
+  std::vector<T> values(NumericCount(file_id, data, sizeof(T), where));
+  ReadNumericInto(data, memory_type, values.data(), values.size(), where);
   return values;
 }
 
 }  // namespace
+
+std::size_t File::NumericCount(const std::string& dataset, std::size_t value_bytes) const {
+  return hdf5::NumericCount(handle_.id(), OpenDataset(dataset), value_bytes, Where(dataset));
+}
+
+void File::ReadInto(const std::string& dataset, std::span<double> values) const {
+  const Handle data = OpenDataset(dataset);
+  const std::string where = Where(dataset);
+  if (hdf5::NumericCount(handle_.id(), data, sizeof(double), where) != values.size()) {
+    throw Error(ErrorCode::kInternal, kStage, "buffer does not match the size of " + where);
+  }
+  ReadNumericInto(data, H5T_NATIVE_DOUBLE, values.data(), values.size(), where);
+}
+
+void File::ReadInto(const std::string& dataset, std::span<float> values) const {
+  const Handle data = OpenDataset(dataset);
+  const std::string where = Where(dataset);
+  if (hdf5::NumericCount(handle_.id(), data, sizeof(float), where) != values.size()) {
+    throw Error(ErrorCode::kInternal, kStage, "buffer does not match the size of " + where);
+  }
+  ReadNumericInto(data, H5T_NATIVE_FLOAT, values.data(), values.size(), where);
+}
 
 std::vector<double> File::ReadDoubles(const std::string& dataset) const {
   return ReadNumeric<double>(handle_.id(), OpenDataset(dataset), H5T_NATIVE_DOUBLE, Where(dataset));

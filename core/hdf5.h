@@ -11,6 +11,7 @@
 #include <map>
 #include <memory>
 #include <optional>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -44,6 +45,72 @@ class Handle {
 void ReadFirstInChildProcess(const std::filesystem::path& path, const std::function<void()>& read,
                              double timeout_s = 0.0);
 
+// Arrays that a child process fills in place and its parent then takes, through an anonymous
+// memory file (Linux memfd): a large dataset is read once, in the child, and never held twice in
+// full (the parent gives the shared pages back as it copies them out).
+class SharedArrays {
+ public:
+  SharedArrays();  // Error{kIo} when the memory file cannot be made
+  ~SharedArrays();
+  SharedArrays(const SharedArrays&) = delete;
+  SharedArrays& operator=(const SharedArrays&) = delete;
+
+  // In the child: room for `count` values under `name` (at most 8 arrays, names under 32 bytes).
+  template <typename T>
+  [[nodiscard]] std::span<T> Allocate(const std::string& name, std::size_t count) {
+    return {static_cast<T*>(Allocate(name, count, sizeof(T))), count};
+  }
+  // In the parent, after ReadInChildProcess returned true: the array the child stored under
+  // `name` as values of T, or nothing when it stored none such.
+  template <typename T>
+  [[nodiscard]] std::optional<std::vector<T>> Take(const std::string& name) {
+    const Entry* entry = Find(name, sizeof(T));
+    if (entry == nullptr) return std::nullopt;
+    std::vector<T> values;
+    values.reserve(entry->count);
+    MoveOut(*entry, [&](const void* data, std::size_t count) {
+      const T* first = static_cast<const T*>(data);
+      values.insert(values.end(), first, first + count);
+    });
+    return values;
+  }
+
+ private:
+  friend bool ReadInChildProcess(const std::filesystem::path&, SharedArrays&,
+                                 const std::function<void(SharedArrays&)>&, double);
+  static constexpr std::uint32_t kMaxArrays = 8;
+  struct Entry {
+    char name[32] = {};
+    std::uint32_t value_bytes = 0;
+    std::uint64_t offset = 0;
+    std::uint64_t count = 0;
+  };
+  struct Directory {
+    std::uint32_t magic = 0;
+    std::uint32_t complete = 0;
+    std::uint32_t arrays = 0;
+    Entry entries[kMaxArrays];
+  };
+  void* Allocate(const std::string& name, std::size_t count, std::size_t value_bytes);
+  void MarkComplete();
+  [[nodiscard]] bool ReadDirectory();
+  [[nodiscard]] const Entry* Find(const std::string& name, std::size_t value_bytes) const;
+  void MoveOut(const Entry& entry, const std::function<void(const void*, std::size_t)>& append);
+
+  int fd_ = -1;
+  std::size_t end_ = 4096;  // the directory's page comes first
+  Directory directory_;
+  std::vector<std::pair<void*, std::size_t>> mappings_;  // the child's
+};
+
+// As ReadFirstInChildProcess, with the same refusals, but the child's `read` stores what it read
+// in `arrays` for the parent to take: the file's data are read once. True when the child read the
+// file and its arrays are there to take (the caller then reads only the file's header itself);
+// false when no child could be started, or the reader refused the file in the child: the caller
+// then reads the whole file itself, and a refusal comes again with the reader's own message.
+bool ReadInChildProcess(const std::filesystem::path& path, SharedArrays& arrays,
+                        const std::function<void(SharedArrays&)>& read, double timeout_s = 0.0);
+
 class File {
  public:
   // Opens read-only. Throws Error{kBadInput} if the file is not HDF5 or is damaged.
@@ -65,6 +132,13 @@ class File {
   [[nodiscard]] std::vector<double> ReadDoubles(const std::string& dataset) const;
   // Reads a numeric dataset as float (for float32 data that need no widening).
   [[nodiscard]] std::vector<float> ReadFloats(const std::string& dataset) const;
+  // The number of values of a numeric dataset; Error{kBadInput} when it is not numeric, or declares
+  // more values (of `value_bytes` each in memory) than the file could hold, so that a damaged
+  // header is refused before anything is allocated for it.
+  [[nodiscard]] std::size_t NumericCount(const std::string& dataset, std::size_t value_bytes) const;
+  // Reads a numeric dataset into `values`, which must hold NumericCount values (converted by HDF5).
+  void ReadInto(const std::string& dataset, std::span<double> values) const;
+  void ReadInto(const std::string& dataset, std::span<float> values) const;
   void WriteDoubles(const std::string& dataset, const std::vector<double>& values,
                     const std::vector<hsize_t>& shape);
   void WriteFloats(const std::string& dataset, const std::vector<float>& values,

@@ -1,5 +1,7 @@
+#include <fcntl.h>
 #include <fmt/format.h>
 #include <signal.h>
+#include <sys/mman.h>
 #include <sys/types.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -7,6 +9,7 @@
 #include <algorithm>
 #include <cerrno>
 #include <chrono>
+#include <cstdint>
 #include <cstdio>
 #include <cstring>
 #include <optional>
@@ -53,15 +56,16 @@ std::optional<int> WaitFor(pid_t child, double timeout_s) {
   }
 }
 
-}  // namespace
-
-void ReadFirstInChildProcess(const std::filesystem::path& path, const std::function<void()>& read,
-                             double timeout_s) {
-  if (g_in_child) return;
+// Runs `read` in a child process: false when no child could be started (or this is one already),
+// true when the child finished (whether its read succeeded or refused the file); throws when it
+// crashed or did not finish in time.
+bool RunInChildProcess(const std::filesystem::path& path, const std::function<void()>& read,
+                       double timeout_s) {
+  if (g_in_child) return false;
   if (timeout_s <= 0.0) timeout_s = DefaultTimeoutS(path);
   std::fflush(nullptr);  // nothing buffered twice
   const pid_t child = fork();
-  if (child < 0) return;  // no child to be had: read here, unguarded, as before
+  if (child < 0) return false;  // no child to be had: the caller reads, unguarded, as before
   if (child == 0) {
     g_in_child = true;
     try {
@@ -91,6 +95,109 @@ void ReadFirstInChildProcess(const std::filesystem::path& path, const std::funct
                     std::to_string(WIFEXITED(*status) ? WEXITSTATUS(*status) : -1) +
                     "); the file is damaged");
   }
+  return true;
+}
+
+// The first page of the memory file: which arrays it holds and where.
+constexpr std::uint32_t kMagic = 0x61726377;  // "arcw"
+constexpr std::size_t kPage = 4096;
+constexpr std::size_t kCopyChunk = 8u << 20;  // bytes copied out before their pages are given back
+
+std::size_t RoundUpToPage(std::size_t bytes) { return (bytes + kPage - 1) / kPage * kPage; }
+
+[[noreturn]] void ThrowSystemError(const std::string& what) {
+  throw Error(ErrorCode::kIo, kStage, what + ": " + std::strerror(errno));
+}
+
+}  // namespace
+
+SharedArrays::SharedArrays() : fd_(memfd_create("arcwheel-arrays", MFD_CLOEXEC)) {
+  static_assert(sizeof(Directory) <= kPage);
+  if (fd_ < 0) ThrowSystemError("cannot create shared memory for the child reader");
+  directory_.magic = kMagic;
+}
+
+SharedArrays::~SharedArrays() {
+  for (const auto& [address, bytes] : mappings_) munmap(address, bytes);
+  close(fd_);
+}
+
+void* SharedArrays::Allocate(const std::string& name, std::size_t count, std::size_t value_bytes) {
+  if (directory_.arrays == kMaxArrays || name.size() >= sizeof(Entry::name)) {
+    throw Error(ErrorCode::kInternal, kStage,
+                "too many shared arrays, or the name '" + name + "' is too long");
+  }
+  Entry& entry = directory_.entries[directory_.arrays++];
+  std::memcpy(entry.name, name.c_str(), name.size() + 1);
+  entry.value_bytes = static_cast<std::uint32_t>(value_bytes);
+  entry.count = count;
+  entry.offset = end_;
+  const std::size_t bytes = count * value_bytes;
+  if (bytes == 0) return nullptr;
+  end_ = RoundUpToPage(end_ + bytes);
+  if (ftruncate(fd_, static_cast<off_t>(end_)) != 0) ThrowSystemError("cannot grow the shared memory");
+  void* address =
+      mmap(nullptr, bytes, PROT_READ | PROT_WRITE, MAP_SHARED, fd_, static_cast<off_t>(entry.offset));
+  if (address == MAP_FAILED) ThrowSystemError("cannot map the shared memory");
+  mappings_.emplace_back(address, bytes);
+  return address;
+}
+
+void SharedArrays::MarkComplete() {
+  directory_.complete = 1;
+  if (pwrite(fd_, &directory_, sizeof directory_, 0) != static_cast<ssize_t>(sizeof directory_)) {
+    ThrowSystemError("cannot write the shared memory's directory");
+  }
+}
+
+bool SharedArrays::ReadDirectory() {
+  Directory directory;
+  if (pread(fd_, &directory, sizeof directory, 0) != static_cast<ssize_t>(sizeof directory)) return false;
+  if (directory.magic != kMagic || directory.complete != 1 || directory.arrays > kMaxArrays) return false;
+  directory_ = directory;
+  return true;
+}
+
+const SharedArrays::Entry* SharedArrays::Find(const std::string& name, std::size_t value_bytes) const {
+  for (std::uint32_t k = 0; k < directory_.arrays; ++k) {
+    const Entry& entry = directory_.entries[k];
+    if (name == entry.name && entry.value_bytes == value_bytes) return &entry;
+  }
+  return nullptr;
+}
+
+void SharedArrays::MoveOut(const Entry& entry, const std::function<void(const void*, std::size_t)>& append) {
+  const std::size_t bytes = entry.count * entry.value_bytes;
+  if (bytes == 0) return;
+  void* address = mmap(nullptr, bytes, PROT_READ, MAP_SHARED, fd_, static_cast<off_t>(entry.offset));
+  if (address == MAP_FAILED) ThrowSystemError("cannot map the shared memory");
+  // Chunks of whole pages and whole values, each given back to the system once copied, so that
+  // the array is never held twice in full.
+  const std::size_t chunk = kCopyChunk / entry.value_bytes * entry.value_bytes;
+  for (std::size_t done = 0; done < bytes; done += chunk) {
+    const std::size_t length = std::min(chunk, bytes - done);
+    append(static_cast<const char*>(address) + done, length / entry.value_bytes);
+    fallocate(fd_, FALLOC_FL_PUNCH_HOLE | FALLOC_FL_KEEP_SIZE, static_cast<off_t>(entry.offset + done),
+              static_cast<off_t>(length));
+  }
+  munmap(address, bytes);
+}
+
+void ReadFirstInChildProcess(const std::filesystem::path& path, const std::function<void()>& read,
+                             double timeout_s) {
+  (void)RunInChildProcess(path, read, timeout_s);
+}
+
+bool ReadInChildProcess(const std::filesystem::path& path, SharedArrays& arrays,
+                        const std::function<void(SharedArrays&)>& read, double timeout_s) {
+  const bool ran = RunInChildProcess(
+      path,
+      [&] {
+        read(arrays);
+        arrays.MarkComplete();
+      },
+      timeout_s);
+  return ran && arrays.ReadDirectory();
 }
 
 }  // namespace arcwheel::hdf5

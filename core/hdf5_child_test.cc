@@ -4,9 +4,13 @@
 #include <gtest/gtest.h>
 
 #include <chrono>
+#include <cstddef>
 #include <cstdlib>
+#include <optional>
+#include <span>
 #include <string>
 #include <thread>
+#include <vector>
 
 #include "core/error.h"
 #include "core/hdf5.h"
@@ -55,6 +59,68 @@ TEST(ReadFirstInChildProcess, LeavesAFinishedOrRefusedReadToTheCaller) {
 TEST(ReadFirstInChildProcess, ReadsDirectlyWhenCalledInsideTheChild) {
   // The reader calls the guard again from inside the child: that call must not run its read.
   EXPECT_EQ(MessageOf([] { ReadFirstInChildProcess(kPath, [] { std::abort(); }); }), "");
+}
+
+// ---- The read-once variant: the child's arrays handed to the parent. ----
+
+TEST(ReadInChildProcess, HandsTheChildsArraysToTheParentExactly) {
+  // 3e6 floats (12 MB) cross the 8 MB copy chunk; the doubles are the closed form i / 7.
+  constexpr std::size_t kFloats = 3'000'000;
+  constexpr std::size_t kDoubles = 1001;
+  SharedArrays arrays;
+  const bool handed = ReadInChildProcess(kPath, arrays, [](SharedArrays& shared) {
+    const std::span<float> floats = shared.Allocate<float>("z", kFloats);
+    for (std::size_t i = 0; i < kFloats; ++i) floats[i] = static_cast<float>(i) * 0.25f;
+    const std::span<double> doubles = shared.Allocate<double>("t", kDoubles);
+    for (std::size_t i = 0; i < kDoubles; ++i) doubles[i] = static_cast<double>(i) / 7.0;
+    (void)shared.Allocate<double>("empty", 0);
+  });
+  ASSERT_TRUE(handed);
+  const std::optional<std::vector<float>> floats = arrays.Take<float>("z");
+  ASSERT_TRUE(floats.has_value());
+  ASSERT_EQ(floats->size(), kFloats);
+  for (std::size_t i = 0; i < kFloats; i += 999) ASSERT_EQ((*floats)[i], static_cast<float>(i) * 0.25f) << i;
+  EXPECT_EQ(floats->back(), static_cast<float>(kFloats - 1) * 0.25f);
+  const std::optional<std::vector<double>> doubles = arrays.Take<double>("t");
+  ASSERT_TRUE(doubles.has_value());
+  ASSERT_EQ(doubles->size(), kDoubles);
+  for (std::size_t i = 0; i < kDoubles; ++i) ASSERT_EQ((*doubles)[i], static_cast<double>(i) / 7.0) << i;
+  EXPECT_EQ(arrays.Take<double>("empty").value().size(), 0u);
+  EXPECT_FALSE(arrays.Take<double>("z").has_value()) << "z was stored as float, not double";
+  EXPECT_FALSE(arrays.Take<float>("absent").has_value());
+}
+
+TEST(ReadInChildProcess, LeavesARefusedReadToTheCaller) {
+  SharedArrays arrays;
+  EXPECT_FALSE(ReadInChildProcess(kPath, arrays, [](SharedArrays& shared) {
+    (void)shared.Allocate<double>("z", 10);
+    throw Error(ErrorCode::kBadInput, "test", "a refusal of the reader's own");
+  }));
+}
+
+TEST(ReadInChildProcess, RefusesAFileWhoseReadKillsTheChild) {
+  SharedArrays arrays;
+  try {
+    (void)ReadInChildProcess(kPath, arrays, [](SharedArrays&) { std::abort(); });
+    FAIL() << "a crashed child must be reported";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.code(), ErrorCode::kBadInput);
+    EXPECT_NE(std::string(e.what()).find("'scan.h5': reading it crashed libhdf5 (signal 6"),
+              std::string::npos)
+        << e.what();
+  }
+}
+
+TEST(ReadInChildProcess, ReadsDirectlyWhenCalledInsideTheChild) {
+  // Inside the guard's child a reader's own guard must not fork again: it says "read it yourself".
+  SharedArrays outer;
+  const bool handed = ReadInChildProcess(kPath, outer, [](SharedArrays& shared) {
+    SharedArrays inner;
+    const bool nested = ReadInChildProcess(kPath, inner, [](SharedArrays&) { std::abort(); });
+    shared.Allocate<double>("nested", 1)[0] = nested ? 1.0 : 0.0;
+  });
+  ASSERT_TRUE(handed);
+  EXPECT_EQ(outer.Take<double>("nested").value().at(0), 0.0);
 }
 
 }  // namespace

@@ -107,16 +107,16 @@ double Median(std::vector<double> values) {
 // Variance of the mean of parameter `row` over the usable phases, exactly through the helix
 // spline (neighbouring phases share spline coefficients, so their errors correlate).
 double SigmaOfMean(const std::vector<PhaseSolution>& solutions, int row, const processing::WheelMap& map) {
-  std::vector<std::pair<double, double>> terms;
   int usable = 0;
   for (const auto& s : solutions) usable += s.fit.usable ? 1 : 0;
-  for (const auto& s : solutions) {
-    if (!s.fit.usable) continue;
-    for (std::size_t k = 0; k < s.u_deg.size(); ++k) {
-      terms.emplace_back(s.u_deg[k], s.circle.sensitivity_to_y(row, static_cast<Eigen::Index>(k)) / usable);
+  const double factor = map.spline->CovarianceFactorOfSum([&](const processing::HelixSpline::TermSink& add) {
+    for (const auto& s : solutions) {
+      if (!s.fit.usable) continue;
+      for (std::size_t k = 0; k < s.u_deg.size(); ++k) {
+        add(s.u_deg[k], s.circle.sensitivity_to_y(row, static_cast<Eigen::Index>(k)) / usable);
+      }
     }
-  }
-  const double factor = map.spline->CovarianceFactorOfSum(terms);
+  });
   return map.noise_sigma_mm * std::sqrt(std::max(0.0, factor));
 }
 

@@ -697,4 +697,11 @@ WheelModel FitWheelModel(std::span<const double> rho_mm, const processing::Helix
   return model;
 }
 
+WheelModel FitWheelModel(std::span<const float> rho_mm, const processing::HelixGeometry& geometry,
+                         const processing::WheelMap& map, const WheelFit& fit,
+                         const WheelModelOptions& options) {
+  const std::vector<double> widened(rho_mm.begin(), rho_mm.end());
+  return FitWheelModel(std::span<const double>(widened), geometry, map, fit, options);
+}
+
 }  // namespace arcwheel::fitting

@@ -90,5 +90,9 @@ struct WheelModel {
                                        const processing::HelixGeometry& geometry,
                                        const processing::WheelMap& map, const WheelFit& fit,
                                        const WheelModelOptions& options);
+[[nodiscard]] WheelModel FitWheelModel(std::span<const float> rho_mm,
+                                       const processing::HelixGeometry& geometry,
+                                       const processing::WheelMap& map, const WheelFit& fit,
+                                       const WheelModelOptions& options);
 
 }  // namespace arcwheel::fitting

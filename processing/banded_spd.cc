@@ -36,6 +36,16 @@ void BandedSpd::Solve(std::vector<double>& b) const {
   }
 }
 
+double BandedSpd::InverseQuadraticForm(std::vector<double>& b) const {
+  double sum = 0.0;
+  for (std::size_t i = 0; i < n_; ++i) {
+    const std::size_t k0 = i >= kBand ? i - kBand : 0;
+    for (std::size_t k = k0; k < i; ++k) b[i] -= a_[k][i - k] * b[k];
+    sum += b[i] * b[i] / a_[i][0];
+  }
+  return sum;
+}
+
 void BandedSpd::ComputeSelectedInverse() {
   // Z = A^{-1} satisfies Z = D^{-1} L^{-1} + (I - L^T) Z; within the band this needs only
   // band entries of Z below row j (Takahashi et al.).

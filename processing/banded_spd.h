@@ -30,11 +30,17 @@ class BandedSpd {
   [[nodiscard]] bool Factorize();
   // Solves A x = b (after Factorize) in place.
   void Solve(std::vector<double>& b) const;
+  // b^T A^{-1} b (after Factorize) as sum_i (L^{-1} b)_i^2 / D_i: one forward pass in place,
+  // which leaves b overwritten.
+  [[nodiscard]] double InverseQuadraticForm(std::vector<double>& b) const;
   // Entries of A^{-1} within the band, after Factorize: Inverse(i, j) for |i - j| <= 3.
   void ComputeSelectedInverse();
   [[nodiscard]] double Inverse(std::size_t i, std::size_t j) const {
     return i <= j ? z_[i][j - i] : z_[j][i - j];
   }
+  // Frees the selected inverse (Inverse and InverseInBand may not be called after).
+  void ReleaseSelectedInverse() { z_ = {}; }
+  [[nodiscard]] bool HasSelectedInverse() const { return z_.size() == n_; }
   // Inverse(i, i + d) for d = 0..3.
   [[nodiscard]] double InverseInBand(std::size_t i, int d) const {
     return z_[i][static_cast<std::size_t>(d)];

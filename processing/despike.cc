@@ -42,8 +42,8 @@ struct Sample {
 // the one being judged: no per-sample index array, so a 1e7-sample scan needs no more memory
 // than its own readings. Decisions use the original values; the rejected samples are changed
 // only after the pass.
-template <typename Statistic>
-std::vector<Sample> Reject(std::span<const double> z, int w, double threshold_mm, Statistic& statistic) {
+template <typename Statistic, typename T>
+std::vector<Sample> Reject(std::span<const T> z, int w, double threshold_mm, Statistic& statistic) {
   const auto half = static_cast<std::size_t>(w);
   std::deque<Sample> window;
   std::size_t centre = 0;
@@ -98,7 +98,8 @@ struct WindowMeanOfOthers {
 };
 
 // Index where the w-th valid sample before (direction -1) or after (+1) `from` lies, clamped.
-std::size_t ContextEdge(std::span<const double> z, std::size_t from, int w, int direction) {
+template <typename T>
+std::size_t ContextEdge(std::span<const T> z, std::size_t from, int w, int direction) {
   std::size_t i = from;
   for (int found = 0; found <= w;) {
     if (direction < 0 ? i == 0 : i + 1 >= z.size()) return direction < 0 ? 0 : z.size();
@@ -112,8 +113,8 @@ std::size_t ContextEdge(std::span<const double> z, std::size_t from, int w, int 
 // the other half as context and keeps only its own decisions, so the result is that of one pass
 // over the whole scan, but for the rounding of the running mean's sum, which starts afresh at a
 // half's context: the split is fixed at two halves so that no decision depends on the machine.
-template <typename Statistic>
-std::vector<Sample> RejectInParallel(std::span<const double> z, int w, double threshold_mm) {
+template <typename Statistic, typename T>
+std::vector<Sample> RejectInParallel(std::span<const T> z, int w, double threshold_mm) {
   const std::size_t middle = z.size() / 2;
   if (z.size() < 100000) {
     Statistic statistic;
@@ -137,7 +138,8 @@ std::vector<Sample> RejectInParallel(std::span<const double> z, int w, double th
 // Up to w valid samples on each side of i (i itself left out), none further than 4w positions
 // from it: across a dropout the wheel has turned on, and the readings there (several
 // micrometres away where the arc radius varies with phase) would outvote i's own neighbours.
-std::vector<std::size_t> NeighbourIndices(std::span<const double> z, std::size_t i, int w) {
+template <typename T>
+std::vector<std::size_t> NeighbourIndices(std::span<const T> z, std::size_t i, int w) {
   const std::size_t reach = 4 * static_cast<std::size_t>(w);
   std::vector<std::size_t> found;
   std::size_t left = 0;
@@ -157,7 +159,8 @@ std::vector<std::size_t> NeighbourIndices(std::span<const double> z, std::size_t
   return found;
 }
 
-std::vector<double> Neighbours(std::span<const double> z, std::size_t i, int w) {
+template <typename T>
+std::vector<double> Neighbours(std::span<const T> z, std::size_t i, int w) {
   std::vector<double> values;
   for (const std::size_t k : NeighbourIndices(z, i, w)) values.push_back(z[k]);
   return values;
@@ -171,8 +174,8 @@ double MedianOf(std::vector<double> values) {
 }
 
 // The neighbours (as NeighbourIndices) of any of `removed`, sorted and unique.
-std::vector<std::size_t> SamplesNear(std::span<const double> z, const std::vector<std::size_t>& removed,
-                                     int w) {
+template <typename T>
+std::vector<std::size_t> SamplesNear(std::span<const T> z, const std::vector<std::size_t>& removed, int w) {
   std::vector<std::size_t> near;
   for (const std::size_t r : removed) {
     const std::vector<std::size_t> found = NeighbourIndices(z, r, w);
@@ -188,20 +191,22 @@ std::vector<std::size_t> SamplesNear(std::span<const double> z, const std::vecto
 // judge again, without the samples already dropped, every sample whose window held one; they
 // stop when nothing more is dropped. Last, every dropped sample is judged against its kept
 // neighbours, and the good ones an early, spiked median condemned come back.
-void DespikeByMedian(std::span<double> z, int w, double threshold_mm, DespikeResult& result) {
+template <typename T>
+void DespikeByMedian(std::span<T> z, int w, double threshold_mm, DespikeResult& result) {
   constexpr int kMaxPasses = 8;
   std::vector<std::pair<std::size_t, double>> dropped;  // index, reading
   std::vector<std::size_t> newly;
-  for (const Sample& s : RejectInParallel<WindowMedian>(z, w, threshold_mm)) newly.push_back(s.index);
+  const std::span<const T> view(z);
+  for (const Sample& s : RejectInParallel<WindowMedian>(view, w, threshold_mm)) newly.push_back(s.index);
   for (int pass = 1; !newly.empty(); ++pass) {
     for (const std::size_t i : newly) {
       dropped.emplace_back(i, z[i]);
-      z[i] = kNaN;
+      z[i] = static_cast<T>(kNaN);
     }
     if (pass == kMaxPasses) break;
     std::vector<std::size_t> next;
-    for (const std::size_t i : SamplesNear(z, newly, w)) {
-      std::vector<double> window = Neighbours(z, i, w);
+    for (const std::size_t i : SamplesNear(view, newly, w)) {
+      std::vector<double> window = Neighbours(view, i, w);
       window.push_back(z[i]);
       if (std::abs(z[i] - MedianOf(std::move(window))) > threshold_mm) next.push_back(i);
     }
@@ -210,12 +215,12 @@ void DespikeByMedian(std::span<double> z, int w, double threshold_mm, DespikeRes
   // Decided for all before any comes back, so that none is judged with a restored one's help.
   std::vector<char> agrees(dropped.size(), 0);
   for (std::size_t k = 0; k < dropped.size(); ++k) {
-    const double median = MedianOf(Neighbours(z, dropped[k].first, w));
+    const double median = MedianOf(Neighbours(view, dropped[k].first, w));
     agrees[k] = std::isfinite(median) && std::abs(dropped[k].second - median) <= threshold_mm;
   }
   for (std::size_t k = 0; k < dropped.size(); ++k) {
     if (agrees[k]) {
-      z[dropped[k].first] = dropped[k].second;
+      z[dropped[k].first] = static_cast<T>(dropped[k].second);
     } else {
       result.indices.push_back(dropped[k].first);
     }
@@ -223,9 +228,10 @@ void DespikeByMedian(std::span<double> z, int w, double threshold_mm, DespikeRes
   std::sort(result.indices.begin(), result.indices.end());
 }
 
-void DespikeByMovingMean(std::span<double> z, int w, double threshold_mm, DespikeResult& result) {
-  for (const Sample& s : RejectInParallel<WindowMeanOfOthers>(z, w, threshold_mm)) {
-    z[s.index] = s.value;  // replaced by the mean of the others, as in the paper
+template <typename T>
+void DespikeByMovingMean(std::span<T> z, int w, double threshold_mm, DespikeResult& result) {
+  for (const Sample& s : RejectInParallel<WindowMeanOfOthers>(std::span<const T>(z), w, threshold_mm)) {
+    z[s.index] = static_cast<T>(s.value);  // replaced by the mean of the others, as in the paper
     result.indices.push_back(s.index);
   }
 }
@@ -265,7 +271,10 @@ std::string DespikeMethodName(DespikeMethod method) {
   return "none";
 }
 
-DespikeResult Despike(std::span<double> z_mm, double noise_sigma_mm, const DespikeOptions& options) {
+namespace {
+
+template <typename T>
+DespikeResult DespikeReadings(std::span<T> z_mm, double noise_sigma_mm, const DespikeOptions& options) {
   ThrowIfProblems(ErrorCode::kInvalidOption, "processing.despike", options.Problems());
   DespikeResult result;
   result.threshold_um =
@@ -281,6 +290,16 @@ DespikeResult Despike(std::span<double> z_mm, double noise_sigma_mm, const Despi
   }
   result.rejected = result.indices.size();
   return result;
+}
+
+}  // namespace
+
+DespikeResult Despike(std::span<double> z_mm, double noise_sigma_mm, const DespikeOptions& options) {
+  return DespikeReadings(z_mm, noise_sigma_mm, options);
+}
+
+DespikeResult Despike(std::span<float> z_mm, double noise_sigma_mm, const DespikeOptions& options) {
+  return DespikeReadings(z_mm, noise_sigma_mm, options);
 }
 
 }  // namespace arcwheel::processing

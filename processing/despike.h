@@ -45,5 +45,6 @@ struct DespikeResult {
 // Despikes `z_mm` in place (NaN = invalid, left alone). `noise_sigma_mm` sets the automatic
 // threshold.
 DespikeResult Despike(std::span<double> z_mm, double noise_sigma_mm, const DespikeOptions& options);
+DespikeResult Despike(std::span<float> z_mm, double noise_sigma_mm, const DespikeOptions& options);
 
 }  // namespace arcwheel::processing

@@ -19,7 +19,8 @@ namespace {
 // are dense; at 1e-7 the edge coefficients of a dropout swung by tens of micrometres.
 constexpr double kPenaltyRelative = 1e-4;
 
-std::pair<std::size_t, std::size_t> ValidSpan(std::span<const double> z) {
+template <typename T>
+std::pair<std::size_t, std::size_t> ValidSpan(std::span<const T> z) {
   std::size_t first = 0;
   while (first < z.size() && !std::isfinite(z[first])) ++first;
   std::size_t last = z.size();
@@ -48,6 +49,16 @@ HelixSpline::Basis HelixSpline::BasisAt(double u) const {
 
 HelixSpline::HelixSpline(std::span<const double> z, const HelixGeometry& geometry, double knot_step_deg)
     : h_(knot_step_deg), normal_(0) {
+  Fit(z, geometry);
+}
+
+HelixSpline::HelixSpline(std::span<const float> z, const HelixGeometry& geometry, double knot_step_deg)
+    : h_(knot_step_deg), normal_(0) {
+  Fit(z, geometry);
+}
+
+template <typename T>
+void HelixSpline::Fit(std::span<const T> z, const HelixGeometry& geometry) {
   const auto [first, last] = ValidSpan(z);
   ARCWHEEL_CHECK(first < last) << "no valid samples reached the helix spline";
   u_first_ = geometry.PhaseAt(first);
@@ -99,15 +110,17 @@ HelixSpline::HelixSpline(std::span<const double> z, const HelixGeometry& geometr
   normal_.ComputeSelectedInverse();
 }
 
-void HelixSpline::Accumulate(std::span<const double> z, const HelixGeometry& geometry, std::size_t begin,
+template <typename T>
+void HelixSpline::Accumulate(std::span<const T> z, const HelixGeometry& geometry, std::size_t begin,
                              std::size_t end, BandedSpd& normal, std::vector<double>& rhs,
                              std::vector<int>& counts) const {
   for (std::size_t i = begin; i < end; ++i) {
-    if (!std::isfinite(z[i])) continue;
+    const double value = z[i];
+    if (!std::isfinite(value)) continue;
     const Basis b = BasisAt(geometry.PhaseAt(i));
     ++counts[b.first];
     for (int a = 0; a < 4; ++a) {
-      rhs[b.first + a] += b.w[a] * z[i];
+      rhs[b.first + a] += b.w[a] * value;
       for (int c = a; c < 4; ++c) normal.Add(b.first + a, b.first + c, b.w[a] * b.w[c]);
     }
   }
@@ -121,6 +134,7 @@ double HelixSpline::Value(double u) const {
 }
 
 double HelixSpline::VarianceFactor(double u) const {
+  ARCWHEEL_CHECK(normal_.HasSelectedInverse()) << "the spline's variance factors were released";
   const Basis b = BasisAt(u);
   // The inverse is symmetric: the diagonal once, each entry above it twice.
   double v = 0.0;
@@ -145,17 +159,13 @@ int HelixSpline::Support(double u) const {
   return count;
 }
 
-double HelixSpline::CovarianceFactorOfSum(const std::vector<std::pair<double, double>>& terms) const {
+double HelixSpline::CovarianceFactorOfSum(const std::function<void(const TermSink&)>& terms) const {
   std::vector<double> v(coefficients_.size(), 0.0);
-  for (const auto& [u, weight] : terms) {
+  terms([&](double u, double weight) {
     const Basis b = BasisAt(u);
     for (int a = 0; a < 4; ++a) v[b.first + a] += weight * b.w[a];
-  }
-  std::vector<double> x = v;
-  normal_.Solve(x);
-  double sum = 0.0;
-  for (std::size_t i = 0; i < v.size(); ++i) sum += v[i] * x[i];
-  return sum;
+  });
+  return normal_.InverseQuadraticForm(v);
 }
 
 }  // namespace arcwheel::processing

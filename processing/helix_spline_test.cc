@@ -146,7 +146,10 @@ TEST(HelixSpline, AgreesWithADenseQrSolveOfTheSamePenalisedProblem) {
   Eigen::VectorXd v = Eigen::VectorXd::Zero(dense.coefficients.size());
   for (const auto& [u, w] : terms) v += w * dense.BasisRow(u);
   const double expected = v.dot(dense.inverse_normal * v);
-  EXPECT_NEAR(spline.CovarianceFactorOfSum(terms), expected, 1e-10 * expected);
+  const double factor = spline.CovarianceFactorOfSum([&](const HelixSpline::TermSink& add) {
+    for (const auto& [u, w] : terms) add(u, w);
+  });
+  EXPECT_NEAR(factor, expected, 1e-10 * expected);
 }
 
 TEST(HelixSpline, SupportCountsTheValidSamplesInTheTwoNearestKnotIntervals) {

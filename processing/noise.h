@@ -10,5 +10,6 @@ namespace arcwheel::processing {
 // wheel contributes almost nothing at one sample's spacing. MAD-based, so spikes do not
 // inflate it. Uses at most ~1e6 differences (evenly spread). Returns 0 for fewer than 10 triples.
 [[nodiscard]] double EstimateNoiseSigmaMm(std::span<const double> z_mm);
+[[nodiscard]] double EstimateNoiseSigmaMm(std::span<const float> z_mm);
 
 }  // namespace arcwheel::processing

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <span>
+#include <type_traits>
 #include <vector>
 
 #include "core/error.h"
@@ -17,10 +18,11 @@ namespace {
 
 constexpr const char* kStage = "processing";
 
-// rho = radius_sign * z, in place; invalid samples stay NaN.
-void ToRadialCoordinate(acquisition::Scan& scan) {
+// rho = radius_sign * z, in place (exact in float and double); invalid samples stay NaN.
+template <typename T>
+void ToRadialCoordinate(const acquisition::Scan& scan, std::vector<T>& rho) {
   if (scan.metadata.radius_sign < 0) {
-    for (double& v : scan.z_mm) v = -v;
+    for (T& v : rho) v = -v;
   }
 }
 
@@ -63,17 +65,19 @@ void CheckOptions(const acquisition::Scan& scan, const ProcessOptions& options) 
 }
 
 // Step 1: the valid samples and the span from the first to the last of them.
-void FindValidSpan(const std::vector<double>& rho, ProcessedScan& out) {
-  out.valid_samples = static_cast<std::size_t>(
-      std::count_if(rho.begin(), rho.end(), [](double v) { return std::isfinite(v); }));
-  const auto first = std::find_if(rho.begin(), rho.end(), [](double v) { return std::isfinite(v); });
-  const auto last = std::find_if(rho.rbegin(), rho.rend(), [](double v) { return std::isfinite(v); });
+template <typename T>
+void FindValidSpan(const std::vector<T>& rho, ProcessedScan& out) {
+  const auto finite = [](T v) { return std::isfinite(static_cast<double>(v)); };
+  out.valid_samples = static_cast<std::size_t>(std::count_if(rho.begin(), rho.end(), finite));
+  const auto first = std::find_if(rho.begin(), rho.end(), finite);
+  const auto last = std::find_if(rho.rbegin(), rho.rend(), finite);
   out.first_valid = static_cast<std::size_t>(first - rho.begin());
   out.last_valid = rho.size() - 1 - static_cast<std::size_t>(last - rho.rbegin());
 }
 
 // Drops runs of equal readings (a stuck sensor); refuses a scan that is nothing else.
-void DropStuckSensorRuns(const acquisition::Scan& scan, std::vector<double>& rho, double stuck_run_deg,
+template <typename T>
+void DropStuckSensorRuns(const acquisition::Scan& scan, std::vector<T>& rho, double stuck_run_deg,
                          ProcessedScan& out) {
   out.stuck = DropStuckReadings(rho, StuckRunSamples(scan, stuck_run_deg));
   if (out.stuck.dropped > 0 && out.stuck.dropped == out.valid_samples) {
@@ -92,11 +96,12 @@ void DropStuckSensorRuns(const acquisition::Scan& scan, std::vector<double>& rho
 }
 
 // Steps 2-3: noise, despiking, and the noise again of what is left.
-void DespikeAndEstimateNoise(std::vector<double>& rho, const DespikeOptions& options, ProcessedScan& out) {
-  out.noise_sigma_mm = EstimateNoiseSigmaMm(rho);
-  out.despike = Despike(rho, out.noise_sigma_mm, options);
+template <typename T>
+void DespikeAndEstimateNoise(std::vector<T>& rho, const DespikeOptions& options, ProcessedScan& out) {
+  out.noise_sigma_mm = EstimateNoiseSigmaMm(std::span<const T>(rho));
+  out.despike = Despike(std::span<T>(rho), out.noise_sigma_mm, options);
   // The noise that matters for the sigmas is that of the samples the map is built from.
-  out.noise_sigma_mm = EstimateNoiseSigmaMm(rho);
+  out.noise_sigma_mm = EstimateNoiseSigmaMm(std::span<const T>(rho));
   if (out.despike.rejected > out.valid_samples / 10) {
     out.warnings.push_back(
         fmt::format("despiking rejected {} of {} valid samples: check the threshold ({:.3g} um)",
@@ -119,7 +124,8 @@ void CorrectBeamOffsetIfAsked(const acquisition::Scan& scan, std::vector<double>
 }
 
 // Step 5 without an encoder: the nominal speed, or the estimate when it is significant or asked for.
-void ChooseSpeedWithoutEncoder(const acquisition::Scan& scan, std::span<const double> rho,
+template <typename T>
+void ChooseSpeedWithoutEncoder(const acquisition::Scan& scan, std::span<const T> rho,
                                const ProcessOptions& options, ProcessedScan& out) {
   if (!scan.metadata.spindle_rpm) {
     throw Error(ErrorCode::kBadInput, kStage, "'" + scan.path + "' lacks spindle_rpm");
@@ -140,7 +146,8 @@ void ChooseSpeedWithoutEncoder(const acquisition::Scan& scan, std::span<const do
 }
 
 // Step 5: the encoder when there is one and it is allowed, else ChooseSpeedWithoutEncoder.
-void ChooseSpeed(const acquisition::Scan& scan, std::span<const double> rho, const ProcessOptions& options,
+template <typename T>
+void ChooseSpeed(const acquisition::Scan& scan, std::span<const T> rho, const ProcessOptions& options,
                  ProcessedScan& out) {
   const bool use_encoder = scan.has_encoder() && (options.rpm_source == RpmSource::kAuto ||
                                                   options.rpm_source == RpmSource::kEncoder);
@@ -194,27 +201,47 @@ ProcessedScan ProcessScan(acquisition::Scan scan, const ProcessOptions& options)
   return ProcessScanInPlace(scan, options);
 }
 
-ProcessedScan ProcessScanInPlace(acquisition::Scan& scan, const ProcessOptions& options) {
-  CheckOptions(scan, options);
+namespace {
+
+// The steps on the readings, in float or double as the scan holds them.
+template <typename T>
+ProcessedScan ProcessReadings(acquisition::Scan& scan, std::vector<T>& rho, const ProcessOptions& options) {
   ProcessedScan out;
+  StageClock& clock = out.timings;
   out.samples = scan.size();
   out.warnings = scan.metadata.notes;  // what the reader noticed comes first
-  ToRadialCoordinate(scan);
-  std::vector<double>& rho = scan.z_mm;
+  clock.Start("valid span");
+  ToRadialCoordinate(scan, rho);
   FindValidSpan(rho, out);
   ThrowIfInterrupted();
 
+  clock.Start("stuck readings");
   DropStuckSensorRuns(scan, rho, options.stuck_run_deg, out);
+  clock.Start("noise and despike");
   DespikeAndEstimateNoise(rho, options.despike, out);
   ThrowIfInterrupted();
 
-  CorrectBeamOffsetIfAsked(scan, rho, options);
-  ChooseSpeed(scan, rho, options, out);
+  clock.Start("spindle speed");
+  if constexpr (std::is_same_v<T, double>) CorrectBeamOffsetIfAsked(scan, rho, options);
+  ChooseSpeed(scan, std::span<const T>(rho), options, out);
   ThrowIfInterrupted();
 
   const HelixGeometry geometry(scan, out.rpm_used);
-  out.map = BuildWheelMap(rho, geometry, out.noise_sigma_mm, out.despike.indices, options.map);
+  out.map = BuildWheelMap(std::span<const T>(rho), geometry, out.noise_sigma_mm, out.despike.indices,
+                          options.map, &clock);
   return out;
+}
+
+}  // namespace
+
+ProcessedScan ProcessScanInPlace(acquisition::Scan& scan, const ProcessOptions& options) {
+  CheckOptions(scan, options);
+  // Steps that change readings by arithmetic work in double, so that their results do not depend
+  // on how the file stored the readings.
+  if (options.beam_offset_mm != 0.0 || options.despike.method == DespikeMethod::kMovingMean) {
+    scan.WidenToDouble();
+  }
+  return acquisition::VisitReadings(scan, [&](auto& rho) { return ProcessReadings(scan, rho, options); });
 }
 
 }  // namespace arcwheel::processing

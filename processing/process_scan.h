@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "acquisition/scan.h"
+#include "core/stage_clock.h"
 #include "processing/despike.h"
 #include "processing/helix_geometry.h"
 #include "processing/spindle_speed.h"
@@ -55,6 +56,7 @@ struct ProcessedScan {
   double rpm_used = 0.0;
   WheelMap map;
   std::vector<std::string> warnings;
+  StageClock timings;  // wall time of each step above
 };
 
 // Throws Error{kInvalidOption} for bad options, kBadInput for scans that cannot be mapped.
@@ -63,7 +65,8 @@ struct ProcessedScan {
 [[nodiscard]] ProcessedScan ProcessScan(acquisition::Scan scan, const ProcessOptions& options);
 
 // As ProcessScan, but the radial coordinate the map was built from (despiked; NaN where invalid)
-// stays in scan.z_mm, for the wheel model's fit of every sample (fitting/wheel_model.h).
+// stays in the scan's readings (z_float_mm or z_mm, see acquisition::VisitReadings), for the wheel
+// model's fit of every sample (fitting/wheel_model.h).
 [[nodiscard]] ProcessedScan ProcessScanInPlace(acquisition::Scan& scan, const ProcessOptions& options);
 
 }  // namespace arcwheel::processing

@@ -48,7 +48,8 @@ struct PhaseBins {
   std::vector<int> count;
 };
 
-PhaseBins BinByPhase(const acquisition::Scan& scan, std::span<const double> z, double rpm, int bins) {
+template <typename T>
+PhaseBins BinByPhase(const acquisition::Scan& scan, std::span<const T> z, double rpm, int bins) {
   const HelixGeometry geometry(scan, rpm);
   const double u0 = geometry.PhaseAt(0);
   PhaseBins out;
@@ -136,8 +137,9 @@ TurnHarmonics FitWindow(const PhaseBins& bins, const std::vector<std::size_t>& c
 // Bins the scan by phase at `rpm` and fits each window whose turns are 90 % covered (FitWindow);
 // `turn` is the window's middle. Windows start every `spacing` windows, at most kMaxWindows of
 // them; `spacing` 0 spreads them over the whole scan.
-std::vector<TurnHarmonics> FitTurns(const acquisition::Scan& scan, std::span<const double> z, double rpm,
-                                    int bins, int harmonics, std::size_t spacing) {
+template <typename T>
+std::vector<TurnHarmonics> FitTurns(const acquisition::Scan& scan, std::span<const T> z, double rpm, int bins,
+                                    int harmonics, std::size_t spacing) {
   const PhaseBins binned = BinByPhase(scan, z, rpm, bins);
   const auto window = static_cast<std::size_t>(kTurnsPerWindow);
   const std::size_t stride = window * (spacing > 0 ? spacing : SpreadSpacing(binned.turns));
@@ -275,8 +277,11 @@ std::vector<std::string> SpindleSpeedOptions::Problems() const {
   return problems;
 }
 
-SpindleSpeedEstimate EstimateSpindleSpeed(const acquisition::Scan& scan, std::span<const double> z,
-                                          const SpindleSpeedOptions& options) {
+namespace {
+
+template <typename T>
+SpindleSpeedEstimate EstimateSpeed(const acquisition::Scan& scan, std::span<const T> z,
+                                   const SpindleSpeedOptions& options) {
   ThrowIfProblems(ErrorCode::kInvalidOption, "processing.speed", options.Problems());
   ARCWHEEL_CHECK(!scan.has_encoder()) << "speed estimation needs a scan without an encoder";
   SpindleSpeedEstimate estimate;
@@ -321,6 +326,18 @@ SpindleSpeedEstimate EstimateSpindleSpeed(const acquisition::Scan& scan, std::sp
   }
   SetResult(rpm, sigma_relative, options, estimate);
   return estimate;
+}
+
+}  // namespace
+
+SpindleSpeedEstimate EstimateSpindleSpeed(const acquisition::Scan& scan, std::span<const double> z_mm,
+                                          const SpindleSpeedOptions& options) {
+  return EstimateSpeed(scan, z_mm, options);
+}
+
+SpindleSpeedEstimate EstimateSpindleSpeed(const acquisition::Scan& scan, std::span<const float> z_mm,
+                                          const SpindleSpeedOptions& options) {
+  return EstimateSpeed(scan, z_mm, options);
 }
 
 }  // namespace arcwheel::processing

@@ -52,5 +52,8 @@ struct SpindleSpeedEstimate {
 [[nodiscard]] SpindleSpeedEstimate EstimateSpindleSpeed(const acquisition::Scan& scan,
                                                         std::span<const double> z_mm,
                                                         const SpindleSpeedOptions& options);
+[[nodiscard]] SpindleSpeedEstimate EstimateSpindleSpeed(const acquisition::Scan& scan,
+                                                        std::span<const float> z_mm,
+                                                        const SpindleSpeedOptions& options);
 
 }  // namespace arcwheel::processing

@@ -6,7 +6,10 @@
 
 namespace arcwheel::processing {
 
-StuckReadingsResult DropStuckReadings(std::span<double> z_mm, std::size_t min_run) {
+namespace {
+
+template <typename T>
+StuckReadingsResult DropStuck(std::span<T> z_mm, std::size_t min_run) {
   StuckReadingsResult result;
   result.min_run = min_run;
   if (min_run < 2) return result;
@@ -19,7 +22,7 @@ StuckReadingsResult DropStuckReadings(std::span<double> z_mm, std::size_t min_ru
     const std::size_t length = end - begin;
     if (std::isfinite(z_mm[begin]) && length >= min_run) {
       std::fill(z_mm.begin() + static_cast<std::ptrdiff_t>(begin),
-                z_mm.begin() + static_cast<std::ptrdiff_t>(end), std::numeric_limits<double>::quiet_NaN());
+                z_mm.begin() + static_cast<std::ptrdiff_t>(end), std::numeric_limits<T>::quiet_NaN());
       result.dropped += length;
       ++result.runs;
       result.longest_run = std::max(result.longest_run, length);
@@ -27,6 +30,16 @@ StuckReadingsResult DropStuckReadings(std::span<double> z_mm, std::size_t min_ru
     begin = end;
   }
   return result;
+}
+
+}  // namespace
+
+StuckReadingsResult DropStuckReadings(std::span<double> z_mm, std::size_t min_run) {
+  return DropStuck(z_mm, min_run);
+}
+
+StuckReadingsResult DropStuckReadings(std::span<float> z_mm, std::size_t min_run) {
+  return DropStuck(z_mm, min_run);
 }
 
 }  // namespace arcwheel::processing

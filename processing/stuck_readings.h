@@ -21,5 +21,6 @@ struct StuckReadingsResult {
 // Sets to NaN every run of `min_run` or more consecutive valid samples with exactly equal values
 // (bitwise, as the sensor wrote them); an invalid sample ends a run. `min_run` < 2 drops nothing.
 StuckReadingsResult DropStuckReadings(std::span<double> z_mm, std::size_t min_run);
+StuckReadingsResult DropStuckReadings(std::span<float> z_mm, std::size_t min_run);
 
 }  // namespace arcwheel::processing

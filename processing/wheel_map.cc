@@ -4,11 +4,13 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 #include <numeric>
 
 #include "core/error.h"
 #include "core/interrupt.h"
+#include "core/parallel.h"
 #include "processing/cubic_interpolation.h"
 
 namespace arcwheel::processing {
@@ -99,33 +101,92 @@ void InterpolateSection(const Section& section, std::span<const double> nodes, d
   }
 }
 
-}  // namespace
+// The map cell of a sample: the phase node nearest its phase in the turn, and the axial node
+// nearest its axial position (-1 when outside the map). Exactly lround(fmod(u, 360) / phase step)
+// and round((y - y_low) / axial step), but without a libm call per sample: fmod(u, 360) is
+// u - 360 trunc(u / 360), exact by Sterbenz's lemma, with one turn added back where u / 360
+// rounded up to the next integer; rounding half away from zero is the integer part plus one
+// where the fraction is at least one half.
+class CellOfSample {
+ public:
+  CellOfSample(std::size_t n_phase, std::size_t n_y, double y_low, double axial_step_mm)
+      : n_phase_(n_phase),
+        n_y_(n_y),
+        phase_step_(360.0 / static_cast<double>(n_phase)),
+        y_low_(y_low),
+        axial_step_(axial_step_mm) {}
 
-std::vector<std::string> MapOptions::Problems() const {
-  std::vector<std::string> problems;
-  if (phases < 4 || phases > 36000)
-    problems.push_back(fmt::format("--phases = {} violates 4..36000", phases));
-  if (!std::isfinite(knot_step_deg) || knot_step_deg > 90)
-    problems.push_back(fmt::format("--knot-step-deg = {} violates finite and <= 90", knot_step_deg));
-  if (!std::isfinite(axial_step_mm))
-    problems.push_back(fmt::format("--axial-step-mm = {} violates finite", axial_step_mm));
-  if (min_support < 1) problems.push_back(fmt::format("map.min_support = {} violates >= 1", min_support));
-  if (!(max_sigma_ratio >= 1.0))
-    problems.push_back(fmt::format("map.max_sigma_ratio = {} violates >= 1", max_sigma_ratio));
-  return problems;
+  [[nodiscard]] long operator()(double u_deg, double y_mm) const {
+    const double t = (y_mm - y_low_) / axial_step_;
+    if (!(t > -0.5) || !(t < static_cast<double>(n_y_))) return -1;  // round(-0.4) is -0: row 0
+    const std::size_t m = t < 0.0 ? 0 : RoundHalfUp(t);
+    if (m >= n_y_) return -1;
+    const std::size_t j = RoundHalfUp(PhaseInTurn(u_deg) / phase_step_) % n_phase_;
+    return static_cast<long>(j * n_y_ + m);
+  }
+
+ private:
+  static double PhaseInTurn(double u_deg) {
+    if (!(u_deg >= 0.0 && u_deg < 1e15)) {
+      const double c = std::fmod(u_deg, 360.0);
+      return c < 0 ? c + 360.0 : c;
+    }
+    const double c = u_deg - 360.0 * static_cast<double>(static_cast<std::int64_t>(u_deg / 360.0));
+    return c < 0.0 ? c + 360.0 : c;
+  }
+  // round(v) for 0 <= v < 2^52.
+  static std::size_t RoundHalfUp(double v) {
+    const auto k = static_cast<std::size_t>(v);
+    return v - static_cast<double>(k) >= 0.5 ? k + 1 : k;
+  }
+
+  std::size_t n_phase_, n_y_;
+  double phase_step_, y_low_, axial_step_;
+};
+
+// Coverage diagnostics: raw and despiked samples per cell around each node. Two workers count the
+// two halves of the scan (integer sums: the same on any machine).
+template <typename T>
+void CountCoverage(std::span<const T> rho, const HelixGeometry& geometry,
+                   std::span<const std::size_t> despiked, double y_low, WheelMap& map) {
+  const CellOfSample cell_of(map.n_phase(), map.n_y(), y_low, map.axial_step_mm);
+  const std::size_t cells = map.n_phase() * map.n_y();
+  std::vector<int> upper(cells, 0);
+  map.sample_count.assign(cells, 0);
+  RunOnWorkers(2, [&](int half) {
+    std::vector<int>& counts = half == 0 ? map.sample_count : upper;
+    const std::size_t begin = half == 0 ? 0 : rho.size() / 2;
+    const std::size_t end = half == 0 ? rho.size() / 2 : rho.size();
+    for (std::size_t i = begin; i < end; ++i) {
+      if (!std::isfinite(static_cast<double>(rho[i]))) continue;
+      if (const long cell = cell_of(geometry.PhaseAt(i), geometry.AxialAt(i)); cell >= 0) {
+        ++counts[static_cast<std::size_t>(cell)];
+      }
+    }
+  });
+  for (std::size_t c = 0; c < cells; ++c) map.sample_count[c] += upper[c];
+  map.despiked_count.assign(cells, 0);
+  for (const std::size_t i : despiked) {
+    if (const long cell = cell_of(geometry.PhaseAt(i), geometry.AxialAt(i)); cell >= 0) {
+      ++map.despiked_count[static_cast<std::size_t>(cell)];
+    }
+  }
 }
 
-WheelMap BuildWheelMap(std::span<const double> rho, const HelixGeometry& geometry, double noise_sigma_mm,
-                       std::span<const std::size_t> despiked, const MapOptions& options) {
+template <typename T>
+WheelMap Build(std::span<const T> rho, const HelixGeometry& geometry, double noise_sigma_mm,
+               std::span<const std::size_t> despiked, const MapOptions& options, StageClock* clock) {
   ThrowIfProblems(ErrorCode::kInvalidOption, "processing.map", options.Problems());
+  if (clock != nullptr) clock->Start("helix spline");
   const auto valid = static_cast<std::size_t>(
-      std::count_if(rho.begin(), rho.end(), [](double v) { return std::isfinite(v); }));
+      std::count_if(rho.begin(), rho.end(), [](T v) { return std::isfinite(static_cast<double>(v)); }));
   WheelMap map;
   map.noise_sigma_mm = noise_sigma_mm;
   map.knot_step_deg = ChooseKnotStep(options, geometry, valid);
   map.pitch_mm = geometry.PitchMm();
   auto spline = std::make_shared<HelixSpline>(rho, geometry, map.knot_step_deg);
 
+  if (clock != nullptr) clock->Start("sections and map");
   const auto n_phase = static_cast<std::size_t>(options.phases);
   map.phase_deg.resize(n_phase);
   map.sections.resize(n_phase);
@@ -133,6 +194,7 @@ WheelMap BuildWheelMap(std::span<const double> rho, const HelixGeometry& geometr
     map.phase_deg[j] = 360.0 * static_cast<double>(j) / options.phases;
     map.sections[j] = SampleSection(*spline, geometry, map.phase_deg[j], noise_sigma_mm, options.min_support);
   }
+  spline->ReleaseVarianceFactors();  // the section sigmas were the last use
   DropImpreciseSectionPoints(map.sections, options.max_sigma_ratio);
   double y_low = -std::numeric_limits<double>::infinity();
   double y_high = std::numeric_limits<double>::infinity();
@@ -156,26 +218,37 @@ WheelMap BuildWheelMap(std::span<const double> rho, const HelixGeometry& geometr
     InterpolateSection(map.sections[j], map.y_mm, map.pitch_mm, std::span(map.rho_mm).subspan(j * n_y, n_y));
   }
 
-  // Coverage diagnostics: raw samples per cell around each node.
-  map.sample_count.assign(n_phase * n_y, 0);
-  map.despiked_count.assign(n_phase * n_y, 0);
-  const double phase_step = 360.0 / options.phases;
-  const auto cell_of = [&](std::size_t i) -> long {
-    const double c = std::fmod(geometry.PhaseAt(i), 360.0);
-    const auto j = static_cast<std::size_t>(std::lround((c < 0 ? c + 360.0 : c) / phase_step)) % n_phase;
-    const double m = std::round((geometry.AxialAt(i) - y_low) / map.axial_step_mm);
-    if (m < 0 || m >= static_cast<double>(n_y)) return -1;
-    return static_cast<long>(j * n_y + static_cast<std::size_t>(m));
-  };
-  for (std::size_t i = 0; i < rho.size(); ++i) {
-    if (!std::isfinite(rho[i])) continue;
-    if (const long cell = cell_of(i); cell >= 0) ++map.sample_count[static_cast<std::size_t>(cell)];
-  }
-  for (const std::size_t i : despiked) {
-    if (const long cell = cell_of(i); cell >= 0) ++map.despiked_count[static_cast<std::size_t>(cell)];
-  }
+  if (clock != nullptr) clock->Start("coverage counts");
+  CountCoverage(rho, geometry, despiked, y_low, map);
   map.spline = std::move(spline);
+  if (clock != nullptr) clock->Stop();
   return map;
+}
+
+}  // namespace
+
+std::vector<std::string> MapOptions::Problems() const {
+  std::vector<std::string> problems;
+  if (phases < 4 || phases > 36000)
+    problems.push_back(fmt::format("--phases = {} violates 4..36000", phases));
+  if (!std::isfinite(knot_step_deg) || knot_step_deg > 90)
+    problems.push_back(fmt::format("--knot-step-deg = {} violates finite and <= 90", knot_step_deg));
+  if (!std::isfinite(axial_step_mm))
+    problems.push_back(fmt::format("--axial-step-mm = {} violates finite", axial_step_mm));
+  if (min_support < 1) problems.push_back(fmt::format("map.min_support = {} violates >= 1", min_support));
+  if (!(max_sigma_ratio >= 1.0))
+    problems.push_back(fmt::format("map.max_sigma_ratio = {} violates >= 1", max_sigma_ratio));
+  return problems;
+}
+
+WheelMap BuildWheelMap(std::span<const double> rho_mm, const HelixGeometry& geometry, double noise_sigma_mm,
+                       std::span<const std::size_t> despiked, const MapOptions& options, StageClock* clock) {
+  return Build(rho_mm, geometry, noise_sigma_mm, despiked, options, clock);
+}
+
+WheelMap BuildWheelMap(std::span<const float> rho_mm, const HelixGeometry& geometry, double noise_sigma_mm,
+                       std::span<const std::size_t> despiked, const MapOptions& options, StageClock* clock) {
+  return Build(rho_mm, geometry, noise_sigma_mm, despiked, options, clock);
 }
 
 }  // namespace arcwheel::processing

@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "core/stage_clock.h"
 #include "processing/helix_geometry.h"
 #include "processing/helix_spline.h"
 
@@ -55,8 +56,12 @@ struct WheelMap {
 };
 
 // `rho_mm` per sample (NaN = invalid), already despiked. `despiked` lists rejected samples.
+// `clock`, when given, times the steps.
 [[nodiscard]] WheelMap BuildWheelMap(std::span<const double> rho_mm, const HelixGeometry& geometry,
                                      double noise_sigma_mm, std::span<const std::size_t> despiked,
-                                     const MapOptions& options);
+                                     const MapOptions& options, StageClock* clock = nullptr);
+[[nodiscard]] WheelMap BuildWheelMap(std::span<const float> rho_mm, const HelixGeometry& geometry,
+                                     double noise_sigma_mm, std::span<const std::size_t> despiked,
+                                     const MapOptions& options, StageClock* clock = nullptr);
 
 }  // namespace arcwheel::processing

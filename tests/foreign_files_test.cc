@@ -93,6 +93,24 @@ bool HasNote(const Scan& scan, const std::string& text) {
   return false;
 }
 
+// `arcwheel process` keeps float32 readings as float32 (half the memory): widened, they must be
+// the very samples of a plain read, whatever the writer did (byte order, chunks, filters).
+TEST_F(ForeignFiles, Float32ReadingsKeptAsFloatAreTheSamplesOfAPlainRead) {
+  int kept_as_float = 0;
+  for (const auto& [name, expected] : expected_.items()) {
+    if (!expected.contains("text") || std::filesystem::path(name).extension() != ".h5") continue;
+    SCOPED_TRACE(name);
+    const Scan plain = acquisition::ReadScan(Good(name));
+    Scan kept = acquisition::ReadScan(Good(name), {.keep_float32 = true});
+    kept_as_float += kept.holds_float() ? 1 : 0;
+    EXPECT_EQ(kept.CountValid(), plain.CountValid());
+    kept.WidenToDouble();
+    ExpectSameColumn(kept.z_mm, plain.z_mm, "z");
+    ExpectSameColumn(kept.t_s, plain.t_s, "t");
+  }
+  EXPECT_GE(kept_as_float, 3) << "h5py's float32 variants (plain, big-endian, compressed) stay float32";
+}
+
 TEST_F(ForeignFiles, EveryVariantReadsToTheSamplesNumbersAndTextOfThePlainFile) {
   const Scan plain = acquisition::ReadScan(Base());
   ASSERT_GT(plain.size() - plain.CountValid(), 50u) << "the scan must carry invalid samples";

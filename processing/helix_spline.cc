@@ -70,25 +70,27 @@ void HelixSpline::Fit(std::span<const T> z, const HelixGeometry& geometry) {
   normal_ = BandedSpd(n);
   std::vector<double> rhs(n, 0.0);
 
-  // Two workers accumulate the normal equations of the two halves; the sums are added. Always two,
-  // so that the order of the sums, and with it every coefficient, does not depend on the machine.
+  // Two workers accumulate the two halves of the scan into the normal equations. The phase rises
+  // with the sample index, so the halves meet in one knot interval: the upper half sums what it
+  // adds to the few rows the lower half also reaches in a small block of its own, added after
+  // both have finished, and the rest in place. Always two halves, so that the order of the sums,
+  // and with it every coefficient, does not depend on the machine.
   const std::size_t middle = first + (last - first) / 2;
-  BandedSpd upper_normal(n);
-  std::vector<double> upper_rhs(n, 0.0);
-  std::vector<int> upper_counts(cells, 0);
+  const std::size_t lower_last = middle > first ? middle - 1 : first;
+  SharedRows shared;
+  shared.begin = middle < last ? BasisAt(geometry.PhaseAt(middle)).first : n;
+  shared.end = std::max(shared.begin, BasisAt(geometry.PhaseAt(lower_last)).first + BandedSpd::kBand + 1);
+  shared.normal = BandedSpd(shared.end - shared.begin + BandedSpd::kBand);
+  shared.rhs.assign(shared.end - shared.begin + BandedSpd::kBand, 0.0);
+  shared.counts.assign(shared.end - shared.begin, 0);
   RunOnWorkers(2, [&, begin = first, end = last](int half) {
     if (half == 0) {
-      Accumulate(z, geometry, begin, middle, normal_, rhs, cell_counts_);
+      Accumulate(z, geometry, begin, middle, rhs, nullptr);
     } else {
-      Accumulate(z, geometry, middle, end, upper_normal, upper_rhs, upper_counts);
+      Accumulate(z, geometry, middle, end, rhs, &shared);
     }
   });
-  for (std::size_t i = 0; i < n; ++i) {
-    rhs[i] += upper_rhs[i];
-    for (std::size_t j = i; j <= std::min(n - 1, i + BandedSpd::kBand); ++j)
-      normal_.Add(i, j, upper_normal.Get(i, j));
-  }
-  for (std::size_t c = 0; c < cells; ++c) cell_counts_[c] += upper_counts[c];
+  AddSharedRows(shared, shared.begin, shared.end + BandedSpd::kBand, rhs);
   ThrowIfInterrupted();
   // Penalty lambda * |D2 c|^2 with lambda relative to the mean diagonal.
   double mean_diagonal = 0.0;
@@ -110,18 +112,51 @@ void HelixSpline::Fit(std::span<const T> z, const HelixGeometry& geometry) {
   normal_.ComputeSelectedInverse();
 }
 
+void HelixSpline::AddSharedRows(SharedRows& shared, std::size_t from, std::size_t to,
+                                std::vector<double>& rhs) {
+  const std::size_t n = rhs.size();
+  for (std::size_t i = from; i < std::min(to, n); ++i) {
+    const std::size_t r = i - shared.begin;
+    rhs[i] += shared.rhs[r];
+    shared.rhs[r] = 0.0;
+    if (r < shared.counts.size()) {
+      cell_counts_[i] += shared.counts[r];
+      shared.counts[r] = 0;
+    }
+    for (std::size_t j = i; j <= std::min(n - 1, i + BandedSpd::kBand); ++j) {
+      normal_.Add(i, j, shared.normal.Get(r, j - shared.begin));
+      shared.normal.Add(r, j - shared.begin, -shared.normal.Get(r, j - shared.begin));
+    }
+  }
+}
+
 template <typename T>
 void HelixSpline::Accumulate(std::span<const T> z, const HelixGeometry& geometry, std::size_t begin,
-                             std::size_t end, BandedSpd& normal, std::vector<double>& rhs,
-                             std::vector<int>& counts) const {
+                             std::size_t end, std::vector<double>& rhs, SharedRows* shared) {
+  bool rows_of_its_own_added = shared == nullptr;
   for (std::size_t i = begin; i < end; ++i) {
     const double value = z[i];
     if (!std::isfinite(value)) continue;
     const Basis b = BasisAt(geometry.PhaseAt(i));
-    ++counts[b.first];
+    if (!rows_of_its_own_added && b.first >= shared->end) {
+      // The block's rows from `end` on are this half's alone: they go in now, before the samples
+      // after them, so that every row sums its samples in their order.
+      AddSharedRows(*shared, shared->end, shared->end + BandedSpd::kBand, rhs);
+      rows_of_its_own_added = true;
+    }
+    if (shared != nullptr && b.first < shared->end) {
+      const std::size_t r = b.first - shared->begin;
+      ++shared->counts[r];
+      for (int a = 0; a < 4; ++a) {
+        shared->rhs[r + a] += b.w[a] * value;
+        for (int c = a; c < 4; ++c) shared->normal.Add(r + a, r + c, b.w[a] * b.w[c]);
+      }
+      continue;
+    }
+    ++cell_counts_[b.first];
     for (int a = 0; a < 4; ++a) {
       rhs[b.first + a] += b.w[a] * value;
-      for (int c = a; c < 4; ++c) normal.Add(b.first + a, b.first + c, b.w[a] * b.w[c]);
+      for (int c = a; c < 4; ++c) normal_.Add(b.first + a, b.first + c, b.w[a] * b.w[c]);
     }
   }
 }

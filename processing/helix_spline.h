@@ -53,12 +53,23 @@ class HelixSpline {
     double w[4] = {0, 0, 0, 0};
   };
   [[nodiscard]] Basis BasisAt(double u_deg) const;
+  // The rows [begin, end) of the normal equations that both halves of the scan reach, as the upper
+  // half sums them (row r of the block is row begin + r).
+  struct SharedRows {
+    std::size_t begin = 0, end = 0;
+    BandedSpd normal{0};
+    std::vector<double> rhs;
+    std::vector<int> counts;
+  };
   template <typename T>
   void Fit(std::span<const T> z, const HelixGeometry& geometry);
-  // Adds samples [begin, end) to the normal equations, right-hand side and cell counts.
+  // Adds samples [begin, end) to the normal equations, right-hand side and cell counts; with
+  // `shared`, those whose interval starts in its rows go there instead.
   template <typename T>
   void Accumulate(std::span<const T> z, const HelixGeometry& geometry, std::size_t begin, std::size_t end,
-                  BandedSpd& normal, std::vector<double>& rhs, std::vector<int>& counts) const;
+                  std::vector<double>& rhs, SharedRows* shared);
+  // Moves rows [from, to) of `shared` into the normal equations (leaving zeros in the block).
+  void AddSharedRows(SharedRows& shared, std::size_t from, std::size_t to, std::vector<double>& rhs);
 
   double u0_ = 0.0;  // first knot
   double h_ = 1.0;   // knot spacing

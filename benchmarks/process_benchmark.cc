@@ -105,17 +105,16 @@ const std::vector<T>& SpikedArcHeights(std::size_t samples) {
                              0.003 * std::sin(2.0 * std::numbers::pi * at / 12000.0) + noise_mm(rng);
     z[i] = static_cast<T>(height_mm);
   }
-  for (std::size_t i = 0; i < samples; ++i) {
+  for (std::size_t i = 0; i < samples;) {  // i: the first sample not yet damaged or passed
     const double u = unit(rng);
     const double spike_mm = (unit(rng) < 0.5 ? -1.0 : 1.0) * (0.005 + 0.195 * unit(rng));
-    std::size_t length = 0;
-    if (u < 1e-4) length = 1;
-    if (u >= 1e-4 && u < 1.1e-4) length = 2 + static_cast<std::size_t>(5.0 * unit(rng));
-    for (std::size_t k = 0; k < length && i < samples; ++k, ++i) z[i] = static_cast<T>(z[i] + spike_mm);
-    if (u >= 1.1e-4 && u < 1.2e-4) {
-      const auto gap = 1 + static_cast<std::size_t>(40.0 * unit(rng));
-      for (std::size_t k = 0; k < gap && i < samples; ++k, ++i) z[i] = std::numeric_limits<T>::quiet_NaN();
-    }
+    std::size_t spiked = 0, gap = 0;
+    if (u < 1e-4) spiked = 1;
+    if (u >= 1e-4 && u < 1.1e-4) spiked = 2 + static_cast<std::size_t>(5.0 * unit(rng));
+    if (u >= 1.1e-4 && u < 1.2e-4) gap = 1 + static_cast<std::size_t>(40.0 * unit(rng));
+    for (std::size_t k = 0; k < spiked && i < samples; ++k, ++i) z[i] = static_cast<T>(z[i] + spike_mm);
+    for (std::size_t k = 0; k < gap && i < samples; ++k, ++i) z[i] = std::numeric_limits<T>::quiet_NaN();
+    if (spiked + gap == 0) ++i;
   }
   return z;
 }

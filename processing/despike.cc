@@ -382,12 +382,26 @@ class Neighbourhood {
     return indices_;
   }
 
-  // The median of i's neighbours, and of z[i] too when `with_self`; NaN when there are none.
-  double Median(std::size_t i, bool with_self) {
+  // Whether the median of i's neighbours, and of z[i] too when `with_self`, is further than the
+  // threshold from x or not finite (no neighbours). Most windows judged here are the clean
+  // neighbours of a spike: as in the first pass, when fewer than half of the n values (rounded
+  // up) lie beyond x + thr, the median cannot (for even n it lies between the two middle values),
+  // and likewise below, so no median is selected. Values beyond 1e300 mm, where the mean of the
+  // two middle values could overflow, always go to the rule itself.
+  bool FarFromMedianAround(std::size_t i, double x, bool with_self, double threshold_mm) {
     values_.clear();
     for (const std::size_t k : Indices(i)) values_.push_back(z_[k]);
     if (with_self) values_.push_back(z_[i]);
-    return MedianInPlace(values_);
+    if (values_.empty()) return true;
+    const auto [above, below] = CountOutside(values_, x, threshold_mm * (1.0 - kScreenMargin));
+    const auto half_or_more = static_cast<double>((values_.size() + 1) / 2);
+    const auto moderate = [](double v) { return std::abs(v) <= 1e300; };
+    if (above < half_or_more && below < half_or_more && moderate(x) &&
+        std::all_of(values_.begin(), values_.end(), moderate)) {
+      return false;
+    }
+    const double median = MedianInPlace(values_);
+    return !std::isfinite(median) || std::abs(x - median) > threshold_mm;
   }
 
  private:
@@ -430,15 +444,14 @@ void DespikeByMedian(std::span<T> z, int w, double threshold_mm, DespikeResult& 
     if (pass == kMaxPasses) break;
     std::vector<std::size_t> next;
     for (const std::size_t i : SamplesNear(neighbourhood, newly)) {
-      if (std::abs(z[i] - neighbourhood.Median(i, true)) > threshold_mm) next.push_back(i);
+      if (neighbourhood.FarFromMedianAround(i, z[i], true, threshold_mm)) next.push_back(i);
     }
     newly = std::move(next);
   }
   // Decided for all before any comes back, so that none is judged with a restored one's help.
   std::vector<char> agrees(dropped.size(), 0);
   for (std::size_t k = 0; k < dropped.size(); ++k) {
-    const double median = neighbourhood.Median(dropped[k].first, false);
-    agrees[k] = std::isfinite(median) && std::abs(dropped[k].second - median) <= threshold_mm;
+    agrees[k] = !neighbourhood.FarFromMedianAround(dropped[k].first, dropped[k].second, false, threshold_mm);
   }
   for (std::size_t k = 0; k < dropped.size(); ++k) {
     if (agrees[k]) {

@@ -42,8 +42,16 @@ struct DespikeResult {
   std::vector<std::size_t> indices;  // which samples (ascending)
 };
 
-// Despikes `z_mm` in place (NaN = invalid, left alone). `noise_sigma_mm` sets the automatic
-// threshold.
+// Despikes `z_mm` in place (NaN and infinities = invalid, left alone). `noise_sigma_mm` sets the
+// automatic threshold.
+//
+// Float32 samples are judged in double from their stored values: a float scan loses exactly the
+// samples that the same values widened to double would. kMedian only drops samples (NaN), so
+// the two results agree sample for sample; kMovingMean's replacement means are computed in double
+// and rounded to float when stored.
+//
+// kMedian costs a few ns per sample: the first pass does not sort windows but screens them (see
+// docs/processing.md, "Despiking"), and runs on two workers for scans of 1e5 samples and more.
 DespikeResult Despike(std::span<double> z_mm, double noise_sigma_mm, const DespikeOptions& options);
 DespikeResult Despike(std::span<float> z_mm, double noise_sigma_mm, const DespikeOptions& options);
 

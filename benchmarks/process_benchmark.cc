@@ -10,6 +10,7 @@
 #include <filesystem>
 #include <limits>
 #include <map>
+#include <memory>
 #include <numbers>
 #include <random>
 #include <span>
@@ -70,19 +71,60 @@ void BM_ProcessEndToEnd(benchmark::State& state) {
 }
 
 // The wheel model's fit alone (fitting/wheel_model.h), on a scan already processed and fitted per
-// phase, with the knots chosen from the data as `process` does.
+// phase, with the knots chosen from the data as `process` does. Arguments: samples; 1 to read
+// them as float32 (as a float32 file holds them), 0 as double; 1 for the warm-up on a subsample
+// (the default), 0 for every Gauss-Newton iteration over every sample. Wall time (the
+// median of 5) and the CPU time of the whole process; the scans are made once per process.
+struct ModelInput {
+  acquisition::Scan scan;
+  processing::ProcessedScan processed;
+  fitting::WheelFit fit;
+  std::vector<float> z_float;
+};
+
+const ModelInput& ModelInputWith(long samples) {
+  static std::map<long, std::unique_ptr<ModelInput>> cache;
+  auto& input = cache[samples];
+  if (input == nullptr) {
+    input = std::make_unique<ModelInput>();
+    input->scan = acquisition::ReadScan(ScanWithSamples(static_cast<double>(samples)));
+    input->processed = processing::ProcessScanInPlace(input->scan, {});
+    input->fit = fitting::FitWheel(input->processed.map, {});
+    input->z_float.assign(input->scan.z_mm.begin(), input->scan.z_mm.end());
+  }
+  return *input;
+}
+
 void BM_WheelModel(benchmark::State& state) {
-  acquisition::Scan scan = acquisition::ReadScan(ScanWithSamples(static_cast<double>(state.range(0))));
-  const auto processed = processing::ProcessScanInPlace(scan, {});
-  const auto fit = fitting::FitWheel(processed.map, {});
-  const processing::HelixGeometry geometry(scan, processed.rpm_used);
+  const ModelInput& input = ModelInputWith(static_cast<long>(state.range(0)));
+  const processing::HelixGeometry geometry(input.scan, input.processed.rpm_used);
+  fitting::WheelModelOptions options;
+  if (state.range(2) == 0) options.warm_start_samples = 0;
   fitting::WheelModel model;
-  for (auto _ : state) model = fitting::FitWheelModel(scan.z_mm, geometry, processed.map, fit, {});
+  for (auto _ : state) {
+    model = state.range(1) == 1
+                ? fitting::FitWheelModel(input.z_float, geometry, input.processed.map, input.fit, options)
+                : fitting::FitWheelModel(input.scan.z_mm, geometry, input.processed.map, input.fit, options);
+  }
   state.counters["samples_in_band"] = static_cast<double>(model.samples);
   state.counters["iterations"] = model.iterations;
   state.counters["knots_Ra_a_b"] = model.radius_knots * 10000 + model.axial_knots * 100 + model.runout_knots;
 }
-BENCHMARK(BM_WheelModel)->Arg(1000000)->Arg(10000000)->Unit(benchmark::kMillisecond)->Iterations(3);
+BENCHMARK(BM_WheelModel)
+    ->Args({1'000'000, 0, 1})
+    ->Args({1'000'000, 1, 1})
+    ->Args({1'000'000, 0, 0})
+    ->Args({10'000'000, 0, 1})
+    ->Args({10'000'000, 1, 1})
+    ->Args({10'000'000, 0, 0})
+    ->Args({100'000'000, 1, 1})
+    ->ArgNames({"samples", "float32", "warm"})
+    ->Unit(benchmark::kMillisecond)
+    ->Iterations(1)
+    ->Repetitions(5)
+    ->ReportAggregatesOnly(true)
+    ->MeasureProcessCPUTime()
+    ->UseRealTime();
 
 // Heights along the helix of a 500 rpm scan with 10 us samples (12000 a turn), in mm: the sag of a
 // 40 mm arc as the sensor crosses 20 mm of it, 3 um of first-order runout and 0.3 um of white

@@ -3,12 +3,16 @@
 #include <fmt/format.h>
 
 #include <Eigen/Dense>
+#include <Eigen/Sparse>
 #include <algorithm>
+#include <array>
 #include <boost/math/distributions/chi_squared.hpp>
 #include <cmath>
+#include <cstdint>
 #include <map>
 #include <numbers>
 
+#include "core/check.h"
 #include "core/error.h"
 #include "core/interrupt.h"
 #include "core/parallel.h"
@@ -23,9 +27,49 @@ constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 using Eigen::MatrixXd;
 using Eigen::VectorXd;
 
+// processing::UniformCubicBSplineWeights with 1/6 as a product: a division by 6 costs as much as
+// the rest of a sample's row, and the weights differ in the last bit at most.
+void CubicWeights(double f, double w[4]) {
+  constexpr double kSixth = 1.0 / 6.0;
+  const double g = 1.0 - f, f2 = f * f, f3 = f2 * f;
+  w[0] = g * g * g * kSixth;
+  w[1] = (3.0 * f3 - 6.0 * f2 + 4.0) * kSixth;
+  w[2] = (-3.0 * f3 + 3.0 * f2 + 3.0 * f + 1.0) * kSixth;
+  w[3] = f3 * kSixth;
+}
+
+// A periodic basis at one phase: the knot interval, the four coefficients it touches and their
+// weights.
+struct PeriodicAt {
+  int interval = 0;
+  int column[4];
+  double w[4];
+};
+
 // Ra(c), a(c), b(c): `knots` coefficients spread evenly over a turn, wrapping around.
 struct PeriodicBasis {
   int knots = 0;
+  // The coefficients of interval j (0 <= j <= knots; j = knots at c just below 360 degrees,
+  // where the division rounds up).
+  void Columns(int j, int column[4]) const {
+    for (int k = 0; k < 4; ++k) {
+      const int i = j - 1 + k;
+      column[k] = knots == 1 ? 0 : (i < 0 ? i + knots : (i >= knots ? i - knots : i));
+    }
+  }
+  // As At, without the library's floor and the integer divisions (0 <= phase_deg < 360;
+  // knots_per_deg = knots / 360).
+  void Weights(double phase_deg, double knots_per_deg, PeriodicAt& at) const {
+    if (knots == 1) {
+      // A constant: its four weights, on the one coefficient, sum to 1.
+      at = {0, {0, 0, 0, 0}, {1.0, 0.0, 0.0, 0.0}};
+      return;
+    }
+    const double t = phase_deg * knots_per_deg;
+    at.interval = static_cast<int>(t);
+    CubicWeights(t - at.interval, at.w);
+    Columns(at.interval, at.column);
+  }
   void At(double phase_deg, int index[4], double weight[4]) const {
     const double t = phase_deg / 360.0 * knots;
     const double interval = std::floor(t);
@@ -65,6 +109,18 @@ struct ProfileBasis {
     }
     return j;
   }
+  // As At, with 1 / step_mm given (a division per sample costs as much as the rest of the weights).
+  int At(double u_mm, double per_step, double weight[4], double slope[4]) const {
+    const double t = std::clamp((u_mm - low_mm) * per_step, 0.0, static_cast<double>(intervals));
+    const int j = std::min(static_cast<int>(t), intervals - 1);
+    const double f = t - j, g = 1.0 - f;
+    CubicWeights(f, weight);
+    slope[0] = -0.5 * g * g * per_step;
+    slope[1] = (1.5 * f * f - 2.0 * f) * per_step;
+    slope[2] = (-1.5 * f * f + f + 0.5) * per_step;
+    slope[3] = 0.5 * f * f * per_step;
+    return j;
+  }
 };
 
 // Knots per turn of Ra(c), a(c) and b(c).
@@ -84,147 +140,368 @@ struct Layout {
   [[nodiscard]] int size() const { return p0() + profile.size(); }
 };
 
-// The band's samples, read through the helix geometry on every pass (no copy of the scan).
-struct Samples {
-  std::span<const double> rho_mm;
-  const processing::HelixGeometry& geometry;
-  double band_low_mm, band_high_mm;
+// Where a sample's cells lie: the map's (phase, axial) grid, for the residual map.
+struct Grid {
+  std::size_t n_phase = 0, n_y = 0;
+  double phase_step_deg = 0, y0_mm = 0, y_step_mm = 0;
+  [[nodiscard]] bool empty() const { return n_phase == 0 || n_y < 2; }
+  [[nodiscard]] std::size_t size() const { return n_phase * n_y; }
 };
 
-// J^T J, J^T r and r^T r of the samples at one set of coefficients (J: d(model)/d(coefficient)).
+Grid GridOf(const processing::WheelMap& map) {
+  Grid grid;
+  grid.n_phase = map.n_phase();
+  grid.n_y = map.n_y();
+  if (grid.empty()) return grid;
+  grid.phase_step_deg = 360.0 / static_cast<double>(grid.n_phase);
+  grid.y0_mm = map.y_mm.front();
+  grid.y_step_mm = map.y_mm[1] - map.y_mm[0];
+  return grid;
+}
+
+// std::lround without the library call: the fraction of a double is exact, so this rounds half
+// away from zero exactly as lround does.
+long RoundHalfAway(double x) {
+  const double magnitude = std::abs(x);
+  auto k = static_cast<long>(magnitude);
+  if (magnitude - static_cast<double>(k) >= 0.5) ++k;
+  return x < 0.0 ? -k : k;
+}
+
+// The phase within the turn, as std::fmod(u, 360) (+ 360 below zero) gives it, without the library
+// call: u - 360 q is exact for the right whole number of turns q (Sterbenz), so only q is guessed
+// here, and corrected when the guess was one off.
+double PhaseInTurn(double unwrapped_deg) {
+  if (!(unwrapped_deg >= 0.0 && unwrapped_deg < 1e15)) {
+    const double c = std::fmod(unwrapped_deg, 360.0);
+    return c < 0.0 ? c + 360.0 : c;
+  }
+  const auto turns = static_cast<double>(static_cast<std::int64_t>(unwrapped_deg * (1.0 / 360.0)));
+  double c = unwrapped_deg - 360.0 * turns;
+  if (c < 0.0) c = unwrapped_deg - 360.0 * (turns - 1.0);
+  if (c >= 360.0) c = unwrapped_deg - 360.0 * (turns + 1.0);
+  return c;
+}
+
+// A sample's row of the Jacobian: the residual and the 16 non-zero entries, whose columns follow
+// from `key` (the knot interval of Ra, a and b, and the profile interval).
+struct Row {
+  std::array<int, 4> key{};
+  double value[16];
+  double residual = 0;
+};
+
+// Evaluates the model at the coefficients theta for one sample after another. Where two of Ra, a
+// and b have the same knots they share their B-spline weights.
+class RowModel {
+ public:
+  RowModel(const Layout& layout, const VectorXd& theta)
+      : layout_(layout),
+        theta_(theta.data()),
+        radius_per_deg_(layout.radius.knots / 360.0),
+        axial_per_deg_(layout.axial.knots / 360.0),
+        runout_per_deg_(layout.runout.knots / 360.0),
+        profile_per_mm_(1.0 / layout.profile.step_mm) {}
+
+  // False where the sample lies beyond the arc (never for a sane band).
+  bool Evaluate(double phase_deg, double y_mm, double rho_mm, Row& row) const {
+    PeriodicAt r, a, b;
+    layout_.radius.Weights(phase_deg, radius_per_deg_, r);
+    if (layout_.axial.knots == layout_.radius.knots) {
+      a = r;
+    } else {
+      layout_.axial.Weights(phase_deg, axial_per_deg_, a);
+    }
+    if (layout_.runout.knots == layout_.radius.knots) {
+      b = r;
+    } else if (layout_.runout.knots == layout_.axial.knots) {
+      b = a;
+    } else {
+      layout_.runout.Weights(phase_deg, runout_per_deg_, b);
+    }
+    double ra = 0, center_axial = 0, center_radial = 0;
+    const double* theta_a = theta_ + layout_.a0();
+    const double* theta_b = theta_ + layout_.b0();
+    for (int k = 0; k < 4; ++k) {
+      ra += r.w[k] * theta_[r.column[k]];
+      center_axial += a.w[k] * theta_a[a.column[k]];
+      center_radial += b.w[k] * theta_b[b.column[k]];
+    }
+    const double u = y_mm - center_axial;
+    const double s2 = ra * ra - u * u;
+    if (!(s2 > 0.0)) return false;
+    const double s = std::sqrt(s2);
+    double wp[4], sp[4];
+    const int jp = layout_.profile.At(u, profile_per_mm_, wp, sp);
+    const double* theta_p = theta_ + layout_.p0() + jp;
+    double p = 0, dp = 0;
+    for (int k = 0; k < 4; ++k) {
+      p += wp[k] * theta_p[k];
+      dp += sp[k] * theta_p[k];
+    }
+    row.residual = rho_mm - (center_radial + s + p);
+    const double per_s = 1.0 / s;
+    const double d_ra = ra * per_s, d_a = u * per_s - dp;
+    for (int k = 0; k < 4; ++k) {
+      row.value[k] = d_ra * r.w[k];
+      row.value[4 + k] = d_a * a.w[k];
+      row.value[8 + k] = b.w[k];
+      row.value[12 + k] = wp[k];
+    }
+    row.key = {r.interval, a.interval, b.interval, jp};
+    return true;
+  }
+
+  // The 16 columns of a row with this key.
+  void Columns(const std::array<int, 4>& key, int column[16]) const {
+    layout_.radius.Columns(key[0], column);
+    layout_.axial.Columns(key[1], column + 4);
+    layout_.runout.Columns(key[2], column + 8);
+    for (int k = 0; k < 4; ++k) {
+      column[4 + k] += layout_.a0();
+      column[8 + k] += layout_.b0();
+      column[12 + k] = layout_.p0() + key[3] + k;
+    }
+  }
+
+ private:
+  const Layout& layout_;
+  const double* theta_;
+  double radius_per_deg_, axial_per_deg_, runout_per_deg_, profile_per_mm_;
+};
+
+// J^T J (lower triangle until Symmetrise), J^T r and r^T r of the samples at one set of
+// coefficients (J: d(model)/d(coefficient)).
 struct NormalEquations {
-  MatrixXd jtj;
+  MatrixXd jtj;  // empty when the pass did not ask for it
   VectorXd jtr;
   double rss = 0.0;
   std::size_t samples = 0;
   void Add(const NormalEquations& other) {
-    jtj += other.jtj;
+    if (jtj.size() != 0) jtj += other.jtj;
     jtr += other.jtr;
     rss += other.rss;
     samples += other.samples;
   }
+  void Symmetrise() {
+    if (jtj.size() != 0) jtj.triangularView<Eigen::StrictlyUpper>() = jtj.transpose();
+  }
 };
 
-// Evaluates the model at (c, y): the residual and the 16 non-zero entries of its Jacobian row.
-// False where the sample lies beyond the arc (never for a sane band).
-bool ModelRow(const Layout& layout, const VectorXd& theta, double phase_deg, double y_mm, double rho_mm,
-              int column[16], double value[16], double& residual) {
-  int ir[4], ia[4], ib[4];
-  double wr[4], wa[4], wb[4], wp[4], sp[4];
-  layout.radius.At(phase_deg, ir, wr);
-  layout.axial.At(phase_deg, ia, wa);
-  layout.runout.At(phase_deg, ib, wb);
-  double ra = 0, a = 0, b = 0;
-  for (int k = 0; k < 4; ++k) {
-    ra += wr[k] * theta[ir[k]];
-    a += wa[k] * theta[layout.a0() + ia[k]];
-    b += wb[k] * theta[layout.b0() + ib[k]];
-  }
-  const double u = y_mm - a;
-  const double s2 = ra * ra - u * u;
-  if (!(s2 > 0.0)) return false;
-  const double s = std::sqrt(s2);
-  const int jp = layout.profile.At(u, wp, sp);
-  double p = 0, dp = 0;
-  for (int k = 0; k < 4; ++k) {
-    p += wp[k] * theta[layout.p0() + jp + k];
-    dp += sp[k] * theta[layout.p0() + jp + k];
-  }
-  residual = rho_mm - (b + s + p);
-  const double d_ra = ra / s, d_a = u / s - dp;
-  for (int k = 0; k < 4; ++k) {
-    column[k] = ir[k];
-    value[k] = d_ra * wr[k];
-    column[4 + k] = layout.a0() + ia[k];
-    value[4 + k] = d_a * wa[k];
-    column[8 + k] = layout.b0() + ib[k];
-    value[8 + k] = wb[k];
-    column[12 + k] = layout.p0() + jp + k;
-    value[12 + k] = wp[k];
-  }
-  return true;
-}
-
-double PhaseInTurn(double unwrapped_deg) {
-  const double c = std::fmod(unwrapped_deg, 360.0);
-  return c < 0.0 ? c + 360.0 : c;
-}
-
-// Neighbouring samples touch the same 16 coefficients (the phase crosses a knot every dozen
-// samples or so, u a profile knot every few turns): their Jacobian rows are summed into a small
-// fixed-size block, which is added into the normal equations only when the coefficients change.
+// Neighbouring samples touch the same 16 coefficients (the phase crosses a knot every few dozen
+// samples or more, u a profile knot every few turns): their Jacobian rows are summed into a small
+// fixed-size block (its lower triangle), which is added into the normal equations only when the
+// coefficients change.
 class BlockAccumulator {
  public:
-  explicit BlockAccumulator(NormalEquations& into) : into_(into) {}
+  BlockAccumulator(const RowModel& model, NormalEquations& into, bool normal_matrix)
+      : model_(model), into_(into), normal_matrix_(normal_matrix) {}
   ~BlockAccumulator() { Flush(); }
   BlockAccumulator(const BlockAccumulator&) = delete;
   BlockAccumulator& operator=(const BlockAccumulator&) = delete;
 
-  void Add(const int column[16], const double value[16], double residual) {
-    if (!std::equal(column, column + 16, columns_)) {
+  void Add(const Row& row) {
+    if (row.key != key_) {
       Flush();
-      std::copy(column, column + 16, columns_);
+      key_ = row.key;
     }
-    const Eigen::Map<const Row> row(value);
-    block_.selfadjointView<Eigen::Lower>().rankUpdate(row);
-    rhs_.noalias() += residual * row;
+    const Eigen::Map<const Vector16> values(row.value);
+    if (normal_matrix_) block_.selfadjointView<Eigen::Lower>().rankUpdate(values);
+    rhs_.noalias() += row.residual * values;
     pending_ = true;
   }
 
   void Flush() {
     if (!pending_) return;
-    const Block full = block_.selfadjointView<Eigen::Lower>();
-    for (int r = 0; r < 16; ++r) {
-      into_.jtr[columns_[r]] += rhs_[r];
-      for (int c = 0; c < 16; ++c) into_.jtj(columns_[r], columns_[c]) += full(r, c);
+    int column[16];
+    model_.Columns(key_, column);
+    for (int r = 0; r < 16; ++r) into_.jtr[column[r]] += rhs_[r];
+    if (normal_matrix_) {
+      for (int c = 0; c < 16; ++c) {
+        into_.jtj(column[c], column[c]) += block_(c, c);
+        for (int r = c + 1; r < 16; ++r) {
+          // Columns repeat where a function has one knot: block(r, c) is then also block(c, r).
+          const int high = std::max(column[r], column[c]), low = std::min(column[r], column[c]);
+          into_.jtj(high, low) += high == low ? 2.0 * block_(r, c) : block_(r, c);
+        }
+      }
+      block_.setZero();
     }
-    block_.setZero();
     rhs_.setZero();
     pending_ = false;
   }
 
  private:
   using Block = Eigen::Matrix<double, 16, 16>;
-  using Row = Eigen::Matrix<double, 16, 1>;
+  using Vector16 = Eigen::Matrix<double, 16, 1>;
+  const RowModel& model_;
   NormalEquations& into_;
-  int columns_[16] = {-1};
+  bool normal_matrix_;
+  std::array<int, 4> key_{-1, -1, -1, -1};
   Block block_ = Block::Zero();
-  Row rhs_ = Row::Zero();
+  Vector16 rhs_ = Vector16::Zero();
   bool pending_ = false;
 };
 
-// One pass over the band's samples on every core.
-NormalEquations Accumulate(const Samples& samples, const Layout& layout, const VectorXd& theta) {
-  const int n = layout.size();
-  const int workers = WorkerCount(0);
-  std::vector<NormalEquations> parts(static_cast<std::size_t>(workers));
+// The work is cut into this many parts whatever the number of cores, and their sums are added in
+// order, so that the rounding, hence the result, does not depend on the machine.
+constexpr int kParts = 8;
+
+// The samples (per sample, NaN = invalid), read through the helix geometry on every pass (no copy
+// of the scan).
+template <typename Sample>
+struct Samples {
+  std::span<const Sample> rho_mm;
+  const processing::HelixGeometry& geometry;
+  double band_low_mm, band_high_mm;
+};
+
+// What a pass over the samples accumulates.
+struct PassRequest {
+  // 1: every sample; k > 1: one sample from each run of k, at a pseudo-random place in the run
+  // (fixed), so that the subsample cannot alias with the turn.
+  std::size_t stride = 1;
+  bool normal_matrix = true;   // J^T J (else J^T r and r^T r only)
+  const Grid* grid = nullptr;  // also the residuals' sums per cell of the map's grid
+};
+
+// Sums of the residuals and their counts per cell of the grid, over part of its axial range.
+struct CellSums {
+  long first_axial = 0, axial_cells = 0;
+  std::vector<double> sum;
+  std::vector<std::uint32_t> count;
+};
+
+// The axial range of each part's samples in the band (whatever the coefficients).
+struct PartRanges {
+  std::array<double, kParts> low_y_mm{}, high_y_mm{};
+};
+
+struct PassResult {
+  NormalEquations normal;
+  std::vector<CellSums> cells;  // per part, when a grid was asked for
+  PartRanges ranges;
+};
+
+std::size_t RunStart(std::size_t run, std::size_t stride) {
+  // splitmix64's finaliser: a fixed, well-spread place in each run.
+  std::uint64_t z = run + 0x9e3779b97f4a7c15ULL;
+  z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
+  z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
+  z ^= z >> 31;
+  return run * stride + static_cast<std::size_t>(z % stride);
+}
+
+// The axial cells that a part's samples between low_y_mm and high_y_mm can fall into.
+CellSums CellSumsFor(const Grid& grid, double low_y_mm, double high_y_mm) {
+  CellSums cells;
+  if (!(low_y_mm <= high_y_mm)) return cells;
+  const long last = static_cast<long>(grid.n_y) - 1;
+  cells.first_axial = std::clamp(RoundHalfAway((low_y_mm - grid.y0_mm) / grid.y_step_mm), 0L, last);
+  const long high = std::clamp(RoundHalfAway((high_y_mm - grid.y0_mm) / grid.y_step_mm), 0L, last);
+  cells.axial_cells = high - cells.first_axial + 1;
+  cells.sum.assign(grid.n_phase * static_cast<std::size_t>(cells.axial_cells), 0.0);
+  cells.count.assign(cells.sum.size(), 0);
+  return cells;
+}
+
+// One part's share of a pass.
+template <typename Sample>
+void AccumulatePart(const Samples<Sample>& samples, const RowModel& model, const PassRequest& request,
+                    int part, NormalEquations& normal, CellSums* cells, double& low_y_mm, double& high_y_mm) {
   const std::size_t total = samples.rho_mm.size();
+  const std::size_t runs = (total + request.stride - 1) / request.stride;
+  const std::size_t begin = runs * static_cast<std::size_t>(part) / kParts;
+  const std::size_t end = runs * static_cast<std::size_t>(part + 1) / kParts;
+  const processing::HelixGeometry& geometry = samples.geometry;
+  BlockAccumulator block(model, normal, request.normal_matrix);
+  Row row;
+  // Locals, not the references, so that the loop keeps them in registers.
+  double rss = 0.0, low = std::numeric_limits<double>::infinity(), high = -low;
+  std::size_t used = 0;
+  const double per_phase_cell = request.grid != nullptr ? 1.0 / request.grid->phase_step_deg : 0.0;
+  const double per_axial_cell = request.grid != nullptr ? 1.0 / request.grid->y_step_mm : 0.0;
+  for (std::size_t run = begin; run < end; ++run) {
+    const std::size_t i = request.stride == 1 ? run : RunStart(run, request.stride);
+    if (i >= total) continue;
+    const auto rho = static_cast<double>(samples.rho_mm[i]);
+    if (!std::isfinite(rho)) continue;
+    const double y = geometry.AxialAt(i);
+    if (y < samples.band_low_mm || y > samples.band_high_mm) continue;
+    low = std::min(low, y);
+    high = std::max(high, y);
+    const double c = PhaseInTurn(geometry.PhaseAt(i));
+    if (!model.Evaluate(c, y, rho, row)) continue;
+    block.Add(row);
+    rss += row.residual * row.residual;
+    ++used;
+    if (cells == nullptr || cells->axial_cells == 0) continue;
+    const Grid& grid = *request.grid;
+    auto p = static_cast<std::size_t>(RoundHalfAway(c * per_phase_cell));
+    if (p >= grid.n_phase) p -= grid.n_phase;  // c rounds up to the turn's end
+    const long a = RoundHalfAway((y - grid.y0_mm) * per_axial_cell) - cells->first_axial;
+    if (a < 0 || a >= cells->axial_cells) continue;
+    const std::size_t cell = p * static_cast<std::size_t>(cells->axial_cells) + static_cast<std::size_t>(a);
+    cells->sum[cell] += row.residual;
+    ++cells->count[cell];
+  }
+  normal.rss += rss;
+  normal.samples += used;
+  low_y_mm = low;
+  high_y_mm = high;
+}
+
+// One pass over the samples on every core. With a grid, each part sums the residuals over the
+// axial range that `previous` (a pass over the same samples) found its samples in.
+template <typename Sample>
+PassResult Accumulate(const Samples<Sample>& samples, const Layout& layout, const VectorXd& theta,
+                      const PassRequest& request, const PartRanges* previous = nullptr) {
+  ARCWHEEL_CHECK(request.grid == nullptr || previous != nullptr) << "a residual map needs the parts' ranges";
+  const int n = layout.size();
+  const RowModel model(layout, theta);
+  std::vector<NormalEquations> parts(kParts);
+  PassResult result;
+  if (request.grid != nullptr && !request.grid->empty()) {
+    for (int part = 0; part < kParts; ++part) {
+      const auto p = static_cast<std::size_t>(part);
+      result.cells.push_back(CellSumsFor(*request.grid, previous->low_y_mm[p], previous->high_y_mm[p]));
+    }
+  }
+  const int workers = std::min(WorkerCount(0), kParts);
   RunOnWorkers(workers, [&](int worker) {
-    NormalEquations& part = parts[static_cast<std::size_t>(worker)];
-    part.jtj = MatrixXd::Zero(n, n);
-    part.jtr = VectorXd::Zero(n);
-    const std::size_t begin = total * static_cast<std::size_t>(worker) / static_cast<std::size_t>(workers);
-    const std::size_t end = total * static_cast<std::size_t>(worker + 1) / static_cast<std::size_t>(workers);
-    BlockAccumulator block(part);
-    int column[16];
-    double value[16];
-    double residual = 0;
-    for (std::size_t i = begin; i < end; ++i) {
-      const double rho = samples.rho_mm[i];
-      if (!std::isfinite(rho)) continue;
-      const double y = samples.geometry.AxialAt(i);
-      if (y < samples.band_low_mm || y > samples.band_high_mm) continue;
-      if (!ModelRow(layout, theta, PhaseInTurn(samples.geometry.PhaseAt(i)), y, rho, column, value,
-                    residual)) {
-        continue;
-      }
-      block.Add(column, value, residual);
-      part.rss += residual * residual;
-      ++part.samples;
+    for (int part = worker; part < kParts; part += workers) {
+      const auto p = static_cast<std::size_t>(part);
+      NormalEquations& normal = parts[p];
+      if (request.normal_matrix) normal.jtj = MatrixXd::Zero(n, n);
+      normal.jtr = VectorXd::Zero(n);
+      AccumulatePart(samples, model, request, part, normal, result.cells.empty() ? nullptr : &result.cells[p],
+                     result.ranges.low_y_mm[p], result.ranges.high_y_mm[p]);
     }
   });
-  NormalEquations sum = std::move(parts[0]);
-  for (std::size_t w = 1; w < parts.size(); ++w) sum.Add(parts[w]);
+  result.normal = std::move(parts[0]);
+  for (std::size_t part = 1; part < parts.size(); ++part) result.normal.Add(parts[part]);
+  result.normal.Symmetrise();
+  return result;
+}
+
+// Mean residual per cell of the map's grid (um), NaN where no sample fell.
+std::vector<double> ResidualMap(const Grid& grid, const std::vector<CellSums>& parts) {
+  if (grid.empty()) return {};
+  std::vector<double> sum(grid.size(), 0.0);
+  std::vector<std::uint64_t> count(grid.size(), 0);
+  for (const CellSums& part : parts) {
+    for (std::size_t p = 0; p < grid.n_phase; ++p) {
+      for (long a = 0; a < part.axial_cells; ++a) {
+        const std::size_t from = p * static_cast<std::size_t>(part.axial_cells) + static_cast<std::size_t>(a);
+        const std::size_t to = p * grid.n_y + static_cast<std::size_t>(part.first_axial + a);
+        sum[to] += part.sum[from];
+        count[to] += part.count[from];
+      }
+    }
+  }
+  for (std::size_t cell = 0; cell < sum.size(); ++cell) {
+    sum[cell] = count[cell] > 0 ? sum[cell] / static_cast<double>(count[cell]) * 1e3 : kNaN;
+  }
   return sum;
 }
 
@@ -286,65 +563,141 @@ MatrixXd Reduction(const Layout& fine, const Knots& coarse, const MatrixXd& null
   return t;
 }
 
+// T^T H T for a reduction T (mostly zeros: block-diagonal, and sparse within its blocks).
+MatrixXd Project(const MatrixXd& h, const MatrixXd& t) {
+  const Eigen::SparseMatrix<double> sparse = t.sparseView();
+  const MatrixXd ht = h * sparse;
+  return MatrixXd(sparse.transpose() * ht);
+}
+
+// H^-1 b for a normal matrix: by Cholesky, or by LDL^T where rounding leaves H not quite
+// positive definite.
+VectorXd SolveNormal(const MatrixXd& h, const VectorXd& b) {
+  const Eigen::LLT<MatrixXd> llt(h);
+  if (llt.info() == Eigen::Success) return llt.solve(b);
+  return h.ldlt().solve(b);
+}
+
 struct Solution {
-  VectorXd theta;          // full parameters
-  MatrixXd reduction;      // full = reduction * reduced
-  MatrixXd reduced_jtj;    // at the solution
-  NormalEquations normal;  // at the solution
+  VectorXd theta;               // the solution: `at` plus the last step
+  VectorXd at;                  // the coefficients where `normal` was accumulated
+  MatrixXd reduction;           // full = reduction * reduced
+  MatrixXd reduced_jtj;         // at `at` (or, after a chord step, at the pass before)
+  NormalEquations normal;       // at `at`
+  std::vector<CellSums> cells;  // the residuals per cell at `at`, when asked for
+  PartRanges ranges;            // of the passes' parts
   int iterations = 0;
+  bool converged = false;
 };
 
-// Gauss-Newton on the reduced parameters, halving a step that raises the residual.
-Solution GaussNewton(const Samples& samples, const Layout& layout, const MatrixXd& reduction, VectorXd theta,
-                     int max_iterations) {
+struct ConvergeRequest {
+  std::size_t stride = 1;  // as PassRequest
+  int max_iterations = 40;
+  // When not empty: the reduced J^T J of a pass at coefficients so close to the start that J
+  // differs only in its last digits; the first iteration then accumulates only J^T r and r^T r
+  // (a chord step: the fixed point, J^T r = 0, is the same).
+  MatrixXd reduced_jtj{};
+  const Grid* grid = nullptr;          // sum the residuals per cell in every pass
+  const PartRanges* ranges = nullptr;  // of an earlier pass over the same samples
+  bool throw_if_not_converged = true;
+};
+
+// Gauss-Newton on the reduced parameters, halving a step that raises the residual. Converged when
+// the step would lower the residual sum of squares by a negligible fraction (the linearised
+// decrease is step . J^T r), or moves no coefficient by more than 1e-11 mm.
+template <typename Sample>
+Solution Converge(const Samples<Sample>& samples, const Layout& layout, const MatrixXd& reduction,
+                  VectorXd theta, ConvergeRequest request) {
   Solution solution;
   solution.reduction = reduction;
   VectorXd previous = theta;
   double previous_rss = std::numeric_limits<double>::infinity();
-  for (int iteration = 1; iteration <= max_iterations; ++iteration) {
+  MatrixXd chord_jtj = std::move(request.reduced_jtj);
+  for (int iteration = 1; iteration <= request.max_iterations; ++iteration) {
     ThrowIfInterrupted();
-    NormalEquations normal = Accumulate(samples, layout, theta);
+    const bool chord = chord_jtj.size() != 0;
+    PassResult pass =
+        Accumulate(samples, layout, theta,
+                   {.stride = request.stride, .normal_matrix = !chord, .grid = request.grid}, request.ranges);
+    NormalEquations& normal = pass.normal;
     if (normal.rss > previous_rss * (1.0 + 1e-12) && (theta - previous).cwiseAbs().maxCoeff() > 1e-13) {
       theta = previous + 0.5 * (theta - previous);  // the step overshot: take half of it
+      chord_jtj.resize(0, 0);
       continue;
     }
-    const MatrixXd reduced_jtj = reduction.transpose() * normal.jtj * reduction;
-    const VectorXd step = reduction * reduced_jtj.ldlt().solve(reduction.transpose() * normal.jtr);
-    solution = {theta, reduction, reduced_jtj, std::move(normal), iteration};
+    MatrixXd reduced_jtj = chord ? chord_jtj : Project(normal.jtj, reduction);
+    chord_jtj.resize(0, 0);  // a chord step once only
+    const VectorXd step = reduction * SolveNormal(reduced_jtj, reduction.transpose() * normal.jtr);
+    solution.at = theta;
+    solution.theta = theta;
+    solution.reduced_jtj = std::move(reduced_jtj);
+    solution.normal = std::move(normal);
+    solution.cells = std::move(pass.cells);
+    solution.ranges = pass.ranges;
+    solution.iterations = iteration;
     if (!step.allFinite()) break;
     previous = theta;
     previous_rss = solution.normal.rss;
     theta += step;
-    // Converged when the step would lower the residual sum of squares by a negligible fraction
-    // (the linearised decrease is step . J^T r), or moves no coefficient by more than 1e-11 mm.
     const double decrease = step.dot(solution.normal.jtr);
     if (decrease <= 1e-10 * solution.normal.rss || step.cwiseAbs().maxCoeff() < 1e-11) {
       solution.theta = theta;
+      solution.converged = true;
       return solution;
     }
   }
-  throw Error(ErrorCode::kFitFailed, kStage,
-              fmt::format("the wheel model did not converge in {} Gauss-Newton iterations", max_iterations));
+  if (request.throw_if_not_converged) {
+    throw Error(ErrorCode::kFitFailed, kStage,
+                fmt::format("the wheel model did not converge in {} Gauss-Newton iterations",
+                            request.max_iterations));
+  }
+  return solution;
 }
 
-// The fine fit's normal equations linearised at its solution, restricted to coarser knots
-// (theta = T x): the x minimising RSS = |z - J T x|^2 with z = r + J theta, that RSS, and T^T J^T J T.
+// One Gauss-Newton step over every sample from theta, without the test for convergence: the fine
+// fit whose normal equations choose the knots, at a start close enough for its linearisation.
+template <typename Sample>
+Solution OneStep(const Samples<Sample>& samples, const Layout& layout, const MatrixXd& reduction,
+                 const VectorXd& theta) {
+  PassResult pass = Accumulate(samples, layout, theta, {});
+  Solution solution;
+  solution.reduction = reduction;
+  solution.at = theta;
+  solution.reduced_jtj = Project(pass.normal.jtj, reduction);
+  solution.theta =
+      theta + reduction * SolveNormal(solution.reduced_jtj, reduction.transpose() * pass.normal.jtr);
+  solution.normal = std::move(pass.normal);
+  solution.ranges = pass.ranges;
+  solution.iterations = 1;
+  return solution;
+}
+
+// The fine fit's normal equations linearised where they were accumulated, restricted to coarser
+// knots (theta = T x): the x minimising RSS = |r - J (T x - at)|^2, that RSS, and T^T J^T J T.
+// The minimum is sought as a correction to x0, T's least-squares approximation of `at`: the sums
+// of squares then stay near the RSS, instead of some 1e10 times it (|J at|^2), where rounding
+// would leave the RSS uncertain by more than the information criterion's penalties at 1e7 samples.
 struct LinearisedFit {
   VectorXd x;
   double rss = 0.0;
-  MatrixXd reduced_jtj;
+  MatrixXd reduced_jtj{};
 };
 
 LinearisedFit Linearise(const Solution& fine, const MatrixXd& reduction) {
   const MatrixXd& jtj = fine.normal.jtj;
-  const VectorXd jtz = fine.normal.jtr + jtj * fine.theta;
-  const double ztz =
-      fine.normal.rss + 2.0 * fine.theta.dot(fine.normal.jtr) + fine.theta.dot(jtj * fine.theta);
+  const Eigen::SparseMatrix<double> t = reduction.sparseView();
+  const Eigen::SparseMatrix<double> tt = t.transpose() * t;  // block-diagonal
+  const VectorXd x0 = Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>>(tt).solve(t.transpose() * fine.at);
+  const VectorXd g = fine.at - reduction * x0;
+  const VectorXd jtj_g = jtj * g;
+  const VectorXd jtz = fine.normal.jtr + jtj_g;
+  const double ztz = fine.normal.rss + 2.0 * g.dot(fine.normal.jtr) + g.dot(jtj_g);
   const VectorXd rhs = reduction.transpose() * jtz;
   LinearisedFit fit;
-  fit.reduced_jtj = reduction.transpose() * jtj * reduction;
-  fit.x = fit.reduced_jtj.ldlt().solve(rhs);
-  fit.rss = std::max(ztz - rhs.dot(fit.x), 0.0);
+  fit.reduced_jtj = Project(jtj, reduction);
+  const VectorXd correction = SolveNormal(fit.reduced_jtj, rhs);
+  fit.x = x0 + correction;
+  fit.rss = std::max(ztz - rhs.dot(correction), 0.0);
   return fit;
 }
 
@@ -407,7 +760,8 @@ struct Fitted {
   Layout layout;
   Variation variation;
   Solution solution;
-  MatrixXd covariance;  // of the full parameters
+  std::vector<double> residual_um;  // the residual map (WheelModel::residual_um)
+  MatrixXd covariance;              // of the full parameters
   double sigma2 = 0;
 };
 
@@ -512,36 +866,6 @@ void SampleProfile(const Fitted& f, double half_width_mm, WheelModel& model) {
   model.profile_pv_um = (high - low) * 1e3;
 }
 
-// Mean residual of the final fit per cell of the map's grid.
-std::vector<double> ResidualMap(const Samples& samples, const Fitted& f, const processing::WheelMap& map) {
-  const std::size_t n_phase = map.n_phase(), n_y = map.n_y();
-  std::vector<double> sum(n_phase * n_y, 0.0);
-  std::vector<int> count(n_phase * n_y, 0);
-  if (n_phase == 0 || n_y < 2) return {};
-  const double phase_step = 360.0 / static_cast<double>(n_phase);
-  const double y0 = map.y_mm.front(), y_step = map.y_mm[1] - map.y_mm[0];
-  int column[16];
-  double value[16];
-  double residual = 0;
-  for (std::size_t i = 0; i < samples.rho_mm.size(); ++i) {
-    const double rho = samples.rho_mm[i];
-    if (!std::isfinite(rho)) continue;
-    const double y = samples.geometry.AxialAt(i);
-    if (y < samples.band_low_mm || y > samples.band_high_mm) continue;
-    const double c = PhaseInTurn(samples.geometry.PhaseAt(i));
-    if (!ModelRow(f.layout, f.solution.theta, c, y, rho, column, value, residual)) continue;
-    const auto p = static_cast<std::size_t>(std::lround(c / phase_step)) % n_phase;
-    const long a = std::lround((y - y0) / y_step);
-    if (a < 0 || a >= static_cast<long>(n_y)) continue;
-    sum[p * n_y + static_cast<std::size_t>(a)] += residual;
-    ++count[p * n_y + static_cast<std::size_t>(a)];
-  }
-  for (std::size_t cell = 0; cell < sum.size(); ++cell) {
-    sum[cell] = count[cell] > 0 ? sum[cell] / count[cell] * 1e3 : kNaN;
-  }
-  return sum;
-}
-
 Layout MakeLayout(const Knots& knots, double half_width_mm, double knot_step_mm) {
   // p spans the band and a margin for the wobble of a(c) about its mean (u beyond it is clamped):
   // a wider margin would leave the outer coefficients without data.
@@ -595,34 +919,6 @@ Knots ChooseKnots(const Solution& fine, const Layout& fine_layout, const std::ve
   return best;
 }
 
-// Fits at the finest knots asked for, then, where the knots are to be chosen, picks them by the
-// BIC from the fine fit's linearised normal equations and refits there.
-Fitted FitAndChoose(const Samples& samples, const WheelFit& fit, const WheelModelOptions& options,
-                    double half_width_mm, WheelModel& model) {
-  const std::vector<int> choices[3] = {KnotCandidates(options.radius_knots, true),
-                                       KnotCandidates(options.axial_knots, true),
-                                       KnotCandidates(options.runout_knots, false)};
-  const Layout fine = MakeLayout({choices[0].back(), choices[1].back(), choices[2].back()}, half_width_mm,
-                                 options.profile_knot_step_mm);
-  const MatrixXd null_space = ProfileNullSpace(fine.profile, half_width_mm);
-  Solution best = GaussNewton(samples, fine, Reduction(fine, fine.knots(), null_space),
-                              StartingPoint(fine, fit), options.max_iterations);
-  model.knots_chosen = choices[0].size() > 1 || choices[1].size() > 1 || choices[2].size() > 1;
-  const Knots knots = model.knots_chosen ? ChooseKnots(best, fine, choices, null_space) : fine.knots();
-  Fitted fitted;
-  fitted.layout = MakeLayout(knots, half_width_mm, options.profile_knot_step_mm);
-  fitted.variation = VariationAtFineFit(best, fine, knots, null_space);
-  if (!(knots == fine.knots())) {
-    const VectorXd start_reduced = Linearise(best, Reduction(fine, knots, null_space)).x;
-    const MatrixXd reduction = Reduction(fitted.layout, knots, null_space);
-    const int iterations = best.iterations;
-    best = GaussNewton(samples, fitted.layout, reduction, reduction * start_reduced, options.max_iterations);
-    best.iterations += iterations;
-  }
-  fitted.solution = std::move(best);
-  return fitted;
-}
-
 }  // namespace
 
 std::vector<std::string> WheelModelOptions::Problems() const {
@@ -648,9 +944,92 @@ std::vector<std::string> WheelModelOptions::Problems() const {
   return problems;
 }
 
-WheelModel FitWheelModel(std::span<const double> rho_mm, const processing::HelixGeometry& geometry,
-                         const processing::WheelMap& map, const WheelFit& fit,
-                         const WheelModelOptions& options) {
+namespace {
+
+// The warm-up's stride: one sample from each run of this many (1: no warm-up).
+std::size_t WarmUpStride(std::size_t total, std::size_t warm_start_samples) {
+  if (warm_start_samples == 0 || total < 4 * warm_start_samples) return 1;
+  return total / warm_start_samples;
+}
+
+// Fits at the finest knots asked for, then, where the knots are to be chosen, picks them by the
+// BIC from the fine fit's linearised normal equations and refits there, and maps the residuals.
+//
+// With a warm-up, the fine fit converges on a subsample; two Gauss-Newton steps over every sample
+// from there give the fine fit's normal equations where the fit over every sample has them (the
+// model is so nearly linear that one step from the subsample's optimum lands on the full one to
+// many digits). They choose the knots, and their linearised solution at the chosen knots is so
+// close to the optimum there that one more pass (J^T r and r^T r only, J^T J taken from the fine
+// pass, the residual map beside) meets the convergence rule; else full iterations follow. Without
+// the warm-up, every Gauss-Newton iteration passes over every sample, and the residual map takes
+// a pass of its own.
+template <typename Sample>
+Fitted FitAndChoose(const Samples<Sample>& samples, const Grid& grid, const WheelFit& fit,
+                    const WheelModelOptions& options, double half_width_mm, WheelModel& model) {
+  const std::vector<int> choices[3] = {KnotCandidates(options.radius_knots, true),
+                                       KnotCandidates(options.axial_knots, true),
+                                       KnotCandidates(options.runout_knots, false)};
+  const Layout fine = MakeLayout({choices[0].back(), choices[1].back(), choices[2].back()}, half_width_mm,
+                                 options.profile_knot_step_mm);
+  const MatrixXd null_space = ProfileNullSpace(fine.profile, half_width_mm);
+  const MatrixXd fine_reduction = Reduction(fine, fine.knots(), null_space);
+  VectorXd start = StartingPoint(fine, fit);
+  const std::size_t stride = WarmUpStride(samples.rho_mm.size(), options.warm_start_samples);
+  const bool warm = stride > 1;
+  if (warm) {
+    const Solution subsample = Converge(
+        samples, fine, fine_reduction, start,
+        {.stride = stride, .max_iterations = options.max_iterations, .throw_if_not_converged = false});
+    // A subsample that cannot support the fine knots leaves the start as it was.
+    if (subsample.converged && subsample.theta.allFinite()) start = subsample.theta;
+  }
+  Solution best =
+      warm ? OneStep(samples, fine, fine_reduction, start)
+           : Converge(samples, fine, fine_reduction, start, {.max_iterations = options.max_iterations});
+  if (warm) {
+    // J at the subsample's optimum is off J at the full data's in its fourth digit (through p'(u)
+    // above all), and the knots, the test of Ra's constancy and the covariance depend on J^T J:
+    // one more step puts it where the fit over every sample has it.
+    const int first = best.iterations;
+    best = OneStep(samples, fine, fine_reduction, best.theta);
+    best.iterations += first;
+  }
+  model.knots_chosen = choices[0].size() > 1 || choices[1].size() > 1 || choices[2].size() > 1;
+  const Knots knots = model.knots_chosen ? ChooseKnots(best, fine, choices, null_space) : fine.knots();
+  Fitted fitted;
+  fitted.layout = MakeLayout(knots, half_width_mm, options.profile_knot_step_mm);
+  fitted.variation = VariationAtFineFit(best, fine, knots, null_space);
+  const PartRanges ranges = best.ranges;
+  const int iterations = best.iterations;
+  ConvergeRequest request{
+      .max_iterations = options.max_iterations, .grid = warm ? &grid : nullptr, .ranges = &ranges};
+  if (!(knots == fine.knots())) {
+    const LinearisedFit linear = Linearise(best, Reduction(fine, knots, null_space));
+    const MatrixXd reduction = Reduction(fitted.layout, knots, null_space);
+    if (warm) request.reduced_jtj = linear.reduced_jtj;
+    best = Converge(samples, fitted.layout, reduction, reduction * linear.x, std::move(request));
+    best.iterations += iterations;
+  } else if (warm) {
+    request.reduced_jtj = best.reduced_jtj;
+    const VectorXd from = best.theta;
+    best = Converge(samples, fine, fine_reduction, from, std::move(request));
+    best.iterations += iterations;
+  }
+  if (warm) {
+    fitted.residual_um = ResidualMap(grid, best.cells);
+  } else {
+    // As the fit was defined: the residuals at the solution, one more pass.
+    const PassResult pass =
+        Accumulate(samples, fitted.layout, best.theta, {.normal_matrix = false, .grid = &grid}, &best.ranges);
+    fitted.residual_um = ResidualMap(grid, pass.cells);
+  }
+  fitted.solution = std::move(best);
+  return fitted;
+}
+
+template <typename Sample>
+WheelModel Fit(std::span<const Sample> rho_mm, const processing::HelixGeometry& geometry,
+               const processing::WheelMap& map, const WheelFit& fit, const WheelModelOptions& options) {
   ThrowIfProblems(ErrorCode::kInvalidOption, kStage, options.Problems());
   WheelModel model;
   model.band_low_mm = fit.band_low_mm;
@@ -658,9 +1037,10 @@ WheelModel FitWheelModel(std::span<const double> rho_mm, const processing::Helix
   model.center_axial_reference_mm = fit.mean_center_axial_mm;
   const double half_width_mm =
       std::max(fit.mean_center_axial_mm - fit.band_low_mm, fit.band_high_mm - fit.mean_center_axial_mm);
-  const Samples samples{rho_mm, geometry, fit.band_low_mm, fit.band_high_mm};
+  const Samples<Sample> samples{rho_mm, geometry, fit.band_low_mm, fit.band_high_mm};
+  const Grid grid = GridOf(map);
 
-  Fitted f = FitAndChoose(samples, fit, options, half_width_mm, model);
+  Fitted f = FitAndChoose(samples, grid, fit, options, half_width_mm, model);
   const Solution& s = f.solution;
   const auto parameters = static_cast<std::size_t>(s.reduction.cols());
   if (s.normal.samples < 4 * parameters) {
@@ -691,17 +1071,24 @@ WheelModel FitWheelModel(std::span<const double> rho_mm, const processing::Helix
   model.variation_significant = model.variation_p_value < options.significance_level;
   RadiusHarmonics(f, options.harmonics, model);
   SampleProfile(f, half_width_mm, model);
-  model.residual_um = ResidualMap(samples, f, map);
+  model.residual_um = std::move(f.residual_um);
   model.coefficients.assign(s.theta.data(), s.theta.data() + s.theta.size());
   model.covariance.assign(f.covariance.data(), f.covariance.data() + f.covariance.size());
   return model;
 }
 
+}  // namespace
+
+WheelModel FitWheelModel(std::span<const double> rho_mm, const processing::HelixGeometry& geometry,
+                         const processing::WheelMap& map, const WheelFit& fit,
+                         const WheelModelOptions& options) {
+  return Fit(rho_mm, geometry, map, fit, options);
+}
+
 WheelModel FitWheelModel(std::span<const float> rho_mm, const processing::HelixGeometry& geometry,
                          const processing::WheelMap& map, const WheelFit& fit,
                          const WheelModelOptions& options) {
-  const std::vector<double> widened(rho_mm.begin(), rho_mm.end());
-  return FitWheelModel(std::span<const double>(widened), geometry, map, fit, options);
+  return Fit(rho_mm, geometry, map, fit, options);
 }
 
 }  // namespace arcwheel::fitting

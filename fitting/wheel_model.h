@@ -32,6 +32,11 @@ struct WheelModelOptions {
   int max_iterations = 40;            // Gauss-Newton iterations per fit
   double significance_level = 0.01;   // of the test "Ra(c) varies"
   int harmonics = 8;                  // radius harmonics reported (at most radius_knots / 2)
+  // Size of the warm-up subsample (one sample out of every run of N / warm_start_samples, N the
+  // scan's size), on which the finest knots' fit converges before the passes over every sample;
+  // 0 (or a scan under 4 times this size) skips it, so that every Gauss-Newton iteration passes
+  // over every sample. Either way the result is the least-squares optimum over every sample.
+  std::size_t warm_start_samples = 100000;
   [[nodiscard]] std::vector<std::string> Problems() const;
 };
 
@@ -54,8 +59,8 @@ struct WheelModel {
   double center_axial_reference_mm = 0;  // mean a, the band's centre
   std::size_t samples = 0;               // samples in the band that the fit used
   int parameters = 0;                    // free parameters (the constraints on p taken off)
-  int iterations = 0;
-  double residual_rms_um = 0;  // of the fit, against the scan's noise estimate:
+  int iterations = 0;                    // Gauss-Newton passes over every sample (the warm-up's not counted)
+  double residual_rms_um = 0;            // of the fit, against the scan's noise estimate:
   double noise_sigma_um = 0;
   double mean_arc_radius_mm = 0, mean_arc_radius_sigma_mm = 0;  // the mean of Ra(c) over a turn
   // max - min of Ra(c) over the phase grid, and its 1-sigma.
@@ -86,6 +91,9 @@ struct WheelModel {
 // Fits the model to rho_mm (per sample, NaN = invalid, as the map was built from) over the band
 // of `fit`, starting from its mean circle. Throws Error{kInvalidOption} for bad options and
 // Error{kFitFailed} when the band holds too few samples or the fit does not converge.
+// Float samples are read as they are (no widened copy); the arithmetic is in double. Nothing is
+// allocated per sample. The work is split into a fixed number of parts, so the result does not
+// depend on the number of cores.
 [[nodiscard]] WheelModel FitWheelModel(std::span<const double> rho_mm,
                                        const processing::HelixGeometry& geometry,
                                        const processing::WheelMap& map, const WheelFit& fit,

@@ -5,6 +5,9 @@
 #include <Eigen/Dense>
 #include <cmath>
 #include <numbers>
+#include <span>
+#include <string>
+#include <vector>
 
 #include "acquisition/simulate.h"
 #include "processing/process_scan.h"
@@ -203,6 +206,137 @@ TEST(WheelModelStatistics, RadiusVariationIsSignificantOnlyWhenThereIsOne) {
         Model(EccentricWheel({{3, 0.002, 0.0}}), PaperScan(seed, 0.1), WheelModelOptions{}).model;
     EXPECT_TRUE(model.variation_significant) << "seed " << seed << " p " << model.variation_p_value;
   }
+}
+
+// The warm-up on a subsample must not change the answer: the same knots, and every output as
+// when every Gauss-Newton iteration passes over every sample (warm_start_samples = 0, the
+// algorithm as it was first written) to 1e-6 relative or 1e-3 of its own sigma; the sigmas
+// themselves to 1e-3 relative (a sigma's own uncertainty is some 1e-3 relative at these sizes).
+void ExpectNear(double fast, double reference, double sigma, const std::string& what) {
+  const double tolerance = std::max(1e-6 * std::abs(reference), 1e-3 * sigma);
+  EXPECT_NEAR(fast, reference, tolerance) << what;
+}
+
+void ExpectSameModel(const WheelModel& fast, const WheelModel& reference) {
+  ASSERT_TRUE(fast.fitted);
+  ASSERT_TRUE(reference.fitted);
+  EXPECT_EQ(fast.radius_knots, reference.radius_knots);
+  EXPECT_EQ(fast.axial_knots, reference.axial_knots);
+  EXPECT_EQ(fast.runout_knots, reference.runout_knots);
+  EXPECT_EQ(fast.samples, reference.samples);
+  EXPECT_EQ(fast.parameters, reference.parameters);
+  ASSERT_EQ(fast.coefficients.size(), reference.coefficients.size());
+  const std::size_t n = reference.coefficients.size();
+  for (std::size_t i = 0; i < n; ++i) {
+    const double sigma = std::sqrt(reference.covariance[i * n + i]);
+    ExpectNear(fast.coefficients[i], reference.coefficients[i], sigma, "coefficient " + std::to_string(i));
+    EXPECT_NEAR(std::sqrt(fast.covariance[i * n + i]), sigma, 1e-3 * sigma) << "sigma " << i;
+  }
+  for (std::size_t i = 0; i < reference.phase_deg.size(); ++i) {
+    ExpectNear(fast.arc_radius_mm[i], reference.arc_radius_mm[i], reference.arc_radius_sigma_mm[i], "Ra");
+    ExpectNear(fast.center_axial_mm[i], reference.center_axial_mm[i], reference.center_axial_sigma_mm[i],
+               "a");
+    ExpectNear(fast.center_radial_mm[i], reference.center_radial_mm[i], reference.center_radial_sigma_mm[i],
+               "b");
+    EXPECT_NEAR(fast.arc_radius_sigma_mm[i], reference.arc_radius_sigma_mm[i],
+                1e-3 * reference.arc_radius_sigma_mm[i]);
+  }
+  for (std::size_t i = 0; i < reference.profile_u_mm.size(); ++i) {
+    ExpectNear(fast.profile_error_um[i], reference.profile_error_um[i], reference.profile_error_sigma_um[i],
+               "p");
+  }
+  ASSERT_EQ(fast.radius_harmonics.size(), reference.radius_harmonics.size());
+  for (std::size_t i = 0; i < reference.radius_harmonics.size(); ++i) {
+    const RadiusHarmonic &f = fast.radius_harmonics[i], &r = reference.radius_harmonics[i];
+    ExpectNear(f.amplitude_um, r.amplitude_um, r.amplitude_sigma_um, "amplitude");
+    ExpectNear(f.phase_deg, r.phase_deg, r.phase_sigma_deg, "phase");
+    EXPECT_NEAR(f.amplitude_sigma_um, r.amplitude_sigma_um, 1e-3 * r.amplitude_sigma_um);
+  }
+  ExpectNear(fast.mean_arc_radius_mm, reference.mean_arc_radius_mm, reference.mean_arc_radius_sigma_mm,
+             "mean Ra");
+  ExpectNear(fast.arc_radius_range_mm, reference.arc_radius_range_mm, reference.arc_radius_range_sigma_mm,
+             "Ra range");
+  // The chi-square's own sigma is sqrt(2 dof).
+  ExpectNear(fast.variation_chi2, reference.variation_chi2, std::sqrt(2.0 * reference.variation_dof), "chi2");
+  EXPECT_EQ(fast.variation_significant, reference.variation_significant);
+  EXPECT_NEAR(fast.residual_rms_um, reference.residual_rms_um, 1e-6 * reference.residual_rms_um);
+  // A cell's mean residual has a sigma of at least the noise over the root of the samples in it
+  // (a few dozen here).
+  ASSERT_EQ(fast.residual_um.size(), reference.residual_um.size());
+  int cells = 0;
+  for (std::size_t i = 0; i < reference.residual_um.size(); ++i) {
+    if (std::isnan(reference.residual_um[i])) {
+      EXPECT_TRUE(std::isnan(fast.residual_um[i])) << "cell " << i;
+      continue;
+    }
+    ++cells;
+    EXPECT_NEAR(fast.residual_um[i], reference.residual_um[i], 1e-3 * reference.residual_rms_um / 10.0)
+        << "cell " << i;
+  }
+  EXPECT_GT(cells, 1000);
+}
+
+// A noisy lobed wheel scanned at 20 kHz (2.6e5 samples), modelled with a warm-up on every 13th
+// sample and without one.
+TEST(WheelModelWarmStart, GivesTheFitOverEverySampleWithTheKnotsChosen) {
+  ScanSettings settings = NoisyScan(7, 0.5);
+  settings.sample_period_s = 50e-6;
+  acquisition::Scan scan = acquisition::SimulateScan(LobedWheelWithProfileError(), settings).scan;
+  const processing::ProcessedScan processed =
+      processing::ProcessScanInPlace(scan, processing::ProcessOptions{});
+  const WheelFit fit = FitWheel(processed.map, WheelFitOptions{});
+  const processing::HelixGeometry geometry(scan, processed.rpm_used);
+  WheelModelOptions fast_options;
+  fast_options.warm_start_samples = scan.size() / 13;
+  WheelModelOptions reference_options;
+  reference_options.warm_start_samples = 0;
+  const WheelModel fast = FitWheelModel(scan.z_mm, geometry, processed.map, fit, fast_options);
+  const WheelModel reference = FitWheelModel(scan.z_mm, geometry, processed.map, fit, reference_options);
+  EXPECT_TRUE(fast.knots_chosen);
+  EXPECT_LT(fast.iterations, reference.iterations);  // the warm-up did take work off
+  ExpectSameModel(fast, reference);
+
+  // float32 samples are read as they are: the same model as from the same values widened.
+  const std::vector<float> narrow(scan.z_mm.begin(), scan.z_mm.end());
+  const std::vector<double> widened(narrow.begin(), narrow.end());
+  const WheelModel from_float =
+      FitWheelModel(std::span<const float>(narrow), geometry, processed.map, fit, fast_options);
+  const WheelModel from_double = FitWheelModel(widened, geometry, processed.map, fit, fast_options);
+  EXPECT_EQ(from_float.coefficients, from_double.coefficients);
+  EXPECT_EQ(from_float.covariance, from_double.covariance);
+  ASSERT_EQ(from_float.residual_um.size(), from_double.residual_um.size());
+  for (std::size_t i = 0; i < from_float.residual_um.size(); ++i) {
+    if (!std::isnan(from_double.residual_um[i])) {
+      EXPECT_EQ(from_float.residual_um[i], from_double.residual_um[i]);
+    }
+  }
+  // And as from the double samples, to float32's rounding of the scan.
+  ExpectSameModel(from_float, fast);
+}
+
+// The same with the knots given (the fine fit is then the final one) and a float32 scan.
+TEST(WheelModelWarmStart, GivesTheFitOverEverySampleWithTheKnotsGiven) {
+  ScanSettings settings = NoisyScan(8, 0.5);
+  settings.sample_period_s = 50e-6;
+  acquisition::Scan scan = acquisition::SimulateScan(LobedWheelWithProfileError(), settings).scan;
+  const processing::ProcessedScan processed =
+      processing::ProcessScanInPlace(scan, processing::ProcessOptions{});
+  const WheelFit fit = FitWheel(processed.map, WheelFitOptions{});
+  const processing::HelixGeometry geometry(scan, processed.rpm_used);
+  const std::vector<float> narrow(scan.z_mm.begin(), scan.z_mm.end());
+  WheelModelOptions options;
+  options.radius_knots = 16;
+  options.axial_knots = 8;
+  options.runout_knots = 16;
+  options.warm_start_samples = scan.size() / 13;
+  const WheelModel fast =
+      FitWheelModel(std::span<const float>(narrow), geometry, processed.map, fit, options);
+  options.warm_start_samples = 0;
+  const WheelModel reference =
+      FitWheelModel(std::span<const float>(narrow), geometry, processed.map, fit, options);
+  EXPECT_FALSE(fast.knots_chosen);
+  EXPECT_EQ(fast.radius_knots, 16);
+  ExpectSameModel(fast, reference);
 }
 
 TEST(WheelModelOptions, EveryProblemIsReportedWithItsValue) {

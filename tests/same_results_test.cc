@@ -3,6 +3,11 @@
 // summary.json that the version before the read-once, float32 and despiker changes wrote
 // (testdata/regression/, made as testdata/README.md says).
 //
+// The `model` section is left out: the wheel model's knot choice was fixed since (its linearised
+// coarser fits lost digits to cancellation, which chose 4 radius knots for a constant-radius
+// wheel at 1e7 samples) and its fit now starts on a subsample; fitting/wheel_model_test holds
+// that fit to the full-data reference path instead.
+//
 // Tolerance: |new - reference| <= 1e-9 |reference| + 1e-12 in the key's own unit. The relative
 // part allows a different order of floating-point sums (another compiler, the sanitizer build);
 // the absolute part, 1e-12 mm or um, allows values that are zero up to round-off.
@@ -36,6 +41,7 @@ void ExpectSameNumbers(const nlohmann::json& reference, const nlohmann::json& ac
                        const std::string& where, int& compared) {
   if (reference.is_object()) {
     for (const auto& [key, value] : reference.items()) {
+      if (where.empty() && key == "model") continue;
       ASSERT_TRUE(actual.contains(key)) << where << "/" << key << " is missing";
       ExpectSameNumbers(value, actual[key], where + "/" + key, compared);
     }
@@ -65,7 +71,7 @@ void ExpectSameSummary(const std::string& scan, const std::string& reference_nam
   nlohmann::json reference = ReadJson(SourceDir() / "testdata" / "regression" / reference_name);
   int compared = 0;
   ExpectSameNumbers(reference, ReadJson(dir / "out" / "summary.json"), "", compared);
-  EXPECT_GT(compared, 4000) << "the reference holds every per-phase number";
+  EXPECT_GT(compared, 3000) << "the reference holds every per-phase number";
 }
 
 // Simulates a scan with `options` and checks that its summary matches `reference_name`.

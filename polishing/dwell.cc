@@ -124,6 +124,21 @@ class Removal {
   [[nodiscard]] Eigen::VectorXd Transposed(const Eigen::VectorXd& rows) const {
     return fft_ ? fft_->ApplyTranspose(rows) : Eigen::VectorXd(sparse_.transpose() * rows);
   }
+  // The same products into vectors the caller keeps: no allocation per iteration.
+  void Multiply(const Eigen::VectorXd& dwell_s, Eigen::VectorXd& rows) const {
+    if (fft_) {
+      fft_->Apply(dwell_s, rows);
+    } else {
+      rows.noalias() = sparse_ * dwell_s;
+    }
+  }
+  void MultiplyTransposed(const Eigen::VectorXd& rows, Eigen::VectorXd& dwell_s) const {
+    if (fft_) {
+      fft_->ApplyTranspose(rows, dwell_s);
+    } else {
+      dwell_s.noalias() = sparse_.transpose() * rows;
+    }
+  }
   [[nodiscard]] Eigen::Index cols() const { return points_; }
   [[nodiscard]] long Nonzeros() const { return fft_ ? fft_->Nonzeros() : sparse_.nonZeros(); }
   [[nodiscard]] bool UsesFft() const { return fft_.has_value(); }
@@ -288,22 +303,23 @@ constexpr int kWarmStartIterations = 100;
 
 Fit ProjectedGradient(const Removal& a, const Eigen::VectorXd& target, const Bounds& bounds, double step,
                       Eigen::VectorXd start, bool warm, const DwellOptions& options) {
-  auto project = [&](const Eigen::VectorXd& t) {
-    return t.cwiseMax(bounds.lower).cwiseMin(bounds.upper).eval();
-  };
   Fit fit;
-  Eigen::VectorXd t = project(start), previous = t, y = t;
+  // The vectors live across iterations: on a million points each is 8 MB, too much to allocate
+  // and fault in a few times per iteration.
+  Eigen::VectorXd t = start.cwiseMax(bounds.lower).cwiseMin(bounds.upper), previous = t, y = t;
+  Eigen::VectorXd residual(target.size()), gradient(t.size());
   double momentum = 1.0;
   std::vector<double> history;
   for (fit.iterations = 1; fit.iterations <= options.max_iterations; ++fit.iterations) {
-    const Eigen::VectorXd residual = a * y - target;
+    a.Multiply(y, residual);
+    residual -= target;
     if (Stalled(residual.norm(), fit.iterations, options, history)) {
       fit.converged = true;
       break;
     }
-    const Eigen::VectorXd gradient = a.Transposed(residual);
-    previous = t;
-    t = project(y - step * gradient);
+    a.MultiplyTransposed(residual, gradient);
+    previous.swap(t);
+    t = (y - step * gradient).cwiseMax(bounds.lower).cwiseMin(bounds.upper);
     const double change = (t - previous).norm();
     if (change <= options.relative_tolerance * t.norm() && (!warm || fit.iterations > kWarmStartIterations)) {
       fit.converged = true;

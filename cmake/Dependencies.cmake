@@ -32,3 +32,11 @@ find_package(PkgConfig REQUIRED)
 pkg_check_modules(CAIRO REQUIRED IMPORTED_TARGET cairo)
 # FFTW: the dwell solve's removal products as FFT convolutions (polishing/removal_fft.h).
 pkg_check_modules(FFTW3 REQUIRED IMPORTED_TARGET fftw3)
+# FFTW's threads library (the same Debian package, no pkg-config file of its own): the large
+# transforms of the dwell solve run on every core.
+find_library(FFTW3_THREADS_LIBRARY fftw3_threads HINTS ${FFTW3_LIBRARY_DIRS} REQUIRED)
+if(NOT TARGET arcwheel_fftw3_threads)
+  add_library(arcwheel_fftw3_threads INTERFACE)
+  target_link_libraries(arcwheel_fftw3_threads INTERFACE ${FFTW3_THREADS_LIBRARY} PkgConfig::FFTW3 Threads::Threads)
+  add_library(arcwheel::fftw3_threads ALIAS arcwheel_fftw3_threads)
+endif()

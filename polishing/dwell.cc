@@ -124,6 +124,21 @@ class Removal {
   [[nodiscard]] Eigen::VectorXd Transposed(const Eigen::VectorXd& rows) const {
     return fft_ ? fft_->ApplyTranspose(rows) : Eigen::VectorXd(sparse_.transpose() * rows);
   }
+  // The same products into vectors the caller keeps: no allocation per iteration.
+  void Multiply(const Eigen::VectorXd& dwell_s, Eigen::VectorXd& rows) const {
+    if (fft_) {
+      fft_->Apply(dwell_s, rows);
+    } else {
+      rows.noalias() = sparse_ * dwell_s;
+    }
+  }
+  void MultiplyTransposed(const Eigen::VectorXd& rows, Eigen::VectorXd& dwell_s) const {
+    if (fft_) {
+      fft_->ApplyTranspose(rows, dwell_s);
+    } else {
+      dwell_s.noalias() = sparse_.transpose() * rows;
+    }
+  }
   [[nodiscard]] Eigen::Index cols() const { return points_; }
   [[nodiscard]] long Nonzeros() const { return fft_ ? fft_->Nonzeros() : sparse_.nonZeros(); }
   [[nodiscard]] bool UsesFft() const { return fft_.has_value(); }
@@ -217,13 +232,14 @@ void AddLeastDwell(Bounds& b, std::span<const Eigen::Vector2d> path, const Dwell
 }
 
 // True when the best residual norm so far has improved on the best one stall_iterations ago by
-// less than stall_improvement times the first residual norm. `history` keeps the running best of every
-// iteration.
-bool Stalled(double residual_norm, int iteration, const DwellOptions& o, std::vector<double>& history) {
+// less than stall_improvement times `reference`, the first residual norm of the whole solve.
+// `history` keeps the running best of every iteration.
+bool Stalled(double residual_norm, int iteration, double reference, const DwellOptions& o,
+             std::vector<double>& history) {
   history.push_back(history.empty() ? residual_norm : std::min(history.back(), residual_norm));
   if (o.stall_iterations <= 0 || iteration <= o.stall_iterations) return false;
   const double earlier = history[history.size() - 1 - static_cast<std::size_t>(o.stall_iterations)];
-  return earlier - history.back() <= o.stall_improvement * history.front();
+  return earlier - history.back() <= o.stall_improvement * reference;
 }
 
 // Largest acceleration the speeds need: |v_k^2 - v_(k-1)^2| / (2 chord_k) over k >= 2 (the
@@ -279,31 +295,39 @@ struct Fit {
   Eigen::VectorXd dwell_s;
   int iterations = 0;
   bool converged = false;
+  double first_residual_norm = 0.0;  // the stall test's reference
 };
 
 // Accelerated projected gradient from `start`. From a warm start near a solution one plain gradient
 // step is short although the accelerated iteration still has far to go, so there the dwell-change
-// test only counts after kWarmStartIterations.
+// test only counts after kWarmStartIterations. A warm start (a shaping round) passes the first
+// solve's first residual norm as the stall test's reference: measured against its own, already
+// small, first residual, a round would polish far below where the first solve stopped.
 constexpr int kWarmStartIterations = 100;
 
 Fit ProjectedGradient(const Removal& a, const Eigen::VectorXd& target, const Bounds& bounds, double step,
-                      Eigen::VectorXd start, bool warm, const DwellOptions& options) {
-  auto project = [&](const Eigen::VectorXd& t) {
-    return t.cwiseMax(bounds.lower).cwiseMin(bounds.upper).eval();
-  };
+                      const Eigen::VectorXd& start, std::optional<double> warm_stall_reference,
+                      const DwellOptions& options) {
+  const bool warm = warm_stall_reference.has_value();
   Fit fit;
-  Eigen::VectorXd t = project(start), previous = t, y = t;
+  // The vectors live across iterations: on a million points each is 8 MB, too much to allocate
+  // and fault in a few times per iteration.
+  Eigen::VectorXd t = start.cwiseMax(bounds.lower).cwiseMin(bounds.upper), previous = t, y = t;
+  Eigen::VectorXd residual(target.size()), gradient(t.size());
   double momentum = 1.0;
   std::vector<double> history;
   for (fit.iterations = 1; fit.iterations <= options.max_iterations; ++fit.iterations) {
-    const Eigen::VectorXd residual = a * y - target;
-    if (Stalled(residual.norm(), fit.iterations, options, history)) {
+    a.Multiply(y, residual);
+    residual -= target;
+    const double residual_norm = residual.norm();
+    if (fit.iterations == 1) fit.first_residual_norm = warm_stall_reference.value_or(residual_norm);
+    if (Stalled(residual_norm, fit.iterations, fit.first_residual_norm, options, history)) {
       fit.converged = true;
       break;
     }
-    const Eigen::VectorXd gradient = a.Transposed(residual);
-    previous = t;
-    t = project(y - step * gradient);
+    a.MultiplyTransposed(residual, gradient);
+    previous.swap(t);
+    t = (y - step * gradient).cwiseMax(bounds.lower).cwiseMin(bounds.upper);
     const double change = (t - previous).norm();
     if (change <= options.relative_tolerance * t.norm() && (!warm || fit.iterations > kWarmStartIterations)) {
       fit.converged = true;
@@ -417,7 +441,8 @@ DwellSolution SolveDwell(const ErrorMap& target, const surfaces::Aperture& apert
   const Eigen::VectorXd at = a * start;
   start *= at.squaredNorm() > 0.0 ? at.dot(rows.target) / at.squaredNorm() : 0.0;
   const double step = 1.0 / GradientLipschitz(a);
-  Fit fit = ProjectedGradient(a, rows.target, bounds, step, start, false, options);
+  Fit fit = ProjectedGradient(a, rows.target, bounds, step, start, std::nullopt, options);
+  const double stall_reference = fit.first_residual_norm;
   DwellSolution solution;
   solution.iterations = fit.iterations;
   solution.converged = fit.converged;
@@ -436,7 +461,7 @@ DwellSolution SolveDwell(const ErrorMap& target, const surfaces::Aperture& apert
       if (added_um <= options.shaping_tolerance_um) break;
       if (solution.shaping_rounds == options.max_shaping_rounds) NotSettled(path, worst, added_um, options);
       ++solution.shaping_rounds;
-      fit = ProjectedGradient(a, rows.target, bounds, step, t, true, options);
+      fit = ProjectedGradient(a, rows.target, bounds, step, t, stall_reference, options);
       solution.iterations += fit.iterations;
       solution.converged = solution.converged && fit.converged;
       t = std::move(fit.dwell_s);

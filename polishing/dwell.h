@@ -78,8 +78,9 @@ struct DwellOptions {
   int max_iterations = 2000;         // projected-gradient iterations, >= 1 (the job file's default too)
   double relative_tolerance = 1e-7;  // stop when the dwell changes by less than this, relative
   // Also stop when the residual norm has improved over the last stall_iterations iterations by
-  // less than stall_improvement times the first residual norm: further iterations only polish
-  // the prediction at the sub-nanometre level. stall_iterations = 0 disables this test.
+  // less than stall_improvement times the first residual norm (of the first solve, also in the
+  // shaping rounds): further iterations only polish the prediction at the sub-nanometre level.
+  // stall_iterations = 0 disables this test.
   int stall_iterations = 100;       // >= 0
   double stall_improvement = 1e-3;  // > 0
   // Shaping rounds (re-solves) allowed before the speeds count as unreachable, >= 1.

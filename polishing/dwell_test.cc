@@ -99,7 +99,7 @@ TEST(SolveDwell, CutsTheResidualRmsTenfoldWithNonNegativeDwellWithinSpeedLimits)
   const std::vector<Eigen::Vector2d> path =
       RasterPath(kDisc, {.line_spacing_mm = 2.0, .point_spacing_mm = 2.5, .extension_mm = 10.0});
   for (const unsigned seed : {1u, 2u, 3u}) {
-    const ErrorMap error = SimulatedErrorMap(seed);
+    const ErrorMap error = SimulatedErrorMap(seed, 2.0);
     const ErrorMap target = RemovalTarget(error, kDisc, {.uniform_layer_um = 1.5});
     const DwellSolution solution = SolveDwell(target, kDisc, path, tool, options);
     ASSERT_EQ(solution.dwell_s.size(), path.size());
@@ -143,7 +143,7 @@ TEST(SolveDwell, AMeasuredGaussianRemovesAsTheAnalyticOneWithinTheInterpolationB
   const DwellOptions options{.max_speed_mm_s = 150.0, .min_speed_mm_s = 0.2, .max_iterations = 500};
   const std::vector<Eigen::Vector2d> path =
       RasterPath(kDisc, {.line_spacing_mm = 2.0, .point_spacing_mm = 2.5, .extension_mm = 10.0});
-  const ErrorMap target = RemovalTarget(SimulatedErrorMap(1), kDisc, {.uniform_layer_um = 1.5});
+  const ErrorMap target = RemovalTarget(SimulatedErrorMap(1, 2.0), kDisc, {.uniform_layer_um = 1.5});
   const DwellSolution solution = SolveDwell(target, kDisc, path, table, options);
   // Same dwell through the analytic, untruncated Gaussian: inside the table each point's rate is
   // within the interpolation bound; outside it the table gives 0 for the Gaussian's value. So the
@@ -290,7 +290,7 @@ TEST(SolveDwell, KeepsTheLeastDwellAndReportsTheAccelerationTheSpeedsNeed) {
   const GaussianRemovalFunction tool{.peak_rate_um_per_s = 2.0, .fwhm_mm = 12.0};
   const std::vector<Eigen::Vector2d> path =
       RasterPath(kDisc, {.line_spacing_mm = 3.0, .point_spacing_mm = 3.0, .extension_mm = 8.0});
-  const ErrorMap target = RemovalTarget(SimulatedErrorMap(4), kDisc, {.uniform_layer_um = 1.5});
+  const ErrorMap target = RemovalTarget(SimulatedErrorMap(4, 2.0), kDisc, {.uniform_layer_um = 1.5});
   const DwellOptions options{.max_speed_mm_s = 200.0, .min_dwell_s = 0.03, .max_iterations = 300};
   const DwellSolution solution = SolveDwell(target, kDisc, path, tool, options);
   for (std::size_t k = 1; k < path.size(); ++k) EXPECT_GE(solution.dwell_s[k], 0.03);
@@ -375,7 +375,7 @@ TEST(SolveDwell, HoldsThePerPointLeastDwellAndRefusesOneOutOfRange) {
   const GaussianRemovalFunction tool{.peak_rate_um_per_s = 2.0, .fwhm_mm = 12.0};
   const std::vector<Eigen::Vector2d> path =
       RasterPath(kDisc, {.line_spacing_mm = 3.0, .point_spacing_mm = 3.0, .extension_mm = 8.0});
-  const ErrorMap target = RemovalTarget(SimulatedErrorMap(4), kDisc, {.uniform_layer_um = 1.5});
+  const ErrorMap target = RemovalTarget(SimulatedErrorMap(4, 2.0), kDisc, {.uniform_layer_um = 1.5});
   DwellOptions options{.max_speed_mm_s = 200.0, .min_speed_mm_s = 1.0, .max_iterations = 300};
   options.least_dwell_s.assign(path.size(), 0.0);
   for (std::size_t k = 1; k < path.size(); k += 17) options.least_dwell_s[k] = 0.5;
@@ -477,7 +477,7 @@ TEST(SpiralPath, CarriesADwellThatCutsTheResidualRmsTenfold) {
   const GaussianRemovalFunction tool{.peak_rate_um_per_s = 2.0, .fwhm_mm = 12.0};
   const auto path =
       SpiralPath(kDisc, {.line_spacing_mm = 2.0, .point_spacing_mm = 2.5, .extension_mm = 10.0});
-  const ErrorMap target = RemovalTarget(SimulatedErrorMap(1), kDisc, {.uniform_layer_um = 1.5});
+  const ErrorMap target = RemovalTarget(SimulatedErrorMap(1, 2.0), kDisc, {.uniform_layer_um = 1.5});
   const DwellSolution solution = SolveDwell(
       target, kDisc, path, tool, {.max_speed_mm_s = 150.0, .min_speed_mm_s = 0.2, .max_iterations = 500});
   const double rms_after = ResidualRmsUm(target, path, solution.dwell_s, 2.0, 12.0);

@@ -10,6 +10,7 @@
 #include <utility>
 
 #include "core/check.h"
+#include "core/parallel.h"
 
 namespace arcwheel::polishing::internal {
 namespace {
@@ -18,6 +19,16 @@ namespace {
 std::mutex& PlannerMutex() {
   static std::mutex mutex;
   return mutex;
+}
+
+// Transforms of at least this many cells run on every core (FFTW's threads): below it, waking the
+// threads costs more than they save.
+constexpr std::size_t kThreadedCells = std::size_t{1} << 18;
+
+// FFTW's threads are set up once per process; call with the planner mutex held.
+int PlanThreads(std::size_t cells) {
+  static const bool ready = fftw_init_threads() != 0;
+  return ready && cells >= kThreadedCells ? WorkerCount(0) : 1;
 }
 
 // The whole number of steps from `origin` to `value`, if it lies within kGridTolerance of one.
@@ -78,6 +89,7 @@ struct FftRemoval::Workspace {
     const std::size_t cells = static_cast<std::size_t>(r) * c;
     const std::size_t half = static_cast<std::size_t>(r) * (c / 2 + 1);
     const std::lock_guard<std::mutex> lock(PlannerMutex());
+    fftw_plan_with_nthreads(PlanThreads(cells));
     grid = fftw_alloc_real(cells);
     spectrum = fftw_alloc_complex(half);
     ARCWHEEL_CHECK(grid != nullptr && spectrum != nullptr) << "FFT arrays of " << r << " x " << c;
@@ -180,12 +192,16 @@ std::optional<FftRemoval> FftRemoval::Make(const ErrorMap& map, std::span<const 
 void FftRemoval::Convolve(bool correlate) const {
   Workspace& w = *work_;
   fftw_execute(w.forward);
-  std::complex<double>* spectrum = w.Spectrum();
+  // Written out: std::complex's operator* checks every product for NaN (C99 Annex G) and keeps
+  // the loop from vectorising; the spectra are finite, and the arithmetic is the same.
+  double* spectrum = &w.spectrum[0][0];
+  const double* kernel = reinterpret_cast<const double*>(w.kernel.data());
+  const double sign = correlate ? -1.0 : 1.0;  // A^T: the kernel's complex conjugate
   const std::size_t n = w.HalfCells();
-  if (correlate) {
-    for (std::size_t k = 0; k < n; ++k) spectrum[k] *= std::conj(w.kernel[k]);
-  } else {
-    for (std::size_t k = 0; k < n; ++k) spectrum[k] *= w.kernel[k];
+  for (std::size_t k = 0; k < 2 * n; k += 2) {
+    const double a = spectrum[k], b = spectrum[k + 1], c = kernel[k], d = sign * kernel[k + 1];
+    spectrum[k] = a * c - b * d;
+    spectrum[k + 1] = a * d + b * c;
   }
   fftw_execute(w.inverse);
 }
@@ -196,26 +212,36 @@ double* FftRemoval::ClearedGrid() const {
 }
 
 Eigen::VectorXd FftRemoval::Apply(const Eigen::VectorXd& dwell_s) const {
-  ARCWHEEL_CHECK(dwell_s.size() == static_cast<Eigen::Index>(point_cell_.size())) << dwell_s.size();
-  double* cells = ClearedGrid();
-  for (std::size_t k = 0; k < point_cell_.size(); ++k)
-    cells[point_cell_[k]] += dwell_s[static_cast<Eigen::Index>(k)];
-  Convolve(false);
   Eigen::VectorXd rows(static_cast<Eigen::Index>(row_cell_.size()));
-  for (std::size_t r = 0; r < row_cell_.size(); ++r) rows[static_cast<Eigen::Index>(r)] = cells[row_cell_[r]];
+  Apply(dwell_s, rows);
   return rows;
 }
 
 Eigen::VectorXd FftRemoval::ApplyTranspose(const Eigen::VectorXd& rows) const {
+  Eigen::VectorXd dwell(static_cast<Eigen::Index>(point_cell_.size()));
+  ApplyTranspose(rows, dwell);
+  return dwell;
+}
+
+void FftRemoval::Apply(const Eigen::VectorXd& dwell_s, Eigen::VectorXd& rows) const {
+  ARCWHEEL_CHECK(dwell_s.size() == static_cast<Eigen::Index>(point_cell_.size())) << dwell_s.size();
+  rows.resize(static_cast<Eigen::Index>(row_cell_.size()));
+  double* cells = ClearedGrid();
+  for (std::size_t k = 0; k < point_cell_.size(); ++k)
+    cells[point_cell_[k]] += dwell_s[static_cast<Eigen::Index>(k)];
+  Convolve(false);
+  for (std::size_t r = 0; r < row_cell_.size(); ++r) rows[static_cast<Eigen::Index>(r)] = cells[row_cell_[r]];
+}
+
+void FftRemoval::ApplyTranspose(const Eigen::VectorXd& rows, Eigen::VectorXd& dwell_s) const {
   ARCWHEEL_CHECK(rows.size() == static_cast<Eigen::Index>(row_cell_.size())) << rows.size();
+  dwell_s.resize(static_cast<Eigen::Index>(point_cell_.size()));
   double* cells = ClearedGrid();
   for (std::size_t r = 0; r < row_cell_.size(); ++r)
     cells[row_cell_[r]] += rows[static_cast<Eigen::Index>(r)];
   Convolve(true);
-  Eigen::VectorXd dwell(static_cast<Eigen::Index>(point_cell_.size()));
   for (std::size_t k = 0; k < point_cell_.size(); ++k)
-    dwell[static_cast<Eigen::Index>(k)] = cells[point_cell_[k]];
-  return dwell;
+    dwell_s[static_cast<Eigen::Index>(k)] = cells[point_cell_[k]];
 }
 
 }  // namespace arcwheel::polishing::internal

@@ -5,7 +5,8 @@
 // of the map's grid (extended beyond the map as far as the path goes), X_n - P_k is a whole number
 // of grid steps, so the sum is the 2-D convolution of the removal function sampled at those steps
 // with the dwell placed on the grid: the same products as the sparse removal matrix, computed with
-// FFTW in O(N log N) instead of O(N x footprint). The removal function is the same at every
+// FFTW in O(N log N) instead of O(N x footprint). Transforms of 2^18 cells or more run on every
+// core (FFTW's threads). The removal function is the same at every
 // point (it is defined in the part's (x, y) projection), so the convolution holds over the whole
 // part, curved or not. A point counts as on the grid when it lies within kGridTolerance of a
 // grid step from a node; the kernel is sampled at the exact steps, so such a point's removal
@@ -39,6 +40,9 @@ class FftRemoval {
   [[nodiscard]] Eigen::VectorXd Apply(const Eigen::VectorXd& dwell_s) const;
   // A^T r: for each point, the sum over the row nodes of the rate times r.
   [[nodiscard]] Eigen::VectorXd ApplyTranspose(const Eigen::VectorXd& rows) const;
+  // The same into vectors the caller keeps (resized if need be): no allocation per product.
+  void Apply(const Eigen::VectorXd& dwell_s, Eigen::VectorXd& rows) const;
+  void ApplyTranspose(const Eigen::VectorXd& rows, Eigen::VectorXd& dwell_s) const;
   // Entries of the sparse matrix that these products stand for: (row, point) pairs with a rate > 0.
   [[nodiscard]] long Nonzeros() const { return nonzeros_; }
 

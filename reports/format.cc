@@ -53,7 +53,7 @@ std::string FormatDuration(double seconds) {
   if (!std::isfinite(seconds)) return "n/a";
   const double magnitude = std::abs(seconds);
   if (magnitude == 0.0) return "0 s";
-  if (magnitude < 1e-3) return FormatSignificant(seconds * 1e6, 3) + " µs";
+  if (magnitude < 1e-5) return FormatSignificant(seconds * 1e6, 3) + " µs";
   if (magnitude < 1.0) return FormatSignificant(seconds * 1e3, 3) + " ms";
   if (magnitude < 600.0) return FormatFixed(seconds, 2) + " s";
   if (magnitude < 7200.0) return FormatFixed(seconds / 60.0, 1) + " min";

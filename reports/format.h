@@ -50,8 +50,8 @@ inline constexpr Unit kWear_um_per_h{"µm/h", 3};
 // "0.19968", 500.0 -> "500", 1e-7 -> "1e−07". For numbers without a fixed scale.
 [[nodiscard]] std::string FormatSignificant(double value, int digits = 6);
 
-// A duration with the unit that suits it: 1e-4 -> "0.1 ms", 2.5 -> "2.50 s", 754 -> "12.6 min",
-// 7200 -> "2.00 h".
+// A duration with the unit that suits it: 5e-6 -> "5 µs", 1e-4 -> "0.1 ms", 2.5 -> "2.50 s", 754 -> "12.6
+// min", 7200 -> "2.00 h".
 [[nodiscard]] std::string FormatDuration(double seconds);
 
 // A height given in um: in nm (1 decimal) when `scale_um`, the size of the figures it is shown

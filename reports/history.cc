@@ -96,7 +96,7 @@ ReportFigure RadiusFigure(const History& h) {
 
 ReportFigure PeakToValleyFigure(const History& h) {
   const std::vector<double> hours = ScanHours(h);
-  plot::LinePlot plot{"Arc error, runout and roundness against scan time",
+  plot::LinePlot plot{"Peak-to-valley figures against scan time",
                       {"time since the first scan (h)"},
                       {"peak-to-valley (µm)"},
                       {{"max arc error",

@@ -155,6 +155,28 @@ TEST(PolishReport, HtmlLoadsCleanlyInChromiumOnADesktopAndAPhoneScreen) {
   }
 }
 
+// On a 400 px phone the PV/RMS table shows its "after" column whole (it was clipped when the
+// numbers had 17 digits).
+TEST(PolishReport, PhoneShowsTheWholeBeforeAfterTable) {
+  TempDir dir;
+  Polish(dir / "out", "--report html");
+  const std::string layout = testing::LayoutInChromium(
+      dir / "out" / "polish_report.html", 400, 900,
+      "(function() {"
+      "  const table = document.querySelectorAll('table')[1];"
+      "  const cells = Array.from(table.querySelectorAll('td, th'));"
+      "  const right = Math.max(...cells.map(c => c.getBoundingClientRect().right));"
+      "  return document.documentElement.clientWidth + ' ' + right + ' ' + "
+      "table.rows[0].cells[2].textContent;"
+      "})()");
+  std::istringstream fields(layout);
+  double viewport = 0.0, right = 0.0;
+  fields >> viewport >> right;
+  ASSERT_GT(viewport, 0.0) << "chromium laid the page out: '" << layout << "'";
+  EXPECT_THAT(layout, HasSubstr("After (predicted residual)")) << "the table measured is the PV/RMS table";
+  EXPECT_LE(right, viewport) << layout;
+}
+
 TEST(ReportCommand, MakesThePolishReportForAPolishFolder) {
   TempDir dir;
   Polish(dir / "out");

@@ -134,7 +134,8 @@ std::vector<std::vector<std::string>> ChangeRows(const Comparison& c) {
     };
     std::string change =
         has_sigma ? FormatWithSigma(h.change, h.sigma, h.unit) : FormatValue(h.change, h.unit);
-    if (has_sigma && h.change > 0.0) change = "+" + change;
+    // An explicit plus for a gain, unless the change rounds to zero.
+    if (h.change > 0.0 && change.find_first_of("123456789") < change.find(' ')) change = "+" + change;
     std::string verdict = "no σ recorded";
     if (has_sigma) verdict = h.significant ? "yes (> 3σ)" : "no (≤ 3σ)";
     rows.push_back(

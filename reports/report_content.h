@@ -70,8 +70,9 @@ struct ReportContent {
 // is the current time (UTC).
 [[nodiscard]] ReportContent ComposeReport(const ReportInputs& inputs, const Tolerances& tolerances);
 
-// A JSON object's leaves as dotted keys ("despike.threshold_um"), strings unquoted, other values
-// as JSON text.
+// A JSON object's leaves as dotted keys ("despike.threshold_um"), each value as FormatJsonValue
+// (reports/format.h) writes it: strings unquoted, integers whole, other numbers at six
+// significant digits.
 [[nodiscard]] std::vector<KeyValue> FlattenJson(const nlohmann::json& object);
 
 // "PASS", "FAIL" or "NO TOLERANCE".

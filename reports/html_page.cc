@@ -33,7 +33,7 @@ td.number { white-space: nowrap; font-variant-numeric: tabular-nums; }
 .banner.pass { background: #0d7a2b; color: #fff; } .banner.fail { background: #b81212; color: #fff; }
 .banner.none { background: #737373; color: #fff; }
 ul.failing { margin: 0.2em 0 0.6em; } p.failing { margin: 0.4em 0 0; }
-table.headline td.result { white-space: nowrap; }
+table.headline td.result, table.headline td.limit { white-space: nowrap; }
 table.headline .note { font-size: 0.85em; color: #8a4b00; }
 table.headline td.value { white-space: nowrap; font-variant-numeric: tabular-nums; }
 figure image { image-rendering: pixelated; }

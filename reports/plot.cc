@@ -8,6 +8,7 @@
 #include <cmath>
 #include <limits>
 #include <memory>
+#include <sstream>
 #include <tuple>
 
 #include "core/check.h"
@@ -114,22 +115,51 @@ Range ResolveRange(const Axis& axis, double data_low, double data_high, bool pad
   return range;
 }
 
-// Lays out title, legend row and axes inside width x height; `right_pt` is kept free on the right.
-Rect PlotArea(double width, double height, int legend_rows, double right_pt) {
+// Lays out title, legend rows and axes inside width x height: `extra_top_pt` below a one-line title
+// (further title lines, legend rows), `right_pt` kept free on the right.
+Rect PlotArea(double width, double height, double extra_top_pt, double right_pt) {
   constexpr double kLeft = 50.0;
   constexpr double kBottom = 30.0;
-  const double top = 18.0 + legend_rows * kLegendRow_pt;
+  const double top = 18.0 + extra_top_pt;
   return {kLeft, top, std::max(10.0, width - kLeft - right_pt - 8.0), std::max(10.0, height - top - kBottom)};
 }
 
-// The title shrinks (down to the tick size) to fit a narrow figure, such as a phone's.
-void DrawTitle(cairo_t* cr, const std::string& title, double width) {
+// A title that fits the figure's width: on one line at 10 pt, else shrunk down to 8.5 pt, else
+// wrapped at spaces at 8.5 pt (a phone's narrow figure).
+struct TitleLayout {
+  std::vector<std::string> lines;
+  double size_pt = kTitleSize_pt;
+  // Height beyond the one line PlotArea always leaves.
+  [[nodiscard]] double ExtraPt() const { return static_cast<double>(lines.size() - 1) * (size_pt + 2.0); }
+};
+
+TitleLayout LayOutTitle(cairo_t* cr, const std::string& title, double width) {
+  constexpr double kSmallest_pt = 8.5;
+  const double available = width - 8.0;
   SetFont(cr, kTitleSize_pt, true);
   const double natural = TextWidth(cr, title);
-  if (natural > width - 8.0)
-    SetFont(cr, std::max(kTickSize_pt, kTitleSize_pt * (width - 8.0) / natural), true);
+  if (natural <= available) return {{title}, kTitleSize_pt};
+  const double shrunk = kTitleSize_pt * available / natural;
+  if (shrunk >= kSmallest_pt) return {{title}, shrunk};
+  SetFont(cr, kSmallest_pt, true);
+  TitleLayout layout{{""}, kSmallest_pt};
+  std::istringstream words(title);
+  for (std::string word; words >> word;) {
+    const std::string joined = layout.lines.back().empty() ? word : layout.lines.back() + " " + word;
+    if (TextWidth(cr, joined) <= available || layout.lines.back().empty()) {
+      layout.lines.back() = joined;
+    } else {
+      layout.lines.push_back(word);
+    }
+  }
+  return layout;
+}
+
+void DrawTitle(cairo_t* cr, const TitleLayout& title, double width) {
+  SetFont(cr, title.size_pt, true);
   SetColour(cr, kInk);
-  DrawText(cr, title, width / 2.0, 9.0, 0.5);
+  for (std::size_t k = 0; k < title.lines.size(); ++k)
+    DrawText(cr, title.lines[k], width / 2.0, 9.0 + static_cast<double>(k) * (title.size_pt + 2.0), 0.5);
 }
 
 // At least three ticks, so that a small plot (a map half a page wide) still shows a scale on
@@ -350,10 +380,13 @@ void DrawLinePlot(cairo_t* cr, const LinePlot& plot, double width, double height
   if (!plot.x_marks.empty())
     legend.push_back({plot.x_marks_label, kMarkColour, LegendEntry::Swatch::kDashed});
   const double legend_width = width - 58.0;
-  const Frame frame{PlotArea(width, height, LegendRows(cr, legend, legend_width), 0.0),
-                    ResolveRange(plot.x, x_low, x_high, true), ResolveRange(plot.y, y_low, y_high, true)};
-  DrawTitle(cr, plot.title, width);
-  if (!legend.empty()) DrawLegend(cr, legend, frame.area.x, 18.0 + kLegendRow_pt / 2.0, legend_width);
+  const TitleLayout title = LayOutTitle(cr, plot.title, width);
+  const Frame frame{
+      PlotArea(width, height, title.ExtraPt() + LegendRows(cr, legend, legend_width) * kLegendRow_pt, 0.0),
+      ResolveRange(plot.x, x_low, x_high, true), ResolveRange(plot.y, y_low, y_high, true)};
+  DrawTitle(cr, title, width);
+  if (!legend.empty())
+    DrawLegend(cr, legend, frame.area.x, 18.0 + title.ExtraPt() + kLegendRow_pt / 2.0, legend_width);
   DrawAxes(cr, frame, plot.x, plot.y, true);
   cairo_save(cr);
   cairo_rectangle(cr, frame.area.x, frame.area.y, frame.area.width, frame.area.height);
@@ -550,7 +583,8 @@ void DrawHeatMap(cairo_t* cr, const HeatMap& map, double width, double height) {
   CheckGrid(map.n_x, map.n_y, map.values.size(), map.x_nodes, map.y_nodes, map.title);
   const Range x_extent = CellExtent(map.x_nodes);
   const Range y_extent = CellExtent(map.y_nodes);
-  Frame frame{PlotArea(width, height, false, kColourBarWidth_pt + 62.0),
+  const TitleLayout title = LayOutTitle(cr, map.title, width);
+  Frame frame{PlotArea(width, height, title.ExtraPt(), kColourBarWidth_pt + 62.0),
               ResolveRange(map.x, x_extent.low, x_extent.high, false),
               ResolveRange(map.y, y_extent.low, y_extent.high, false)};
   if (map.equal_aspect) frame = EqualAspect(frame);
@@ -571,7 +605,7 @@ void DrawHeatMap(cairo_t* cr, const HeatMap& map, double width, double height) {
         return count == 0 ? kMissingColour
                           : Viridis((sum / count - colours.low) / (colours.high - colours.low));
       });
-  DrawTitle(cr, map.title, width);
+  DrawTitle(cr, title, width);
   PaintGridImage(cr, frame, image.get(), x_extent, y_extent);
   DrawYMarks(cr, frame, map.y_marks, map.y_marks_label);
   DrawAxes(cr, frame, map.x, map.y, false);
@@ -593,11 +627,12 @@ void DrawPathMap(cairo_t* cr, const PathMap& map, double width, double height) {
       Extend(overlay.y[i], y_low, y_high);
     }
   }
-  Frame frame{PlotArea(width, height, false, kColourBarWidth_pt + 62.0),
+  const TitleLayout title = LayOutTitle(cr, map.title, width);
+  Frame frame{PlotArea(width, height, title.ExtraPt(), kColourBarWidth_pt + 62.0),
               ResolveRange(map.x, x_low, x_high, true), ResolveRange(map.y, y_low, y_high, true)};
   if (map.equal_aspect) frame = EqualAspect(frame);
   const Range colours = ColourRange(map.values, map.colour_min, map.colour_max);
-  DrawTitle(cr, map.title, width);
+  DrawTitle(cr, title, width);
   DrawAxes(cr, frame, map.x, map.y, true);
   cairo_save(cr);
   cairo_rectangle(cr, frame.area.x, frame.area.y, frame.area.width, frame.area.height);
@@ -628,9 +663,11 @@ void DrawCategoryMap(cairo_t* cr, const CategoryMap& map, double width, double h
   for (const Category& category : map.categories)
     legend.push_back({category.label, category.colour, LegendEntry::Swatch::kBox});
   const double legend_width = width - 58.0;
-  const Frame frame{PlotArea(width, height, LegendRows(cr, legend, legend_width), 0.0),
-                    ResolveRange(map.x, x_extent.low, x_extent.high, false),
-                    ResolveRange(map.y, y_extent.low, y_extent.high, false)};
+  const TitleLayout title = LayOutTitle(cr, map.title, width);
+  const Frame frame{
+      PlotArea(width, height, title.ExtraPt() + LegendRows(cr, legend, legend_width) * kLegendRow_pt, 0.0),
+      ResolveRange(map.x, x_extent.low, x_extent.high, false),
+      ResolveRange(map.y, y_extent.low, y_extent.high, false)};
   // Display blocks at least ~3 pt wide and tall, so that a lone flagged cell stays visible.
   const auto max_columns = static_cast<std::size_t>(std::max(1.0, frame.area.width / 3.0));
   const auto max_rows = static_cast<std::size_t>(std::max(1.0, frame.area.height / 3.0));
@@ -645,8 +682,8 @@ void DrawCategoryMap(cairo_t* cr, const CategoryMap& map, double width, double h
         return map.categories[worst].colour;
       },
       map.coarse_display ? max_columns : kMaxImageColumns, map.coarse_display ? max_rows : kMaxImageRows);
-  DrawTitle(cr, map.title, width);
-  DrawLegend(cr, legend, frame.area.x, 18.0 + kLegendRow_pt / 2.0, legend_width);
+  DrawTitle(cr, title, width);
+  DrawLegend(cr, legend, frame.area.x, 18.0 + title.ExtraPt() + kLegendRow_pt / 2.0, legend_width);
   PaintGridImage(cr, frame, image.get(), x_extent, y_extent);
   DrawYMarks(cr, frame, map.y_marks, map.y_marks_label);
   DrawAxes(cr, frame, map.x, map.y, false);

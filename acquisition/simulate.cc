@@ -130,7 +130,7 @@ SimulatedScan SimulateScan(const WheelModel& wheel, const ScanSettings& s) {
   meta.wheel_width_mm = wheel.width_mm;
   meta.wheel_id = s.wheel_id;
   meta.sensor = "simulated laser triangulation sensor";
-  meta.timestamp = "2017-09-13T10:00:00Z";
+  meta.timestamp = s.timestamp;
 
   scan.z_mm.resize(n);
   if (s.write_time) scan.t_s.resize(n);

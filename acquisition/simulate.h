@@ -88,6 +88,7 @@ struct ScanSettings {
   bool float32 = true;          // HDF5 z as float32 (else float64)
   std::uint64_t seed = 1;
   std::string wheel_id = "simulated";
+  std::string timestamp = "2017-09-13T10:00:00Z";  // ISO 8601, written as the scan's timestamp
 };
 
 // What the simulator injected, for the truth file.

@@ -125,6 +125,8 @@ void AddSimulateCommand(CLI::App& app) {
   cmd->add_flag("--float64", args->float64, "HDF5 z as float64 (default float32)");
   cmd->add_option("--seed", s.seed, "random seed")->capture_default_str();
   cmd->add_option("--wheel-id", s.wheel_id, "wheel id written to the file")->capture_default_str();
+  cmd->add_option("--timestamp", s.timestamp, "scan date and time written to the file (ISO 8601)")
+      ->capture_default_str();
   cmd->add_option("--truth-phases", args->truth_phases, "phases in the truth file")->capture_default_str();
   cmd->callback([args, cmd] {
     if (cmd->count("--true-rpm") == 0) args->settings.spindle_rpm_true = args->settings.spindle_rpm_nominal;

@@ -15,5 +15,7 @@ void AddFrameCommand(CLI::App& app);
 void AddTransformCommand(CLI::App& app);
 void AddHeadcenterCommand(CLI::App& app);
 void AddPolishCommand(CLI::App& app);
+void AddCompareCommand(CLI::App& app);
+void AddHistoryCommand(CLI::App& app);
 
 }  // namespace arcwheel::cli

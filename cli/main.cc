@@ -30,6 +30,8 @@ const std::vector<Command> kCommands = {
     {"fit", arcwheel::cli::AddFitCommand},
     {"toolpath", arcwheel::cli::AddToolpathCommand},
     {"report", arcwheel::cli::AddReportCommand},
+    {"compare", arcwheel::cli::AddCompareCommand},
+    {"history", arcwheel::cli::AddHistoryCommand},
     {"frame", arcwheel::cli::AddFrameCommand},
     {"transform", arcwheel::cli::AddTransformCommand},
     {"headcenter", arcwheel::cli::AddHeadcenterCommand},

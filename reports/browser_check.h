@@ -21,4 +21,23 @@ struct BrowserRun {
 // load) and recording the network log, then takes a screenshot of `width` x `height` pixels.
 [[nodiscard]] BrowserRun LoadInChromium(const std::filesystem::path& page, int width, int height);
 
+// Lays out a copy of `page` in a `width` x `height` headless chromium window with a script added
+// at the end of its body, and returns the text that `expression` (JavaScript, a string) evaluates
+// to there, e.g. bounding boxes from getBoundingClientRect(); "" if chromium fails.
+[[nodiscard]] std::string LayoutInChromium(const std::filesystem::path& page, int width, int height,
+                                           const std::string& expression);
+
+// ---- Reading a report's text as a reader would ----
+
+// The text of an HTML page a reader sees: without tags, inline SVG drawings (their text is glyph
+// outlines, their numbers coordinates) and the style sheet; entities &amp; &lt; &gt; decoded.
+[[nodiscard]] std::string VisibleHtmlText(const std::string& html);
+
+// The most significant digits of any number in `text`: a run of digits with at most one decimal
+// point, not touching a letter, digit, '_', '/' or '-' (ids, hashes, paths and dates are words, not
+// numbers); leading zeros are not significant, nor trailing zeros of an integer.
+[[nodiscard]] int MaxSignificantDigits(const std::string& text);
+// That number, for a failure message.
+[[nodiscard]] std::string LongestNumber(const std::string& text);
+
 }  // namespace arcwheel::reports::testing

@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <filesystem>
+#include <functional>
 #include <memory>
 #include <optional>
 #include <string>
@@ -45,11 +46,22 @@ struct Cell {
 // not fit.
 class PdfFlow {
  public:
-  PdfFlow(const std::filesystem::path& path, std::string footer)
+  // Writes to `path`; footers read "FOOTER · page x of TOTAL_PAGES" (or "page x" when 0).
+  PdfFlow(const std::filesystem::path& path, std::string footer, int total_pages = 0)
       : surface_(cairo_pdf_surface_create(path.c_str(), kPageWidth_pt, kPageHeight_pt),
                  cairo_surface_destroy),
-        footer_(std::move(footer)) {
+        footer_(std::move(footer)),
+        total_pages_(total_pages) {
     CheckStatus("cannot create '" + path.string() + "'");
+    cr_ = cairo_create(surface_.get());
+  }
+  // Lays out without writing anything and without painting figures: to count the pages.
+  explicit PdfFlow(std::string footer)
+      : surface_(cairo_pdf_surface_create_for_stream(Discard, nullptr, kPageWidth_pt, kPageHeight_pt),
+                 cairo_surface_destroy),
+        footer_(std::move(footer)),
+        counting_(true) {
+    CheckStatus("cannot create a PDF surface");
     cr_ = cairo_create(surface_.get());
   }
   PdfFlow(const PdfFlow&) = delete;
@@ -73,7 +85,32 @@ class PdfFlow {
     y_ += 4.0;
   }
 
+  // A large coloured box across the page with `text` in it (the report's verdict).
+  void Banner(const std::string& text, Verdict verdict) {
+    constexpr double kHeight = 34.0;
+    Ensure(kHeight + 4.0);
+    if (verdict == Verdict::kPass) cairo_set_source_rgb(cr_, 0.05, 0.48, 0.17);
+    if (verdict == Verdict::kFail) cairo_set_source_rgb(cr_, 0.72, 0.07, 0.07);
+    if (verdict == Verdict::kNoTolerance) cairo_set_source_rgb(cr_, 0.45, 0.45, 0.45);
+    cairo_rectangle(cr_, kMargin_pt, y_, kContentWidth_pt, kHeight);
+    cairo_fill(cr_);
+    Font(22.0, true);
+    cairo_set_source_rgb(cr_, 1.0, 1.0, 1.0);
+    Text(text, kMargin_pt + 10.0, y_ + 25.0);
+    y_ += kHeight + 4.0;
+  }
+
+  // Starts a table: draws its header row (bold) now and again at the top of each page the table
+  // continues on, until the next Heading or EndTable.
+  void TableHeader(const std::vector<Cell>& cells, const std::vector<double>& widths) {
+    header_cells_ = cells;
+    header_widths_ = widths;
+    Row(cells, widths, true);
+  }
+  void EndTable() { header_cells_.clear(); }
+
   void Heading(const std::string& text, double keep_with_next_pt) {
+    EndTable();
     Ensure(22.0 + keep_with_next_pt);
     Font(11.0, true);
     y_ += 6.0;
@@ -100,7 +137,9 @@ class PdfFlow {
       tallest = std::max(tallest, lines.back().size());
     }
     const double height = static_cast<double>(tallest) * kLine_pt + 2.0;
-    Ensure(height);
+    if (Ensure(height) && !header_cells_.empty() && !bold) Row(header_cells_, header_widths_, true);
+    // A page break drew the footer (and perhaps the header) in their own fonts.
+    Font(kBodySize_pt, bold);
     double x = kMargin_pt;
     for (std::size_t c = 0; c < cells.size(); ++c) {
       if (cells[c].verdict) VerdictBackground(*cells[c].verdict, x, widths[c]);
@@ -121,10 +160,12 @@ class PdfFlow {
     Font(kBodySize_pt - 0.5, false);
     const std::vector<std::string> caption = Wrap(figure.caption, kContentWidth_pt);
     Ensure(height + static_cast<double>(caption.size()) * kLine_pt + 10.0);
-    cairo_save(cr_);
-    cairo_translate(cr_, kMargin_pt, y_);
-    plot::Draw(cr_, figure.figure, kContentWidth_pt, height);
-    cairo_restore(cr_);
+    if (!counting_) {
+      cairo_save(cr_);
+      cairo_translate(cr_, kMargin_pt, y_);
+      plot::Draw(cr_, figure.figure, kContentWidth_pt, height);
+      cairo_restore(cr_);
+    }
     y_ += height + 2.0;
     Font(kBodySize_pt - 0.5, false);
     cairo_set_source_rgb(cr_, 0.33, 0.33, 0.33);
@@ -150,7 +191,7 @@ class PdfFlow {
       caption_lines = std::max(caption_lines, captions.back().size());
     }
     Ensure(height + static_cast<double>(caption_lines) * kLine_pt + 10.0);
-    for (std::size_t i = 0; i < figures.size(); ++i) {
+    for (std::size_t i = 0; i < figures.size() && !counting_; ++i) {
       cairo_save(cr_);
       cairo_translate(cr_, kMargin_pt + static_cast<double>(i) * (width + kRowGap_pt), y_);
       plot::Draw(cr_, figures[i].figure, width, width * figures[i].height_over_width);
@@ -179,7 +220,14 @@ class PdfFlow {
     CheckStatus("cannot write the PDF");
   }
 
+  // Pages begun so far (all of them after Finish).
+  [[nodiscard]] int Pages() const { return page_ - 1; }
+
  private:
+  static cairo_status_t Discard(void* /*closure*/, const unsigned char* /*data*/, unsigned int /*length*/) {
+    return CAIRO_STATUS_SUCCESS;
+  }
+
   void CheckStatus(const std::string& what) const {
     const cairo_status_t status = cairo_surface_status(surface_.get());
     if (status != CAIRO_STATUS_SUCCESS)
@@ -243,25 +291,47 @@ class PdfFlow {
     cairo_set_source_rgb(cr_, 0.13, 0.13, 0.13);
   }
 
-  void Ensure(double height) {
-    if (y_ + height <= kPageHeight_pt - kMargin_pt || y_ <= kMargin_pt) return;
+  // Starts a new page when `height` does not fit on this one; true if it did.
+  bool Ensure(double height) {
+    if (y_ + height <= kPageHeight_pt - kMargin_pt || y_ <= kMargin_pt) return false;
     Footer();
     cairo_show_page(cr_);
     y_ = kMargin_pt;
+    return true;
   }
 
   void Footer() {
     Font(7.0, false);
     cairo_set_source_rgb(cr_, 0.45, 0.45, 0.45);
-    Text(fmt::format("{} · page {}", footer_, page_), kMargin_pt, kPageHeight_pt - kMargin_pt / 2.0);
+    const std::string page =
+        total_pages_ > 0 ? fmt::format("page {} of {}", page_, total_pages_) : fmt::format("page {}", page_);
+    Text(footer_ + " · " + page, kMargin_pt, kPageHeight_pt - kMargin_pt / 2.0);
     ++page_;
   }
 
   std::unique_ptr<cairo_surface_t, decltype(&cairo_surface_destroy)> surface_;
   cairo_t* cr_ = nullptr;
   std::string footer_;
+  int total_pages_ = 0;
+  bool counting_ = false;
+  std::vector<Cell> header_cells_;
+  std::vector<double> header_widths_;
   double y_ = kMargin_pt;
   int page_ = 1;
 };
+
+// Lays the document out twice: once to count its pages, then into `path` with "page x of N" in
+// every footer. `draw` must lay out the same content both times and end with Finish().
+inline void RenderPdfPages(const std::filesystem::path& path, const std::string& footer,
+                           const std::function<void(PdfFlow&)>& draw) {
+  int pages = 0;
+  {
+    PdfFlow counter(footer);
+    draw(counter);
+    pages = counter.Pages();
+  }
+  PdfFlow pdf(path, footer, pages);
+  draw(pdf);
+}
 
 }  // namespace arcwheel::reports::internal

@@ -8,6 +8,8 @@
 #include <cmath>
 #include <limits>
 #include <memory>
+#include <sstream>
+#include <tuple>
 
 #include "core/check.h"
 #include "core/error.h"
@@ -18,7 +20,7 @@ namespace {
 constexpr const char* kFont = "DejaVu Sans";
 constexpr double kTitleSize_pt = 10.0;
 constexpr double kLabelSize_pt = 8.0;
-constexpr double kTickSize_pt = 7.0;
+
 constexpr double kLegendRow_pt = 13.0;
 constexpr double kColourBarWidth_pt = 10.0;
 // Display resolution of a heat map: larger grids are averaged down in blocks, which keeps the
@@ -28,6 +30,7 @@ constexpr std::size_t kMaxImageRows = 480;
 const Rgb kMissingColour{0.80, 0.80, 0.80};
 const Rgb kInk{0.15, 0.15, 0.15};
 const Rgb kGrid{0.88, 0.88, 0.88};
+const Rgb kMarkColour{0.60, 0.10, 0.45};
 
 struct Range {
   double low = 0.0;
@@ -112,18 +115,51 @@ Range ResolveRange(const Axis& axis, double data_low, double data_high, bool pad
   return range;
 }
 
-// Lays out title, legend row and axes inside width x height; `right_pt` is kept free on the right.
-Rect PlotArea(double width, double height, bool has_legend, double right_pt) {
+// Lays out title, legend rows and axes inside width x height: `extra_top_pt` below a one-line title
+// (further title lines, legend rows), `right_pt` kept free on the right.
+Rect PlotArea(double width, double height, double extra_top_pt, double right_pt) {
   constexpr double kLeft = 50.0;
   constexpr double kBottom = 30.0;
-  const double top = 18.0 + (has_legend ? kLegendRow_pt : 0.0);
+  const double top = 18.0 + extra_top_pt;
   return {kLeft, top, std::max(10.0, width - kLeft - right_pt - 8.0), std::max(10.0, height - top - kBottom)};
 }
 
-void DrawTitle(cairo_t* cr, const std::string& title, double width) {
+// A title that fits the figure's width: on one line at 10 pt, else shrunk down to 8.5 pt, else
+// wrapped at spaces at 8.5 pt (a phone's narrow figure).
+struct TitleLayout {
+  std::vector<std::string> lines;
+  double size_pt = kTitleSize_pt;
+  // Height beyond the one line PlotArea always leaves.
+  [[nodiscard]] double ExtraPt() const { return static_cast<double>(lines.size() - 1) * (size_pt + 2.0); }
+};
+
+TitleLayout LayOutTitle(cairo_t* cr, const std::string& title, double width) {
+  constexpr double kSmallest_pt = 8.5;
+  const double available = width - 8.0;
   SetFont(cr, kTitleSize_pt, true);
+  const double natural = TextWidth(cr, title);
+  if (natural <= available) return {{title}, kTitleSize_pt};
+  const double shrunk = kTitleSize_pt * available / natural;
+  if (shrunk >= kSmallest_pt) return {{title}, shrunk};
+  SetFont(cr, kSmallest_pt, true);
+  TitleLayout layout{{""}, kSmallest_pt};
+  std::istringstream words(title);
+  for (std::string word; words >> word;) {
+    const std::string joined = layout.lines.back().empty() ? word : layout.lines.back() + " " + word;
+    if (TextWidth(cr, joined) <= available || layout.lines.back().empty()) {
+      layout.lines.back() = joined;
+    } else {
+      layout.lines.push_back(word);
+    }
+  }
+  return layout;
+}
+
+void DrawTitle(cairo_t* cr, const TitleLayout& title, double width) {
+  SetFont(cr, title.size_pt, true);
   SetColour(cr, kInk);
-  DrawText(cr, title, width / 2.0, 9.0, 0.5);
+  for (std::size_t k = 0; k < title.lines.size(); ++k)
+    DrawText(cr, title.lines[k], width / 2.0, 9.0 + static_cast<double>(k) * (title.size_pt + 2.0), 0.5);
 }
 
 // At least three ticks, so that a small plot (a map half a page wide) still shows a scale on
@@ -179,10 +215,30 @@ struct LegendEntry {
   enum class Swatch { kLine, kDashed, kDot, kBox } swatch = Swatch::kLine;
 };
 
-void DrawLegend(cairo_t* cr, const std::vector<LegendEntry>& entries, double x, double y) {
+double LegendEntryWidth(cairo_t* cr, const LegendEntry& entry) {
   SetFont(cr, kLabelSize_pt);
+  return 18.0 + TextWidth(cr, entry.label) + 14.0;
+}
+
+// Rows the legend takes when wrapped to `width` (0 without entries).
+int LegendRows(cairo_t* cr, const std::vector<LegendEntry>& entries, double width) {
+  if (entries.empty()) return 0;
+  int rows = 1;
+  double cursor = 0.0;
+  for (const LegendEntry& entry : entries) {
+    const double entry_width = LegendEntryWidth(cr, entry);
+    if (cursor > 0.0 && cursor + entry_width > width) ++rows, cursor = 0.0;
+    cursor += entry_width;
+  }
+  return rows;
+}
+
+// Entries left to right from (x, y), wrapped onto further rows at `width`.
+void DrawLegend(cairo_t* cr, const std::vector<LegendEntry>& entries, double x, double y, double width) {
   double cursor = x;
   for (const LegendEntry& entry : entries) {
+    const double entry_width = LegendEntryWidth(cr, entry);
+    if (cursor > x && cursor - x + entry_width > width) cursor = x, y += kLegendRow_pt;
     SetColour(cr, entry.colour);
     switch (entry.swatch) {
       case LegendEntry::Swatch::kBox:
@@ -205,13 +261,15 @@ void DrawLegend(cairo_t* cr, const std::vector<LegendEntry>& entries, double x, 
     }
     SetColour(cr, kInk);
     DrawText(cr, entry.label, cursor + 18.0, y, 0.0);
-    cursor += 18.0 + TextWidth(cr, entry.label) + 14.0;
+    cursor += entry_width;
   }
 }
 
 void CheckSeries(const Series& series) {
   ARCWHEEL_CHECK(series.x.size() == series.y.size())
       << "series '" << series.label << "' x and y differ in size";
+  ARCWHEEL_CHECK(series.y_error.empty() || series.y_error.size() == series.x.size())
+      << "series '" << series.label << "' error bars do not match its points";
   ARCWHEEL_CHECK(series.band_low.size() == series.band_high.size() &&
                  (series.band_low.empty() || series.band_low.size() == series.x.size()))
       << "series '" << series.label << "' band does not match its points";
@@ -241,11 +299,28 @@ void DrawBand(cairo_t* cr, const Frame& frame, const Series& series) {
 void DrawSeries(cairo_t* cr, const Frame& frame, const Series& series) {
   if (!series.band_low.empty()) DrawBand(cr, frame, series);
   SetColour(cr, series.colour);
+  if (!series.y_error.empty()) {
+    cairo_set_line_width(cr, 0.9);
+    for (std::size_t i = 0; i < series.x.size(); ++i) {
+      if (!std::isfinite(series.x[i]) || !std::isfinite(series.y[i]) || !std::isfinite(series.y_error[i]))
+        continue;
+      const double x = frame.Px(series.x[i]);
+      const double top = frame.Py(series.y[i] + series.y_error[i]);
+      const double bottom = frame.Py(series.y[i] - series.y_error[i]);
+      cairo_move_to(cr, x, top);
+      cairo_line_to(cr, x, bottom);
+      cairo_move_to(cr, x - 2.5, top);
+      cairo_line_to(cr, x + 2.5, top);
+      cairo_move_to(cr, x - 2.5, bottom);
+      cairo_line_to(cr, x + 2.5, bottom);
+    }
+    cairo_stroke(cr);
+  }
   if (series.markers) {
     for (std::size_t i = 0; i < series.x.size(); ++i) {
       if (!std::isfinite(series.x[i]) || !std::isfinite(series.y[i])) continue;
       cairo_new_sub_path(cr);
-      cairo_arc(cr, frame.Px(series.x[i]), frame.Py(series.y[i]), 1.1, 0.0, 2.0 * M_PI);
+      cairo_arc(cr, frame.Px(series.x[i]), frame.Py(series.y[i]), series.marker_size_pt, 0.0, 2.0 * M_PI);
     }
     cairo_fill(cr);
     return;
@@ -284,8 +359,13 @@ void DrawLinePlot(cairo_t* cr, const LinePlot& plot, double width, double height
         Extend(series.band_low[i], y_low, y_high);
         Extend(series.band_high[i], y_low, y_high);
       }
+      if (!series.y_error.empty()) {
+        Extend(series.y[i] - series.y_error[i], y_low, y_high);
+        Extend(series.y[i] + series.y_error[i], y_low, y_high);
+      }
     }
   }
+  for (double x : plot.x_marks) Extend(x, x_low, x_high);
   std::vector<LegendEntry> legend;
   if (plot.series.size() > 1) {
     for (const Series& s : plot.series) {
@@ -297,10 +377,16 @@ void DrawLinePlot(cairo_t* cr, const LinePlot& plot, double width, double height
   }
   for (const XSpan& span : plot.spans)
     legend.push_back({span.label, {0.55, 0.55, 0.55}, LegendEntry::Swatch::kBox});
-  const Frame frame{PlotArea(width, height, !legend.empty(), 0.0), ResolveRange(plot.x, x_low, x_high, true),
-                    ResolveRange(plot.y, y_low, y_high, true)};
-  DrawTitle(cr, plot.title, width);
-  if (!legend.empty()) DrawLegend(cr, legend, frame.area.x, 18.0 + kLegendRow_pt / 2.0);
+  if (!plot.x_marks.empty())
+    legend.push_back({plot.x_marks_label, kMarkColour, LegendEntry::Swatch::kDashed});
+  const double legend_width = width - 58.0;
+  const TitleLayout title = LayOutTitle(cr, plot.title, width);
+  const Frame frame{
+      PlotArea(width, height, title.ExtraPt() + LegendRows(cr, legend, legend_width) * kLegendRow_pt, 0.0),
+      ResolveRange(plot.x, x_low, x_high, true), ResolveRange(plot.y, y_low, y_high, true)};
+  DrawTitle(cr, title, width);
+  if (!legend.empty())
+    DrawLegend(cr, legend, frame.area.x, 18.0 + title.ExtraPt() + kLegendRow_pt / 2.0, legend_width);
   DrawAxes(cr, frame, plot.x, plot.y, true);
   cairo_save(cr);
   cairo_rectangle(cr, frame.area.x, frame.area.y, frame.area.width, frame.area.height);
@@ -310,6 +396,16 @@ void DrawLinePlot(cairo_t* cr, const LinePlot& plot, double width, double height
     cairo_rectangle(cr, frame.Px(span.low), frame.area.y, frame.Px(span.high) - frame.Px(span.low),
                     frame.area.height);
     cairo_fill(cr);
+  }
+  for (double x : plot.x_marks) {
+    const double dash[] = {5.0, 3.0};
+    SetColour(cr, kMarkColour);
+    cairo_set_line_width(cr, 1.2);
+    cairo_set_dash(cr, dash, 2, 0.0);
+    cairo_move_to(cr, frame.Px(x), frame.area.y);
+    cairo_line_to(cr, frame.Px(x), frame.area.y + frame.area.height);
+    cairo_stroke(cr);
+    cairo_set_dash(cr, nullptr, 0, 0.0);
   }
   for (const Series& series : plot.series) DrawSeries(cr, frame, series);
   cairo_restore(cr);
@@ -341,9 +437,10 @@ using ContextPtr = std::unique_ptr<cairo_t, decltype(&cairo_destroy)>;
 // Builds the display image of an n_x x n_y grid: columns follow x, rows follow y from the top
 // (largest y) down. `colour_of_block(i0, i1, j0, j1)` gives the colour of a block of cells.
 template <typename BlockColour>
-SurfacePtr GridImage(std::size_t n_x, std::size_t n_y, const BlockColour& colour_of_block) {
-  const std::size_t columns = std::min(n_x, kMaxImageColumns);
-  const std::size_t rows = std::min(n_y, kMaxImageRows);
+SurfacePtr GridImage(std::size_t n_x, std::size_t n_y, const BlockColour& colour_of_block,
+                     std::size_t max_columns = kMaxImageColumns, std::size_t max_rows = kMaxImageRows) {
+  const std::size_t columns = std::min(n_x, max_columns);
+  const std::size_t rows = std::min(n_y, max_rows);
   SurfacePtr image(
       cairo_image_surface_create(CAIRO_FORMAT_ARGB32, static_cast<int>(columns), static_cast<int>(rows)),
       cairo_surface_destroy);
@@ -458,11 +555,36 @@ Frame EqualAspect(Frame frame) {
   return frame;
 }
 
+// Dashed lines across the map at `marks` (e.g. the band's ends), in white over black so that they
+// show on every colour, labelled at the right end inside the plot.
+void DrawYMarks(cairo_t* cr, const Frame& frame, const std::vector<double>& marks, const std::string& label) {
+  const double dash[] = {4.0, 3.0};
+  for (double y : marks) {
+    if (!(y > frame.y.low && y < frame.y.high)) continue;
+    for (const auto& [colour, line_width, offset] :
+         {std::tuple{Rgb{0, 0, 0}, 2.2, 0.0}, std::tuple{Rgb{1, 1, 1}, 1.0, 0.0}}) {
+      SetColour(cr, colour);
+      cairo_set_line_width(cr, line_width);
+      cairo_set_dash(cr, dash, 2, offset);
+      cairo_move_to(cr, frame.area.x, frame.Py(y));
+      cairo_line_to(cr, frame.area.x + frame.area.width, frame.Py(y));
+      cairo_stroke(cr);
+    }
+    cairo_set_dash(cr, nullptr, 0, 0.0);
+    if (!label.empty()) {
+      SetFont(cr, kTickSize_pt, true);
+      SetColour(cr, {1, 1, 1});
+      DrawText(cr, label, frame.area.x + frame.area.width - 3.0, frame.Py(y) - 6.0, 1.0);
+    }
+  }
+}
+
 void DrawHeatMap(cairo_t* cr, const HeatMap& map, double width, double height) {
   CheckGrid(map.n_x, map.n_y, map.values.size(), map.x_nodes, map.y_nodes, map.title);
   const Range x_extent = CellExtent(map.x_nodes);
   const Range y_extent = CellExtent(map.y_nodes);
-  Frame frame{PlotArea(width, height, false, kColourBarWidth_pt + 62.0),
+  const TitleLayout title = LayOutTitle(cr, map.title, width);
+  Frame frame{PlotArea(width, height, title.ExtraPt(), kColourBarWidth_pt + 62.0),
               ResolveRange(map.x, x_extent.low, x_extent.high, false),
               ResolveRange(map.y, y_extent.low, y_extent.high, false)};
   if (map.equal_aspect) frame = EqualAspect(frame);
@@ -483,8 +605,9 @@ void DrawHeatMap(cairo_t* cr, const HeatMap& map, double width, double height) {
         return count == 0 ? kMissingColour
                           : Viridis((sum / count - colours.low) / (colours.high - colours.low));
       });
-  DrawTitle(cr, map.title, width);
+  DrawTitle(cr, title, width);
   PaintGridImage(cr, frame, image.get(), x_extent, y_extent);
+  DrawYMarks(cr, frame, map.y_marks, map.y_marks_label);
   DrawAxes(cr, frame, map.x, map.y, false);
   DrawColourBar(cr, frame.area, colours, map.colour_bar_label);
 }
@@ -504,11 +627,12 @@ void DrawPathMap(cairo_t* cr, const PathMap& map, double width, double height) {
       Extend(overlay.y[i], y_low, y_high);
     }
   }
-  Frame frame{PlotArea(width, height, false, kColourBarWidth_pt + 62.0),
+  const TitleLayout title = LayOutTitle(cr, map.title, width);
+  Frame frame{PlotArea(width, height, title.ExtraPt(), kColourBarWidth_pt + 62.0),
               ResolveRange(map.x, x_low, x_high, true), ResolveRange(map.y, y_low, y_high, true)};
   if (map.equal_aspect) frame = EqualAspect(frame);
   const Range colours = ColourRange(map.values, map.colour_min, map.colour_max);
-  DrawTitle(cr, map.title, width);
+  DrawTitle(cr, title, width);
   DrawAxes(cr, frame, map.x, map.y, true);
   cairo_save(cr);
   cairo_rectangle(cr, frame.area.x, frame.area.y, frame.area.width, frame.area.height);
@@ -535,24 +659,33 @@ void DrawCategoryMap(cairo_t* cr, const CategoryMap& map, double width, double h
     ARCWHEEL_CHECK(code < map.categories.size()) << "category " << int{code};
   const Range x_extent = CellExtent(map.x_nodes);
   const Range y_extent = CellExtent(map.y_nodes);
-  const Frame frame{PlotArea(width, height, true, 0.0),
-                    ResolveRange(map.x, x_extent.low, x_extent.high, false),
-                    ResolveRange(map.y, y_extent.low, y_extent.high, false)};
+  std::vector<LegendEntry> legend;
+  for (const Category& category : map.categories)
+    legend.push_back({category.label, category.colour, LegendEntry::Swatch::kBox});
+  const double legend_width = width - 58.0;
+  const TitleLayout title = LayOutTitle(cr, map.title, width);
+  const Frame frame{
+      PlotArea(width, height, title.ExtraPt() + LegendRows(cr, legend, legend_width) * kLegendRow_pt, 0.0),
+      ResolveRange(map.x, x_extent.low, x_extent.high, false),
+      ResolveRange(map.y, y_extent.low, y_extent.high, false)};
+  // Display blocks at least ~3 pt wide and tall, so that a lone flagged cell stays visible.
+  const auto max_columns = static_cast<std::size_t>(std::max(1.0, frame.area.width / 3.0));
+  const auto max_rows = static_cast<std::size_t>(std::max(1.0, frame.area.height / 3.0));
   // When cells are merged for display the highest code wins, so a lone missing cell still shows.
-  SurfacePtr image =
-      GridImage(map.n_x, map.n_y, [&](std::size_t i0, std::size_t i1, std::size_t j0, std::size_t j1) {
+  SurfacePtr image = GridImage(
+      map.n_x, map.n_y,
+      [&](std::size_t i0, std::size_t i1, std::size_t j0, std::size_t j1) {
         std::uint8_t worst = 0;
         for (std::size_t i = i0; i < i1; ++i) {
           for (std::size_t j = j0; j < j1; ++j) worst = std::max(worst, map.codes[i * map.n_y + j]);
         }
         return map.categories[worst].colour;
-      });
-  std::vector<LegendEntry> legend;
-  for (const Category& category : map.categories)
-    legend.push_back({category.label, category.colour, LegendEntry::Swatch::kBox});
-  DrawTitle(cr, map.title, width);
-  DrawLegend(cr, legend, frame.area.x, 18.0 + kLegendRow_pt / 2.0);
+      },
+      map.coarse_display ? max_columns : kMaxImageColumns, map.coarse_display ? max_rows : kMaxImageRows);
+  DrawTitle(cr, title, width);
+  DrawLegend(cr, legend, frame.area.x, 18.0 + title.ExtraPt() + kLegendRow_pt / 2.0, legend_width);
   PaintGridImage(cr, frame, image.get(), x_extent, y_extent);
+  DrawYMarks(cr, frame, map.y_marks, map.y_marks_label);
   DrawAxes(cr, frame, map.x, map.y, false);
 }
 

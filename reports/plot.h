@@ -34,6 +34,12 @@ struct Rgb {
 [[nodiscard]] std::vector<double> NiceTicks(double low, double high, int max_ticks);
 // The step NiceTicks uses for the same arguments.
 [[nodiscard]] double NiceStep(double low, double high, int max_ticks);
+// Width (points) at which the HTML reports draw a figure for a phone screen: shown about 370 px
+// wide there, its 7 pt tick labels render near 9 px.
+inline constexpr double kPhoneFigureWidth_pt = 280.0;
+// Tick label size, the smallest text of a figure.
+inline constexpr double kTickSize_pt = 7.0;
+
 // Tick label with as many decimals as `step` needs ("0.25" for step 0.05 -> "0.25"), negative
 // values with the minus sign U+2212 ("−0.25").
 [[nodiscard]] std::string FormatTick(double value, double step);
@@ -55,6 +61,9 @@ struct Series {
   Rgb colour;
   bool markers = false;  // dots at the points instead of a line
   bool dashed = false;
+  // Optional error bars y -/+ y_error: empty or of the size of x.
+  std::vector<double> y_error = {};
+  double marker_size_pt = 1.1;  // radius of the dots
 };
 
 // A shaded x interval with a label, e.g. the band of the wheel used for the fits.
@@ -70,6 +79,9 @@ struct LinePlot {
   Axis y;
   std::vector<Series> series;
   std::vector<XSpan> spans;
+  // Dashed vertical lines at these x values (e.g. dressings), one legend entry `x_marks_label`.
+  std::vector<double> x_marks = {};
+  std::string x_marks_label = {};
 };
 
 // A continuous field on a regular grid, coloured with viridis and explained by a colour bar.
@@ -92,6 +104,9 @@ struct HeatMap {
   // One unit of x as long as one unit of y on the page (a disc stays round); the plot area
   // shrinks to keep it.
   bool equal_aspect = false;
+  // Dashed lines across the map at these y values (e.g. the band used for the fits), with a label.
+  std::vector<double> y_marks;
+  std::string y_marks_label;
 };
 
 // A path in the plane coloured by a value along it (viridis, with a colour bar), e.g. a tool
@@ -128,6 +143,12 @@ struct CategoryMap {
   std::vector<double> x_nodes;
   std::vector<double> y_nodes;
   std::vector<Category> categories;
+  // As HeatMap::y_marks.
+  std::vector<double> y_marks;
+  std::string y_marks_label;
+  // Merge cells into display blocks of at least 3 x 3 pt (the worst cell of a block wins), so
+  // that a lone flagged cell of a large grid is seen rather than a speck.
+  bool coarse_display = false;
 };
 
 using Figure = std::variant<LinePlot, HeatMap, CategoryMap, PathMap>;

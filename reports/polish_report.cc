@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <regex>
 
 #include "core/version.h"
 #include "reports/html_page.h"
@@ -16,10 +17,15 @@ using internal::kContentWidth_pt;
 using internal::kLine_pt;
 using internal::RowFigureWidthPt;
 
+// "um" written as a unit in ASCII, as the path CSV's comments do, with the micro sign.
+std::string MicroSign(const std::string& text) {
+  return std::regex_replace(text, std::regex(R"(\bum\b)"), "µm");
+}
+
 // The "# key: value" comment of the path CSV that starts with `key`, or "not recorded".
 std::string Comment(const PolishingPathTable& path, const std::string& key) {
   for (const std::string& line : path.comments) {
-    if (line.rfind(key + ": ", 0) == 0) return line.substr(key.size() + 2);
+    if (line.rfind(key + ": ", 0) == 0) return MicroSign(line.substr(key.size() + 2));
   }
   return "not recorded";
 }
@@ -43,24 +49,26 @@ std::vector<KeyValue> Provenance(const PolishReportInputs& in) {
 
 // A machine limit as the job gives it (shortest form), or "none" for 0 (not limited).
 std::string Limit(double value, const char* unit) {
-  return value > 0.0 ? fmt::format("{} {}", value, unit) : "none";
+  return value > 0.0 ? FormatSignificant(value) + " " + unit : "none";
 }
 
 std::string SpeedLimits(const PolishSummary& s) {
   if (s.limit_min_speed_mm_s > 0.0)
-    return fmt::format("limits {} … {} mm/s", s.limit_min_speed_mm_s, s.limit_max_speed_mm_s);
+    return "limits " + FormatSignificant(s.limit_min_speed_mm_s) + " … " +
+           FormatSignificant(s.limit_max_speed_mm_s) + " mm/s";
   return "limit " + Limit(s.limit_max_speed_mm_s, "mm/s");
 }
 
 std::vector<KeyValue> PathRows(const PolishSummary& s) {
   return {
-      {"Total dwell time", s.total_time_text + " s"},
+      {"Total dwell time", FormatDuration(s.total_time_s)},
       {"Path points", fmt::format("{} (rows of polishing_path.csv)", s.points)},
       {"Aperture nodes", fmt::format("{} (rows of residual_map.csv)", s.aperture_nodes)},
-      {"TCP speed range", FormatNumber(s.min_speed_mm_s, 3) + " … " + FormatNumber(s.max_speed_mm_s, 3) +
-                              " mm/s (" + SpeedLimits(s) + ")"},
-      {"Largest acceleration", FormatNumber(s.max_acceleration_mm_s2, 1) + " mm/s² (limit " +
-                                   Limit(s.limit_max_acceleration_mm_s2, "mm/s²") + ")"},
+      {"TCP speed range", FormatFixed(s.min_speed_mm_s, 3) + " … " +
+                              FormatValue(s.max_speed_mm_s, units::kSpeed_mm_per_s) + " (" + SpeedLimits(s) +
+                              ")"},
+      {"Largest acceleration", FormatValue(s.max_acceleration_mm_s2, units::kAcceleration_mm_per_s2) +
+                                   " (limit " + Limit(s.limit_max_acceleration_mm_s2, "mm/s²") + ")"},
       {"Solver iterations", fmt::format("{} ({})", s.solver_iterations,
                                         s.solver_converged ? "converged" : "iteration limit reached")},
   };
@@ -107,6 +115,17 @@ std::vector<std::vector<ReportFigure>> MapRows(const ResidualMap& map) {
     }
   }
   const double width = RowFigureWidthPt(2);
+  // A residual of nm size is shown in nm on its own scale, so that its ticks read as whole numbers.
+  double residual_low = INFINITY, residual_high = -INFINITY;
+  for (double v : map.residual_um) {
+    if (std::isfinite(v))
+      residual_low = std::min(residual_low, v), residual_high = std::max(residual_high, v);
+  }
+  const bool in_nm = std::isfinite(residual_low) && residual_high - residual_low < 0.1;
+  std::vector<double> residual_own = map.residual_um;
+  if (in_nm) {
+    for (double& v : residual_own) v *= 1000.0;
+  }
   const double ratio = MapRatio(width, Span(map.x_mm), Span(map.y_mm));
   const std::string shared_label = "depth (µm)";
   auto shared = [&](const std::string& title, const std::vector<double>& values) {
@@ -117,14 +136,16 @@ std::vector<std::vector<ReportFigure>> MapRows(const ResidualMap& map) {
   return {
       {{fmt::format("Removal target: the error minus its minimum plus the uniform layer. Target, removal and "
                     "residual share one colour scale, {} … {} µm, the range of all three.",
-                    FormatNumber(low, 3), FormatNumber(high, 3)),
+                    FormatFixed(low, 3), FormatFixed(high, 3)),
         shared("Removal target (before)", map.target_um), ratio},
        {"Removal the dwell times are predicted to make, on the target's colour scale.",
         shared("Predicted removal", map.removal_um), ratio}},
       {{"Predicted residual (target minus removal) on the target's colour scale: what is left of it.",
         shared("Predicted residual (after)", map.residual_um), ratio},
        {"The same residual on its own scale (0.5 to 99.5 percentile) to show its shape; grey: no node.",
-        ResidualHeatMap(map, "Predicted residual, own scale", map.residual_um, "residual (µm)"), ratio}}};
+        ResidualHeatMap(map, "Predicted residual, own scale", residual_own,
+                        in_nm ? "residual (nm)" : "residual (µm)"),
+        ratio}}};
 }
 
 // The clear aperture's outline (centred on the part origin) when the job records it.
@@ -195,9 +216,9 @@ ReportFigure SpeedPlot(const PolishReportInputs& in) {
   };
   std::string caption = "TCP speed into each point against the length of the path up to it";
   if (s.limit_max_speed_mm_s > 0.0)
-    limit(fmt::format("max speed {} mm/s", s.limit_max_speed_mm_s), s.limit_max_speed_mm_s, 1);
+    limit("max speed " + FormatSignificant(s.limit_max_speed_mm_s) + " mm/s", s.limit_max_speed_mm_s, 1);
   if (s.limit_min_speed_mm_s > 0.0)
-    limit(fmt::format("min speed {} mm/s", s.limit_min_speed_mm_s), s.limit_min_speed_mm_s, 2);
+    limit("min speed " + FormatSignificant(s.limit_min_speed_mm_s) + " mm/s", s.limit_min_speed_mm_s, 2);
   caption += s.limit_max_speed_mm_s > 0.0 ? "; dashed: the machine's speed limits from the job." : ".";
   return {caption, plot, 0.42};
 }
@@ -209,8 +230,11 @@ PolishReportContent ComposePolishReport(const PolishReportInputs& inputs) {
   PolishReportContent content;
   content.title = "Polishing report: " + s.job_name;
   content.provenance = Provenance(inputs);
-  content.form = {{"PV", s.before_pv_text + " µm", s.after_pv_text + " µm"},
-                  {"RMS (about the mean)", s.before_rms_text + " µm", s.after_rms_text + " µm"}};
+  // Each column in the unit its PV calls for: a residual of nm size in nm.
+  content.form = {
+      {"PV", FormatHeight(s.before_pv_um, s.before_pv_um), FormatHeight(s.after_pv_um, s.after_pv_um)},
+      {"RMS (about the mean)", FormatHeight(s.before_rms_um, s.before_pv_um),
+       FormatHeight(s.after_rms_um, s.after_pv_um)}};
   content.path = PathRows(s);
   content.figure_rows = MapRows(inputs.residual);
   content.figure_rows.push_back(PathMaps(inputs));
@@ -233,8 +257,9 @@ std::string RenderPolishHtml(const PolishReportContent& content) {
   return html + HtmlPageEnd();
 }
 
-void RenderPolishPdf(const PolishReportContent& content, const std::filesystem::path& path) {
-  internal::PdfFlow pdf(path, content.title);
+namespace {
+
+void LayoutPolishPdf(internal::PdfFlow& pdf, const PolishReportContent& content) {
   pdf.SetMetadata(content.title);
   pdf.Title(content.title);
   const std::vector<double> key_value = {0.32 * kContentWidth_pt, 0.68 * kContentWidth_pt};
@@ -243,7 +268,7 @@ void RenderPolishPdf(const PolishReportContent& content, const std::filesystem::
   pdf.Heading("Form error over the aperture", 3 * kLine_pt);
   const std::vector<double> form = {0.32 * kContentWidth_pt, 0.34 * kContentWidth_pt,
                                     0.34 * kContentWidth_pt};
-  pdf.Row({{"Quantity", {}}, {"Before (error)", {}}, {"After (predicted residual)", {}}}, form, true);
+  pdf.TableHeader({{"Quantity", {}}, {"Before (error)", {}}, {"After (predicted residual)", {}}}, form);
   for (const std::vector<std::string>& row : content.form)
     pdf.Row({{row[0], {}}, {row[1], {}}, {row[2], {}}}, form, false);
   pdf.Heading("Path and dwell", 3 * kLine_pt);
@@ -255,9 +280,17 @@ void RenderPolishPdf(const PolishReportContent& content, const std::filesystem::
                                         3.0 * kLine_pt;
   pdf.Heading("Plots", first_row_pt);
   for (const std::vector<ReportFigure>& row : content.figure_rows) pdf.FigureRow(row);
-  pdf.Heading("Job as used", kLine_pt);
+  pdf.Heading("Job as used", 2 * kLine_pt);
+  pdf.TableHeader({{"Job key", {}}, {"Value", {}}}, key_value);
   for (const KeyValue& row : content.job) pdf.Row({{row.key, {}}, {row.value, {}}}, key_value, false);
   pdf.Finish();
+}
+
+}  // namespace
+
+void RenderPolishPdf(const PolishReportContent& content, const std::filesystem::path& path) {
+  internal::RenderPdfPages(path, content.title,
+                           [&](internal::PdfFlow& pdf) { LayoutPolishPdf(pdf, content); });
 }
 
 WrittenPolishReports WritePolishReports(const std::filesystem::path& outdir) {

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <ctime>
 #include <limits>
 
 #include "core/version.h"
@@ -19,19 +20,18 @@ constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 struct HeadlineSpec {
   std::string_view key;
   const char* label;
-  const char* unit;
-  int decimals;
+  Unit unit;
 };
 
 // Same order as kHeadlineKeys.
 constexpr std::array<HeadlineSpec, 7> kHeadline = {{
-    {key::kMeanArcRadiusMm, "Mean arc radius (± 1σ)", "mm", 5},
-    {key::kArcRadiusRangeMm, "Arc radius range (max − min)", "mm", 4},
-    {key::kArcRadiusFluctuationPct, "Arc radius fluctuation (range / mean)", "%", 3},
-    {key::kCenterAxialDeviationMm, "Arc centre axial deviation (max − min)", "mm", 4},
-    {key::kMaxArcErrorUm, "Max arc error in the band", "µm", 2},
-    {key::kMaxRunoutUm, "Max runout in the band", "µm", 2},
-    {key::kMaxRoundnessUm, "Max roundness in the band", "µm", 2},
+    {key::kMeanArcRadiusMm, "Mean arc radius", units::kRadius_mm},
+    {key::kArcRadiusRangeMm, "Arc radius range (max − min)", units::kLength_mm},
+    {key::kArcRadiusFluctuationPct, "Arc radius fluctuation (range / mean)", units::kPercent},
+    {key::kCenterAxialDeviationMm, "Arc centre axial deviation (max − min)", units::kLength_mm},
+    {key::kMaxArcErrorUm, "Max arc error in the band", units::kLength_um},
+    {key::kMaxRunoutUm, "Max runout in the band", units::kLength_um},
+    {key::kMaxRoundnessUm, "Max roundness in the band", units::kLength_um},
 }};
 
 double HeadlineValue(const Summary& s, std::string_view name) {
@@ -44,33 +44,102 @@ double HeadlineValue(const Summary& s, std::string_view name) {
   return s.max_roundness_um;
 }
 
-std::string WithUnit(const std::string& number, const char* unit) {
-  return number == "n/a" ? number : number + " " + unit;
-}
-
-// Limits are shown as given (shortest form that reads back exactly), not rounded.
+// Limits are shown as given (at most six significant digits), not rounded to the value's digits.
 std::string LimitText(const Limit& limit, const HeadlineSpec& spec) {
-  const std::string unit = spec.unit;
-  if (limit.min && limit.max) return fmt::format("{} … {} {}", *limit.min, *limit.max, unit);
-  if (limit.max) return fmt::format("≤ {} {}", *limit.max, unit);
-  return fmt::format("≥ {} {}", *limit.min, unit);
+  const std::string unit(spec.unit.symbol);
+  if (limit.min && limit.max)
+    return FormatSignificant(*limit.min) + " … " + FormatSignificant(*limit.max) + " " + unit;
+  if (limit.max) return "≤ " + FormatSignificant(*limit.max) + " " + unit;
+  return "≥ " + FormatSignificant(*limit.min) + " " + unit;
 }
 
-std::vector<HeadlineRow> HeadlineRows(const Summary& summary, const Tolerances& tolerances) {
+double FiniteMedian(std::vector<double> values) {
+  std::erase_if(values, [](double v) { return !std::isfinite(v); });
+  if (values.empty()) return kNaN;
+  const auto middle = values.begin() + static_cast<std::ptrdiff_t>(values.size() / 2);
+  std::nth_element(values.begin(), middle, values.end());
+  return *middle;
+}
+
+std::size_t UsableCount(const PhaseSeries& p) {
+  return static_cast<std::size_t>(std::count(p.usable.begin(), p.usable.end(), true));
+}
+
+// "≈ X from noise (expected PV of n values of 1σ s)": what a peak-to-valley of n values would be
+// if each held only its noise; "" when the noise is not recorded.
+std::string NoisePv(std::size_t n, double sigma, Unit unit) {
+  if (!std::isfinite(sigma) || n < 2) return "";
+  return "≈ " + FormatValue(ExpectedNormalRange(n) * sigma, unit) + " from noise (expected PV of " +
+         std::to_string(n) + " values of 1σ " + FormatFixed(sigma, unit.decimals + 1) + " " +
+         std::string(unit.symbol) + ")";
+}
+
+// The per-axial-section point count of the arc fits, for the arc error's noise share.
+std::size_t SectionPoints(const ReportInputs& inputs) {
+  const double median = FiniteMedian(inputs.summary.phases.points_in_band);
+  if (std::isfinite(median)) return static_cast<std::size_t>(median);
+  std::size_t in_band = 0;
+  for (double y : inputs.map.y_mm)
+    in_band += y >= inputs.summary.band_low_mm && y <= inputs.summary.band_high_mm;
+  return in_band;
+}
+
+// Uncertainty (with its meaning) and the noise's share of the row's figure.
+void Explain(const ReportInputs& inputs, HeadlineRow& row) {
+  const Summary& s = inputs.summary;
+  const std::size_t phases = UsableCount(s.phases);
+  const double map_sigma_um = s.map_sigma_um;
+  const std::string map_sigma_text =
+      std::isfinite(map_sigma_um)
+          ? "map value 1σ " + FormatValue(map_sigma_um, units::kNoise_um) + " (median)"
+          : "";
+  if (row.key == key::kMeanArcRadiusMm) {
+    row.uncertainty = "± " + FormatValue(s.mean_arc_radius_sigma_mm, units::kRadius_mm) + " (σ of the mean)";
+    if (std::isfinite(s.arc_radius_std_mm))
+      row.uncertainty += "; phase-to-phase σ " + FormatValue(s.arc_radius_std_mm, units::kLength_mm);
+  } else if (row.key == key::kArcRadiusRangeMm || row.key == key::kArcRadiusFluctuationPct) {
+    const bool pct = row.key == key::kArcRadiusFluctuationPct;
+    const double to_unit = pct ? 100.0 / s.mean_arc_radius_mm : 1.0;
+    const Unit unit = pct ? units::kPercent : units::kLength_mm;
+    if (std::isfinite(s.arc_radius_std_mm))
+      row.uncertainty = "phase-to-phase σ " + FormatValue(s.arc_radius_std_mm * to_unit, unit);
+    if (std::isfinite(s.arc_radius_noise_std_mm) && !pct) {
+      row.uncertainty += "; of it noise " + FormatValue(s.arc_radius_noise_std_mm, unit) + ", wheel " +
+                         FormatValue(s.arc_radius_excess_std_mm, unit) + " (in quadrature)";
+    }
+    row.noise = NoisePv(phases, s.arc_radius_noise_std_mm * to_unit, unit);
+    if (s.model && !pct) {
+      row.noise += (row.noise.empty() ? "" : "; ") + std::string("wheel model, noise removed: ") +
+                   FormatWithSigma(s.model->arc_radius_range_mm, s.model->arc_radius_range_sigma_mm, unit);
+    }
+  } else if (row.key == key::kCenterAxialDeviationMm) {
+    const double sigma_mm = FiniteMedian(s.phases.center_axial_sigma_mm);
+    if (std::isfinite(sigma_mm))
+      row.uncertainty = "per-phase 1σ " + FormatValue(sigma_mm, units::kLength_mm) + " (median)";
+    row.noise = NoisePv(phases, sigma_mm, units::kLength_mm);
+  } else if (row.key == key::kMaxArcErrorUm) {
+    row.uncertainty = map_sigma_text;
+    row.noise = NoisePv(SectionPoints(inputs), map_sigma_um, units::kLength_um);
+  } else {  // runout and roundness: a turn of map values at one axial node
+    row.uncertainty = map_sigma_text;
+    row.noise = NoisePv(inputs.map.n_phase(), map_sigma_um, units::kLength_um);
+    if (row.key == key::kMaxRunoutUm)
+      row.note = s.runout_note.empty() ? "" : "Caveat: " + s.runout_note + ".";
+  }
+}
+
+std::vector<HeadlineRow> HeadlineRows(const ReportInputs& inputs, const Tolerances& tolerances) {
   std::vector<HeadlineRow> rows;
   for (const HeadlineSpec& spec : kHeadline) {
     HeadlineRow row;
     row.key = spec.key;
     row.label = spec.label;
-    const double value = HeadlineValue(summary, spec.key);
-    row.value = WithUnit(FormatNumber(value, spec.decimals), spec.unit);
-    if (row.key == key::kMeanArcRadiusMm && std::isfinite(value)) {
-      row.value = FormatNumber(value, spec.decimals) + " ± " +
-                  FormatNumber(summary.mean_arc_radius_sigma_mm, spec.decimals) + " mm";
-    }
+    const double value = HeadlineValue(inputs.summary, spec.key);
+    row.value = FormatValue(value, spec.unit);
+    Explain(inputs, row);
     std::optional<Limit> limit;
     if (const auto it = tolerances.limits.find(row.key); it != tolerances.limits.end()) limit = it->second;
-    row.tolerance = limit ? LimitText(*limit, spec) : "-";
+    row.tolerance = limit ? LimitText(*limit, spec) : "–";
     row.verdict = Judge(value, limit);
     rows.push_back(row);
   }
@@ -86,6 +155,24 @@ Verdict Overall(const std::vector<HeadlineRow>& rows) {
   return overall;
 }
 
+std::vector<std::string> FailingRows(const std::vector<HeadlineRow>& rows) {
+  std::vector<std::string> failing;
+  for (const HeadlineRow& row : rows) {
+    if (row.verdict == Verdict::kFail)
+      failing.push_back(row.label + ": " + row.value + " (limit " + row.tolerance + ")");
+  }
+  return failing;
+}
+
+std::string UtcNow() {
+  const std::time_t now = std::time(nullptr);
+  std::tm utc{};
+  gmtime_r(&now, &utc);
+  char text[32];
+  std::strftime(text, sizeof text, "%Y-%m-%d %H:%M UTC", &utc);
+  return text;
+}
+
 std::string ScanText(const json& scan, std::string_view name) {
   const auto it = scan.find(name);
   if (it == scan.end() || it->is_null()) return "not recorded";
@@ -93,10 +180,15 @@ std::string ScanText(const json& scan, std::string_view name) {
   return it->dump();
 }
 
-std::string ScanNumber(const json& scan, std::string_view name, int decimals, const char* unit) {
+std::string ScanNumber(const json& scan, std::string_view name, Unit unit) {
   const auto it = scan.find(name);
   if (it == scan.end() || !it->is_number()) return "not recorded";
-  return FormatNumber(it->get<double>(), decimals) + " " + unit;
+  return FormatValue(it->get<double>(), unit);
+}
+
+double ScanValue(const json& scan, std::string_view name) {
+  const auto it = scan.find(name);
+  return it == scan.end() || !it->is_number() ? kNaN : it->get<double>();
 }
 
 std::vector<KeyValue> Provenance(const ReportInputs& inputs) {
@@ -104,32 +196,40 @@ std::vector<KeyValue> Provenance(const ReportInputs& inputs) {
   const InputProvenance& in = s.input;
   const double valid_pct =
       in.samples > 0 ? 100.0 * static_cast<double>(in.valid_samples) / static_cast<double>(in.samples) : kNaN;
-  std::string estimated = FormatNumber(s.spindle_rpm_estimated, 2) + " rpm";
+  std::string estimated = FormatValue(s.spindle_rpm_estimated, units::kSpeed_rpm);
   if (!s.spindle_rpm_source.empty()) estimated += " (used: " + s.spindle_rpm_source + ")";
   std::vector<KeyValue> rows = {
       {"Wheel id", ScanText(s.scan, key::scan::kWheelId)},
       {"Scan date/time", ScanText(s.scan, key::scan::kTimestamp)},
       {"Sensor", ScanText(s.scan, key::scan::kSensor)},
+      {"Wheel diameter × width", ScanNumber(s.scan, key::scan::kWheelDiameterMm, {"mm", 1}) + " × " +
+                                     ScanNumber(s.scan, key::scan::kWheelWidthMm, {"mm", 1})},
       {"Operator", ScanText(s.scan, key::scan::kOperator)},
-      {"Spindle speed, nominal", FormatNumber(s.spindle_rpm_nominal, 2) + " rpm"},
+      {"Spindle speed, nominal", FormatValue(s.spindle_rpm_nominal, units::kSpeed_rpm)},
       {"Spindle speed, estimated", estimated},
-      {"Feed", ScanNumber(s.scan, key::scan::kFeedMmPerMin, 3, "mm/min")},
-      {"Sample period", ScanNumber(s.scan, key::scan::kSamplePeriodS, 7, "s")},
+      {"Feed", ScanNumber(s.scan, key::scan::kFeedMmPerMin, units::kFeed_mm_per_min)},
+      {"Sample period", std::isfinite(ScanValue(s.scan, key::scan::kSamplePeriodS))
+                            ? FormatDuration(ScanValue(s.scan, key::scan::kSamplePeriodS))
+                            : "not recorded"},
       {"Samples", fmt::format("{}", in.samples)},
-      {"Valid samples", fmt::format("{} ({}%)", in.valid_samples, FormatNumber(valid_pct, 2))},
+      {"Valid samples", fmt::format("{} ({} %)", in.valid_samples, FormatFixed(valid_pct, 2))},
       {"Despiked samples", fmt::format("{}", in.despiked_samples)},
-      {"Band used (axial)", FormatNumber(s.band_low_mm, 3) + " … " + FormatNumber(s.band_high_mm, 3) +
-                                " mm (half width " + FormatNumber(s.band_half_width_mm, 3) + " mm)"},
+      {"Band used (axial)", FormatFixed(s.band_low_mm, 3) + " … " + FormatFixed(s.band_high_mm, 3) +
+                                " mm (half width " + FormatValue(s.band_half_width_mm, units::kPosition_mm) +
+                                ")"},
       {"Map", fmt::format("{} phases × {} axial nodes", inputs.map.n_phase(), inputs.map.n_y())},
   };
   if (std::isfinite(s.noise_sigma_um))
-    rows.push_back({"Measurement noise (1σ)", FormatNumber(s.noise_sigma_um, 3) + " µm"});
+    rows.push_back({"Measurement noise (1σ)", FormatValue(s.noise_sigma_um, units::kNoise_um)});
   if (std::isfinite(s.map_sigma_um))
-    rows.push_back({"Map value noise (median 1σ)", FormatNumber(s.map_sigma_um, 3) + " µm"});
+    rows.push_back({"Map value noise (median 1σ)", FormatValue(s.map_sigma_um, units::kNoise_um)});
   rows.push_back({"Input file", in.path + (in.format.empty() ? "" : " (" + in.format + ")")});
   rows.push_back({"Input SHA-256", in.sha256});
   rows.push_back({"Processed by", "arcwheel " + s.arcwheel_version});
   rows.push_back({"Report by", std::string("arcwheel ") + kVersion});
+  rows.push_back({"Report date", UtcNow()});
+  // Left blank for the signature of whoever releases the wheel.
+  rows.push_back({"Approved by (name, date)", "____________________________"});
   return rows;
 }
 
@@ -139,7 +239,7 @@ void Flatten(const json& value, const std::string& prefix, std::vector<KeyValue>
       Flatten(child, prefix.empty() ? key : prefix + "." + key, out);
     return;
   }
-  out.push_back({prefix, value.is_string() ? value.get<std::string>() : value.dump()});
+  out.push_back({prefix, FormatJsonValue(value)});
 }
 
 // Per-phase values with unusable phases blanked, so that plots show gaps instead of outliers.
@@ -183,9 +283,12 @@ ReportFigure FormErrorMap(const ReportInputs& inputs) {
   map.x_nodes = inputs.map.phase_deg;
   map.y_nodes = inputs.map.y_mm;
   map.colour_bar_label = "form error (µm)";
+  map.y_marks = {inputs.summary.band_low_mm, inputs.summary.band_high_mm};
+  map.y_marks_label = "band";
   return {
       "Unwrapped form-error map: radial deviation of the wheel from the circle of mean radius and mean "
-      "centre, by phase and axial position (colour range: 0.5 to 99.5 percentile; grey: no value).",
+      "centre, by phase and axial position (colour range: 0.5 to 99.5 percentile; grey: no value; dashed: "
+      "the band used for the fits).",
       map, 0.5};
 }
 
@@ -214,14 +317,6 @@ plot::Series ModelSeries(const std::string& label, const std::vector<double>& x,
   return series;
 }
 
-double FiniteMedian(std::vector<double> values) {
-  std::erase_if(values, [](double v) { return !std::isfinite(v); });
-  if (values.empty()) return kNaN;
-  const auto middle = values.begin() + static_cast<std::ptrdiff_t>(values.size() / 2);
-  std::nth_element(values.begin(), middle, values.end());
-  return *middle;
-}
-
 // With the model, the per-phase radii become dots (their 1-sigma band would hide the model's) and
 // Ra(c) is drawn over them with its own band.
 ReportFigure RadiusPlotWithModel(const PhaseSeries& p, const ModelCurves& model) {
@@ -236,7 +331,7 @@ ReportFigure RadiusPlotWithModel(const PhaseSeries& p, const ModelCurves& model)
   const double median_sigma_um = FiniteMedian(UsableOnly(p.arc_radius_sigma_mm, p.usable)) * 1000.0;
   return {fmt::format("Arc radius of each axial section (dots; median 1σ {} µm), and the wheel model's Ra(c) "
                       "fitted to every sample, with its 1-sigma band.",
-                      FormatNumber(median_sigma_um, 2)),
+                      FormatFixed(median_sigma_um, 2)),
           plot, 0.42};
 }
 
@@ -250,15 +345,29 @@ ReportFigure CentrePlot(const PhaseSeries& p, const ModelCurves* model) {
   const auto [axial, mean_axial] = deviation_um(p.center_axial_mm);
   const auto [radial, mean_radial] = deviation_um(p.center_radial_mm);
   if (model == nullptr) {
-    plot::LinePlot plot{
-        "Arc centre vs phase (deviation from its mean)",
-        kPhaseAxis,
-        FreeAxis("centre deviation (µm)"),
-        {{"axial a − mean", p.phase_deg, axial, {}, {}, plot::SeriesColour(0)},
-         {"radial b − mean", p.phase_deg, radial, {}, {}, plot::SeriesColour(1), false, true}},
-        {}};
-    return {fmt::format("Arc centre position by phase: axial a (mean {} mm) and radial b (mean {} mm).",
-                        FormatNumber(mean_axial, 4), FormatNumber(mean_radial, 4)),
+    plot::Series axial_series{"axial a − mean", p.phase_deg, axial, {}, {}, plot::SeriesColour(0)};
+    plot::Series radial_series{"radial b − mean",     p.phase_deg, radial, {}, {},
+                               plot::SeriesColour(1), false,       true};
+    // Each phase's own 1-sigma as a band, so that motion within it reads as noise.
+    auto add_band = [](plot::Series& series, const std::vector<double>& sigma_mm) {
+      if (sigma_mm.size() != series.y.size()) return;
+      for (std::size_t i = 0; i < sigma_mm.size(); ++i) {
+        series.band_low.push_back(series.y[i] - sigma_mm[i] * 1000.0);
+        series.band_high.push_back(series.y[i] + sigma_mm[i] * 1000.0);
+      }
+    };
+    add_band(axial_series, p.center_axial_sigma_mm);
+    add_band(radial_series, p.center_radial_sigma_mm);
+    const bool banded = !axial_series.band_low.empty();
+    plot::LinePlot plot{banded ? "Arc centre vs phase (deviation from its mean; shaded: ± 1σ)"
+                               : "Arc centre vs phase (deviation from its mean)",
+                        kPhaseAxis,
+                        FreeAxis("centre deviation (µm)"),
+                        {axial_series, radial_series},
+                        {}};
+    return {fmt::format("Arc centre position by phase: axial a (mean {} mm) and radial b (mean {} mm){}.",
+                        FormatFixed(mean_axial, 4), FormatFixed(mean_radial, 4),
+                        banded ? ", each with its per-phase 1-sigma band" : ""),
             plot, 0.42};
   }
   // The model's a(c) and b(c) against the same means, so that they lie over the per-phase points.
@@ -278,7 +387,7 @@ ReportFigure CentrePlot(const PhaseSeries& p, const ModelCurves* model) {
   return {
       fmt::format("Arc centre position by phase: axial a (per-phase mean {} mm) and radial b (per-phase mean "
                   "{} mm); dots: per-phase fits, lines: the wheel model with its 1-sigma band.",
-                  FormatNumber(mean_axial, 4), FormatNumber(mean_radial, 4)),
+                  FormatFixed(mean_axial, 4), FormatFixed(mean_radial, 4)),
       plot, 0.42};
 }
 
@@ -319,54 +428,14 @@ std::pair<std::size_t, std::size_t> ExtremePhases(const PhaseSeries& p) {
   return {largest, smallest};
 }
 
-// The fitted arc of phase `k` over the band, on the branch (above or below the centre) on which
-// the measured section lies.
-plot::Series FittedArc(const ReportInputs& inputs, std::size_t k, const std::string& label,
-                       plot::Rgb colour) {
-  const PhaseSeries& p = inputs.summary.phases;
-  const double a = p.center_axial_mm[k], b = p.center_radial_mm[k], radius = p.arc_radius_mm[k];
-  double side = 0.0;
-  for (std::size_t j = 0; j < inputs.map.n_y(); ++j) {
-    const double rho = inputs.map.rho_mm[k * inputs.map.n_y() + j];
-    if (std::isfinite(rho)) side += rho - b;
-  }
-  plot::Series arc{label, {}, {}, {}, {}, colour, false, true};
-  constexpr int kPoints = 200;
-  const double low = inputs.summary.band_low_mm, high = inputs.summary.band_high_mm;
-  for (int i = 0; i <= kPoints; ++i) {
-    const double y = low + (high - low) * i / kPoints;
-    const double under_root = radius * radius - (y - a) * (y - a);
-    arc.x.push_back(y);
-    arc.y.push_back(under_root < 0.0 ? kNaN : b + std::copysign(std::sqrt(under_root), side));
-  }
-  return arc;
-}
-
-plot::Series MeasuredSection(const ReportInputs& inputs, std::size_t k, const std::string& label,
-                             plot::Rgb colour) {
-  plot::Series section{label, inputs.map.y_mm, {}, {}, {}, colour, true};
-  section.y.assign(inputs.map.rho_mm.begin() + static_cast<std::ptrdiff_t>(k * inputs.map.n_y()),
-                   inputs.map.rho_mm.begin() + static_cast<std::ptrdiff_t>((k + 1) * inputs.map.n_y()));
-  return section;
-}
-
 std::vector<ReportFigure> SectionFigures(const ReportInputs& inputs) {
   const PhaseSeries& p = inputs.summary.phases;
   const auto [largest, smallest] = ExtremePhases(p);
   if (largest == std::string::npos) return {};
   auto name = [&p](std::size_t k, const char* which) {
-    return fmt::format("c = {} deg ({})", FormatNumber(p.phase_deg[k], 1), which);
+    return fmt::format("c = {} deg ({})", FormatFixed(p.phase_deg[k], 1), which);
   };
   const std::string large = name(largest, "largest Ra"), small = name(smallest, "smallest Ra");
-  const plot::XSpan band{inputs.summary.band_low_mm, inputs.summary.band_high_mm, "band"};
-  plot::LinePlot sections{"Measured sections and fitted arcs",
-                          kAxialAxis,
-                          FreeAxis("radial coordinate rho (mm)"),
-                          {MeasuredSection(inputs, largest, large, plot::SeriesColour(0)),
-                           FittedArc(inputs, largest, "fit", plot::SeriesColour(0)),
-                           MeasuredSection(inputs, smallest, small, plot::SeriesColour(1)),
-                           FittedArc(inputs, smallest, "fit", plot::SeriesColour(1))},
-                          {band}};
   const SectionResidual r_large = SectionResiduals(inputs, largest);
   const SectionResidual r_small = SectionResiduals(inputs, smallest);
   plot::LinePlot residuals{
@@ -376,11 +445,11 @@ std::vector<ReportFigure> SectionFigures(const ReportInputs& inputs) {
       {{large, r_large.y_mm, r_large.residual_um, {}, {}, plot::SeriesColour(0)},
        {small, r_small.y_mm, r_small.residual_um, {}, {}, plot::SeriesColour(1), false, true}},
       {}};
+  // The sections themselves would lie on one curve at page scale; their residuals show the shape.
   return {
-      {"Axial sections (map nodes, dots) at the phases of largest and smallest arc radius, with their fitted "
-       "arcs over the band.",
-       sections, 0.5},
-      {"Geometric residuals of the same two sections inside the band, in micrometres.", residuals, 0.42}};
+      {"Geometric residuals of the axial sections at the phases of largest and smallest arc radius against "
+       "their own fitted arcs, inside the band, in micrometres.",
+       residuals, 0.42}};
 }
 
 ReportFigure ProfileErrorPlot(const ModelCurves& model) {
@@ -419,7 +488,8 @@ ReportFigure ModelResidualMap(const ReportInputs& inputs) {
       map, 0.5};
 }
 
-ReportFigure CoverageMap(const WheelMapData& map) {
+ReportFigure CoverageMap(const ReportInputs& inputs) {
+  const WheelMapData& map = inputs.map;
   plot::CategoryMap coverage;
   coverage.title = "Coverage and despiking";
   coverage.x = FreeAxis("phase c (deg)");
@@ -428,35 +498,48 @@ ReportFigure CoverageMap(const WheelMapData& map) {
   coverage.n_y = map.n_y();
   coverage.x_nodes = map.phase_deg;
   coverage.y_nodes = map.y_mm;
-  coverage.categories = {{"samples ok", {0.86, 0.90, 0.94}},
-                         {"some samples despiked", {0.90, 0.62, 0.00}},
-                         {"no valid sample", {0.80, 0.10, 0.10}}};
+  coverage.coarse_display = true;
+  coverage.y_marks = {inputs.summary.band_low_mm, inputs.summary.band_high_mm};
+  coverage.y_marks_label = "band";
   coverage.codes.resize(map.sample_count.size());
+  std::size_t despiked_cells = 0, missing_cells = 0;
+  double despiked_samples = 0.0;
   for (std::size_t i = 0; i < coverage.codes.size(); ++i) {
     const bool missing = !(map.sample_count[i] > 0.0) || !std::isfinite(map.rho_mm[i]);
-    coverage.codes[i] = missing ? 2 : (map.despiked_count[i] > 0.0 ? 1 : 0);
+    const bool despiked = map.despiked_count[i] > 0.0;
+    coverage.codes[i] = missing ? 2 : (despiked ? 1 : 0);
+    missing_cells += missing;
+    despiked_cells += despiked && !missing;
+    if (despiked && !missing) despiked_samples += map.despiked_count[i];
   }
-  return {
-      "Map cells by their raw samples: where samples were missing or replaced by despiking (a merged "
-      "display pixel shows its worst cell).",
-      coverage, 0.5};
+  coverage.categories = {
+      {"samples ok", {0.86, 0.90, 0.94}},
+      {fmt::format("despiked: {} cells, {} samples", despiked_cells, FormatSignificant(despiked_samples)),
+       {0.90, 0.62, 0.00}},
+      {fmt::format("no valid sample: {} cells", missing_cells), {0.80, 0.10, 0.10}}};
+  return {fmt::format(
+              "Map cells by their raw samples: where samples were missing or replaced by despiking, enlarged "
+              "to blocks of a few points so that a single cell shows (a block takes its worst cell). {} of "
+              "{} cells hold despiked samples, {} hold no valid sample.",
+              despiked_cells, coverage.codes.size(), missing_cells),
+          coverage, 0.5};
 }
 
 std::string WithSigma(double value, double sigma, int decimals, const char* unit) {
-  return FormatSigned(value, decimals) + " ± " + FormatNumber(sigma, decimals) + " " + unit;
+  return FormatSigned(value, decimals) + " ± " + FormatFixed(sigma, decimals) + " " + unit;
 }
 
 // p-values below 0.001 as "p < 0.001": the test's decision needs no more digits.
 std::string PValueText(double p_value) {
   if (std::isfinite(p_value) && p_value < 0.001) return "p < 0.001";
-  return "p = " + FormatNumber(p_value, 3);
+  return "p = " + FormatFixed(p_value, 3);
 }
 
 std::string VariesText(const ModelSummary& m) {
   return fmt::format("{} (χ² = {} with {} dof, {}; significance level {})",
-                     m.variation_significant ? "yes" : "no", FormatNumber(m.variation_chi2, 1),
+                     m.variation_significant ? "yes" : "no", FormatFixed(m.variation_chi2, 1),
                      m.variation_dof, PValueText(m.variation_p_value),
-                     fmt::format("{}", m.significance_level));
+                     FormatSignificant(m.significance_level));
 }
 
 std::string KnotsText(const ModelSummary& m) {
@@ -471,8 +554,8 @@ std::string KnotsText(const ModelSummary& m) {
 
 std::string ResidualText(const ModelSummary& m) {
   const double ratio = m.residual_rms_um / m.noise_sigma_um;
-  return fmt::format("{} µm against a noise estimate of {} µm (ratio {})", FormatNumber(m.residual_rms_um, 3),
-                     FormatNumber(m.noise_sigma_um, 3), FormatNumber(ratio, 2));
+  return fmt::format("{} µm against a noise estimate of {} µm (ratio {})", FormatFixed(m.residual_rms_um, 3),
+                     FormatFixed(m.noise_sigma_um, 3), FormatFixed(ratio, 2));
 }
 
 // One line on why a summary has no model, from what it records.
@@ -502,7 +585,7 @@ ModelReport ModelPart(const Summary& s) {
       {"Radius varies with phase", VariesText(m)},
       {"Knots", KnotsText(m)},
       {"Residual RMS", ResidualText(m)},
-      {"Profile error p(u), peak-to-valley", FormatNumber(m.profile_pv_um, 2) + " µm"},
+      {"Profile error p(u), peak-to-valley", FormatFixed(m.profile_pv_um, 2) + " µm"},
   };
   for (const ModelHarmonic& h : m.radius_harmonics) {
     part.harmonics.push_back({fmt::format("{}", h.order),
@@ -514,10 +597,20 @@ ModelReport ModelPart(const Summary& s) {
 
 }  // namespace
 
-std::string FormatSigned(double value, int decimals) {
-  std::string text = FormatNumber(value, decimals);
-  if (!text.empty() && text.front() == '-') text.replace(0, 1, "−");
-  return text;
+std::string FormatSigned(double value, int decimals) { return FormatFixed(value, decimals); }
+
+double ExpectedNormalRange(std::size_t n) {
+  if (n < 2) return 0.0;
+  // E[max - min] = integral of 1 - F(x)^n - (1 - F(x))^n over x (F the normal CDF); the integrand
+  // is below 1e-12 outside |x| < 12 for any n a report meets.
+  constexpr double kStep = 1e-3;
+  const double count = static_cast<double>(n);
+  double sum = 0.0;
+  for (double x = -12.0; x <= 12.0; x += kStep) {
+    const double cdf = 0.5 * std::erfc(-x / std::sqrt(2.0));
+    sum += 1.0 - std::pow(cdf, count) - std::pow(1.0 - cdf, count);
+  }
+  return sum * kStep;
 }
 
 std::string FormatNumber(double value, int decimals) {
@@ -566,8 +659,9 @@ ReportContent ComposeReport(const ReportInputs& inputs, const Tolerances& tolera
   content.title =
       "Wheel inspection report: " + (wheel == "not recorded" ? std::string("wheel id not recorded") : wheel);
   content.provenance = Provenance(inputs);
-  content.headline = HeadlineRows(s, tolerances);
+  content.headline = HeadlineRows(inputs, tolerances);
   content.overall = Overall(content.headline);
+  content.failing = FailingRows(content.headline);
   content.model = ModelPart(s);
   // ReadReportInputs guarantees the map's /model when the summary has one.
   const ModelCurves* model = content.model.shown && inputs.map.model ? &*inputs.map.model : nullptr;
@@ -579,7 +673,7 @@ ReportContent ComposeReport(const ReportInputs& inputs, const Tolerances& tolera
   content.figures.push_back(ArcErrorPlot(s.phases));
   content.figures.push_back(RunoutPlot(s));
   for (ReportFigure& figure : SectionFigures(inputs)) content.figures.push_back(std::move(figure));
-  content.figures.push_back(CoverageMap(inputs.map));
+  content.figures.push_back(CoverageMap(inputs));
   if (!s.processing.empty()) Flatten(s.processing, "", content.processing);
   content.warnings = s.warnings;
   return content;

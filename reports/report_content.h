@@ -5,6 +5,7 @@
 #include <string>
 #include <vector>
 
+#include "reports/format.h"
 #include "reports/plot.h"
 #include "reports/report_inputs.h"
 #include "reports/tolerances.h"
@@ -16,14 +17,22 @@ struct KeyValue {
   std::string value;
 };
 
-// One row of the headline table. Numbers are shown at fixed precision: lengths in mm with 4
-// decimals (0.1 um; the mean arc radius and its 1-sigma with 5), um values with 2, percentages
-// with 3. A number that could not be computed shows as "n/a".
+// One row of the headline table (the decision block). Numbers are shown at fixed precision
+// (reports/format.h): lengths in mm with 4 decimals (0.1 um; the mean arc radius and its sigma
+// with 5), um values with 2, percentages with 3. A number that could not be computed shows as
+// "n/a".
 struct HeadlineRow {
-  std::string key;        // summary.json key, e.g. "max_runout_um"
-  std::string label;      // e.g. "Max runout in the band"
-  std::string value;      // e.g. "7.25 µm"
-  std::string tolerance;  // e.g. "≤ 10.00 µm", or "-" without one
+  std::string key;    // summary.json key, e.g. "max_runout_um"
+  std::string label;  // e.g. "Max runout in the band"
+  std::string value;  // e.g. "7.13 µm"
+  // The uncertainty with its meaning, e.g. "± 0.00021 mm (σ of the mean)" or "phase-to-phase σ
+  // 0.0021 mm"; "" when the summary has none.
+  std::string uncertainty;
+  // For a peak-to-valley figure, the part that noise alone explains, e.g. "≈ 0.50 µm from noise
+  // (expected PV of 360 values of 1σ 0.08 µm)"; "" for other rows.
+  std::string noise;
+  std::string note;       // a caveat shown with the row (runout: wheel plus spindle), or ""
+  std::string tolerance;  // e.g. "≤ 10 µm", or "–" without one
   Verdict verdict = Verdict::kNoTolerance;
 };
 
@@ -49,27 +58,36 @@ struct ReportContent {
   std::vector<KeyValue> provenance;         // wheel, scan settings, input file and SHA-256, versions
   std::vector<HeadlineRow> headline;        // in kHeadlineKeys order
   Verdict overall = Verdict::kNoTolerance;  // kFail if any row fails, kPass if some pass and none fail
+  // The failing rows, each "label: value (limit ...)", in headline order.
+  std::vector<std::string> failing;
   ModelReport model;
   std::vector<ReportFigure> figures;
   std::vector<KeyValue> processing;  // summary.json "processing", flattened to dotted keys
   std::vector<std::string> warnings;
 };
 
-// Builds the report from the two inputs and the tolerances. Pure: no I/O.
+// Builds the report from the two inputs and the tolerances. No I/O; the provenance's report date
+// is the current time (UTC).
 [[nodiscard]] ReportContent ComposeReport(const ReportInputs& inputs, const Tolerances& tolerances);
 
-// A JSON object's leaves as dotted keys ("despike.threshold_um"), strings unquoted, other values
-// as JSON text.
+// A JSON object's leaves as dotted keys ("despike.threshold_um"), each value as FormatJsonValue
+// (reports/format.h) writes it: strings unquoted, integers whole, other numbers at six
+// significant digits.
 [[nodiscard]] std::vector<KeyValue> FlattenJson(const nlohmann::json& object);
 
 // "PASS", "FAIL" or "NO TOLERANCE".
 [[nodiscard]] std::string VerdictText(Verdict verdict);
 
-// `value` with `decimals` decimals, or "n/a" when not finite.
+// `value` with `decimals` decimals, or "n/a" when not finite; a hyphen for a minus sign. Kept for
+// callers that need plain ASCII; the reports print through reports/format.h.
 [[nodiscard]] std::string FormatNumber(double value, int decimals);
 
-// As FormatNumber, with "−" (U+2212) for a minus sign, as tables print it.
+// FormatFixed (reports/format.h): "−" (U+2212) for a minus sign, as tables print it.
 [[nodiscard]] std::string FormatSigned(double value, int decimals);
+
+// Expected range (max − min) of n independent standard normal values (the control-chart constant
+// d2(n)): 1.128 for 2, 3.078 for 10, 5.015 for 100. 0 for n < 2.
+[[nodiscard]] double ExpectedNormalRange(std::size_t n);
 
 // Geometric residuals |p - centre| - Ra, in um, of the section at map phase row `phase_index`
 // against the circle (center_axial_mm, center_radial_mm, arc_radius_mm) of that phase, for the

@@ -22,18 +22,42 @@ std::string VerdictBadge(Verdict verdict) {
   return "<span class=\"verdict " + VerdictClass(verdict) + "\">" + VerdictText(verdict) + "</span>";
 }
 
-std::string HeadlineTable(const ReportContent& content) {
-  std::string html = "<p>Overall: " + VerdictBadge(content.overall) + "</p>\n";
-  html +=
-      "<div "
-      "class=\"table-scroll\"><table>\n<tr><th>Quantity</th><th>Value</th><th>Tolerance</th><th>Result</th></"
-      "tr>\n";
-  for (const HeadlineRow& row : content.headline) {
-    html += "<tr><td>" + Escape(row.label) + "</td><td class=\"number\">" + Escape(row.value) +
-            "</td><td class=\"number\">" + Escape(row.tolerance) + "</td><td>" + VerdictBadge(row.verdict) +
-            "</td></tr>\n";
+std::string DecisionLine(const ReportContent& content) {
+  if (content.overall == Verdict::kFail) {
+    std::string html = "<p class=\"failing\"><strong>Failing:</strong></p>\n<ul class=\"failing\">\n";
+    for (const std::string& row : content.failing) html += "<li>" + Escape(row) + "</li>\n";
+    return html + "</ul>\n";
   }
-  return html + "</table></div>\n";
+  if (content.overall == Verdict::kPass) return "<p>Every limit given holds.</p>\n";
+  return "<p>No limits given: nothing was judged (<code>arcwheel report --tolerance KEY=MAX</code>).</p>\n";
+}
+
+std::string Cell(const std::string& css_class, const std::string& label, const std::string& html) {
+  return "<td class=\"" + css_class + "\" data-label=\"" + Escape(label) + "\">" + html + "</td>";
+}
+
+// The decision block: verdict, failing rows, and the headline table. On a phone the table
+// reflows into one card per quantity (CSS), so that the Result stays on screen.
+std::string DecisionBlock(const ReportContent& content) {
+  std::string html = "<section class=\"decision\" id=\"decision\">\n";
+  html += "<div class=\"banner " + VerdictClass(content.overall) +
+          "\">Overall: " + VerdictText(content.overall) + "</div>\n" + DecisionLine(content);
+  html +=
+      "<table class=\"headline\">\n<thead><tr><th>Quantity</th><th>Value</th><th>Uncertainty (meaning)</th>"
+      "<th>Noise alone (part of the PV)</th><th>Limit</th><th>Result</th></tr></thead>\n<tbody>\n";
+  for (const HeadlineRow& row : content.headline) {
+    const bool judged = row.verdict != Verdict::kNoTolerance;
+    html += "<tr>" +
+            Cell("quantity", "Quantity",
+                 Escape(row.label) +
+                     (row.note.empty() ? "" : "<div class=\"note\">" + Escape(row.note) + "</div>")) +
+            Cell("value detail", "Value", Escape(row.value)) +
+            Cell("detail", "Uncertainty", Escape(row.uncertainty)) +
+            Cell("detail", "Noise alone", Escape(row.noise)) +
+            Cell("limit detail", "Limit", Escape(row.tolerance)) +
+            Cell("result", "Result", judged ? VerdictBadge(row.verdict) : "") + "</tr>\n";
+  }
+  return html + "</tbody>\n</table>\n</section>\n";
 }
 
 std::string ModelSection(const ModelReport& model) {
@@ -63,8 +87,8 @@ std::string Warnings(const std::vector<std::string>& warnings) {
 
 std::string RenderHtml(const ReportContent& content) {
   std::string html = HtmlPageStart(content.title);
+  html += DecisionBlock(content);
   html += "<h2>Scan and provenance</h2>\n" + KeyValueTable(content.provenance);
-  html += "<h2>Headline numbers</h2>\n" + HeadlineTable(content);
   html += "<h2>Wheel model</h2>\n" + ModelSection(content.model);
   html += "<h2>Plots</h2>\n" + Figures(content);
   html += "<h2>Warnings</h2>\n" + Warnings(content.warnings);

@@ -143,6 +143,12 @@ PhaseSeries ParsePhases(const json& root, const JsonWhere& top) {
   series.center_axial_mm = RequireNumberArray(phases, where, key::phases::kCenterAxialMm, n);
   series.center_radial_mm = RequireNumberArray(phases, where, key::phases::kCenterRadialMm, n);
   series.arc_error_um = RequireNumberArray(phases, where, key::phases::kArcErrorUm, n);
+  if (phases.contains(key::phases::kCenterAxialSigmaMm))
+    series.center_axial_sigma_mm = RequireNumberArray(phases, where, key::phases::kCenterAxialSigmaMm, n);
+  if (phases.contains(key::phases::kCenterRadialSigmaMm))
+    series.center_radial_sigma_mm = RequireNumberArray(phases, where, key::phases::kCenterRadialSigmaMm, n);
+  if (phases.contains(key::phases::kPointsInBand))
+    series.points_in_band = RequireNumberArray(phases, where, key::phases::kPointsInBand, n);
   series.usable.assign(n, true);
   if (const auto it = phases.find(key::phases::kUsable); it != phases.end()) {
     const JsonWhere usable_where = where.Child(key::phases::kUsable);
@@ -252,6 +258,11 @@ void ParseHeadline(const json& root, const JsonWhere& top, Summary& summary) {
   summary.noise_sigma_um = OptionalNumber(root, top, key::kNoiseSigmaUm);
   summary.map_sigma_um = OptionalNumber(root, top, key::kMapSigmaUm);
   summary.spindle_rpm_source = OptionalString(root, top, key::kSpindleRpmSource);
+  summary.mean_center_axial_sigma_mm = OptionalNumber(root, top, key::kMeanCenterAxialSigmaMm);
+  summary.arc_radius_std_mm = OptionalNumber(root, top, key::kArcRadiusStdMm);
+  summary.arc_radius_noise_std_mm = OptionalNumber(root, top, key::kArcRadiusNoiseStdMm);
+  summary.arc_radius_excess_std_mm = OptionalNumber(root, top, key::kArcRadiusExcessStdMm);
+  summary.runout_note = OptionalString(root, top, key::kRunoutNote);
 }
 
 // A file without schema_version was written before versions were recorded: read it as 1.0.

@@ -35,6 +35,10 @@ struct PhaseSeries {
   std::vector<double> center_axial_mm;
   std::vector<double> center_radial_mm;
   std::vector<double> arc_error_um;
+  // Optional in the file; empty when absent.
+  std::vector<double> center_axial_sigma_mm;
+  std::vector<double> center_radial_sigma_mm;
+  std::vector<double> points_in_band;
   // Optional in the file; all true when absent.
   std::vector<bool> usable;
 };
@@ -109,6 +113,14 @@ struct Summary {
   double noise_sigma_um = 0.0;
   double map_sigma_um = 0.0;
   std::string spindle_rpm_source;
+  double mean_center_axial_sigma_mm = 0.0;  // NaN when absent
+  // Phase-to-phase spread of the per-phase arc radii, and the parts of it that the per-phase
+  // noise explains and that remain (in quadrature); NaN when absent.
+  double arc_radius_std_mm = 0.0;
+  double arc_radius_noise_std_mm = 0.0;
+  double arc_radius_excess_std_mm = 0.0;
+  // What runout includes (wheel plus spindle error motion); "" when absent.
+  std::string runout_note;
   // "model" when the file has one.
   std::optional<ModelSummary> model;
 };

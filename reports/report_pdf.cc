@@ -25,25 +25,53 @@ void RenderModel(PdfFlow& pdf, const ModelReport& model) {
     pdf.Row({{row[0], {}}, {row[1], {}}, {row[2], {}}}, columns, false);
 }
 
-}  // namespace
+std::string DecisionLine(const ReportContent& content) {
+  if (content.overall == Verdict::kFail) {
+    std::string text = "Failing: ";
+    for (std::size_t i = 0; i < content.failing.size(); ++i)
+      text += (i == 0 ? "" : "; ") + content.failing[i];
+    return text + ".";
+  }
+  if (content.overall == Verdict::kPass) return "Every limit given holds.";
+  return "No limits given: nothing was judged (arcwheel report --tolerance KEY=MAX).";
+}
 
-void RenderPdf(const ReportContent& content, const std::filesystem::path& path) {
-  PdfFlow pdf(path, content.title);
+// The decision block: verdict, the failing rows, the headline table with uncertainties, the
+// noise's share and the limits.
+void RenderDecision(PdfFlow& pdf, const ReportContent& content) {
+  pdf.Banner("Overall: " + VerdictText(content.overall), content.overall);
+  pdf.Paragraph(DecisionLine(content));
+  pdf.Space(3.0);
+  const std::vector<double> widths = {0.21 * kContentWidth_pt, 0.13 * kContentWidth_pt,
+                                      0.23 * kContentWidth_pt, 0.23 * kContentWidth_pt,
+                                      0.11 * kContentWidth_pt, 0.09 * kContentWidth_pt};
+  pdf.TableHeader({{"Quantity", {}},
+                   {"Value", {}},
+                   {"Uncertainty (meaning)", {}},
+                   {"Noise alone (part of the PV)", {}},
+                   {"Limit", {}},
+                   {"Result", {}}},
+                  widths);
+  for (const HeadlineRow& row : content.headline) {
+    const bool judged = row.verdict != Verdict::kNoTolerance;
+    pdf.Row({{row.label + (row.note.empty() ? "" : ". " + row.note), {}},
+             {row.value, {}},
+             {row.uncertainty, {}},
+             {row.noise, {}},
+             {row.tolerance, {}},
+             {judged ? VerdictText(row.verdict) : "", judged ? std::optional(row.verdict) : std::nullopt}},
+            widths, false);
+  }
+  pdf.EndTable();
+}
+
+void Layout(PdfFlow& pdf, const ReportContent& content) {
   pdf.SetMetadata(content.title);
   pdf.Title(content.title);
+  RenderDecision(pdf, content);
   pdf.Heading("Scan and provenance", 3 * kLine_pt);
   const std::vector<double> key_value = {0.32 * kContentWidth_pt, 0.68 * kContentWidth_pt};
   for (const KeyValue& row : content.provenance) pdf.Row({{row.key, {}}, {row.value, {}}}, key_value, false);
-  pdf.Heading("Headline numbers", 10 * kLine_pt);
-  pdf.Paragraph("Overall: " + VerdictText(content.overall), content.overall);
-  pdf.Space(3.0);
-  const std::vector<double> headline = {0.40 * kContentWidth_pt, 0.25 * kContentWidth_pt,
-                                        0.20 * kContentWidth_pt, 0.15 * kContentWidth_pt};
-  pdf.Row({{"Quantity", {}}, {"Value", {}}, {"Tolerance", {}}, {"Result", {}}}, headline, true);
-  for (const HeadlineRow& row : content.headline) {
-    pdf.Row({{row.label, {}}, {row.value, {}}, {row.tolerance, {}}, {VerdictText(row.verdict), row.verdict}},
-            headline, false);
-  }
   RenderModel(pdf, content.model);
   const double first_figure_pt =
       content.figures.empty() ? 0.0
@@ -55,8 +83,15 @@ void RenderPdf(const ReportContent& content, const std::filesystem::path& path) 
   for (const std::string& warning : content.warnings) pdf.Paragraph("• " + warning);
   pdf.Heading("Processing parameters", kLine_pt);
   if (content.processing.empty()) pdf.Paragraph("None recorded.");
+  if (!content.processing.empty()) pdf.TableHeader({{"Parameter", {}}, {"Value", {}}}, key_value);
   for (const KeyValue& row : content.processing) pdf.Row({{row.key, {}}, {row.value, {}}}, key_value, false);
   pdf.Finish();
+}
+
+}  // namespace
+
+void RenderPdf(const ReportContent& content, const std::filesystem::path& path) {
+  internal::RenderPdfPages(path, content.title, [&](PdfFlow& pdf) { Layout(pdf, content); });
 }
 
 }  // namespace arcwheel::reports

@@ -28,14 +28,15 @@ using namespace arcwheel::testing;  // the shared test helpers (core/testing/tes
 using testing::BrowserRun;
 using testing::FixtureOptions;
 using ::testing::HasSubstr;
+using testing::LayoutInChromium;
 using testing::LoadInChromium;
 using ::testing::Not;
 using testing::WriteFixture;
 
 // The fixture's headline literals (reports/report_fixture.cc) as the report must print them:
-// mm with 4 decimals (mean radius and sigma with 5), um with 2, percent with 3.
-const std::vector<std::string> kFixtureHeadline = {
-    "75.01234 ± 0.00021 mm", "0.0061 mm", "0.008 %", "0.0043 mm", "1.58 µm", "7.13 µm", "3.47 µm"};
+// mm with 4 decimals (mean radius with 5), um with 2, percent with 3.
+const std::vector<std::string> kFixtureHeadline = {"75.01234 mm", "0.0061 mm", "0.008 %", "0.0043 mm",
+                                                   "1.58 µm",     "7.13 µm",   "3.47 µm"};
 
 Tolerances FixtureTolerances() {
   Tolerances t;
@@ -57,11 +58,47 @@ TEST(ComposeReport, ShowsTheSummaryHeadlineNumbersAndJudgesThemAgainstTolerances
   EXPECT_EQ(content.headline[0].verdict, Verdict::kPass);
   EXPECT_EQ(content.headline[0].tolerance, "74.9 … 75.1 mm");
   EXPECT_EQ(content.headline[1].verdict, Verdict::kNoTolerance);
+  EXPECT_EQ(content.headline[1].tolerance, "–") << "a row without a limit says so once";
   EXPECT_EQ(content.headline[4].verdict, Verdict::kPass);
   EXPECT_EQ(content.headline[5].verdict, Verdict::kFail);
   EXPECT_EQ(content.headline[5].tolerance, "≤ 7 µm");
   EXPECT_EQ(content.overall, Verdict::kFail);
+  EXPECT_THAT(content.failing, ::testing::ElementsAre("Max runout in the band: 7.13 µm (limit ≤ 7 µm)"));
   EXPECT_EQ(content.title, "Wheel inspection report: W17-arc75");
+}
+
+// The fixture records sigma of the mean 0.00021 mm and phase-to-phase sigma 0.0021 mm
+// (report_fixture.cc); the map values' median 1-sigma is 0.05 um.
+TEST(ComposeReport, StatesWhatEachUncertaintyMeans) {
+  TempDir dir;
+  WriteFixture(dir.path());
+  const ReportContent content = ComposeReport(ReadReportInputs(dir.path()), {});
+  EXPECT_THAT(content.headline[0].uncertainty, HasSubstr("± 0.00021 mm (σ of the mean)"));
+  EXPECT_THAT(content.headline[0].uncertainty, HasSubstr("phase-to-phase σ 0.0021 mm"));
+  EXPECT_THAT(content.headline[1].uncertainty, HasSubstr("phase-to-phase σ 0.0021 mm"));
+  EXPECT_THAT(content.headline[5].uncertainty, HasSubstr("map value 1σ 0.050 µm (median)"));
+  EXPECT_THAT(content.headline[5].note, HasSubstr("spindle")) << "the runout caveat sits with runout";
+}
+
+// Runout is a peak-to-valley of 72 map values (one per phase) of 1-sigma 0.05 um: noise alone
+// gives d2(72) * 0.05 um with d2(72) = 4.776 (expected range of 72 standard normals, between the
+// tabulated d2(50) = 4.498 and d2(100) = 5.015), so about 0.24 um.
+TEST(ComposeReport, GivesThePartOfEachPeakToValleyThatNoiseExplains) {
+  TempDir dir;
+  WriteFixture(dir.path());
+  const ReportContent content = ComposeReport(ReadReportInputs(dir.path()), {});
+  EXPECT_THAT(content.headline[5].noise,
+              HasSubstr("≈ 0.24 µm from noise (expected PV of 72 values of 1σ 0.050 µm)"));
+  EXPECT_TRUE(content.headline[0].noise.empty()) << "the mean is no peak-to-valley";
+}
+
+TEST(ExpectedNormalRange, MatchesTheControlChartConstants) {
+  // d2(n) from the standard tables (e.g. ASTM STP 15D): independent of the integral computed here.
+  EXPECT_NEAR(ExpectedNormalRange(2), 1.128, 1e-3);
+  EXPECT_NEAR(ExpectedNormalRange(10), 3.078, 1e-3);
+  EXPECT_NEAR(ExpectedNormalRange(25), 3.931, 1e-3);
+  EXPECT_NEAR(ExpectedNormalRange(100), 5.015, 1e-3);
+  EXPECT_EQ(ExpectedNormalRange(1), 0.0);
 }
 
 TEST(ComposeReport, PassesOverallOnlyWhenEveryToleranceHolds) {
@@ -82,8 +119,8 @@ TEST(ComposeReport, ListsTheProcessingParametersByTheirKeys) {
   std::map<std::string, std::string> rows;
   for (const KeyValue& row : content.processing) rows[row.key] = row.value;
   // The parameters the fixture records (report_fixture.h), strings unquoted.
-  EXPECT_EQ(rows["despike_threshold_um"], "5.0");
-  EXPECT_EQ(rows["band_half_width_mm"], "8.0");
+  EXPECT_EQ(rows["despike_threshold_um"], "5") << "a whole number without decimals";
+  EXPECT_EQ(rows["band_half_width_mm"], "8");
   EXPECT_EQ(rows["fit_span"], "band");
   EXPECT_EQ(rows["axial_step_mm"], "0.1");
 }
@@ -398,6 +435,98 @@ TEST(Chromium, LoadsTheHtmlReportCleanlyOnADesktopAndAPhoneScreen) {
     // Text, tables and the viridis map give hundreds of colours; a blank page gives one.
     EXPECT_GT(run.distinct_colours, 100u);
   }
+}
+
+// ---- The report as an operator reads it ----
+
+// `text` with every run of white space as one space (pdftotext breaks wrapped cells into lines).
+std::string OneLine(const std::string& text) { return std::regex_replace(text, std::regex(R"(\s+)"), " "); }
+
+TEST(WriteReports, PdfOpensWithTheDecisionNamingTheFailingRows) {
+  TempDir dir;
+  WriteFixture(dir.path());
+  const WrittenReports written = WriteReports(dir.path(), FixtureTolerances());
+  const std::string text = OneLine(PdfText(written.pdf));
+  const std::size_t verdict = text.find("Overall: FAIL");
+  ASSERT_NE(verdict, std::string::npos);
+  EXPECT_LT(verdict, text.find("Scan and provenance")) << "the decision before the provenance";
+  EXPECT_LT(text.find("W17-arc75"), verdict) << "only the title before it";
+  EXPECT_LT(verdict, text.find("Failing: Max runout in the band: 7.13 µm (limit ≤ 7 µm)."));
+  EXPECT_LT(text.find("Failing:"), text.find("Scan and provenance"));
+  EXPECT_THAT(text, HasSubstr("σ of the mean"));
+  EXPECT_THAT(text, HasSubstr("phase-to-phase σ 0.0021 mm"));
+  EXPECT_THAT(text, HasSubstr("spindle's error motion")) << "the runout caveat";
+  EXPECT_THAT(text, HasSubstr("from noise (expected PV of"));
+  // Provenance a release needs: the wheel's size, the report's date, pages, a signature.
+  EXPECT_THAT(text, HasSubstr("Wheel diameter × width"));
+  EXPECT_THAT(text, HasSubstr("Report date"));
+  EXPECT_THAT(text, HasSubstr("Approved by"));
+  EXPECT_THAT(text, ::testing::ContainsRegex("page 1 of [2-9]"));
+  EXPECT_THAT(text, Not(HasSubstr("NO TOLERANCE"))) << "a row without a limit says '–' once";
+}
+
+TEST(WriteReports, NoNumberInEitherReportHasMoreThanSevenSignificantDigits) {
+  TempDir dir;
+  WriteFixture(dir.path());
+  const WrittenReports written = WriteReports(dir.path(), FixtureTolerances());
+  const std::string pdf = PdfText(written.pdf);
+  const std::string html = testing::VisibleHtmlText(ReadText(written.html));
+  EXPECT_LE(testing::MaxSignificantDigits(pdf), 7) << testing::LongestNumber(pdf);
+  EXPECT_LE(testing::MaxSignificantDigits(html), 7) << testing::LongestNumber(html);
+  // The check sees what it must: a long number fails it, an id or hash does not.
+  EXPECT_EQ(testing::MaxSignificantDigits("radius 0.19967978891870555 mm"), 17);
+  EXPECT_EQ(
+      testing::MaxSignificantDigits("sha 3b1f5e0c9a7d4e2b8c6f1a0d99887766554433221100, 2400000 samples"), 2);
+  EXPECT_THAT(html, HasSubstr("Sample period")) << "the provenance was scanned too";
+}
+
+// The decision block and every Result cell inside a 400 px wide window; the plots' smallest text
+// (the 7 pt tick labels) at least 9 px there.
+TEST(Chromium, PhoneShowsTheDecisionAndResultColumnAndReadablePlotText) {
+  TempDir dir;
+  WriteFixture(dir.path());
+  const WrittenReports written = WriteReports(dir.path(), FixtureTolerances());
+  const std::string layout = LayoutInChromium(
+      written.html, 400, 900,
+      "(function() {"
+      "  const lines = ['viewport ' + document.documentElement.clientWidth];"
+      "  const box = (name, e) => { const r = e.getBoundingClientRect();"
+      "    lines.push(name + ' ' + r.left + ' ' + r.right + ' ' + r.width); };"
+      "  box('decision', document.getElementById('decision'));"
+      "  document.querySelectorAll('#decision td.result, #decision td.quantity').forEach(e => box('cell', "
+      "e));"
+      "  document.querySelectorAll('figure svg').forEach(s => { const r = s.getBoundingClientRect();"
+      "    if (r.width > 0) lines.push('svg ' + r.width / s.viewBox.baseVal.width); });"
+      "  return lines.join(' | ');"
+      "})()");
+  ASSERT_THAT(layout, HasSubstr("viewport ")) << "chromium laid the page out";
+  std::istringstream entries(std::regex_replace(layout, std::regex(R"( \| )"), "\n"));
+  double viewport = 0.0;
+  int cells = 0, plots = 0;
+  for (std::string entry; std::getline(entries, entry);) {
+    std::istringstream fields(entry);
+    std::string name;
+    fields >> name;
+    if (name == "viewport") fields >> viewport;
+    if (name == "decision" || name == "cell") {
+      double left = 0.0, right = 0.0, width = 0.0;
+      fields >> left >> right >> width;
+      EXPECT_GE(left, 0.0) << entry;
+      EXPECT_LE(right, viewport) << entry;
+      EXPECT_GT(width, 0.0) << entry;
+      cells += name == "cell";
+    }
+    if (name == "svg") {
+      double px_per_pt = 0.0;
+      fields >> px_per_pt;
+      EXPECT_GE(px_per_pt * plot::kTickSize_pt, 9.0) << "tick labels of a plot render at least 9 px";
+      ++plots;
+    }
+  }
+  // 400 px less a scroll bar (chromium draws one; a phone overlays it).
+  EXPECT_THAT(viewport, ::testing::AllOf(::testing::Ge(380.0), ::testing::Le(400.0))) << layout;
+  EXPECT_EQ(cells, 14) << "7 quantities, each with its result";
+  EXPECT_GE(plots, 7);
 }
 
 }  // namespace

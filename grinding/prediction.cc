@@ -8,11 +8,11 @@
 #include <limits>
 #include <numbers>
 
+#include "core/check.h"
 #include "core/error.h"
-#include "core/hdf5.h"
 #include "core/parallel.h"
-#include "core/version.h"
 #include "grinding/toolpath.h"
+#include "schema/grid_map.h"
 
 namespace arcwheel::grinding {
 
@@ -259,21 +259,27 @@ FormPrediction PredictFormError(const Surface& surface, const Aperture& aperture
 
 void WritePredictionHdf5(const FormPrediction& prediction, const std::filesystem::path& path,
                          const std::string& surface_description, const std::string& wheel_description) {
-  hdf5::File file = hdf5::File::Create(path);
-  file.CreateGroup("/prediction");
-  const hsize_t nx = prediction.x_mm.size(), ny = prediction.y_mm.size();
-  file.WriteDoubles("/prediction/x_mm", prediction.x_mm, {nx});
-  file.WriteDoubles("/prediction/y_mm", prediction.y_mm, {ny});
-  file.WriteDoubles("/prediction/error_um", prediction.error_um, {ny, nx});
-  file.WriteDoubles("/prediction/low_order_um", prediction.low_order_um, {ny, nx});
-  file.WriteAttribute("/prediction", "pv_um", prediction.pv_um);
-  file.WriteAttribute("/prediction", "rms_um", prediction.rms_um);
-  file.WriteAttribute("/prediction", "pv_after_tilt_um", prediction.pv_after_tilt_um);
-  file.WriteAttribute("/prediction", "rms_after_tilt_um", prediction.rms_after_tilt_um);
-  file.WriteAttribute("/prediction", "ripple_pv_um", prediction.ripple_pv_um);
-  file.WriteAttribute("/", "surface", surface_description);
-  file.WriteAttribute("/", "wheel", wheel_description);
-  file.WriteAttribute("/", "arcwheel_version", std::string(kVersion));
+  namespace layout = schema::grid_map;
+  const size_t nx = prediction.x_mm.size(), ny = prediction.y_mm.size();
+  ARCWHEEL_CHECK(nx >= 2 && ny >= 2) << "prediction map of " << nx << " x " << ny << " nodes";
+  // PredictFormError lays the nodes evenly from the first to the last.
+  layout::Content map{
+      .x0_mm = prediction.x_mm.front(),
+      .y0_mm = prediction.y_mm.front(),
+      .dx_mm = (prediction.x_mm.back() - prediction.x_mm.front()) / static_cast<double>(nx - 1),
+      .dy_mm = (prediction.y_mm.back() - prediction.y_mm.front()) / static_cast<double>(ny - 1),
+      .nx = static_cast<int>(nx),
+      .ny = static_cast<int>(ny),
+      .error_um = prediction.error_um,
+      .quantity = std::string(layout::kPredictedFormError)};
+  map.layers = {{std::string(layout::kLowOrderUm), prediction.low_order_um}};
+  map.figures = {{std::string(layout::kPvUmAttribute), prediction.pv_um},
+                 {std::string(layout::kRmsUmAttribute), prediction.rms_um},
+                 {"pv_after_tilt_um", prediction.pv_after_tilt_um},
+                 {"rms_after_tilt_um", prediction.rms_after_tilt_um},
+                 {"ripple_pv_um", prediction.ripple_pv_um}};
+  map.texts = {{"surface", surface_description}, {"wheel", wheel_description}};
+  layout::WriteGridMap(map, path);
 }
 
 }  // namespace arcwheel::grinding

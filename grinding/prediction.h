@@ -73,8 +73,10 @@ struct FormPrediction {
                                               const surfaces::Aperture& aperture, const Wheel& wheel,
                                               const PredictionOptions& options);
 
-// Writes /prediction/{x_mm, y_mm, error_um, low_order_um} and the PV/RMS figures as attributes to
-// an HDF5 file (through the caller's atomic staging). Throws Error{kIo}.
+// Writes the map as a grid map (schema/grid_map.h, the layout `arcwheel polish` reads): error_um,
+// low_order_um, x_mm, y_mm and the grid attributes at the root, the PV/RMS figures and the surface
+// and wheel descriptions as root attributes (through the caller's atomic staging). Throws
+// Error{kIo}.
 void WritePredictionHdf5(const FormPrediction& prediction, const std::filesystem::path& path,
                          const std::string& surface_description, const std::string& wheel_description);
 

@@ -15,5 +15,6 @@ void AddFrameCommand(CLI::App& app);
 void AddTransformCommand(CLI::App& app);
 void AddHeadcenterCommand(CLI::App& app);
 void AddPolishCommand(CLI::App& app);
+void AddRegenerateCommand(CLI::App& app);
 
 }  // namespace arcwheel::cli

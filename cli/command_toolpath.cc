@@ -16,6 +16,7 @@ void AddToolpathCommand(CLI::App& app) {
     std::string wheel;
     std::string output;
     double max_wheel_change_mm = grinding::kDefaultMaxWheelChangeMm;
+    std::string wheel_profile = "mean";
   };
   auto arguments = std::make_shared<Arguments>();
   CLI::App* command = app.add_subcommand(
@@ -30,11 +31,19 @@ void AddToolpathCommand(CLI::App& app) {
           "--max-wheel-change-mm", arguments->max_wheel_change_mm,
           "refuse a measured arc radius farther than this from the job's nominal one (a wrong wheel)")
       ->capture_default_str();
+  command
+      ->add_option("--wheel-profile", arguments->wheel_profile,
+                   "with a summary: mean (the per-phase fits' mean radius and mean profile) or model (the "
+                   "wheel model's mean radius and profile error p(u), from wheel_map.h5 beside it)")
+      ->check(CLI::IsMember({"mean", "model"}))
+      ->capture_default_str();
   command->add_option("-o,--output", arguments->output, "output folder")->required();
   command->callback([arguments] {
     std::optional<std::filesystem::path> wheel;
     if (!arguments->wheel.empty()) wheel = arguments->wheel;
-    (void)RunToolpathStep(arguments->job, wheel, arguments->max_wheel_change_mm, arguments->output);
+    (void)RunToolpathStep(arguments->job, wheel, arguments->max_wheel_change_mm, arguments->output,
+                          arguments->wheel_profile == "model" ? grinding::WheelProfileSource::kModel
+                                                              : grinding::WheelProfileSource::kMeanProfile);
   });
 }
 

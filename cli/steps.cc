@@ -36,10 +36,11 @@ void RunProcessStep(const std::filesystem::path& scan, const std::filesystem::pa
 
 ToolpathStepResult RunToolpathStep(const std::filesystem::path& job_path,
                                    const std::optional<std::filesystem::path>& wheel_summary,
-                                   double max_wheel_change_mm, const std::filesystem::path& output) {
+                                   double max_wheel_change_mm, const std::filesystem::path& output,
+                                   grinding::WheelProfileSource wheel_profile) {
   const auto start = std::chrono::steady_clock::now();
-  ToolpathStepResult result{.job = grinding::ReadJob(job_path, wheel_summary, max_wheel_change_mm),
-                            .report = {}};
+  ToolpathStepResult result{
+      .job = grinding::ReadJob(job_path, wheel_summary, max_wheel_change_mm, wheel_profile), .report = {}};
   const grinding::Job& job = result.job;
   result.report = grinding::RunToolpathJob(job, output);
   const grinding::ToolpathSummary& t = result.report.toolpath;
@@ -53,10 +54,13 @@ ToolpathStepResult RunToolpathStep(const std::filesystem::path& job_path,
     const grinding::FormPrediction& p = result.report.prediction;
     fmt::print(
         "predicted form error (arc radius error {:.2g} mm: {}{}): PV {:.3f} um, RMS {:.3f} um; "
-        "after tilt PV {:.3f} um, RMS {:.3f} um; runout ripple PV {:.3f} um\n",
+        "after tilt PV {:.3f} um, RMS {:.3f} um; runout ripple PV {:.3f} um{}\n",
         job.prediction.arc_radius_error_mm, job.arc_radius_error_source,
         job.prediction.runout_radial_um.empty() ? ", no runout" : ", with runout", p.pv_um, p.rms_um,
-        p.pv_after_tilt_um, p.rms_after_tilt_um, p.ripple_pv_um);
+        p.pv_after_tilt_um, p.rms_after_tilt_um, p.ripple_pv_um,
+        job.prediction.profile_u_mm.empty()
+            ? ""
+            : fmt::format("; profile error p(u) PV {:.3f} um", p.profile_pv_um));
   }
   fmt::print("wrote {} in {:.2f} s\n", output.string(), StepSecondsSince(start));
   return result;

@@ -22,9 +22,10 @@ struct ToolpathStepResult {
 
 // `arcwheel toolpath JOB [--wheel SUMMARY] [--max-wheel-change-mm L] -o OUTDIR`, with its terminal
 // lines.
-ToolpathStepResult RunToolpathStep(const std::filesystem::path& job_path,
-                                   const std::optional<std::filesystem::path>& wheel_summary,
-                                   double max_wheel_change_mm, const std::filesystem::path& output);
+ToolpathStepResult RunToolpathStep(
+    const std::filesystem::path& job_path, const std::optional<std::filesystem::path>& wheel_summary,
+    double max_wheel_change_mm, const std::filesystem::path& output,
+    grinding::WheelProfileSource wheel_profile = grinding::WheelProfileSource::kMeanProfile);
 
 // `arcwheel polish JOB -o OUTDIR`, with its terminal lines; `error_map` replaces the job's map.
 polishing::PolishRunReport RunPolishStep(const std::filesystem::path& job_path,

@@ -48,6 +48,13 @@ struct WheelChange {
 // apart); half a millimetre lets many dressings through and stops a wrong wheel.
 inline constexpr double kDefaultMaxWheelChangeMm = 0.5;
 
+// Which measured wheel a summary gives the path (--wheel-profile, docs/grinding.md):
+//   kMeanProfile: the per-phase fits' mean arc radius and, with wheel.use_profile, their mean profile;
+//   kModel: the wheel model's mean arc radius and, with wheel.use_profile, its profile error p(u)
+//           (from wheel_map.h5 beside the summary); without use_profile the path is a pure arc and
+//           the prediction includes the error p(u) prints.
+enum class WheelProfileSource { kMeanProfile, kModel };
+
 struct Job {
   std::string name;  // "name" key, or the job file's stem
   std::filesystem::path source;
@@ -64,6 +71,7 @@ struct Job {
   // Where prediction.arc_radius_error_mm came from: "prediction.arc_radius_error_mm" (the job),
   // "the measured radius's 1-sigma" (the summary) or "none" (0 by default).
   std::string arc_radius_error_source = "none";
+  WheelProfileSource wheel_profile = WheelProfileSource::kMeanProfile;
   // The job with every default filled in, as used: JSON text (parse it where it is written out),
   // so that this header does not pull nlohmann/json into every includer.
   std::string resolved_json;
@@ -78,11 +86,13 @@ struct Job {
 // a limit that is not > 0.
 [[nodiscard]] Job ReadJob(const std::filesystem::path& path,
                           const std::optional<std::filesystem::path>& wheel_summary_override,
-                          double max_wheel_change_mm = kDefaultMaxWheelChangeMm);
+                          double max_wheel_change_mm = kDefaultMaxWheelChangeMm,
+                          WheelProfileSource wheel_profile = WheelProfileSource::kMeanProfile);
 
 // The same from JSON text already in memory (`source` names it in messages).
 [[nodiscard]] Job ParseJob(const std::string& text, const std::filesystem::path& source,
                            const std::optional<std::filesystem::path>& wheel_summary_override,
-                           double max_wheel_change_mm = kDefaultMaxWheelChangeMm);
+                           double max_wheel_change_mm = kDefaultMaxWheelChangeMm,
+                           WheelProfileSource wheel_profile = WheelProfileSource::kMeanProfile);
 
 }  // namespace arcwheel::grinding

@@ -172,6 +172,30 @@ TEST(ParseJob, TakesTheWheelFromASummaryAndNeedsItsTotalRadius) {
   EXPECT_NO_THROW((void)ParseJob(job.dump(), dir / "job.json", dir / "summary.json"));
 }
 
+TEST(ParseJob, TheWheelModelProfileNeedsAModelAndItsWheelMap) {
+  const testing::TempDir dir;
+  WriteText(dir / "summary.json", R"({"mean_arc_radius_mm": 55.0, "mean_arc_radius_sigma_mm": 0.002,
+    "scan": {"wheel_diameter_mm": 400.0}})");
+  json job = SmallJob();
+  job["wheel"].erase("arc_radius_mm");
+  job["wheel"]["summary"] = "summary.json";
+  job["prediction"] = {{"runout_um", 0.0}};
+  EXPECT_THAT(ErrorMessageOf([&] {
+                (void)ParseJob(job.dump(), dir / "job.json", std::nullopt, kDefaultMaxWheelChangeMm,
+                               WheelProfileSource::kModel);
+              }),
+              HasSubstr("has no wheel model (model.mean_arc_radius_mm), which --wheel-profile model needs"));
+  // A model in the summary but no wheel_map.h5 beside it: refused naming the map.
+  WriteText(dir / "summary.json", R"({"mean_arc_radius_mm": 55.0, "mean_arc_radius_sigma_mm": 0.002,
+    "scan": {"wheel_diameter_mm": 400.0}, "model": {"mean_arc_radius_mm": 55.01,
+    "mean_arc_radius_sigma_mm": 0.0001}})");
+  EXPECT_EQ(ErrorOf([&] {
+              (void)ParseJob(job.dump(), dir / "job.json", std::nullopt, kDefaultMaxWheelChangeMm,
+                             WheelProfileSource::kModel);
+            }).code(),
+            ErrorCode::kIo);
+}
+
 struct CsvPoint {
   double v[12];
 };

@@ -173,6 +173,8 @@ nlohmann::json SummaryJson(const Job& job, const ToolpathRunReport& report,
   j["surface"] = job.surface->Describe();
   j["wheel"] = job.wheel.description;
   if (job.wheel_change) j["arc_radius"] = ArcRadiusJson(*job.wheel_change);
+  if (job.wheel_summary)
+    j["wheel_profile"] = job.wheel_profile == WheelProfileSource::kModel ? "model" : "mean";
   const ToolpathSummary& t = report.toolpath;
   j["toolpath"] = {{"passes", t.passes},
                    {"rows_per_pass", t.rows_per_pass},
@@ -192,7 +194,8 @@ nlohmann::json SummaryJson(const Job& job, const ToolpathRunReport& report,
                        {"rms_um", p.rms_um},
                        {"pv_after_tilt_um", p.pv_after_tilt_um},
                        {"rms_after_tilt_um", p.rms_after_tilt_um},
-                       {"ripple_pv_um", p.ripple_pv_um}};
+                       {"ripple_pv_um", p.ripple_pv_um},
+                       {"profile_pv_um", p.profile_pv_um}};
   }
   j["files"] = files;
   return j;

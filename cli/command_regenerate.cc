@@ -54,6 +54,7 @@ struct RegenerateArgs {
   std::string output;
   std::string previous;
   std::string polish_map = "prediction";
+  std::string wheel_profile = "mean";
   double max_wheel_change_mm = grinding::kDefaultMaxWheelChangeMm;
 };
 
@@ -422,6 +423,12 @@ void RunRegenerate(const RegenerateArgs& args) {
   if (args.polish_map == "nominal-path" && args.polish.empty()) {
     throw Error(ErrorCode::kInvalidOption, kRegenerateStage, "--polish-map nominal-path needs --polish");
   }
+  // Checked before any step runs: a wrong --previous would otherwise fail only at the report.
+  if (!args.previous.empty() && !fs::exists(fs::path(args.previous) / kRecordFileName)) {
+    throw Error(ErrorCode::kInvalidOption, kRegenerateStage,
+                fmt::format("--previous '{}' holds no {}: not a finished regeneration", args.previous,
+                            kRecordFileName));
+  }
   const fs::path outdir(args.output);
   EnsureDirectory(outdir);
   // The report and the record describe the steps below: gone until they are rewritten.
@@ -439,10 +446,17 @@ void RunRegenerate(const RegenerateArgs& args) {
                                 });
   if (status.wheel_ran) RemoveStale(outdir, {kToolpathStep.id, kPolishStep.id});
 
-  const json toolpath_inputs = StepInputs({{"job", args.job}, {"wheel_summary", summary}},
-                                          {{"max_wheel_change_mm", args.max_wheel_change_mm}});
+  // --wheel-profile model reads p(u) from the wheel map too.
+  const json toolpath_inputs =
+      StepInputs({{"job", args.job},
+                  {"wheel_summary", summary},
+                  {"wheel_map", outdir / kWheelStep.id / schema::wheel_map::kFileName}},
+                 {{"max_wheel_change_mm", args.max_wheel_change_mm}, {"wheel_profile", args.wheel_profile}});
   status.toolpath_ran = RunOrReuse(outdir, kToolpathStep, toolpath_inputs, [&](const fs::path& folder) {
-    const ToolpathStepResult result = RunToolpathStep(args.job, summary, args.max_wheel_change_mm, folder);
+    const ToolpathStepResult result =
+        RunToolpathStep(args.job, summary, args.max_wheel_change_mm, folder,
+                        args.wheel_profile == "model" ? grinding::WheelProfileSource::kModel
+                                                      : grinding::WheelProfileSource::kMeanProfile);
     if (!result.report.predicted) {
       throw Error(ErrorCode::kBadInput, "grinding.job",
                   fmt::format("'{}': key 'prediction.enabled' is false: regenerate predicts the form error",
@@ -513,6 +527,12 @@ void AddRegenerateCommand(CLI::App& app) {
          "map to polish: prediction (what the regenerated toolpath leaves) or nominal-path (what the "
          "job's nominal wheel's path leaves with the measured wheel, e.g. on a part ground before)")
       ->check(CLI::IsMember({"prediction", "nominal-path"}))
+      ->capture_default_str();
+  cmd->add_option(
+         "--wheel-profile", args->wheel_profile,
+         "the measured wheel for the toolpath: mean (per-phase fits) or model (the wheel model's radius "
+         "and p(u)), as toolpath --wheel-profile")
+      ->check(CLI::IsMember({"mean", "model"}))
       ->capture_default_str();
   cmd->add_option("--max-wheel-change-mm", args->max_wheel_change_mm,
                   "refuse a measured arc radius farther than this from the job's nominal one")

@@ -241,6 +241,12 @@ TEST_F(Regenerate, RedoesNothingWhoseInputsAreUnchangedAndComparesWithThePreviou
   EXPECT_THAT(html, HasSubstr(first.string()));
   EXPECT_THAT(html, HasSubstr("+0.00000 mm"));
   EXPECT_EQ(ReadJson(second / "regenerate.json")["previous"], first.string());
+  // A --previous that is no regeneration is refused before any step runs.
+  const auto refused = RunArcwheel(
+      Command(*dir_ / "third", "polish.json", "--previous " + (*dir_ / "first" / "wheel").string()));
+  EXPECT_EQ(refused.exit_status, 2) << refused.output;
+  EXPECT_THAT(refused.output, HasSubstr("holds no regenerate.json"));
+  EXPECT_FALSE(fs::exists(*dir_ / "third"));
 }
 
 TEST_F(Regenerate, AFailedPolishStepLeavesTheWheelAndToolpathAndNamesTheStep) {

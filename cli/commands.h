@@ -17,5 +17,6 @@ void AddHeadcenterCommand(CLI::App& app);
 void AddPolishCommand(CLI::App& app);
 void AddCompareCommand(CLI::App& app);
 void AddHistoryCommand(CLI::App& app);
+void AddRegenerateCommand(CLI::App& app);
 
 }  // namespace arcwheel::cli

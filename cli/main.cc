@@ -36,6 +36,7 @@ const std::vector<Command> kCommands = {
     {"transform", arcwheel::cli::AddTransformCommand},
     {"headcenter", arcwheel::cli::AddHeadcenterCommand},
     {"polish", arcwheel::cli::AddPolishCommand},
+    {"regenerate", arcwheel::cli::AddRegenerateCommand},
 };
 
 constexpr const char* kExitCodes =

@@ -13,6 +13,7 @@
 #include "core/json_text.h"
 #include "core/memory_budget.h"
 #include "core/parallel.h"
+#include "schema/wheel_map.h"
 #include "surfaces/surface_json.h"
 
 namespace arcwheel::grinding {
@@ -32,11 +33,51 @@ constexpr double kBytesPerPredictionNode = 40.0;
 struct WheelSource {
   Wheel wheel;
   std::optional<WheelSummary> summary;
+  std::optional<WheelChange> change;
+  ProfileError unfollowed_profile;  // the model's p(u) under a pure-arc path (for the prediction)
 };
+
+// With --wheel-profile model, the summary's radius and profile are the wheel model's: its mean
+// arc radius with 1-sigma, and p(u) from the wheel_map.h5 written beside the summary.
+WheelSummary WithModel(WheelSummary m, const std::filesystem::path& summary_path, JsonSection& s) {
+  if (!std::isfinite(m.model_mean_arc_radius_mm)) {
+    s.Fail("summary", fmt::format("'{}' has no wheel model (model.mean_arc_radius_mm), which "
+                                  "--wheel-profile model needs: process the scan without --no-model",
+                                  summary_path.string()));
+  }
+  m.mean_arc_radius_mm = m.model_mean_arc_radius_mm;
+  m.mean_arc_radius_sigma_mm = m.model_mean_arc_radius_sigma_mm;
+  const ProfileError p = ReadModelProfile(summary_path.parent_path() / schema::wheel_map::kFileName);
+  m.profile_u_mm = p.u_mm;
+  m.profile_error_um = p.error_um;
+  return m;
+}
+
+// The measured radius replaces the nominal one within `max_change_mm`; beyond it the wheel on the
+// spindle is not the one the job was written for (or the scan is of another wheel).
+WheelChange CheckWheelChange(JsonSection& s, std::optional<double> nominal_mm, const WheelSummary& measured,
+                             const std::filesystem::path& summary_path, double max_change_mm) {
+  WheelChange change{.nominal_arc_radius_mm = nominal_mm,
+                     .measured_arc_radius_mm = measured.mean_arc_radius_mm,
+                     .measured_sigma_mm = measured.mean_arc_radius_sigma_mm,
+                     .max_change_mm = max_change_mm};
+  if (nominal_mm && !(std::abs(change.DifferenceMm()) <= max_change_mm)) {
+    s.Fail(
+        "arc_radius_mm",
+        fmt::format("= {} mm (the nominal wheel) and the measured wheel '{}' (mean_arc_radius_mm = {} mm, "
+                    "1-sigma {:.2g} mm) differ by {:+.4f} mm, more than the limit --max-wheel-change-mm = {} "
+                    "mm: a dressing changes the arc radius by micrometres, so this is another wheel or "
+                    "another wheel's scan; check the wheel, or raise the limit",
+                    *nominal_mm, summary_path.string(), measured.mean_arc_radius_mm,
+                    measured.mean_arc_radius_sigma_mm, change.DifferenceMm(), max_change_mm));
+  }
+  return change;
+}
 
 WheelSource ReadWheel(JsonSection& s, const std::filesystem::path& job_path,
                       const std::optional<std::filesystem::path>& override_summary,
-                      std::optional<std::filesystem::path>& summary_path) {
+                      std::optional<std::filesystem::path>& summary_path, double max_change_mm,
+                      WheelProfileSource source) {
   WheelSource out;
   std::optional<std::string> summary_key = s.OptionalString("summary");
   if (override_summary) {
@@ -47,13 +88,12 @@ WheelSource ReadWheel(JsonSection& s, const std::filesystem::path& job_path,
   }
   Wheel& w = out.wheel;
   if (summary_path) {
-    if (s.Has("arc_radius_mm")) {
-      s.Fail("arc_radius_mm", fmt::format("conflicts with the measured wheel '{}': the arc radius "
-                                          "comes from its mean_arc_radius_mm",
-                                          summary_path->string()));
-    }
+    // The job's arc radius is the nominal wheel's; the measured one wins.
+    const std::optional<double> nominal = s.OptionalNumber("arc_radius_mm");
     out.summary = ReadWheelSummary(*summary_path);
+    if (source == WheelProfileSource::kModel) out.summary = WithModel(*out.summary, *summary_path, s);
     const WheelSummary& m = *out.summary;
+    out.change = CheckWheelChange(s, nominal, m, *summary_path, max_change_mm);
     w.arc_radius_mm = m.mean_arc_radius_mm;
     s.SetResolved("summary", summary_path->string());
     s.SetResolved("arc_radius_mm", w.arc_radius_mm);
@@ -69,7 +109,8 @@ WheelSource ReadWheel(JsonSection& s, const std::filesystem::path& job_path,
       s.SetResolved("total_radius_mm", *total);
     }
     w.base_radius_mm = *total - w.arc_radius_mm;
-    if (s.Boolean("use_profile", true)) {
+    const bool use_profile = s.Boolean("use_profile", true);
+    if (use_profile) {
       for (size_t k = 0; k < m.profile_u_mm.size(); ++k) {
         if (std::isfinite(m.profile_u_mm[k]) && std::isfinite(m.profile_error_um[k])) {
           w.profile_u_mm.push_back(m.profile_u_mm[k]);
@@ -77,10 +118,15 @@ WheelSource ReadWheel(JsonSection& s, const std::filesystem::path& job_path,
         }
       }
     }
-    w.description = fmt::format("measured wheel '{}' ({}): Ra = {} +- {} mm, Rb = {} mm{}",
-                                summary_path->filename().string(), m.wheel_id.empty() ? "no id" : m.wheel_id,
-                                w.arc_radius_mm, m.mean_arc_radius_sigma_mm, w.base_radius_mm,
-                                w.HasProfile() ? ", with its mean arc profile" : "");
+    const bool model = source == WheelProfileSource::kModel;
+    if (model && !use_profile) out.unfollowed_profile = {m.profile_u_mm, m.profile_error_um};
+    w.description = fmt::format(
+        "measured wheel '{}' ({}){}: Ra = {} mm (1-sigma {:.2g} mm), Rb = {} mm{}",
+        summary_path->filename().string(), m.wheel_id.empty() ? "no id" : m.wheel_id,
+        model ? ", wheel model" : "", w.arc_radius_mm, m.mean_arc_radius_sigma_mm, w.base_radius_mm,
+        w.HasProfile() ? (model ? ", with its profile error p(u)" : ", with its mean arc profile")
+        : model        ? ", a pure arc (p(u) left to the prediction)"
+                       : "");
   } else {
     if (!s.Has("arc_radius_mm"))
       s.Expected("arc_radius_mm", "the arc radius in mm (or wheel.summary / --wheel)");
@@ -121,6 +167,9 @@ void ReadPrediction(JsonSection& s, const std::optional<WheelSummary>& summary, 
   job.predict = s.Boolean("enabled", true);
   PredictionOptions& p = job.prediction;
   p.feed_mm_per_min = feed;
+  job.arc_radius_error_source = s.Has("arc_radius_error_mm") ? "prediction.arc_radius_error_mm"
+                                : summary                    ? "the measured radius's 1-sigma"
+                                                             : "none";
   p.arc_radius_error_mm = s.Number("arc_radius_error_mm", summary ? summary->mean_arc_radius_sigma_mm : 0.0);
   p.keep_total_radius = s.Boolean("keep_total_radius", true);
   const std::optional<double> rpm = s.OptionalNumber("spindle_rpm");
@@ -237,7 +286,12 @@ std::vector<std::string> MachineOptions::Problems() const {
 }
 
 Job ParseJob(const std::string& text, const std::filesystem::path& source,
-             const std::optional<std::filesystem::path>& wheel_summary_override) {
+             const std::optional<std::filesystem::path>& wheel_summary_override, double max_wheel_change_mm,
+             WheelProfileSource wheel_profile) {
+  if (!(max_wheel_change_mm > 0.0)) {
+    throw Error(ErrorCode::kInvalidOption, kStage,
+                fmt::format("--max-wheel-change-mm = {} violates > 0", max_wheel_change_mm));
+  }
   const nlohmann::json document = ParseJsonText(text, source.string(), kStage);
   JsonSection root(document, {.file = source.string(), .stage = kStage, .docs_page = "docs/grinding.md"});
   Job job;
@@ -250,9 +304,14 @@ Job ParseJob(const std::string& text, const std::filesystem::path& source,
   });
   root.Section("aperture", true, [&](JsonSection& s) { job.aperture = surfaces::ReadAperture(s); });
   std::optional<WheelSummary> summary;
+  ProfileError unfollowed_profile;
+  job.wheel_profile = wheel_profile;
   root.Section("wheel", false, [&](JsonSection& s) {
-    WheelSource wheel = ReadWheel(s, source, wheel_summary_override, job.wheel_summary);
+    WheelSource wheel =
+        ReadWheel(s, source, wheel_summary_override, job.wheel_summary, max_wheel_change_mm, wheel_profile);
     job.wheel = std::move(wheel.wheel);
+    job.wheel_change = wheel.change;
+    unfollowed_profile = std::move(wheel.unfollowed_profile);
     summary = std::move(wheel.summary);
   });
   root.Section("path", true, [&](JsonSection& s) { job.path = ReadPath(s); });
@@ -266,6 +325,8 @@ Job ParseJob(const std::string& text, const std::filesystem::path& source,
   root.Section("prediction", false, [&](JsonSection& s) {
     ReadPrediction(s, summary, job.path.feed_mm_per_min, job);
     job.prediction.threads = job.path.threads;
+    job.prediction.profile_u_mm = unfollowed_profile.u_mm;
+    job.prediction.profile_error_um = unfollowed_profile.error_um;
   });
   root.Section("outputs", false, [&](JsonSection& s) {
     job.outputs.csv = s.Boolean("csv", true);
@@ -279,12 +340,13 @@ Job ParseJob(const std::string& text, const std::filesystem::path& source,
 }
 
 Job ReadJob(const std::filesystem::path& path,
-            const std::optional<std::filesystem::path>& wheel_summary_override) {
+            const std::optional<std::filesystem::path>& wheel_summary_override, double max_wheel_change_mm,
+            WheelProfileSource wheel_profile) {
   std::ifstream in(path);
   if (!in) throw Error(ErrorCode::kIo, kStage, fmt::format("cannot open job file '{}'", path.string()));
   std::ostringstream text;
   text << in.rdbuf();
-  return ParseJob(text.str(), path, wheel_summary_override);
+  return ParseJob(text.str(), path, wheel_summary_override, max_wheel_change_mm, wheel_profile);
 }
 
 }  // namespace arcwheel::grinding

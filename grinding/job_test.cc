@@ -23,6 +23,7 @@ using arcwheel::testing::ErrorMessageOf;
 using arcwheel::testing::ErrorOf;
 using arcwheel::testing::WriteText;
 using nlohmann::json;
+using ::testing::AllOf;
 using ::testing::HasSubstr;
 
 json SmallJob() {
@@ -144,14 +145,55 @@ TEST(ParseJob, TakesTheWheelFromASummaryAndNeedsItsTotalRadius) {
   EXPECT_DOUBLE_EQ(parsed.prediction.arc_radius_error_mm, 0.002);          // the summary's 1-sigma
   EXPECT_NEAR(parsed.prediction.runout_radial_um[0], 0.75, 1e-12);         // TIR / 2 at phase 0
 
+  // A nominal radius in the job: the measured one wins, both are recorded.
+  job["wheel"]["arc_radius_mm"] = 55.3;
+  const Job dressed = ParseJob(job.dump(), dir / "job.json", std::nullopt);
+  EXPECT_DOUBLE_EQ(dressed.wheel.arc_radius_mm, 55.0);
+  ASSERT_TRUE(dressed.wheel_change.has_value());
+  EXPECT_EQ(dressed.wheel_change->nominal_arc_radius_mm, 55.3);
+  EXPECT_EQ(dressed.wheel_change->measured_sigma_mm, 0.002);
+  EXPECT_NEAR(dressed.wheel_change->DifferenceMm(), -0.3, 1e-12);
+  EXPECT_EQ(dressed.arc_radius_error_source, "the measured radius's 1-sigma");
+  // Beyond the limit it is another wheel: refused with both radii and the limit.
+  EXPECT_THAT(ErrorMessageOf([&] { (void)ParseJob(job.dump(), dir / "job.json", std::nullopt, 0.25); }),
+              AllOf(HasSubstr("key 'wheel.arc_radius_mm' = 55.3 mm (the nominal wheel)"),
+                    HasSubstr("mean_arc_radius_mm = 55 mm"), HasSubstr("differ by -0.3000 mm"),
+                    HasSubstr("--max-wheel-change-mm = 0.25 mm")));
   job["wheel"]["arc_radius_mm"] = 50.0;
-  EXPECT_THAT(ExpectRefused(job, dir / "job.json"), HasSubstr("key 'wheel.arc_radius_mm' conflicts"));
+  EXPECT_THAT(ExpectRefused(job, dir / "job.json"),
+              HasSubstr("more than the limit --max-wheel-change-mm = 0.5 mm"));
+  EXPECT_EQ(ErrorOf([&] { (void)ParseJob(job.dump(), dir / "job.json", std::nullopt, 0.0); }).code(),
+            ErrorCode::kInvalidOption);
   job["wheel"].erase("arc_radius_mm");
   job["wheel"]["summary"] = "missing.json";
   EXPECT_EQ(ErrorOf([&] { (void)ParseJob(job.dump(), dir / "job.json", std::nullopt); }).code(),
             ErrorCode::kIo);
   // --wheel replaces the job's summary.
   EXPECT_NO_THROW((void)ParseJob(job.dump(), dir / "job.json", dir / "summary.json"));
+}
+
+TEST(ParseJob, TheWheelModelProfileNeedsAModelAndItsWheelMap) {
+  const testing::TempDir dir;
+  WriteText(dir / "summary.json", R"({"mean_arc_radius_mm": 55.0, "mean_arc_radius_sigma_mm": 0.002,
+    "scan": {"wheel_diameter_mm": 400.0}})");
+  json job = SmallJob();
+  job["wheel"].erase("arc_radius_mm");
+  job["wheel"]["summary"] = "summary.json";
+  job["prediction"] = {{"runout_um", 0.0}};
+  EXPECT_THAT(ErrorMessageOf([&] {
+                (void)ParseJob(job.dump(), dir / "job.json", std::nullopt, kDefaultMaxWheelChangeMm,
+                               WheelProfileSource::kModel);
+              }),
+              HasSubstr("has no wheel model (model.mean_arc_radius_mm), which --wheel-profile model needs"));
+  // A model in the summary but no wheel_map.h5 beside it: refused naming the map.
+  WriteText(dir / "summary.json", R"({"mean_arc_radius_mm": 55.0, "mean_arc_radius_sigma_mm": 0.002,
+    "scan": {"wheel_diameter_mm": 400.0}, "model": {"mean_arc_radius_mm": 55.01,
+    "mean_arc_radius_sigma_mm": 0.0001}})");
+  EXPECT_EQ(ErrorOf([&] {
+              (void)ParseJob(job.dump(), dir / "job.json", std::nullopt, kDefaultMaxWheelChangeMm,
+                             WheelProfileSource::kModel);
+            }).code(),
+            ErrorCode::kIo);
 }
 
 struct CsvPoint {

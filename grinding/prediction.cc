@@ -8,11 +8,11 @@
 #include <limits>
 #include <numbers>
 
+#include "core/check.h"
 #include "core/error.h"
-#include "core/hdf5.h"
 #include "core/parallel.h"
-#include "core/version.h"
 #include "grinding/toolpath.h"
+#include "schema/grid_map.h"
 
 namespace arcwheel::grinding {
 
@@ -205,6 +205,20 @@ std::vector<std::string> PredictionOptions::Problems() const {
     problems.push_back(fmt::format("prediction.map_nodes = [{}, {}] violates >= 2 each", nodes_x, nodes_y));
   }
   if (threads < 0) problems.push_back(fmt::format("machine.threads = {} violates >= 0", threads));
+  if (profile_u_mm.size() != profile_error_um.size()) {
+    problems.push_back(fmt::format("prediction profile sizes u_mm = {}, error_um = {} violates equal",
+                                   profile_u_mm.size(), profile_error_um.size()));
+  }
+  for (size_t k = 0; k < profile_u_mm.size() && k < profile_error_um.size(); ++k) {
+    if (!std::isfinite(profile_u_mm[k]) || !std::isfinite(profile_error_um[k]) ||
+        (k > 0 && !(profile_u_mm[k] > profile_u_mm[k - 1]))) {
+      problems.push_back(
+          fmt::format("prediction profile node {}: u_mm = {}, error_um = {} violates finite, "
+                      "u_mm strictly increasing",
+                      k, profile_u_mm[k], profile_error_um[k]));
+      break;
+    }
+  }
   return problems;
 }
 
@@ -217,6 +231,27 @@ void SetEccentricRunout(double total_indicated_runout_um, PredictionOptions& opt
         0.5 * total_indicated_runout_um * std::cos(k * std::numbers::pi / 180.0);
   }
 }
+
+namespace {
+
+// The height error (um) that a profile error the path does not follow prints at (x, y): -p(u) N3
+// with u = Ra fy / N3, the contact's axial offset from the arc centre (eq. 5).
+double ProfilePrintUm(const Surface& surface, const Wheel& wheel, const PredictionOptions& o, double x_mm,
+                      double y_mm) {
+  const std::vector<double>& u = o.profile_u_mm;
+  if (u.empty()) return 0.0;
+  const SurfacePoint s = surface.Evaluate(x_mm, y_mm);
+  const double n3 = std::sqrt(s.fx * s.fx + s.fy * s.fy + 1.0);
+  const double at = wheel.arc_radius_mm * s.fy / n3;
+  const std::vector<double>& e = o.profile_error_um;
+  if (u.size() == 1 || at <= u.front()) return -e.front() * n3;
+  if (at >= u.back()) return -e.back() * n3;
+  const size_t k = static_cast<size_t>(std::upper_bound(u.begin(), u.end(), at) - u.begin());
+  const double t = (at - u[k - 1]) / (u[k] - u[k - 1]);
+  return -(e[k - 1] + t * (e[k] - e[k - 1])) * n3;
+}
+
+}  // namespace
 
 FormPrediction PredictFormError(const Surface& surface, const Aperture& aperture, const Wheel& wheel,
                                 const PredictionOptions& options) {
@@ -233,6 +268,7 @@ FormPrediction PredictFormError(const Surface& surface, const Aperture& aperture
   p.error_um.assign(nx * ny, nan);
   p.low_order_um.assign(nx * ny, nan);
   std::vector<double> ripple_um(nx * ny, nan);
+  std::vector<double> profile_um(nx * ny, nan);
   const NodePredictor predictor(surface, wheel, options);
   const int workers = WorkerCount(options.threads);
   RunOnWorkers(workers, [&](int worker) {
@@ -243,7 +279,8 @@ FormPrediction PredictFormError(const Surface& surface, const Aperture& aperture
         const size_t k = j * nx + i;
         p.low_order_um[k] = 1e3 * e.low_order_mm;
         ripple_um[k] = 1e3 * e.ripple_mm;
-        p.error_um[k] = 1e3 * (e.low_order_mm + e.ripple_mm);
+        profile_um[k] = ProfilePrintUm(surface, wheel, options, p.x_mm[i], p.y_mm[j]);
+        p.error_um[k] = 1e3 * (e.low_order_mm + e.ripple_mm) + profile_um[k];
       }
     }
   });
@@ -254,26 +291,34 @@ FormPrediction PredictFormError(const Surface& surface, const Aperture& aperture
   p.pv_after_tilt_um = flat.pv_um;
   p.rms_after_tilt_um = flat.rms_um;
   p.ripple_pv_um = PvRms(ripple_um).pv_um;
+  if (!options.profile_u_mm.empty()) p.profile_pv_um = PvRms(profile_um).pv_um;
   return p;
 }
 
 void WritePredictionHdf5(const FormPrediction& prediction, const std::filesystem::path& path,
                          const std::string& surface_description, const std::string& wheel_description) {
-  hdf5::File file = hdf5::File::Create(path);
-  file.CreateGroup("/prediction");
-  const hsize_t nx = prediction.x_mm.size(), ny = prediction.y_mm.size();
-  file.WriteDoubles("/prediction/x_mm", prediction.x_mm, {nx});
-  file.WriteDoubles("/prediction/y_mm", prediction.y_mm, {ny});
-  file.WriteDoubles("/prediction/error_um", prediction.error_um, {ny, nx});
-  file.WriteDoubles("/prediction/low_order_um", prediction.low_order_um, {ny, nx});
-  file.WriteAttribute("/prediction", "pv_um", prediction.pv_um);
-  file.WriteAttribute("/prediction", "rms_um", prediction.rms_um);
-  file.WriteAttribute("/prediction", "pv_after_tilt_um", prediction.pv_after_tilt_um);
-  file.WriteAttribute("/prediction", "rms_after_tilt_um", prediction.rms_after_tilt_um);
-  file.WriteAttribute("/prediction", "ripple_pv_um", prediction.ripple_pv_um);
-  file.WriteAttribute("/", "surface", surface_description);
-  file.WriteAttribute("/", "wheel", wheel_description);
-  file.WriteAttribute("/", "arcwheel_version", std::string(kVersion));
+  namespace layout = schema::grid_map;
+  const size_t nx = prediction.x_mm.size(), ny = prediction.y_mm.size();
+  ARCWHEEL_CHECK(nx >= 2 && ny >= 2) << "prediction map of " << nx << " x " << ny << " nodes";
+  // PredictFormError lays the nodes evenly from the first to the last.
+  layout::Content map{
+      .x0_mm = prediction.x_mm.front(),
+      .y0_mm = prediction.y_mm.front(),
+      .dx_mm = (prediction.x_mm.back() - prediction.x_mm.front()) / static_cast<double>(nx - 1),
+      .dy_mm = (prediction.y_mm.back() - prediction.y_mm.front()) / static_cast<double>(ny - 1),
+      .nx = static_cast<int>(nx),
+      .ny = static_cast<int>(ny),
+      .error_um = prediction.error_um,
+      .quantity = std::string(layout::kPredictedFormError)};
+  map.layers = {{std::string(layout::kLowOrderUm), prediction.low_order_um}};
+  map.figures = {{std::string(layout::kPvUmAttribute), prediction.pv_um},
+                 {std::string(layout::kRmsUmAttribute), prediction.rms_um},
+                 {"pv_after_tilt_um", prediction.pv_after_tilt_um},
+                 {"rms_after_tilt_um", prediction.rms_after_tilt_um},
+                 {"ripple_pv_um", prediction.ripple_pv_um},
+                 {"profile_pv_um", prediction.profile_pv_um}};
+  map.texts = {{"surface", surface_description}, {"wheel", wheel_description}};
+  layout::WriteGridMap(map, path);
 }
 
 }  // namespace arcwheel::grinding

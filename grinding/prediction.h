@@ -43,6 +43,14 @@ struct PredictionOptions {
   std::vector<double> runout_phase_deg{};
   std::vector<double> runout_radial_um{};
   double spindle_rpm = 0.0;  // > 0 when there is runout
+  // Profile error of the real wheel that the path's wheel does not follow (e.g. the wheel model's
+  // p(u) under a pure-arc path): deviation from the arc along its normal, um, positive = rim
+  // standing out, at axial offsets u (mm, ascending) from the arc centre; linear between nodes,
+  // the end values beyond them. Empty: none. A rim standing out by p at the contact, whose axial
+  // offset is u = Ra fy / N3 (eq. 5), cuts the surface p deeper along the normal: a height error
+  // of -p(u) N3 at the node (first order).
+  std::vector<double> profile_u_mm{};
+  std::vector<double> profile_error_um{};
   double feed_mm_per_min = 1000.0;
   // Map nodes over the aperture's bounding box; nodes outside the aperture are NaN.
   int nodes_x = 201;
@@ -64,7 +72,8 @@ struct FormPrediction {
   // After removing the least-squares plane (piston and tilt: the part's alignment).
   double pv_after_tilt_um = 0.0;
   double rms_after_tilt_um = 0.0;
-  double ripple_pv_um = 0.0;  // PV of the runout part alone
+  double ripple_pv_um = 0.0;   // PV of the runout part alone
+  double profile_pv_um = 0.0;  // PV of the profile-error part alone (0 without one)
 };
 
 // Throws Error{kInvalidOption, "grinding.prediction"} for invalid options and
@@ -73,8 +82,10 @@ struct FormPrediction {
                                               const surfaces::Aperture& aperture, const Wheel& wheel,
                                               const PredictionOptions& options);
 
-// Writes /prediction/{x_mm, y_mm, error_um, low_order_um} and the PV/RMS figures as attributes to
-// an HDF5 file (through the caller's atomic staging). Throws Error{kIo}.
+// Writes the map as a grid map (schema/grid_map.h, the layout `arcwheel polish` reads): error_um,
+// low_order_um, x_mm, y_mm and the grid attributes at the root, the PV/RMS figures and the surface
+// and wheel descriptions as root attributes (through the caller's atomic staging). Throws
+// Error{kIo}.
 void WritePredictionHdf5(const FormPrediction& prediction, const std::filesystem::path& path,
                          const std::string& surface_description, const std::string& wheel_description);
 

@@ -198,9 +198,15 @@ TEST(WritePredictionHdf5, WritesTheMapAndItsFigures) {
                        {.arc_radius_error_mm = 0.1, .nodes_x = 11, .nodes_y = 7});
   WritePredictionHdf5(p, dir / "prediction.h5", "surface", "wheel");
   const hdf5::File file = hdf5::File::OpenReadOnly(dir / "prediction.h5");
-  EXPECT_EQ(file.Shape("/prediction/error_um"), (std::vector<hsize_t>{7, 11}));
-  EXPECT_EQ(file.ReadDoubles("/prediction/error_um"), p.error_um);
-  EXPECT_DOUBLE_EQ(*file.ReadAttributeDouble("/prediction", "pv_um"), p.pv_um);
+  EXPECT_EQ(file.Shape("/error_um"), (std::vector<hsize_t>{7, 11}));
+  EXPECT_EQ(file.ReadDoubles("/error_um"), p.error_um);
+  EXPECT_DOUBLE_EQ(*file.ReadAttributeDouble("/", "pv_um"), p.pv_um);
+  // The grid attributes place node (i, j) where the prediction computed it.
+  const double x0 = *file.ReadAttributeDouble("/", "x0_mm"), dx = *file.ReadAttributeDouble("/", "dx_mm");
+  const double y0 = *file.ReadAttributeDouble("/", "y0_mm"), dy = *file.ReadAttributeDouble("/", "dy_mm");
+  for (size_t i = 0; i < p.x_mm.size(); ++i) EXPECT_NEAR(x0 + static_cast<double>(i) * dx, p.x_mm[i], 1e-12);
+  for (size_t j = 0; j < p.y_mm.size(); ++j) EXPECT_NEAR(y0 + static_cast<double>(j) * dy, p.y_mm[j], 1e-12);
+  EXPECT_EQ(*file.ReadAttributeString("/", "schema_version"), "1.0");
   EXPECT_EQ(*file.ReadAttributeString("/", "wheel"), "wheel");
 }
 

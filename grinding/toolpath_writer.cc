@@ -152,6 +152,18 @@ void WriteHeaders(const Job& job, std::ofstream* csv, std::ofstream* gcode, std:
   }
 }
 
+// The nominal and the measured arc radius side by side (docs/grinding.md, toolpath_summary.json).
+nlohmann::json ArcRadiusJson(const WheelChange& c) {
+  nlohmann::json j;
+  j["nominal_mm"] = c.nominal_arc_radius_mm ? nlohmann::json(*c.nominal_arc_radius_mm) : nlohmann::json();
+  j["measured_mm"] = c.measured_arc_radius_mm;
+  j["measured_sigma_mm"] = c.measured_sigma_mm;
+  j["difference_mm"] = c.nominal_arc_radius_mm ? nlohmann::json(c.DifferenceMm()) : nlohmann::json();
+  j["max_change_mm"] = c.max_change_mm;
+  j["used"] = "measured";
+  return j;
+}
+
 nlohmann::json SummaryJson(const Job& job, const ToolpathRunReport& report,
                            const std::vector<std::string>& files) {
   nlohmann::json j;
@@ -160,6 +172,9 @@ nlohmann::json SummaryJson(const Job& job, const ToolpathRunReport& report,
   j["job_path"] = job.source.string();
   j["surface"] = job.surface->Describe();
   j["wheel"] = job.wheel.description;
+  if (job.wheel_change) j["arc_radius"] = ArcRadiusJson(*job.wheel_change);
+  if (job.wheel_summary)
+    j["wheel_profile"] = job.wheel_profile == WheelProfileSource::kModel ? "model" : "mean";
   const ToolpathSummary& t = report.toolpath;
   j["toolpath"] = {{"passes", t.passes},
                    {"rows_per_pass", t.rows_per_pass},
@@ -173,12 +188,14 @@ nlohmann::json SummaryJson(const Job& job, const ToolpathRunReport& report,
   if (report.predicted) {
     const FormPrediction& p = report.prediction;
     j["prediction"] = {{"arc_radius_error_mm", job.prediction.arc_radius_error_mm},
+                       {"arc_radius_error_source", job.arc_radius_error_source},
                        {"keep_total_radius", job.prediction.keep_total_radius},
                        {"pv_um", p.pv_um},
                        {"rms_um", p.rms_um},
                        {"pv_after_tilt_um", p.pv_after_tilt_um},
                        {"rms_after_tilt_um", p.rms_after_tilt_um},
-                       {"ripple_pv_um", p.ripple_pv_um}};
+                       {"ripple_pv_um", p.ripple_pv_um},
+                       {"profile_pv_um", p.profile_pv_um}};
   }
   j["files"] = files;
   return j;
@@ -210,9 +227,18 @@ void AppendCsvLines(const ToolpathRow& row, double feed_mm_per_min, std::string&
   }
 }
 
+std::string ArcRadiusLine(const WheelChange& c) {
+  const std::string measured =
+      fmt::format("measured {} mm (1-sigma {:.2g} mm)", c.measured_arc_radius_mm, c.measured_sigma_mm);
+  if (!c.nominal_arc_radius_mm)
+    return fmt::format("arc radius: {}, used; the job gives no nominal", measured);
+  return fmt::format("arc radius: {}, used; nominal {} mm (job); difference {:+.4f} mm (limit +-{} mm)",
+                     measured, *c.nominal_arc_radius_mm, c.DifferenceMm(), c.max_change_mm);
+}
+
 std::vector<std::string> ToolpathHeaderLines(const Job& job) {
   const ToolpathOptions& o = job.path;
-  return {
+  std::vector<std::string> lines = {
       fmt::format("arcwheel {} parallel-grinding toolpath (method.md A.8, eq. 5), job '{}'", kVersion,
                   job.name),
       "surface: " + job.surface->Describe(),
@@ -226,6 +252,8 @@ std::vector<std::string> ToolpathHeaderLines(const Job& job) {
           o.feed_mm_per_min, o.passes, o.depth_per_pass_um, o.lead_in_mm, o.lead_out_mm,
           o.zigzag ? "zigzag" : "one way"),
   };
+  if (job.wheel_change) lines.insert(lines.begin() + 4, ArcRadiusLine(*job.wheel_change));
+  return lines;
 }
 
 ToolpathRunReport RunToolpathJob(const Job& job, const std::filesystem::path& output_folder) {

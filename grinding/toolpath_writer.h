@@ -30,6 +30,10 @@ ToolpathRunReport RunToolpathJob(const Job& job, const std::filesystem::path& ou
 // Appends the CSV lines of `row` (formats.md section 6, shortest round-trip numbers) to `out`.
 void AppendCsvLines(const ToolpathRow& row, double feed_mm_per_min, std::string& out);
 
+// "arc radius: measured R mm (1-sigma s mm), used; nominal N mm (job); difference ..." for the
+// headers and the terminal.
+[[nodiscard]] std::string ArcRadiusLine(const WheelChange& change);
+
 // The header lines shared by the three toolpath files (without comment markers).
 [[nodiscard]] std::vector<std::string> ToolpathHeaderLines(const Job& job);
 

@@ -9,8 +9,10 @@
 #include <optional>
 
 #include "core/error.h"
+#include "core/hdf5.h"
 #include "core/json_text.h"
 #include "schema/summary.h"
+#include "schema/wheel_map.h"
 
 namespace arcwheel::grinding {
 namespace {
@@ -168,7 +170,46 @@ WheelSummary ReadWheelSummary(const std::filesystem::path& path) {
     }
   }
   ReadPhases(root, path, s);
+  if (root.contains(key::kModel) && root.at(key::kModel).is_object()) {
+    const json& model = root.at(key::kModel);
+    if (model.contains(key::model::kMeanArcRadiusMm) && model.at(key::model::kMeanArcRadiusMm).is_number())
+      s.model_mean_arc_radius_mm = model.at(key::model::kMeanArcRadiusMm).get<double>();
+    if (model.contains(key::model::kMeanArcRadiusSigmaMm) &&
+        model.at(key::model::kMeanArcRadiusSigmaMm).is_number())
+      s.model_mean_arc_radius_sigma_mm = model.at(key::model::kMeanArcRadiusSigmaMm).get<double>();
+  }
   return s;
+}
+
+ProfileError ReadModelProfile(const std::filesystem::path& wheel_map) {
+  namespace map = schema::wheel_map;
+  const auto read = [&wheel_map] {
+    const hdf5::File file = hdf5::File::OpenReadOnly(wheel_map);
+    for (const std::string_view dataset : {map::kModelProfileUMm, map::kModelProfileErrorUm}) {
+      if (!file.HasObject(std::string(dataset))) {
+        Bad(wheel_map, dataset,
+            "is missing: the wheel was processed without its model (--no-model), or the "
+            "model could not be fitted (see summary.json's warnings)");
+      }
+    }
+    const std::vector<double> u = file.ReadDoubles(std::string(map::kModelProfileUMm));
+    const std::vector<double> e = file.ReadDoubles(std::string(map::kModelProfileErrorUm));
+    if (u.size() != e.size())
+      Bad(wheel_map, map::kModelProfileErrorUm, "differs in length from profile_u_mm");
+    ProfileError p;
+    for (size_t k = 0; k < u.size(); ++k) {
+      if (!std::isfinite(u[k]) || !std::isfinite(e[k])) continue;
+      if (!p.u_mm.empty() && !(u[k] > p.u_mm.back()))
+        Bad(wheel_map, map::kModelProfileUMm, "is not increasing");
+      p.u_mm.push_back(u[k]);
+      p.error_um.push_back(e[k]);
+    }
+    if (p.u_mm.size() < 2) Bad(wheel_map, map::kModelProfileErrorUm, "has fewer than 2 finite nodes");
+    return p;
+  };
+  // A damaged file is read first in a child process, as every HDF5 reader here (core/hdf5.h).
+  hdf5::ReadFirstInChildProcess(wheel_map, [&read] { (void)read(); });
+  return read();
 }
 
 }  // namespace arcwheel::grinding

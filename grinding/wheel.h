@@ -7,6 +7,7 @@
 // Rb = total radius - Ra (the base radius) about the wheel centre, in the plane y = wheel-centre y.
 
 #include <filesystem>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -50,7 +51,23 @@ struct WheelSummary {
   std::vector<double> center_radial_mm;
   std::string wheel_id;
   std::string arcwheel_version;
+  // The wheel model's mean arc radius and its 1-sigma (`model.mean_arc_radius_mm`, `_sigma_mm`);
+  // NaN when the summary has no model.
+  double model_mean_arc_radius_mm = std::numeric_limits<double>::quiet_NaN();
+  double model_mean_arc_radius_sigma_mm = std::numeric_limits<double>::quiet_NaN();
 };
+
+// The wheel model's profile error common to all phases, p(u): radial deviation from the arc (um,
+// positive = rim standing out) at axial offsets u from the arc centre (mm), finite nodes only.
+struct ProfileError {
+  std::vector<double> u_mm;
+  std::vector<double> error_um;
+};
+
+// Reads p(u) from a wheel_map.h5's /model/profile_u_mm and /model/profile_error_um. Throws
+// Error{kBadInput, "grinding.wheel"} naming the file and the dataset if it has no model (processed
+// with --no-model) or fewer than 2 finite nodes, Error{kIo} if it cannot be read.
+[[nodiscard]] ProfileError ReadModelProfile(const std::filesystem::path& wheel_map);
 
 // Reads a summary.json. Throws Error{kIo} if it cannot be read, Error{kBadInput,
 // "grinding.wheel"} naming the file and key if a required key is missing or malformed.

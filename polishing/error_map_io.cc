@@ -21,6 +21,7 @@
 #include "core/error.h"
 #include "core/memory_budget.h"
 #include "polishing/grid_csv.h"
+#include "schema/grid_map.h"
 
 namespace arcwheel::polishing {
 namespace {
@@ -640,36 +641,21 @@ PixelMap ReadZygoDatx(const std::filesystem::path& path) {
 
 ErrorMap ReadErrorMapHdf5(const hdf5::File& file) {
   const std::string name = file.path().string();
-  if (!file.HasObject("/error_um"))
-    Fail(name, "dataset 'error_um' is missing (arcwheel HDF5 error map, docs/polishing.md)");
-  const std::vector<hsize_t> shape = file.Shape("/error_um");
-  if (shape.size() != 2 || shape[0] == 0 || shape[1] == 0 ||
-      static_cast<double>(shape[0]) * static_cast<double>(shape[1]) > kMaxNodes) {
-    Fail(name, "dataset 'error_um' must be [ny][nx] with 1 .. 1e8 nodes");
-  }
-  CheckMapNodes(name, "dataset 'error_um'", static_cast<double>(shape[0]), static_cast<double>(shape[1]));
+  // Any grid-map layout: arcwheel's grid map, the older polish grid, a prediction.h5 of before.
+  const schema::grid_map::Location at = schema::grid_map::LocateGridMap(file, kStage);
+  const std::string dataset = at.error_dataset.substr(1);
+  if (at.nx == 0 || at.ny == 0 || static_cast<double>(at.nx) * static_cast<double>(at.ny) > kMaxNodes)
+    Fail(name, fmt::format("dataset '{}' must be [ny][nx] with 1 .. 1e8 nodes", dataset));
+  CheckMapNodes(name, fmt::format("dataset '{}'", dataset), at.ny, at.nx);
   ErrorMap map;
-  auto attribute = [&](const char* key) {
-    const std::optional<double> v = file.ReadAttributeDouble("/", key);
-    if (!v || !std::isfinite(*v))
-      Fail(name, fmt::format("root attribute '{}' is {}", key, v ? "not finite" : "missing"));
-    return *v;
-  };
-  map.grid.x0_mm = attribute("x0_mm");
-  map.grid.y0_mm = attribute("y0_mm");
-  map.grid.dx_mm = attribute("dx_mm");
-  map.grid.dy_mm = attribute("dy_mm");
-  if (!(map.grid.dx_mm > 0.0))
-    Fail(name, fmt::format("root attribute 'dx_mm' = {} must be > 0", map.grid.dx_mm));
-  if (!(map.grid.dy_mm > 0.0))
-    Fail(name, fmt::format("root attribute 'dy_mm' = {} must be > 0", map.grid.dy_mm));
-  map.grid.ny = static_cast<int>(shape[0]);
-  map.grid.nx = static_cast<int>(shape[1]);
-  map.error_um = file.ReadDoubles("/error_um");
+  map.grid = {
+      .x0_mm = at.x0_mm, .y0_mm = at.y0_mm, .dx_mm = at.dx_mm, .dy_mm = at.dy_mm, .nx = at.nx, .ny = at.ny};
+  map.error_um = file.ReadDoubles(at.error_dataset);
+  const auto nx = static_cast<std::size_t>(at.nx);
   for (std::size_t k = 0; k < map.error_um.size(); ++k) {
     if (std::isinf(map.error_um[k])) {
-      Fail(name, fmt::format("dataset 'error_um' value [{}][{}] = {} {}", k / shape[1], k % shape[1],
-                             map.error_um[k], kInfinityIsDamage));
+      Fail(name, fmt::format("dataset '{}' value [{}][{}] = {} {}", dataset, k / nx, k % nx, map.error_um[k],
+                             kInfinityIsDamage));
     }
   }
   return map;
@@ -683,16 +669,19 @@ ErrorMap ReadErrorMapHdf5(const std::filesystem::path& path) {
 void WriteErrorMapHdf5(const ErrorMap& map, const std::filesystem::path& path) {
   OutputSet outputs;
   const std::filesystem::path temporary = outputs.Stage(path);
-  {
-    hdf5::File file = hdf5::File::Create(temporary);
-    file.WriteDoubles("/error_um", map.error_um,
-                      {static_cast<hsize_t>(map.grid.ny), static_cast<hsize_t>(map.grid.nx)});
-    file.WriteAttribute("/", "x0_mm", map.grid.x0_mm);
-    file.WriteAttribute("/", "y0_mm", map.grid.y0_mm);
-    file.WriteAttribute("/", "dx_mm", map.grid.dx_mm);
-    file.WriteAttribute("/", "dy_mm", map.grid.dy_mm);
-  }
+  schema::grid_map::WriteGridMap(GridMapContent(map, schema::grid_map::kErrorMap), temporary);
   outputs.Commit();
+}
+
+schema::grid_map::Content GridMapContent(const ErrorMap& map, std::string_view quantity) {
+  return {.x0_mm = map.grid.x0_mm,
+          .y0_mm = map.grid.y0_mm,
+          .dx_mm = map.grid.dx_mm,
+          .dy_mm = map.grid.dy_mm,
+          .nx = map.grid.nx,
+          .ny = map.grid.ny,
+          .error_um = map.error_um,
+          .quantity = std::string(quantity)};
 }
 
 ErrorMap ReadErrorMapCsv(const std::filesystem::path& path) {

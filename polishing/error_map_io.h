@@ -30,6 +30,7 @@
 
 #include "core/hdf5.h"
 #include "polishing/removal_target.h"
+#include "schema/grid_map.h"
 
 namespace arcwheel::polishing {
 
@@ -95,13 +96,18 @@ struct MapPlacement {
 [[nodiscard]] PixelMap ReadZygoDatx(const hdf5::File& file);
 [[nodiscard]] PixelMap ReadZygoDatx(const std::filesystem::path& path);
 
-// arcwheel's own HDF5 grid (docs/polishing.md): dataset `error_um` [ny][nx] (float64, NaN = no
-// data, an infinity refused) and root attributes `x0_mm`, `y0_mm`, `dx_mm`, `dy_mm`: node (i, j) lies at
-// (x0 + i dx, y0 + j dy).
+// arcwheel's HDF5 grid map (schema/grid_map.h, docs/outputs.md "Grid maps"): dataset `error_um`
+// [ny][nx] (float64, NaN = no data, an infinity refused) and root attributes `x0_mm`, `y0_mm`,
+// `dx_mm`, `dy_mm`: node (i, j) lies at (x0 + i dx, y0 + j dy). Also reads the layouts written
+// before it: the same without `schema_version`, and a prediction.h5 with `/prediction/error_um`,
+// `/prediction/x_mm`, `/prediction/y_mm`. So `arcwheel toolpath`'s prediction.h5 and
+// `arcwheel polish`'s residual_map.h5 are error maps as they are.
 [[nodiscard]] ErrorMap ReadErrorMapHdf5(const hdf5::File& file);
 [[nodiscard]] ErrorMap ReadErrorMapHdf5(const std::filesystem::path& path);
-// Writes that layout. Throws Error{kIo}.
+// Writes that layout (quantity "error map"). Throws Error{kIo}.
 void WriteErrorMapHdf5(const ErrorMap& map, const std::filesystem::path& path);
+// The grid map of `map`, saying what it is in `quantity`, for writers that add layers or figures.
+[[nodiscard]] schema::grid_map::Content GridMapContent(const ErrorMap& map, std::string_view quantity);
 
 // Reads an error map CSV: a header `x_mm,y_mm,error_um`, then one node of a regular grid per row
 // (any order; missing nodes and `nan` have no data). Throws Error{kIo} if unreadable and

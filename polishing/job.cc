@@ -167,7 +167,8 @@ ErrorMap ReadErrorMapSection(JsonSection& s, const std::filesystem::path& file) 
 
 }  // namespace
 
-PolishJob ReadPolishJob(const std::filesystem::path& path) {
+PolishJob ReadPolishJob(const std::filesystem::path& path,
+                        const std::optional<std::filesystem::path>& error_map_override) {
   const json document = ReadJsonFile(path, kStage);
   PolishJob job;
   job.source = path;
@@ -180,9 +181,14 @@ PolishJob ReadPolishJob(const std::filesystem::path& path) {
   s.Section("aperture", true, [&](JsonSection& c) { job.aperture = surfaces::ReadAperture(c); });
   s.Section("error_map", true, [&](JsonSection& c) {
     const std::string file = c.String("file", "");
-    if (file.empty()) c.Expected("file", "the error map's file name (.csv, .dat, .datx or .h5)");
-    job.error_map_file =
-        std::filesystem::path(file).is_absolute() ? std::filesystem::path(file) : path.parent_path() / file;
+    if (error_map_override) {
+      job.error_map_file = *error_map_override;
+      c.SetResolved("file", job.error_map_file.string());
+    } else {
+      if (file.empty()) c.Expected("file", "the error map's file name (.csv, .dat, .datx or .h5)");
+      job.error_map_file =
+          std::filesystem::path(file).is_absolute() ? std::filesystem::path(file) : path.parent_path() / file;
+    }
     job.error_map = ReadErrorMapSection(c, job.error_map_file);
   });
   s.Section("removal_target", false,
@@ -352,6 +358,18 @@ PolishRunReport RunPolishJob(const PolishJob& job, const std::filesystem::path& 
   write(schema::polish::kPathFileName, PolishingPathCsv(points, comments));
   write("polish.mod", RapidModule(points, job.tool, job.work_object, "ArcwheelPolish", comments));
   write(schema::polish::kResidualMapFileName, ResidualCsv(target, report.dwell));
+  {
+    // The residual as a grid map (schema/grid_map.h): an error map for the next polish run.
+    schema::grid_map::Content residual =
+        GridMapContent(report.dwell.residual_um, schema::grid_map::kPolishResidual);
+    residual.layers = {
+        {std::string(schema::grid_map::kTargetUm), target.error_um},
+        {std::string(schema::grid_map::kRemovalUm), report.dwell.predicted_removal_um.error_um}};
+    residual.figures = {{std::string(schema::grid_map::kPvUmAttribute), report.dwell.after.pv_um},
+                        {std::string(schema::grid_map::kRmsUmAttribute), report.dwell.after.rms_um}};
+    schema::grid_map::WriteGridMap(residual,
+                                   outputs.Stage(output_folder / schema::polish::kResidualGridFileName));
+  }
   write(schema::polish::kSummaryFileName, summary.dump(2) + "\n");
   outputs.Commit();
   return report;

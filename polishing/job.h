@@ -4,6 +4,7 @@
 
 #include <filesystem>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -37,8 +38,11 @@ struct PolishJob {
 };
 
 // Reads and validates a job; the error map's "file" is relative to the job's folder.
+// `error_map_override` replaces the job's `error_map.file` (then the job may leave it out), as
+// `arcwheel regenerate` does with the predicted form error.
 // Throws Error{kIo} or Error{kBadInput, "polishing.job"} naming the file and the dotted key.
-[[nodiscard]] PolishJob ReadPolishJob(const std::filesystem::path& path);
+[[nodiscard]] PolishJob ReadPolishJob(const std::filesystem::path& path,
+                                      const std::optional<std::filesystem::path>& error_map_override = {});
 
 // Bytes a polish run holds per item, measured as the peak resident memory of `arcwheel polish`
 // over jobs of 845 to 1.3e6 dwell points and 4e3 to 1.6e6 map nodes (docs/polishing.md, "Sizes"):

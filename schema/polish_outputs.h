@@ -19,6 +19,8 @@ inline constexpr Version kVersion{kMajorVersion, kMinorVersion};
 
 inline constexpr std::string_view kSummaryFileName = "polish_summary.json";
 inline constexpr std::string_view kResidualMapFileName = "residual_map.csv";
+// The same residual (and target and removal) as a grid map, schema/grid_map.h.
+inline constexpr std::string_view kResidualGridFileName = "residual_map.h5";
 inline constexpr std::string_view kPathFileName = "polishing_path.csv";
 
 // polish_summary.json. A key of a nested object lives in the namespace named after the object.

@@ -20,8 +20,10 @@ export UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
 # run the same solver on the Gaussian footprint, PredictsTheRemovalOfAnOffsetEllipticFootprint on
 # a measured one, FollowsTheArchimedeanSpiral the spiral). Here they cost 160 of dwell_test's 270
 # CPU-s (measured 2026-12-02). Likewise the wheel model's statistics over many noise draws
-# (WheelModelStatistics; its noise-free and single-draw cases run the same fit). And the history
-# of eight simulated and processed scans (HistoryCommand.ReportsTheKnownWear*; the comparison of
-# three scans and the history's refusals and building blocks still run).
-export GTEST_FILTER="${GTEST_FILTER:--*N1e7*:SolveDwell.CutsTheResidualRmsTenfold*:SolveDwell.AMeasuredGaussian*:SpiralPath.CarriesADwell*:WheelModelStatistics.*:HistoryCommand.ReportsTheKnownWear*}"
+# (WheelModelStatistics; its noise-free and single-draw cases run the same fit). The history of
+# eight simulated and processed scans (HistoryCommand.ReportsTheKnownWear*; the comparison of
+# three scans and the history's refusals and building blocks still run). And the second scan that
+# tests/regenerate_test processes for --wheel-profile model (WheelProfileModel; the Regenerate
+# cases run process, toolpath and polish on the first).
+export GTEST_FILTER="${GTEST_FILTER:--*N1e7*:SolveDwell.CutsTheResidualRmsTenfold*:SolveDwell.AMeasuredGaussian*:SpiralPath.CarriesADwell*:WheelModelStatistics.*:HistoryCommand.ReportsTheKnownWear*:WheelProfileModel.*}"
 ctest --preset asan --parallel "$(nproc)" "$@"

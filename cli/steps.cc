@@ -1,0 +1,87 @@
+#include "cli/steps.h"
+
+#include <fmt/core.h>
+
+#include <CLI/CLI.hpp>
+#include <chrono>
+#include <string>
+#include <vector>
+
+#include "cli/commands.h"
+#include "core/error.h"
+
+namespace arcwheel::cli {
+namespace {
+
+double StepSecondsSince(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+}  // namespace
+
+void RunProcessStep(const std::filesystem::path& scan, const std::filesystem::path& output) {
+  // command_process.cc keeps its pipeline (options, run record, model, writers) inside the
+  // command; running that command here keeps one definition of what `process` writes.
+  CLI::App app{"arcwheel", "arcwheel"};
+  app.require_subcommand(1);
+  AddProcessCommand(app);
+  // CLI11 takes an argument vector in reverse order.
+  std::vector<std::string> arguments = {scan.string(), output.string(), "-o", "-q", "process"};
+  try {
+    app.parse(arguments);
+  } catch (const CLI::ParseError& error) {
+    throw Error(ErrorCode::kInvalidOption, "process", error.what());
+  }
+}
+
+ToolpathStepResult RunToolpathStep(const std::filesystem::path& job_path,
+                                   const std::optional<std::filesystem::path>& wheel_summary,
+                                   double max_wheel_change_mm, const std::filesystem::path& output,
+                                   grinding::WheelProfileSource wheel_profile) {
+  const auto start = std::chrono::steady_clock::now();
+  ToolpathStepResult result{
+      .job = grinding::ReadJob(job_path, wheel_summary, max_wheel_change_mm, wheel_profile), .report = {}};
+  const grinding::Job& job = result.job;
+  result.report = grinding::RunToolpathJob(job, output);
+  const grinding::ToolpathSummary& t = result.report.toolpath;
+  if (job.wheel_change) fmt::print("{}\n", grinding::ArcRadiusLine(*job.wheel_change));
+  fmt::print(
+      "{} control points in {} pass(es) of {} rows; rows straight to {:.2e} mm; "
+      "{} gouge checks, smallest gap {:.3f} um\n",
+      t.control_points, t.passes, t.rows_per_pass, t.max_row_deviation_mm, t.gouge_checks,
+      1e3 * t.min_gouge_gap_mm);
+  if (result.report.predicted) {
+    const grinding::FormPrediction& p = result.report.prediction;
+    fmt::print(
+        "predicted form error (arc radius error {:.2g} mm: {}{}): PV {:.3f} um, RMS {:.3f} um; "
+        "after tilt PV {:.3f} um, RMS {:.3f} um; runout ripple PV {:.3f} um{}\n",
+        job.prediction.arc_radius_error_mm, job.arc_radius_error_source,
+        job.prediction.runout_radial_um.empty() ? ", no runout" : ", with runout", p.pv_um, p.rms_um,
+        p.pv_after_tilt_um, p.rms_after_tilt_um, p.ripple_pv_um,
+        job.prediction.profile_u_mm.empty()
+            ? ""
+            : fmt::format("; profile error p(u) PV {:.3f} um", p.profile_pv_um));
+  }
+  fmt::print("wrote {} in {:.2f} s\n", output.string(), StepSecondsSince(start));
+  return result;
+}
+
+polishing::PolishRunReport RunPolishStep(const std::filesystem::path& job_path,
+                                         const std::optional<std::filesystem::path>& error_map,
+                                         const std::filesystem::path& output) {
+  const auto start = std::chrono::steady_clock::now();
+  const polishing::PolishJob job = polishing::ReadPolishJob(job_path, error_map);
+  const polishing::PolishRunReport report = polishing::RunPolishJob(job, output);
+  const polishing::DwellSolution& d = report.dwell;
+  fmt::print(
+      "{} dwell points; error PV {:.4f} um, RMS {:.4f} um -> predicted residual PV {:.4f} um, "
+      "RMS {:.4f} um over {} aperture nodes\n",
+      report.points, d.before.pv_um, d.before.rms_um, d.after.pv_um, d.after.rms_um, d.before.nodes);
+  fmt::print("total dwell {:.1f} s; speeds {:.3f} .. {:.3f} mm/s, up to {:.1f} mm/s^2; {} iterations{}\n",
+             d.total_time_s, report.min_speed_mm_s, report.max_speed_mm_s, d.max_acceleration_mm_s2,
+             d.iterations, d.converged ? "" : " (iteration limit reached)");
+  fmt::print("wrote {} in {:.2f} s\n", output.string(), StepSecondsSince(start));
+  return report;
+}
+
+}  // namespace arcwheel::cli

@@ -264,8 +264,9 @@ std::string SummaryJson(const RunRecord& record, const processing::ProcessedScan
 void WriteProcessOutputs(const std::filesystem::path& outdir, const RunRecord& record,
                          const processing::ProcessedScan& processed, const WheelFit& fit,
                          const WheelModel* model) {
-  EnsureDirectory(outdir);
+  // A folder this call makes goes again if a write fails: nothing of a failed run stays behind.
   OutputSet outputs;
+  outputs.CreateFolder(outdir);
   const auto summary_path = outputs.Stage(outdir / key::kFileName);
   const auto map_path = outputs.Stage(outdir / h5::kFileName);
   {

@@ -10,6 +10,8 @@
 #include <vector>
 
 #include "acquisition/simulate.h"
+#include "core/testing/testing.h"
+#include "fitting/outputs.h"
 #include "fitting/wheel_fit.h"
 #include "processing/process_scan.h"
 
@@ -269,6 +271,23 @@ TEST(ScanPipeline, BurstsOfSpikesAreRemovedBeforeTheFit) {
   // Without noise a missed spike would show as tens of micrometres of arc error.
   EXPECT_LT(r.fit.max_arc_error_um, 0.05);
   EXPECT_GE(r.processed.despike.rejected, 20u);
+}
+
+// A run whose outputs cannot be written leaves nothing behind, not even the folder it made:
+// metadata that is not UTF-8 (which no reader lets through) makes the summary's JSON refuse.
+TEST(ScanPipeline, AFailedWriteLeavesNoFolderBehind) {
+  const Result run = RunPipeline(PaperWheel(), PaperScan());
+  const processing::ProcessedScan& processed = run.processed;
+  const fitting::WheelFit& fit = run.fit;
+  fitting::RunRecord record;
+  record.metadata.wheel_id = "\xff\xfe not UTF-8";
+  testing::TempDir dir;
+  const std::filesystem::path outdir = dir / "new" / "out";
+  EXPECT_ANY_THROW(fitting::WriteProcessOutputs(outdir, record, processed, fit, nullptr));
+  EXPECT_FALSE(std::filesystem::exists(dir / "new")) << "the folders it made are removed";
+  record.metadata.wheel_id = "D15";
+  fitting::WriteProcessOutputs(outdir, record, processed, fit, nullptr);
+  EXPECT_EQ(testing::ListFolder(outdir), "summary.json\nwheel_map.h5\n");
 }
 
 }  // namespace

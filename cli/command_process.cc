@@ -134,6 +134,19 @@ void PrintModelHeadline(const fitting::WheelModel& m) {
              m.radius_knots, m.axial_knots, m.runout_knots);
 }
 
+// The value of a choice option, or a problem in the form of Problems(): "--flag = value violates
+// one of ...".
+template <typename Parse, typename Value>
+void ParseChoice(const char* flag, const std::string& text, const char* choices, Parse parse, Value& value,
+                 std::vector<std::string>& problems) {
+  try {
+    value = parse(text);
+  } catch (const Error& e) {
+    if (e.code() != ErrorCode::kInvalidOption) throw;
+    problems.push_back(fmt::format("{} = {} violates {}", flag, text, choices));
+  }
+}
+
 // One line per stage on stderr, so that the outputs and the headline stay as they are.
 void PrintTimings(const StageClock& clock) {
   double total_s = 0.0;
@@ -146,12 +159,16 @@ void PrintTimings(const StageClock& clock) {
 }
 
 void Run(ProcessArgs& args) {
-  args.processing.despike.method = processing::ParseDespikeMethod(args.despike_method);
-  args.processing.rpm_source = processing::ParseRpmSource(args.rpm_source);
-  args.fit.fit_span = fitting::ParseFitSpan(args.fit_span);
   // Every bad option of both stages in one message, before the scan is read: the fit's would
   // otherwise surface only after the whole scan had been processed.
-  std::vector<std::string> problems = args.processing.Problems();
+  std::vector<std::string> problems;
+  ParseChoice("--despike", args.despike_method, "median, moving-mean or none", processing::ParseDespikeMethod,
+              args.processing.despike.method, problems);
+  ParseChoice("--rpm-source", args.rpm_source, "auto, nominal, encoder or estimate",
+              processing::ParseRpmSource, args.processing.rpm_source, problems);
+  ParseChoice("--fit-span", args.fit_span, "band or full", fitting::ParseFitSpan, args.fit.fit_span,
+              problems);
+  for (std::string& problem : args.processing.Problems()) problems.push_back(std::move(problem));
   for (std::string& problem : args.fit.Problems()) problems.push_back(std::move(problem));
   if (!args.no_model) {
     for (std::string& problem : args.model.Problems()) problems.push_back(std::move(problem));

@@ -159,6 +159,20 @@ TEST(Cli, ProcessRefusesEveryBadOptionOfBothStagesInOneMessageBeforeReadingTheSc
   EXPECT_FALSE(std::filesystem::exists(dir / "out"));
 }
 
+TEST(Cli, ProcessNamesTheFlagOfEveryUnknownChoiceInTheSameMessage) {
+  TempDir dir;
+  WriteText(dir / "scan.csv", "never read\n");
+  const auto run = RunArcwheel("process " + (dir / "scan.csv").string() + " -o " + (dir / "out").string() +
+                               " --despike mean --rpm-source guess --fit-span half --phases 2");
+  EXPECT_EQ(run.exit_status, 2) << run.output;
+  EXPECT_NE(run.output.find("process: --despike = mean violates median, moving-mean or none; --rpm-source = "
+                            "guess violates auto, nominal, encoder or estimate; --fit-span = half violates "
+                            "band or full; --phases = 2 violates 4..36000"),
+            std::string::npos)
+      << run.output;
+  EXPECT_FALSE(std::filesystem::exists(dir / "out"));
+}
+
 TEST(Cli, TruncatedHdf5IsRefusedAndEarlierOutputsSurvive) {
   TempDir dir;
   ASSERT_EQ(RunArcwheel("simulate " + (dir / "scan.h5").string()).exit_status, 0);

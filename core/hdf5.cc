@@ -228,22 +228,25 @@ std::size_t File::NumericCount(const std::string& dataset, std::size_t value_byt
   return hdf5::NumericCount(handle_.id(), OpenDataset(dataset), value_bytes, Where(dataset));
 }
 
-void File::ReadInto(const std::string& dataset, std::span<double> values) const {
-  const Handle data = OpenDataset(dataset);
-  const std::string where = Where(dataset);
-  if (hdf5::NumericCount(handle_.id(), data, sizeof(double), where) != values.size()) {
+namespace {
+
+template <typename T>
+void ReadIntoSpan(hid_t file_id, const Handle& data, hid_t memory_type, std::span<T> values,
+                  const std::string& where) {
+  if (NumericCount(file_id, data, sizeof(T), where) != values.size()) {
     throw Error(ErrorCode::kInternal, kStage, "buffer does not match the size of " + where);
   }
-  ReadNumericInto(data, H5T_NATIVE_DOUBLE, values.data(), values.size(), where);
+  ReadNumericInto(data, memory_type, values.data(), values.size(), where);
+}
+
+}  // namespace
+
+void File::ReadInto(const std::string& dataset, std::span<double> values) const {
+  ReadIntoSpan(handle_.id(), OpenDataset(dataset), H5T_NATIVE_DOUBLE, values, Where(dataset));
 }
 
 void File::ReadInto(const std::string& dataset, std::span<float> values) const {
-  const Handle data = OpenDataset(dataset);
-  const std::string where = Where(dataset);
-  if (hdf5::NumericCount(handle_.id(), data, sizeof(float), where) != values.size()) {
-    throw Error(ErrorCode::kInternal, kStage, "buffer does not match the size of " + where);
-  }
-  ReadNumericInto(data, H5T_NATIVE_FLOAT, values.data(), values.size(), where);
+  ReadIntoSpan(handle_.id(), OpenDataset(dataset), H5T_NATIVE_FLOAT, values, Where(dataset));
 }
 
 std::vector<double> File::ReadDoubles(const std::string& dataset) const {

@@ -10,6 +10,7 @@
 #include "core/error.h"
 #include "reports/html_page.h"
 #include "reports/pdf_flow.h"
+#include "reports/statistics.h"
 #include "schema/summary.h"
 
 namespace arcwheel::reports {
@@ -75,14 +76,6 @@ std::size_t Bracket(const std::vector<double>& nodes, double value) {
   const auto upper = std::upper_bound(nodes.begin(), nodes.end(), value);
   const auto i = static_cast<std::size_t>(std::distance(nodes.begin(), upper));
   return std::min(i == 0 ? 0 : i - 1, nodes.size() - 2);
-}
-
-double FiniteMedian(std::vector<double> values) {
-  std::erase_if(values, [](double v) { return !std::isfinite(v); });
-  if (values.empty()) return kNaN;
-  const auto middle = values.begin() + static_cast<std::ptrdiff_t>(values.size() / 2);
-  std::nth_element(values.begin(), middle, values.end());
-  return *middle;
 }
 
 MapDifference Difference(const WheelMapData& before, const WheelMapData& after, const std::string& where) {

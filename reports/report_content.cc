@@ -8,6 +8,7 @@
 #include <limits>
 
 #include "core/version.h"
+#include "reports/statistics.h"
 #include "schema/summary.h"
 
 namespace arcwheel::reports {
@@ -51,14 +52,6 @@ std::string LimitText(const Limit& limit, const HeadlineSpec& spec) {
     return FormatSignificant(*limit.min) + " … " + FormatSignificant(*limit.max) + " " + unit;
   if (limit.max) return "≤ " + FormatSignificant(*limit.max) + " " + unit;
   return "≥ " + FormatSignificant(*limit.min) + " " + unit;
-}
-
-double FiniteMedian(std::vector<double> values) {
-  std::erase_if(values, [](double v) { return !std::isfinite(v); });
-  if (values.empty()) return kNaN;
-  const auto middle = values.begin() + static_cast<std::ptrdiff_t>(values.size() / 2);
-  std::nth_element(values.begin(), middle, values.end());
-  return *middle;
 }
 
 std::size_t UsableCount(const PhaseSeries& p) {

@@ -306,7 +306,15 @@ class BlockAccumulator {
       key_ = row.key;
     }
     const Eigen::Map<const Vector16> values(row.value);
-    if (normal_matrix_) block_.selfadjointView<Eigen::Lower>().rankUpdate(values);
+    if (normal_matrix_) {
+      // The lower triangle, column by column (contiguous, so the compiler vectorises it): the same
+      // products and sums as Eigen's rankUpdate, which as a generic call cost a fifth of a pass.
+      for (int c = 0; c < 16; ++c) {
+        const double vc = row.value[c];
+        double* column = block_.col(c).data();
+        for (int r = c; r < 16; ++r) column[r] += vc * row.value[r];
+      }
+    }
     rhs_.noalias() += row.residual * values;
     pending_ = true;
   }

@@ -16,6 +16,7 @@
 #include "core/error.h"
 #include "core/interrupt.h"
 #include "core/parallel.h"
+#include "processing/helix_geometry.h"
 #include "processing/uniform_cubic_bspline.h"
 
 namespace arcwheel::fitting {
@@ -157,30 +158,6 @@ Grid GridOf(const processing::WheelMap& map) {
   grid.y0_mm = map.y_mm.front();
   grid.y_step_mm = map.y_mm[1] - map.y_mm[0];
   return grid;
-}
-
-// std::lround without the library call: the fraction of a double is exact, so this rounds half
-// away from zero exactly as lround does.
-long RoundHalfAway(double x) {
-  const double magnitude = std::abs(x);
-  auto k = static_cast<long>(magnitude);
-  if (magnitude - static_cast<double>(k) >= 0.5) ++k;
-  return x < 0.0 ? -k : k;
-}
-
-// The phase within the turn, as std::fmod(u, 360) (+ 360 below zero) gives it, without the library
-// call: u - 360 q is exact for the right whole number of turns q (Sterbenz), so only q is guessed
-// here, and corrected when the guess was one off.
-double PhaseInTurn(double unwrapped_deg) {
-  if (!(unwrapped_deg >= 0.0 && unwrapped_deg < 1e15)) {
-    const double c = std::fmod(unwrapped_deg, 360.0);
-    return c < 0.0 ? c + 360.0 : c;
-  }
-  const auto turns = static_cast<double>(static_cast<std::int64_t>(unwrapped_deg * (1.0 / 360.0)));
-  double c = unwrapped_deg - 360.0 * turns;
-  if (c < 0.0) c = unwrapped_deg - 360.0 * (turns - 1.0);
-  if (c >= 360.0) c = unwrapped_deg - 360.0 * (turns + 1.0);
-  return c;
 }
 
 // A sample's row of the Jacobian: the residual and the 16 non-zero entries, whose columns follow
@@ -405,8 +382,10 @@ CellSums CellSumsFor(const Grid& grid, double low_y_mm, double high_y_mm) {
   CellSums cells;
   if (!(low_y_mm <= high_y_mm)) return cells;
   const long last = static_cast<long>(grid.n_y) - 1;
-  cells.first_axial = std::clamp(RoundHalfAway((low_y_mm - grid.y0_mm) / grid.y_step_mm), 0L, last);
-  const long high = std::clamp(RoundHalfAway((high_y_mm - grid.y0_mm) / grid.y_step_mm), 0L, last);
+  cells.first_axial =
+      std::clamp(processing::RoundHalfAway((low_y_mm - grid.y0_mm) / grid.y_step_mm), 0L, last);
+  const long high =
+      std::clamp(processing::RoundHalfAway((high_y_mm - grid.y0_mm) / grid.y_step_mm), 0L, last);
   cells.axial_cells = high - cells.first_axial + 1;
   cells.sum.assign(grid.n_phase * static_cast<std::size_t>(cells.axial_cells), 0.0);
   cells.count.assign(cells.sum.size(), 0);
@@ -438,16 +417,16 @@ void AccumulatePart(const Samples<Sample>& samples, const RowModel& model, const
     if (y < samples.band_low_mm || y > samples.band_high_mm) continue;
     low = std::min(low, y);
     high = std::max(high, y);
-    const double c = PhaseInTurn(geometry.PhaseAt(i));
+    const double c = processing::PhaseInTurn(geometry.PhaseAt(i));
     if (!model.Evaluate(c, y, rho, row)) continue;
     block.Add(row);
     rss += row.residual * row.residual;
     ++used;
     if (cells == nullptr || cells->axial_cells == 0) continue;
     const Grid& grid = *request.grid;
-    auto p = static_cast<std::size_t>(RoundHalfAway(c * per_phase_cell));
+    auto p = static_cast<std::size_t>(processing::RoundHalfAway(c * per_phase_cell));
     if (p >= grid.n_phase) p -= grid.n_phase;  // c rounds up to the turn's end
-    const long a = RoundHalfAway((y - grid.y0_mm) * per_axial_cell) - cells->first_axial;
+    const long a = processing::RoundHalfAway((y - grid.y0_mm) * per_axial_cell) - cells->first_axial;
     if (a < 0 || a >= cells->axial_cells) continue;
     const std::size_t cell = p * static_cast<std::size_t>(cells->axial_cells) + static_cast<std::size_t>(a);
     cells->sum[cell] += row.residual;

@@ -276,16 +276,32 @@ void ExpectSameModel(const WheelModel& fast, const WheelModel& reference) {
   EXPECT_GT(cells, 1000);
 }
 
+// A noisy lobed wheel scanned at 20 kHz (2.6e5 samples), processed and fitted phase by phase.
+struct WarmStartScan {
+  explicit WarmStartScan(unsigned seed)
+      : scan(acquisition::SimulateScan(LobedWheelWithProfileError(), Settings(seed)).scan),
+        processed(processing::ProcessScanInPlace(scan, processing::ProcessOptions{})),
+        fit(FitWheel(processed.map, WheelFitOptions{})),
+        geometry(scan, processed.rpm_used) {}
+  static ScanSettings Settings(unsigned seed) {
+    ScanSettings settings = NoisyScan(seed, 0.5);
+    settings.sample_period_s = 50e-6;
+    return settings;
+  }
+  acquisition::Scan scan;
+  processing::ProcessedScan processed;
+  WheelFit fit;
+  processing::HelixGeometry geometry;
+};
+
 // A noisy lobed wheel scanned at 20 kHz (2.6e5 samples), modelled with a warm-up on every 13th
 // sample and without one.
 TEST(WheelModelWarmStart, GivesTheFitOverEverySampleWithTheKnotsChosen) {
-  ScanSettings settings = NoisyScan(7, 0.5);
-  settings.sample_period_s = 50e-6;
-  acquisition::Scan scan = acquisition::SimulateScan(LobedWheelWithProfileError(), settings).scan;
-  const processing::ProcessedScan processed =
-      processing::ProcessScanInPlace(scan, processing::ProcessOptions{});
-  const WheelFit fit = FitWheel(processed.map, WheelFitOptions{});
-  const processing::HelixGeometry geometry(scan, processed.rpm_used);
+  const WarmStartScan scanned(7);
+  const acquisition::Scan& scan = scanned.scan;
+  const processing::ProcessedScan& processed = scanned.processed;
+  const WheelFit& fit = scanned.fit;
+  const processing::HelixGeometry& geometry = scanned.geometry;
   WheelModelOptions fast_options;
   fast_options.warm_start_samples = scan.size() / 13;
   WheelModelOptions reference_options;
@@ -316,13 +332,11 @@ TEST(WheelModelWarmStart, GivesTheFitOverEverySampleWithTheKnotsChosen) {
 
 // The same with the knots given (the fine fit is then the final one) and a float32 scan.
 TEST(WheelModelWarmStart, GivesTheFitOverEverySampleWithTheKnotsGiven) {
-  ScanSettings settings = NoisyScan(8, 0.5);
-  settings.sample_period_s = 50e-6;
-  acquisition::Scan scan = acquisition::SimulateScan(LobedWheelWithProfileError(), settings).scan;
-  const processing::ProcessedScan processed =
-      processing::ProcessScanInPlace(scan, processing::ProcessOptions{});
-  const WheelFit fit = FitWheel(processed.map, WheelFitOptions{});
-  const processing::HelixGeometry geometry(scan, processed.rpm_used);
+  const WarmStartScan scanned(8);
+  const acquisition::Scan& scan = scanned.scan;
+  const processing::ProcessedScan& processed = scanned.processed;
+  const WheelFit& fit = scanned.fit;
+  const processing::HelixGeometry& geometry = scanned.geometry;
   const std::vector<float> narrow(scan.z_mm.begin(), scan.z_mm.end());
   WheelModelOptions options;
   options.radius_knots = 16;

@@ -2,7 +2,9 @@
 // Where each sample lies on the helix (formats.md section 1, method.md A.1-A.3): its unwrapped
 // phase u (deg, continuous across turns: u = c + 360 k on turn k) and its axial position y (mm).
 
+#include <cmath>
 #include <cstddef>
+#include <cstdint>
 #include <vector>
 
 #include "acquisition/scan.h"
@@ -10,6 +12,32 @@
 namespace arcwheel::processing {
 
 enum class PhaseSource { kNominal, kEstimated, kEncoder };
+
+// Per-sample arithmetic of the map's and the model's cells, exactly as the library calls give it
+// but without them (a call per sample cost as much as the rest of a sample's work).
+
+// std::lround(x): the fraction of a double is exact, so this rounds half away from zero as lround.
+[[nodiscard]] inline long RoundHalfAway(double x) {
+  const double magnitude = std::abs(x);
+  auto k = static_cast<long>(magnitude);
+  if (magnitude - static_cast<double>(k) >= 0.5) ++k;
+  return x < 0.0 ? -k : k;
+}
+
+// The phase within the turn, as std::fmod(u, 360) (+ 360 below zero) gives it: u - 360 q is exact
+// for the right whole number of turns q (Sterbenz), so only q is guessed, and corrected when the
+// guess was one off.
+[[nodiscard]] inline double PhaseInTurn(double unwrapped_deg) {
+  if (!(unwrapped_deg >= 0.0 && unwrapped_deg < 1e15)) {
+    const double c = std::fmod(unwrapped_deg, 360.0);
+    return c < 0.0 ? c + 360.0 : c;
+  }
+  const auto turns = static_cast<double>(static_cast<std::int64_t>(unwrapped_deg * (1.0 / 360.0)));
+  double c = unwrapped_deg - 360.0 * turns;
+  if (c < 0.0) c = unwrapped_deg - 360.0 * (turns - 1.0);
+  if (c >= 360.0) c = unwrapped_deg - 360.0 * (turns + 1.0);
+  return c;
+}
 
 class HelixGeometry {
  public:

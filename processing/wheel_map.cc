@@ -103,15 +103,12 @@ void InterpolateSection(const Section& section, std::span<const double> nodes, d
 
 // The map cell of a sample: the phase node nearest its phase in the turn, and the axial node
 // nearest its axial position (-1 when outside the map). Exactly lround(fmod(u, 360) / phase step)
-// and round((y - y_low) / axial step), but without a libm call per sample: fmod(u, 360) is
-// u - 360 trunc(u / 360), exact by Sterbenz's lemma, with one turn added back where u / 360
-// rounded up to the next integer; rounding half away from zero is the integer part plus one
-// where the fraction is at least one half.
+// and round((y - y_low) / axial step), without a libm call per sample (helix_geometry.h).
 class CellOfSample {
  public:
   CellOfSample(std::size_t n_phase, std::size_t n_y, double y_low, double axial_step_mm)
-      : n_phase_(n_phase),
-        n_y_(n_y),
+      : n_phase_(static_cast<long>(n_phase)),
+        n_y_(static_cast<long>(n_y)),
         phase_step_(360.0 / static_cast<double>(n_phase)),
         y_low_(y_low),
         axial_step_(axial_step_mm) {}
@@ -119,28 +116,14 @@ class CellOfSample {
   [[nodiscard]] long operator()(double u_deg, double y_mm) const {
     const double t = (y_mm - y_low_) / axial_step_;
     if (!(t > -0.5) || !(t < static_cast<double>(n_y_))) return -1;  // round(-0.4) is -0: row 0
-    const std::size_t m = t < 0.0 ? 0 : RoundHalfUp(t);
+    const long m = RoundHalfAway(t);
     if (m >= n_y_) return -1;
-    const std::size_t j = RoundHalfUp(PhaseInTurn(u_deg) / phase_step_) % n_phase_;
-    return static_cast<long>(j * n_y_ + m);
+    const long j = RoundHalfAway(PhaseInTurn(u_deg) / phase_step_) % n_phase_;
+    return j * n_y_ + m;
   }
 
  private:
-  static double PhaseInTurn(double u_deg) {
-    if (!(u_deg >= 0.0 && u_deg < 1e15)) {
-      const double c = std::fmod(u_deg, 360.0);
-      return c < 0 ? c + 360.0 : c;
-    }
-    const double c = u_deg - 360.0 * static_cast<double>(static_cast<std::int64_t>(u_deg / 360.0));
-    return c < 0.0 ? c + 360.0 : c;
-  }
-  // round(v) for 0 <= v < 2^52.
-  static std::size_t RoundHalfUp(double v) {
-    const auto k = static_cast<std::size_t>(v);
-    return v - static_cast<double>(k) >= 0.5 ? k + 1 : k;
-  }
-
-  std::size_t n_phase_, n_y_;
+  long n_phase_, n_y_;
   double phase_step_, y_low_, axial_step_;
 };
 

@@ -1,4 +1,9 @@
+include(GNUInstallDirs)
+
 # arcwheel_add_library(NAME n SRCS ... DEPS ...): target arcwheel_<n>, alias arcwheel::<n>.
+# arcwheel_install_library(NAME n HEADERS ...): installs arcwheel_<n> as arcwheel::<n> of the
+#   arcwheel CMake package (cmake/ArcwheelPackage.cmake), and its public headers, the ones listed,
+#   under include/arcwheel/<n>/, where `#include "<n>/x.h"` finds them as in the source tree.
 # arcwheel_add_test(NAME n SRCS ... DEPS ... [SHARDS k] [COST s]): a GoogleTest binary registered with
 #   CTest as <folder>/<n>, or with SHARDS as <folder>/<n>/<i> for i < k, each running every k-th
 #   test (GoogleTest's sharding), so that CTest runs a long binary on both cores. COST (about the
@@ -29,9 +34,19 @@ function(arcwheel_add_library)
   cmake_parse_arguments(ARG "" "NAME" "SRCS;DEPS" ${ARGN})
   add_library(arcwheel_${ARG_NAME} STATIC ${ARG_SRCS})
   add_library(arcwheel::${ARG_NAME} ALIAS arcwheel_${ARG_NAME})
-  target_include_directories(arcwheel_${ARG_NAME} PUBLIC ${PROJECT_SOURCE_DIR} ${PROJECT_BINARY_DIR}/generated)
+  target_include_directories(arcwheel_${ARG_NAME} PUBLIC $<BUILD_INTERFACE:${PROJECT_SOURCE_DIR}>
+                             $<BUILD_INTERFACE:${PROJECT_BINARY_DIR}/generated>
+                             $<INSTALL_INTERFACE:${CMAKE_INSTALL_INCLUDEDIR}/arcwheel>)
   target_link_libraries(arcwheel_${ARG_NAME} PUBLIC ${ARG_DEPS})
   target_compile_options(arcwheel_${ARG_NAME} PRIVATE ${ARCWHEEL_WARNINGS})
+endfunction()
+
+function(arcwheel_install_library)
+  cmake_parse_arguments(ARG "" "NAME" "HEADERS" ${ARGN})
+  set_target_properties(arcwheel_${ARG_NAME} PROPERTIES EXPORT_NAME ${ARG_NAME})
+  install(TARGETS arcwheel_${ARG_NAME} EXPORT arcwheelTargets ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR})
+  install(FILES ${ARG_HEADERS} DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/arcwheel/${ARG_NAME})
+  set_property(GLOBAL APPEND PROPERTY ARCWHEEL_INSTALLED_LIBRARIES ${ARG_NAME})
 endfunction()
 
 function(arcwheel_add_test)

@@ -18,15 +18,6 @@ if(ARCWHEEL_BUILD_BENCHMARKS)
   find_package(benchmark REQUIRED)
 endif()
 
-# HDF5's CMake module exposes variables, not a target: wrap them once here.
-if(NOT TARGET arcwheel_hdf5)
-  add_library(arcwheel_hdf5 INTERFACE)
-  target_include_directories(arcwheel_hdf5 SYSTEM INTERFACE ${HDF5_C_INCLUDE_DIRS} ${HDF5_INCLUDE_DIRS})
-  target_link_libraries(arcwheel_hdf5 INTERFACE ${HDF5_C_LIBRARIES})
-  target_compile_definitions(arcwheel_hdf5 INTERFACE ${HDF5_C_DEFINITIONS} ${HDF5_DEFINITIONS})
-  add_library(arcwheel::hdf5 ALIAS arcwheel_hdf5)
-endif()
-
 # cairo draws the report plots to SVG, PNG and PDF from one drawing code (reports/).
 find_package(PkgConfig REQUIRED)
 pkg_check_modules(CAIRO REQUIRED IMPORTED_TARGET cairo)
@@ -35,8 +26,6 @@ pkg_check_modules(FFTW3 REQUIRED IMPORTED_TARGET fftw3)
 # FFTW's threads library (the same Debian package, no pkg-config file of its own): the large
 # transforms of the dwell solve run on every core.
 find_library(FFTW3_THREADS_LIBRARY fftw3_threads HINTS ${FFTW3_LIBRARY_DIRS} REQUIRED)
-if(NOT TARGET arcwheel_fftw3_threads)
-  add_library(arcwheel_fftw3_threads INTERFACE)
-  target_link_libraries(arcwheel_fftw3_threads INTERFACE ${FFTW3_THREADS_LIBRARY} PkgConfig::FFTW3 Threads::Threads)
-  add_library(arcwheel::fftw3_threads ALIAS arcwheel_fftw3_threads)
-endif()
+# HDF5's CMake module gives variables, FFTW's threads a bare library: wrap them as targets, the
+# same way here and in the installed package (arcwheelConfig.cmake).
+include(${CMAKE_CURRENT_LIST_DIR}/ArcwheelSystemTargets.cmake)

@@ -3,24 +3,15 @@
 #include <fmt/core.h>
 
 #include <filesystem>
-#include <future>
 #include <optional>
 #include <string>
-#include <utility>
 #include <vector>
 
-#include "acquisition/scan_reader.h"
 #include "cli/commands.h"
-#include "core/error.h"
-#include "core/interrupt.h"
 #include "core/progress.h"
-#include "core/sha256.h"
 #include "core/stage_clock.h"
-#include "core/text_encoding.h"
-#include "fitting/outputs.h"
-#include "fitting/wheel_fit.h"
+#include "fitting/process_pipeline.h"
 #include "fitting/wheel_model.h"
-#include "processing/process_scan.h"
 #include "reports/report.h"
 #include "reports/tolerances.h"
 #include "schema/summary.h"
@@ -32,60 +23,12 @@ namespace {
 struct ProcessArgs {
   std::string scan_path;
   std::string outdir;
-  processing::ProcessOptions processing;
-  fitting::WheelFitOptions fit;
-  fitting::WheelModelOptions model;
-  bool no_model = false;
-  std::string despike_method = "median";
-  std::string rpm_source = "auto";
-  std::string fit_span = "band";
+  fitting::ProcessPipelineOptions pipeline;
   std::vector<std::string> report_formats;
   std::string tolerance_file;
   bool quiet = false;
   bool timings = false;
 };
-
-fitting::RunRecord MakeRecord(const ProcessArgs& args, const acquisition::Scan& scan) {
-  fitting::RunRecord record;
-  // The path as the file system gives it may be in a legacy encoding; summary.json must stay UTF-8
-  // (docs/inputs.md).
-  bool latin1_path = false;
-  record.input_path = AsUtf8(args.scan_path, latin1_path);
-  const std::string extension = std::filesystem::path(args.scan_path).extension().string();
-  record.input_format = extension == ".h5" || extension == ".hdf5" ? "hdf5" : "csv";
-  record.metadata = scan.metadata;
-  record.has_encoder = scan.has_encoder();
-  const auto& p = args.processing;
-  namespace parameter = schema::summary::processing;
-  record.numeric_parameters = {
-      {std::string(parameter::kPhases), p.map.phases},
-      {std::string(parameter::kBandHalfWidthMm), args.fit.band_half_width_mm},
-      {std::string(parameter::kDespikeWindowHalfWidth), p.despike.window_half_width},
-      {std::string(parameter::kDespikeThresholdUm), p.despike.threshold_um},
-      {std::string(parameter::kDespikeThresholdSigmas), p.despike.threshold_sigmas},
-      {std::string(parameter::kDespikeMinThresholdUm), p.despike.min_threshold_um},
-      {std::string(parameter::kSpeedMaxHarmonic), p.speed.max_harmonic},
-      {std::string(parameter::kSpeedSignificanceSigmas), p.speed.significance_sigmas},
-      {std::string(parameter::kMapMinSupport), p.map.min_support},
-      {std::string(parameter::kMapMaxSigmaRatio), p.map.max_sigma_ratio},
-      {std::string(parameter::kFitMinPoints), args.fit.min_points},
-      {std::string(parameter::kFitMinBandCoverage), args.fit.min_band_coverage},
-      {std::string(parameter::kRunoutMinPhaseCoverage), args.fit.min_phase_coverage},
-      {std::string(parameter::kBeamOffsetMm), p.beam_offset_mm},
-      {std::string(parameter::kWheelRadiusMm), p.wheel_radius_mm},
-      {std::string(parameter::kStuckRunDeg), p.stuck_run_deg},
-      {std::string(parameter::kModelKnots), args.model.radius_knots},
-      {std::string(parameter::kModelAxialKnots), args.model.axial_knots},
-      {std::string(parameter::kModelRunoutKnots), args.model.runout_knots},
-      {std::string(parameter::kModelProfileStepMm), args.model.profile_knot_step_mm},
-  };
-  record.text_parameters = {{std::string(parameter::kDespikeMethod), args.despike_method},
-                            {std::string(parameter::kRpmSource), args.rpm_source},
-                            {std::string(parameter::kFitSpan), args.fit_span},
-                            {std::string(parameter::kFilter), "none"},
-                            {std::string(parameter::kModel), args.no_model ? "off" : "on"}};
-  return record;
-}
 
 void PrintHeadline(const ProcessArgs& args, const processing::ProcessedScan& p, const fitting::WheelFit& f) {
   const std::filesystem::path out(args.outdir);
@@ -108,43 +51,12 @@ void PrintHeadline(const ProcessArgs& args, const processing::ProcessedScan& p, 
   fmt::print("max roundness        {:.3f} um\n", f.max_roundness_um);
 }
 
-// The wheel model over every sample in the band (fitting/wheel_model.h). The per-phase fits are
-// the contract's results, so a model that cannot be fitted is a warning, not a failed run.
-std::optional<fitting::WheelModel> FitModelUnlessOff(const ProcessArgs& args, const acquisition::Scan& scan,
-                                                     processing::ProcessedScan& processed,
-                                                     const fitting::WheelFit& fit) {
-  if (args.no_model) return std::nullopt;
-  try {
-    const processing::HelixGeometry geometry(scan, processed.rpm_used);
-    return acquisition::VisitReadings(scan, [&](const auto& rho) {
-      return fitting::FitWheelModel(std::span(rho), geometry, processed.map, fit, args.model);
-    });
-  } catch (const Error& e) {
-    if (e.code() != ErrorCode::kFitFailed) throw;
-    processed.warnings.push_back(std::string("no wheel model: ") + e.what());
-    return std::nullopt;
-  }
-}
-
 void PrintModelHeadline(const fitting::WheelModel& m) {
   fmt::print("model arc radius     {:.5f} +- {:.5f} mm, range {:.5f} +- {:.5f} mm\n", m.mean_arc_radius_mm,
              m.mean_arc_radius_sigma_mm, m.arc_radius_range_mm, m.arc_radius_range_sigma_mm);
   fmt::print("model radius varies  {} (chi-square {:.1f} on {} dof, p = {:.2g}); knots Ra/a/b {}/{}/{}\n",
              m.variation_significant ? "yes" : "no", m.variation_chi2, m.variation_dof, m.variation_p_value,
              m.radius_knots, m.axial_knots, m.runout_knots);
-}
-
-// The value of a choice option, or a problem in the form of Problems(): "--flag = value violates
-// one of ...".
-template <typename Parse, typename Value>
-void ParseChoice(const char* flag, const std::string& text, const char* choices, Parse parse, Value& value,
-                 std::vector<std::string>& problems) {
-  try {
-    value = parse(text);
-  } catch (const Error& e) {
-    if (e.code() != ErrorCode::kInvalidOption) throw;
-    problems.push_back(fmt::format("{} = {} violates {}", flag, text, choices));
-  }
 }
 
 // One line per stage on stderr, so that the outputs and the headline stay as they are.
@@ -159,54 +71,13 @@ void PrintTimings(const StageClock& clock) {
 }
 
 void Run(ProcessArgs& args) {
-  // Every bad option of both stages in one message, before the scan is read: the fit's would
-  // otherwise surface only after the whole scan had been processed.
-  std::vector<std::string> problems;
-  ParseChoice("--despike", args.despike_method, "median, moving-mean or none", processing::ParseDespikeMethod,
-              args.processing.despike.method, problems);
-  ParseChoice("--rpm-source", args.rpm_source, "auto, nominal, encoder or estimate",
-              processing::ParseRpmSource, args.processing.rpm_source, problems);
-  ParseChoice("--fit-span", args.fit_span, "band or full", fitting::ParseFitSpan, args.fit.fit_span,
-              problems);
-  for (std::string& problem : args.processing.Problems()) problems.push_back(std::move(problem));
-  for (std::string& problem : args.fit.Problems()) problems.push_back(std::move(problem));
-  if (!args.no_model) {
-    for (std::string& problem : args.model.Problems()) problems.push_back(std::move(problem));
-  }
-  ThrowIfProblems(ErrorCode::kInvalidOption, "process", problems);
   Progress progress(!args.quiet);
-  progress.Update("reading", 0.0);
-  // ReadScan forks (an HDF5 file is read first in a child process, core/hdf5_child.cc), and no
-  // thread may be alive at fork(): the input's SHA-256 starts after it, on the second core while
-  // the first one processes.
-  StageClock clock;
-  clock.Start("reading");
-  acquisition::Scan scan = acquisition::ReadScan(args.scan_path, {.keep_float32 = true});
-  clock.Stop();
-  auto sha256 = std::async(std::launch::async, [path = args.scan_path] { return Sha256OfFile(path); });
-  fitting::RunRecord record = MakeRecord(args, scan);
-  ThrowIfInterrupted();
-  progress.Update("processing", 0.3);
-  processing::ProcessedScan processed = processing::ProcessScanInPlace(scan, args.processing);
-  clock.Append(processed.timings);
-  progress.Update("fitting", 0.7);
-  clock.Start("per-phase fits");
-  const fitting::WheelFit fit = fitting::FitWheel(processed.map, args.fit);
-  clock.Start("wheel model");
-  const std::optional<fitting::WheelModel> model = FitModelUnlessOff(args, scan, processed, fit);
-  clock.Start("releasing the samples");
-  scan = {};  // the samples are no longer needed
-  progress.Update("writing", 0.9);
-  clock.Start("waiting for the SHA-256");
-  record.input_sha256 = sha256.get();
-  ThrowIfInterrupted();
-  clock.Start("writing");
-  fitting::WriteProcessOutputs(args.outdir, record, processed, fit, model ? &*model : nullptr);
-  clock.Stop();
+  const fitting::ProcessPipelineResult result =
+      fitting::RunProcessPipeline(args.scan_path, args.outdir, args.pipeline, progress);
   progress.Done();
-  if (args.timings) PrintTimings(clock);
-  if (!args.quiet) PrintHeadline(args, processed, fit);
-  if (!args.quiet && model) PrintModelHeadline(*model);
+  if (args.timings) PrintTimings(result.clock);
+  if (!args.quiet) PrintHeadline(args, result.processed, result.fit);
+  if (!args.quiet && result.model) PrintModelHeadline(*result.model);
   if (!args.report_formats.empty()) {
     // The report is drawn from the files just written, exactly as `arcwheel report` would.
     reports::Tolerances tolerances;
@@ -235,15 +106,17 @@ void AddProcessCommand(CLI::App& app) {
       ->required()
       ->check(CLI::ExistingFile);
   cmd->add_option("-o,--output", args->outdir, "output folder")->required();
-  auto& p = args->processing;
+  auto& p = args->pipeline.processing;
   cmd->add_option("--phases", p.map.phases, "phase nodes per turn")->capture_default_str();
-  cmd->add_option("--band-half-width-mm", args->fit.band_half_width_mm, "half width of the grinding band")
+  cmd->add_option("--band-half-width-mm", args->pipeline.fit.band_half_width_mm,
+                  "half width of the grinding band")
       ->capture_default_str();
-  cmd->add_option("--fit-span", args->fit_span, "band: fit inside the band; full: the whole rim")
+  cmd->add_option("--fit-span", args->pipeline.fit_span, "band: fit inside the band; full: the whole rim")
       ->capture_default_str();
   cmd->add_option("--axial-step-mm", p.map.axial_step_mm, "map node spacing (default one helix pitch)");
   cmd->add_option("--knot-step-deg", p.map.knot_step_deg, "helix spline knot spacing (default 360/phases)");
-  cmd->add_option("--despike", args->despike_method, "median (burst-safe), moving-mean (the paper's), none")
+  cmd->add_option("--despike", args->pipeline.despike_method,
+                  "median (burst-safe), moving-mean (the paper's), none")
       ->capture_default_str();
   cmd->add_option("--despike-window", p.despike.window_half_width, "window half-width, samples")
       ->capture_default_str();
@@ -251,7 +124,7 @@ void AddProcessCommand(CLI::App& app) {
                   "rejection threshold (default: sigmas x noise)");
   cmd->add_option("--despike-sigmas", p.despike.threshold_sigmas, "automatic threshold in noise sigmas")
       ->capture_default_str();
-  cmd->add_option("--rpm-source", args->rpm_source, "auto, nominal, encoder or estimate")
+  cmd->add_option("--rpm-source", args->pipeline.rpm_source, "auto, nominal, encoder or estimate")
       ->capture_default_str();
   cmd->add_option("--stuck-run-deg", p.stuck_run_deg,
                   "drop runs of equal readings lasting this much of a turn (stuck sensor); 0 keeps them")
@@ -259,7 +132,7 @@ void AddProcessCommand(CLI::App& app) {
   cmd->add_option("--beam-offset-mm", p.beam_offset_mm, "correct a beam offset from the axis (method.md A.7)")
       ->capture_default_str();
   cmd->add_option("--wheel-radius-mm", p.wheel_radius_mm, "wheel radius for the beam-offset correction");
-  cmd->add_option("--min-points", args->fit.min_points, "fewest section points for a usable phase")
+  cmd->add_option("--min-points", args->pipeline.fit.min_points, "fewest section points for a usable phase")
       ->capture_default_str();
   cmd->add_option("--report", args->report_formats,
                   "also render the inspection report: html,pdf (both are written)")
@@ -268,19 +141,19 @@ void AddProcessCommand(CLI::App& app) {
   cmd->add_option("--tolerances", args->tolerance_file,
                   "tolerance file for the report's pass/fail (docs/reports.md)")
       ->check(CLI::ExistingFile);
-  cmd->add_option("--model-knots", args->model.radius_knots,
+  cmd->add_option("--model-knots", args->pipeline.model.radius_knots,
                   "knots per turn of the model's arc radius Ra(c); 0: chosen from the data, 1: constant")
       ->capture_default_str();
-  cmd->add_option("--model-axial-knots", args->model.axial_knots,
+  cmd->add_option("--model-axial-knots", args->pipeline.model.axial_knots,
                   "knots per turn of the model's arc-centre axial position a(c); 0: chosen, 1: constant")
       ->capture_default_str();
-  cmd->add_option("--model-runout-knots", args->model.runout_knots,
+  cmd->add_option("--model-runout-knots", args->pipeline.model.runout_knots,
                   "knots per turn of the model's arc-centre radial position b(c); 0: chosen")
       ->capture_default_str();
-  cmd->add_option("--model-profile-step-mm", args->model.profile_knot_step_mm,
+  cmd->add_option("--model-profile-step-mm", args->pipeline.model.profile_knot_step_mm,
                   "knot spacing of the model's common profile error p(u)")
       ->capture_default_str();
-  cmd->add_flag("--no-model", args->no_model, "skip the wheel model (docs/wheel_model.md)");
+  cmd->add_flag("--no-model", args->pipeline.no_model, "skip the wheel model (docs/wheel_model.md)");
   cmd->add_flag("-q,--quiet", args->quiet, "no progress and no headline");
   cmd->add_flag("--timings", args->timings, "print the wall time of each stage on stderr");
   cmd->callback([args] { Run(*args); });

@@ -1,0 +1,174 @@
+#include "fitting/process_pipeline.h"
+
+#include <fmt/core.h>
+
+#include <future>
+#include <span>
+#include <utility>
+#include <vector>
+
+#include "acquisition/scan_reader.h"
+#include "core/error.h"
+#include "core/interrupt.h"
+#include "core/sha256.h"
+#include "core/text_encoding.h"
+#include "processing/helix_geometry.h"
+#include "schema/summary.h"
+
+namespace arcwheel::fitting {
+namespace {
+
+RunRecord MakeRecord(const std::string& scan_path, const ProcessPipelineOptions& options,
+                     const acquisition::Scan& scan) {
+  RunRecord record;
+  // The path as the file system gives it may be in a legacy encoding; summary.json must stay UTF-8
+  // (docs/inputs.md).
+  bool latin1_path = false;
+  record.input_path = AsUtf8(scan_path, latin1_path);
+  const std::string extension = std::filesystem::path(scan_path).extension().string();
+  record.input_format = extension == ".h5" || extension == ".hdf5" ? "hdf5" : "csv";
+  record.metadata = scan.metadata;
+  record.has_encoder = scan.has_encoder();
+  const auto& p = options.processing;
+  namespace parameter = schema::summary::processing;
+  record.numeric_parameters = {
+      {std::string(parameter::kPhases), p.map.phases},
+      {std::string(parameter::kBandHalfWidthMm), options.fit.band_half_width_mm},
+      {std::string(parameter::kDespikeWindowHalfWidth), p.despike.window_half_width},
+      {std::string(parameter::kDespikeThresholdUm), p.despike.threshold_um},
+      {std::string(parameter::kDespikeThresholdSigmas), p.despike.threshold_sigmas},
+      {std::string(parameter::kDespikeMinThresholdUm), p.despike.min_threshold_um},
+      {std::string(parameter::kSpeedMaxHarmonic), p.speed.max_harmonic},
+      {std::string(parameter::kSpeedSignificanceSigmas), p.speed.significance_sigmas},
+      {std::string(parameter::kMapMinSupport), p.map.min_support},
+      {std::string(parameter::kMapMaxSigmaRatio), p.map.max_sigma_ratio},
+      {std::string(parameter::kFitMinPoints), options.fit.min_points},
+      {std::string(parameter::kFitMinBandCoverage), options.fit.min_band_coverage},
+      {std::string(parameter::kRunoutMinPhaseCoverage), options.fit.min_phase_coverage},
+      {std::string(parameter::kBeamOffsetMm), p.beam_offset_mm},
+      {std::string(parameter::kWheelRadiusMm), p.wheel_radius_mm},
+      {std::string(parameter::kStuckRunDeg), p.stuck_run_deg},
+      {std::string(parameter::kModelKnots), options.model.radius_knots},
+      {std::string(parameter::kModelAxialKnots), options.model.axial_knots},
+      {std::string(parameter::kModelRunoutKnots), options.model.runout_knots},
+      {std::string(parameter::kModelProfileStepMm), options.model.profile_knot_step_mm},
+  };
+  record.text_parameters = {{std::string(parameter::kDespikeMethod), options.despike_method},
+                            {std::string(parameter::kRpmSource), options.rpm_source},
+                            {std::string(parameter::kFitSpan), options.fit_span},
+                            {std::string(parameter::kFilter), "none"},
+                            {std::string(parameter::kModel), options.no_model ? "off" : "on"}};
+  return record;
+}
+
+// The wheel model over every sample in the band (fitting/wheel_model.h). The per-phase fits are
+// the contract's results, so a model that cannot be fitted is a warning, not a failed run.
+std::optional<WheelModel> FitModelUnlessOff(const ProcessPipelineOptions& options,
+                                            const acquisition::Scan& scan,
+                                            processing::ProcessedScan& processed, const WheelFit& fit) {
+  if (options.no_model) return std::nullopt;
+  try {
+    const processing::HelixGeometry geometry(scan, processed.rpm_used);
+    return acquisition::VisitReadings(scan, [&](const auto& rho) {
+      return FitWheelModel(std::span(rho), geometry, processed.map, fit, options.model);
+    });
+  } catch (const Error& e) {
+    if (e.code() != ErrorCode::kFitFailed) throw;
+    processed.warnings.push_back(std::string("no wheel model: ") + e.what());
+    return std::nullopt;
+  }
+}
+
+// The value of a choice option, or a problem in the form of Problems(): "--flag = value violates
+// one of ...".
+template <typename Parse, typename Value>
+void ParseChoice(const char* flag, const std::string& text, const char* choices, Parse parse, Value& value,
+                 std::vector<std::string>& problems) {
+  try {
+    value = parse(text);
+  } catch (const Error& e) {
+    if (e.code() != ErrorCode::kInvalidOption) throw;
+    problems.push_back(fmt::format("{} = {} violates {}", flag, text, choices));
+  }
+}
+
+// Everything after the scan is in memory. `sha256` delivers the input's hash (computed meanwhile
+// on another thread when the scan came from a file).
+ProcessPipelineResult RunOnScan(acquisition::Scan scan, const std::string& scan_path,
+                                std::future<std::string> sha256, const std::filesystem::path& outdir,
+                                const ProcessPipelineOptions& options, Progress& progress, StageClock clock) {
+  ProcessPipelineResult result;
+  result.record = MakeRecord(scan_path, options, scan);
+  ThrowIfInterrupted();
+  progress.Update("processing", 0.3);
+  result.processed = processing::ProcessScanInPlace(scan, options.processing);
+  clock.Append(result.processed.timings);
+  progress.Update("fitting", 0.7);
+  clock.Start("per-phase fits");
+  result.fit = FitWheel(result.processed.map, options.fit);
+  clock.Start("wheel model");
+  result.model = FitModelUnlessOff(options, scan, result.processed, result.fit);
+  clock.Start("releasing the samples");
+  scan = {};  // the samples are no longer needed
+  progress.Update("writing", 0.9);
+  clock.Start("waiting for the SHA-256");
+  result.record.input_sha256 = sha256.get();
+  ThrowIfInterrupted();
+  if (!outdir.empty()) {
+    clock.Start("writing");
+    WriteProcessOutputs(outdir, result.record, result.processed, result.fit,
+                        result.model ? &*result.model : nullptr);
+  }
+  clock.Stop();
+  result.clock = std::move(clock);
+  return result;
+}
+
+}  // namespace
+
+void ResolveProcessPipelineOptions(ProcessPipelineOptions& options) {
+  // Every bad option of both stages in one message, before the scan is read: the fit's would
+  // otherwise surface only after the whole scan had been processed.
+  std::vector<std::string> problems;
+  ParseChoice("--despike", options.despike_method, "median, moving-mean or none",
+              processing::ParseDespikeMethod, options.processing.despike.method, problems);
+  ParseChoice("--rpm-source", options.rpm_source, "auto, nominal, encoder or estimate",
+              processing::ParseRpmSource, options.processing.rpm_source, problems);
+  ParseChoice("--fit-span", options.fit_span, "band or full", ParseFitSpan, options.fit.fit_span, problems);
+  for (std::string& problem : options.processing.Problems()) problems.push_back(std::move(problem));
+  for (std::string& problem : options.fit.Problems()) problems.push_back(std::move(problem));
+  if (!options.no_model) {
+    for (std::string& problem : options.model.Problems()) problems.push_back(std::move(problem));
+  }
+  ThrowIfProblems(ErrorCode::kInvalidOption, "process", problems);
+}
+
+ProcessPipelineResult RunProcessPipeline(const std::string& scan_path, const std::filesystem::path& outdir,
+                                         ProcessPipelineOptions options, Progress& progress) {
+  ResolveProcessPipelineOptions(options);
+  progress.Update("reading", 0.0);
+  // ReadScan forks (an HDF5 file is read first in a child process, core/hdf5_child.cc), and no
+  // thread may be alive at fork(): the input's SHA-256 starts after it, on the second core while
+  // the first one processes.
+  StageClock clock;
+  clock.Start("reading");
+  acquisition::Scan scan = acquisition::ReadScan(scan_path, {.keep_float32 = true});
+  clock.Stop();
+  auto sha256 = std::async(std::launch::async, [scan_path] { return Sha256OfFile(scan_path); });
+  return RunOnScan(std::move(scan), scan_path, std::move(sha256), outdir, options, progress,
+                   std::move(clock));
+}
+
+ProcessPipelineResult RunProcessPipeline(acquisition::Scan scan, std::string input_sha256,
+                                         const std::filesystem::path& outdir, ProcessPipelineOptions options,
+                                         Progress& progress) {
+  ResolveProcessPipelineOptions(options);
+  // The readers validate what they read; a scan built in memory gets the same checks here.
+  acquisition::ValidateScan(scan);
+  std::promise<std::string> known;
+  known.set_value(std::move(input_sha256));
+  const std::string scan_path = scan.path;
+  return RunOnScan(std::move(scan), scan_path, known.get_future(), outdir, options, progress, StageClock{});
+}
+
+}  // namespace arcwheel::fitting

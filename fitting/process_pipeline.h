@@ -1,0 +1,64 @@
+#pragma once
+// The `arcwheel process` pipeline as one library call: read the scan, process it
+// (processing/process_scan.h), fit every phase (wheel_fit.h) and the wheel model (wheel_model.h),
+// and write summary.json and wheel_map.h5 (outputs.h). The command line and the Python module
+// both call it, so that there is one definition of what `process` computes and writes.
+
+#include <filesystem>
+#include <optional>
+#include <string>
+
+#include "acquisition/scan.h"
+#include "core/progress.h"
+#include "core/stage_clock.h"
+#include "fitting/outputs.h"
+#include "fitting/wheel_fit.h"
+#include "fitting/wheel_model.h"
+#include "processing/process_scan.h"
+
+namespace arcwheel::fitting {
+
+// Every option of `arcwheel process` that reaches the computation, at the command's defaults.
+struct ProcessPipelineOptions {
+  processing::ProcessOptions processing;
+  WheelFitOptions fit;
+  WheelModelOptions model;
+  bool no_model = false;  // skip the wheel model
+  // The choice options as the command line spells them: "median", "moving-mean" or "none";
+  // "auto", "nominal", "encoder" or "estimate"; "band" or "full". The pipeline parses them into
+  // the structs above (processing.despike.method, processing.rpm_source, fit.fit_span).
+  std::string despike_method = "median";
+  std::string rpm_source = "auto";
+  std::string fit_span = "band";
+};
+
+// Parses the choice options into the structs and checks every option of both stages (and of the
+// model unless no_model); throws one Error{kInvalidOption, "process"} listing every problem.
+void ResolveProcessPipelineOptions(ProcessPipelineOptions& options);
+
+struct ProcessPipelineResult {
+  RunRecord record;  // what summary.json says of the input and the parameters
+  processing::ProcessedScan processed;
+  WheelFit fit;
+  std::optional<WheelModel> model;  // empty with no_model, or when the model could not be fitted
+  StageClock clock;                 // wall time of each step (`arcwheel process --timings`)
+};
+
+// Reads the scan at `scan_path` (acquisition::ReadScan, float32 readings kept as float32),
+// hashes the file on a second thread meanwhile, and runs the pipeline. The record states
+// `scan_path` as given (converted to UTF-8). When `outdir` is not empty, writes
+// OUTDIR/summary.json and OUTDIR/wheel_map.h5 (WriteProcessOutputs: nothing partial on failure).
+// Throws Error: kInvalidOption for bad options (before the scan is read), kBadInput/kIo from the
+// reader, kFitFailed when no phase gives a usable fit, kInterrupted when a signal arrives
+// (core/interrupt.h).
+[[nodiscard]] ProcessPipelineResult RunProcessPipeline(const std::string& scan_path,
+                                                       const std::filesystem::path& outdir,
+                                                       ProcessPipelineOptions options, Progress& progress);
+
+// The same for a scan already in memory, e.g. a simulated one: nothing is read or hashed, and the
+// record states scan.path and `input_sha256` as given (empty when the samples came from no file).
+[[nodiscard]] ProcessPipelineResult RunProcessPipeline(acquisition::Scan scan, std::string input_sha256,
+                                                       const std::filesystem::path& outdir,
+                                                       ProcessPipelineOptions options, Progress& progress);
+
+}  // namespace arcwheel::fitting

@@ -35,6 +35,10 @@ void InstallInterruptHandlers() {
 
 bool InterruptRequested() noexcept { return g_interrupted != 0; }
 
+void RequestInterrupt() noexcept { g_interrupted = 1; }
+
+void ClearInterruptRequest() noexcept { g_interrupted = 0; }
+
 void ThrowIfInterrupted() {
   if (g_interrupted != 0) throw Error(ErrorCode::kInterrupted, "arcwheel", "interrupted by a signal");
 }

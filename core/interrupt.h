@@ -9,5 +9,10 @@ void InstallInterruptHandlers();
 [[nodiscard]] bool InterruptRequested() noexcept;
 // Throws Error{kInterrupted} once a signal has arrived.
 void ThrowIfInterrupted();
+// For a host that installs its own signal handlers (the Python module): sets the flag, as the
+// handlers above do (async-signal-safe, so a handler may call it) ...
+void RequestInterrupt() noexcept;
+// ... and lowers it once the interrupted work has unwound, so that the next call runs.
+void ClearInterruptRequest() noexcept;
 
 }  // namespace arcwheel

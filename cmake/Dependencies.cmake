@@ -11,6 +11,13 @@ find_package(Threads REQUIRED)
 find_package(Boost 1.74 REQUIRED)
 # OpenCV: only the Delaunay triangulation (cv::Subdiv2D) for scattered error maps (polishing/).
 find_package(OpenCV REQUIRED COMPONENTS core imgproc)
+if(ARCWHEEL_BUILD_PYTHON)
+  # Debian's interpreter, which has numpy, h5py and matplotlib (scripts/packages.txt); a python3
+  # earlier on the PATH (pyenv) may lack them.
+  set(Python3_EXECUTABLE /usr/bin/python3 CACHE FILEPATH "The Python interpreter the module is built for")
+  find_package(Python3 REQUIRED COMPONENTS Interpreter Development.Module)
+  find_package(pybind11 2.10 CONFIG REQUIRED)
+endif()
 if(ARCWHEEL_BUILD_TESTS)
   find_package(GTest REQUIRED)
 endif()

@@ -1,0 +1,214 @@
+// arcwheel.process: the `arcwheel process` pipeline (fitting/process_pipeline.h) with its results
+// as a dict of numpy arrays, and optionally the files the command writes.
+
+#include <cmath>
+#include <filesystem>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "core/progress.h"
+#include "fitting/outputs.h"
+#include "fitting/process_pipeline.h"
+#include "python/src/bindings.h"
+#include "reports/report.h"
+#include "reports/tolerances.h"
+#include "schema/summary.h"
+#include "schema/wheel_map.h"
+
+namespace arcwheel::python {
+namespace {
+
+using Options = fitting::ProcessPipelineOptions;
+namespace h5 = schema::wheel_map;
+
+// The options of `arcwheel process` that reach the computation, named as its flags in snake_case.
+const std::vector<OptionField<Options>>& ProcessFields() {
+  static const std::vector<OptionField<Options>> fields = {
+      Field<Options>(
+          "phases", [](Options & o) -> auto& { return o.processing.map.phases; }),
+      Field<Options>(
+          "band_half_width_mm", [](Options & o) -> auto& { return o.fit.band_half_width_mm; }),
+      Field<Options>(
+          "fit_span", [](Options & o) -> auto& { return o.fit_span; }),
+      Field<Options>(
+          "axial_step_mm", [](Options & o) -> auto& { return o.processing.map.axial_step_mm; }),
+      Field<Options>(
+          "knot_step_deg", [](Options & o) -> auto& { return o.processing.map.knot_step_deg; }),
+      Field<Options>(
+          "despike", [](Options & o) -> auto& { return o.despike_method; }),
+      Field<Options>(
+          "despike_window", [](Options & o) -> auto& { return o.processing.despike.window_half_width; }),
+      Field<Options>(
+          "despike_threshold_um", [](Options & o) -> auto& { return o.processing.despike.threshold_um; }),
+      Field<Options>(
+          "despike_sigmas", [](Options & o) -> auto& { return o.processing.despike.threshold_sigmas; }),
+      Field<Options>(
+          "rpm_source", [](Options & o) -> auto& { return o.rpm_source; }),
+      Field<Options>(
+          "stuck_run_deg", [](Options & o) -> auto& { return o.processing.stuck_run_deg; }),
+      Field<Options>(
+          "beam_offset_mm", [](Options & o) -> auto& { return o.processing.beam_offset_mm; }),
+      Field<Options>(
+          "wheel_radius_mm", [](Options & o) -> auto& { return o.processing.wheel_radius_mm; }),
+      Field<Options>(
+          "min_points", [](Options & o) -> auto& { return o.fit.min_points; }),
+      Field<Options>(
+          "model_knots", [](Options & o) -> auto& { return o.model.radius_knots; }),
+      Field<Options>(
+          "model_axial_knots", [](Options & o) -> auto& { return o.model.axial_knots; }),
+      Field<Options>(
+          "model_runout_knots", [](Options & o) -> auto& { return o.model.runout_knots; }),
+      Field<Options>(
+          "model_profile_step_mm", [](Options & o) -> auto& { return o.model.profile_knot_step_mm; }),
+      Field<Options>(
+          "no_model", [](Options & o) -> auto& { return o.no_model; }),
+  };
+  return fields;
+}
+
+// The name of a dataset inside its group: "/map/rho" -> "rho".
+py::str Leaf(std::string_view dataset) { return std::string(dataset.substr(dataset.rfind('/') + 1)); }
+
+py::dict MapArrays(processing::WheelMap& map, std::vector<double>&& form_error_um) {
+  const auto n_phase = static_cast<py::ssize_t>(map.n_phase());
+  const auto n_y = static_cast<py::ssize_t>(map.n_y());
+  py::dict d;
+  d[Leaf(h5::kMapPhaseDeg)] = ToNumpy(std::move(map.phase_deg));
+  d[Leaf(h5::kMapYMm)] = ToNumpy(std::move(map.y_mm));
+  d[Leaf(h5::kMapRhoMm)] = ToNumpy(std::move(map.rho_mm), {n_phase, n_y});
+  d[Leaf(h5::kMapFormErrorUm)] = ToNumpy(std::move(form_error_um), {n_phase, n_y});
+  d[Leaf(h5::kMapSampleCount)] = ToNumpy(std::move(map.sample_count), {n_phase, n_y});
+  d[Leaf(h5::kMapDespikedCount)] = ToNumpy(std::move(map.despiked_count), {n_phase, n_y});
+  return d;
+}
+
+// wheel_map.h5's /fit: NaN where a phase is not usable, as the file has it; plus the phase nodes,
+// chi2_per_dof and the flags that summary.json carries.
+py::dict FitArrays(const std::vector<double>& phase_deg, const fitting::WheelFit& fit) {
+  const auto column = [&](auto member) {
+    std::vector<double> values;
+    for (const fitting::PhaseFit& p : fit.phases) values.push_back(p.usable ? p.*member : std::nan(""));
+    return ToNumpy(std::move(values));
+  };
+  py::dict d;
+  d["phase_deg"] = ToNumpy(phase_deg);
+  d[Leaf(h5::kFitArcRadiusMm)] = column(&fitting::PhaseFit::arc_radius_mm);
+  d[Leaf(h5::kFitArcRadiusSigmaMm)] = column(&fitting::PhaseFit::arc_radius_sigma_mm);
+  d[Leaf(h5::kFitCenterAxialMm)] = column(&fitting::PhaseFit::center_axial_mm);
+  d[Leaf(h5::kFitCenterAxialSigmaMm)] = column(&fitting::PhaseFit::center_axial_sigma_mm);
+  d[Leaf(h5::kFitCenterRadialMm)] = column(&fitting::PhaseFit::center_radial_mm);
+  d[Leaf(h5::kFitCenterRadialSigmaMm)] = column(&fitting::PhaseFit::center_radial_sigma_mm);
+  d[Leaf(h5::kFitArcErrorUm)] = column(&fitting::PhaseFit::arc_error_um);
+  d["chi2_per_dof"] = column(&fitting::PhaseFit::chi2_per_dof);
+  std::vector<int> points;
+  std::vector<std::string> flags;
+  py::array_t<bool> usable(static_cast<py::ssize_t>(fit.phases.size()));
+  for (std::size_t i = 0; i < fit.phases.size(); ++i) {
+    points.push_back(fit.phases[i].points);
+    flags.push_back(fit.phases[i].flag);
+    usable.mutable_at(static_cast<py::ssize_t>(i)) = fit.phases[i].usable;
+  }
+  d[Leaf(h5::kFitPointsInBand)] = ToNumpy(std::move(points));
+  d[Leaf(h5::kFitUsable)] = usable;
+  d["flag"] = flags;
+  return d;
+}
+
+py::dict AxialArrays(fitting::WheelFit& fit) {
+  py::dict d;
+  d[Leaf(h5::kAxialYMm)] = ToNumpy(std::move(fit.axial_y_mm));
+  d[Leaf(h5::kAxialRunoutUm)] = ToNumpy(std::move(fit.runout_um));
+  d[Leaf(h5::kAxialRoundnessUm)] = ToNumpy(std::move(fit.roundness_um));
+  return d;
+}
+
+// wheel_map.h5's /model arrays, on the map's phase nodes.
+py::dict ModelArrays(fitting::WheelModel& m, py::ssize_t n_phase, py::ssize_t n_y) {
+  py::dict d;
+  d["phase_deg"] = ToNumpy(std::move(m.phase_deg));
+  d[Leaf(h5::kModelArcRadiusMm)] = ToNumpy(std::move(m.arc_radius_mm));
+  d[Leaf(h5::kModelArcRadiusSigmaMm)] = ToNumpy(std::move(m.arc_radius_sigma_mm));
+  d[Leaf(h5::kModelCenterAxialMm)] = ToNumpy(std::move(m.center_axial_mm));
+  d[Leaf(h5::kModelCenterAxialSigmaMm)] = ToNumpy(std::move(m.center_axial_sigma_mm));
+  d[Leaf(h5::kModelCenterRadialMm)] = ToNumpy(std::move(m.center_radial_mm));
+  d[Leaf(h5::kModelCenterRadialSigmaMm)] = ToNumpy(std::move(m.center_radial_sigma_mm));
+  d[Leaf(h5::kModelProfileUMm)] = ToNumpy(std::move(m.profile_u_mm));
+  d[Leaf(h5::kModelProfileErrorUm)] = ToNumpy(std::move(m.profile_error_um));
+  d[Leaf(h5::kModelProfileErrorSigmaUm)] = ToNumpy(std::move(m.profile_error_sigma_um));
+  if (m.residual_um.size() == static_cast<std::size_t>(n_phase * n_y)) {
+    d[Leaf(h5::kModelResidualUm)] = ToNumpy(std::move(m.residual_um), {n_phase, n_y});
+  }
+  const auto n = static_cast<py::ssize_t>(m.coefficients.size());
+  d[Leaf(h5::kModelCoefficients)] = ToNumpy(std::move(m.coefficients));
+  d[Leaf(h5::kModelCovariance)] = ToNumpy(std::move(m.covariance), {n, n});
+  return d;
+}
+
+// The pieces arcwheel.Result is made of (arcwheel/__init__.py).
+py::dict ResultDict(fitting::ProcessPipelineResult& r) {
+  const fitting::WheelModel* model = r.model && r.model->fitted ? &*r.model : nullptr;
+  py::dict d;
+  d["summary"] = ParseJson(fitting::SummaryJson(r.record, r.processed, r.fit, model));
+  const auto n_phase = static_cast<py::ssize_t>(r.processed.map.n_phase());
+  const auto n_y = static_cast<py::ssize_t>(r.processed.map.n_y());
+  d["fits"] = FitArrays(r.processed.map.phase_deg, r.fit);
+  d["map"] = MapArrays(r.processed.map, std::move(r.fit.form_error_um));
+  d["axial"] = AxialArrays(r.fit);
+  d["model"] = model != nullptr ? py::object(ModelArrays(*r.model, n_phase, n_y)) : py::none();
+  py::list timings;
+  for (const StageClock::Stage& stage : r.clock.stages())
+    timings.append(py::make_tuple(stage.name, stage.seconds));
+  d["timings"] = timings;
+  return d;
+}
+
+// The inspection report of `arcwheel process --report`, drawn from the files just written.
+void WriteReport(const std::filesystem::path& outdir,
+                 const std::optional<std::filesystem::path>& tolerance_file) {
+  reports::Tolerances tolerances;
+  if (tolerance_file) tolerances = reports::ReadTolerances(*tolerance_file);
+  (void)reports::WriteReports(outdir, tolerances);
+}
+
+py::dict Process(const py::object& scan_or_path, const std::optional<std::filesystem::path>& output_dir,
+                 bool report, const std::optional<std::filesystem::path>& tolerances,
+                 const py::kwargs& kwargs) {
+  Options options;
+  ApplyOptions(ProcessFields(), kwargs, options, "process");
+  if ((report || tolerances) && !output_dir) {
+    throw Error(ErrorCode::kInvalidOption, "process", "report and tolerances need output_dir");
+  }
+  const std::filesystem::path outdir = output_dir.value_or(std::filesystem::path());
+  fitting::ProcessPipelineResult result;
+  if (py::isinstance<acquisition::Scan>(scan_or_path)) {
+    // The pipeline works on the readings in place: it gets a copy, and the caller keeps the scan.
+    acquisition::Scan scan = scan_or_path.cast<const acquisition::Scan&>();
+    result = RunReleased([&] {
+      Progress quiet(false);
+      return fitting::RunProcessPipeline(std::move(scan), "", outdir, options, quiet);
+    });
+  } else {
+    const std::string path = py::str(py::module_::import("os").attr("fspath")(scan_or_path));
+    result = RunReleased([&] {
+      Progress quiet(false);
+      return fitting::RunProcessPipeline(path, outdir, options, quiet);
+    });
+  }
+  if (report)
+    RunReleased([&] {
+      WriteReport(outdir, tolerances);
+      return 0;
+    });
+  return ResultDict(result);
+}
+
+}  // namespace
+
+void BindProcess(py::module_& module) {
+  module.def("_process", &Process, py::arg("scan_or_path"), py::kw_only(), py::arg("output_dir") = py::none(),
+             py::arg("report") = false, py::arg("tolerances") = py::none());
+  module.attr("PROCESS_OPTIONS") = Defaults(ProcessFields());
+}
+
+}  // namespace arcwheel::python

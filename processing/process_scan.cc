@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "core/error.h"
+#include "core/free_memory.h"
 #include "core/interrupt.h"
 #include "processing/noise.h"
 #include "processing/stuck_readings.h"
@@ -226,6 +227,7 @@ ProcessedScan ProcessReadings(acquisition::Scan& scan, std::vector<T>& rho, cons
   ChooseSpeed(scan, std::span<const T>(rho), options, out);
   ThrowIfInterrupted();
 
+  ReturnFreedMemory();  // the speed estimate's and the despiker's arrays
   const HelixGeometry geometry(scan, out.rpm_used);
   out.map = BuildWheelMap(std::span<const T>(rho), geometry, out.noise_sigma_mm, out.despike.indices,
                           options.map, &clock);

@@ -6,6 +6,7 @@
 #include <numbers>
 #include <numeric>
 #include <random>
+#include <span>
 #include <vector>
 
 #include "processing/banded_spd.h"
@@ -39,12 +40,75 @@ TEST(BandedSpd, SolveAndSelectedInverseMatchADenseInverse) {
                   1e-13);
     }
   }
+  // b^T A^-1 b, whole and in blocks of rows (the same numbers in the same order).
+  std::vector<double> q(n);
+  Eigen::VectorXd q_dense(n);
+  for (std::size_t i = 0; i < n; ++i) q_dense(static_cast<Eigen::Index>(i)) = q[i] = unit(rng);
+  std::vector<double> whole = q;
+  const double form = banded.InverseQuadraticForm(whole);
+  EXPECT_NEAR(form, q_dense.dot(inverse * q_dense), 1e-13 * form);
+  for (const std::size_t block_rows : {1u, 2u, 3u, 7u, 39u, 40u}) {
+    std::vector<double> blocks = q;
+    BandedSpd::ForwardPass pass;
+    for (std::size_t first = 0; first < n; first += block_rows) {
+      banded.InverseQuadraticFormRows(std::span(blocks).subspan(first, std::min(block_rows, n - first)),
+                                      pass);
+    }
+    EXPECT_EQ(pass.next_row, n);
+    EXPECT_EQ(pass.sum, form) << "blocks of " << block_rows;
+  }
   std::vector<double> b(n);
   Eigen::VectorXd rhs(n);
   for (std::size_t i = 0; i < n; ++i) rhs(static_cast<Eigen::Index>(i)) = b[i] = unit(rng);
   banded.Solve(b);
   const Eigen::VectorXd x = dense.ldlt().solve(rhs);
   for (std::size_t i = 0; i < n; ++i) EXPECT_NEAR(b[i], x(static_cast<Eigen::Index>(i)), 1e-13);
+}
+
+TEST(BandedSpd, SweepInBlocksGivesEveryEntryOfTheSelectedInverseOnce) {
+  const std::size_t n = 23;
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> unit(-1.0, 1.0);
+  Eigen::MatrixXd dense = Eigen::MatrixXd::Zero(n, n);
+  BandedSpd banded(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    for (std::size_t j = i; j <= std::min(n - 1, i + 3); ++j) {
+      const double v = i == j ? 8.0 + unit(rng) : unit(rng);
+      dense(static_cast<Eigen::Index>(i), static_cast<Eigen::Index>(j)) = v;
+      dense(static_cast<Eigen::Index>(j), static_cast<Eigen::Index>(i)) = v;
+      banded.Add(i, j, v);
+    }
+  }
+  ASSERT_TRUE(banded.Factorize());
+  const Eigen::MatrixXd inverse = dense.inverse();
+  banded.ComputeSelectedInverse();
+  // Block sizes below, at and beyond the band and the size, and one that leaves a short last block.
+  for (const std::size_t block_rows : {1u, 2u, 3u, 4u, 5u, 22u, 23u, 40u}) {
+    std::vector<int> visits(n, 0);
+    std::size_t expected_end = n;
+    banded.SweepSelectedInverse(block_rows, [&](const BandedSpd::InverseBlock& block) {
+      EXPECT_EQ(block.end, expected_end) << "blocks run downwards without gaps";
+      EXPECT_LT(block.first, block.end);
+      EXPECT_LE(block.end - block.first, block_rows);
+      expected_end = block.first;
+      for (std::size_t i = block.first; i < block.end; ++i) {
+        ++visits[i];
+        for (int d = 0; d <= 3 && i + static_cast<std::size_t>(d) < n; ++d) {
+          const auto j = static_cast<Eigen::Index>(i) + d;
+          EXPECT_NEAR(block.InverseInBand(i, d), inverse(static_cast<Eigen::Index>(i), j), 1e-13);
+          // The same recurrence in the same order: the numbers of the whole computation.
+          EXPECT_EQ(block.InverseInBand(i, d), banded.InverseInBand(i, d)) << i << ", " << d;
+        }
+      }
+      // The three rows above the block are still readable (a spline value needs four rows).
+      for (std::size_t i = block.end; i < std::min(n, block.end + 3); ++i) {
+        EXPECT_EQ(block.InverseInBand(i, 0), banded.InverseInBand(i, 0)) << "row " << i;
+      }
+    });
+    EXPECT_EQ(expected_end, 0u);
+    for (std::size_t i = 0; i < n; ++i)
+      EXPECT_EQ(visits[i], 1) << "row " << i << ", blocks of " << block_rows;
+  }
 }
 
 TEST(NaturalCubicSpline, InterpolatesItsPointsAndIsExactForStraightLines) {

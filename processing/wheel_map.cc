@@ -141,7 +141,10 @@ class CellOfSample {
     if (!(t > -0.5) || !(t < static_cast<double>(n_y_))) return -1;  // round(-0.4) is -0: row 0
     const long m = RoundHalfAway(t);
     if (m >= n_y_) return -1;
-    const long j = RoundHalfAway(PhaseInTurn(u_deg) / phase_step_) % n_phase_;
+    // The phase in the turn lies in [0, 360): its node is 0 .. n_phase, and n_phase is node 0
+    // (a comparison instead of a 64-bit division per sample).
+    long j = RoundHalfAway(PhaseInTurn(u_deg) / phase_step_);
+    if (j == n_phase_) j = 0;
     return j * n_y_ + m;
   }
 

@@ -65,11 +65,10 @@ void CheckOptions(const acquisition::Scan& scan, const ProcessOptions& options) 
   }
 }
 
-// Step 1: the valid samples and the span from the first to the last of them.
+// Step 1: the span from the first to the last valid sample (DropStuckSensorRuns counts them).
 template <typename T>
 void FindValidSpan(const std::vector<T>& rho, ProcessedScan& out) {
   const auto finite = [](T v) { return std::isfinite(static_cast<double>(v)); };
-  out.valid_samples = static_cast<std::size_t>(std::count_if(rho.begin(), rho.end(), finite));
   const auto first = std::find_if(rho.begin(), rho.end(), finite);
   const auto last = std::find_if(rho.rbegin(), rho.rend(), finite);
   out.first_valid = static_cast<std::size_t>(first - rho.begin());
@@ -81,6 +80,7 @@ template <typename T>
 void DropStuckSensorRuns(const acquisition::Scan& scan, std::vector<T>& rho, double stuck_run_deg,
                          ProcessedScan& out) {
   out.stuck = DropStuckReadings(rho, StuckRunSamples(scan, stuck_run_deg));
+  out.valid_samples = out.stuck.valid;
   if (out.stuck.dropped > 0 && out.stuck.dropped == out.valid_samples) {
     throw Error(
         ErrorCode::kBadInput, kStage,

@@ -14,6 +14,7 @@
 #include "processing/cubic_interpolation.h"
 #include "processing/despike.h"
 #include "processing/noise.h"
+#include "processing/stuck_readings.h"
 
 namespace arcwheel::processing {
 namespace {
@@ -165,6 +166,65 @@ TEST(Noise, IsTheMedianAbsoluteDeviationOfTheSecondDifferences) {
     for (std::size_t i = 7; i < n; i += 101) quantised[i] = kNaN;
     EXPECT_EQ(EstimateNoiseSigmaMm(z), NoiseByDefinition(z)) << n;
     EXPECT_EQ(EstimateNoiseSigmaMm(quantised), NoiseByDefinition(quantised)) << n;
+  }
+}
+
+// Runs of equal valid readings by their definition: one pass that ends a run at each change.
+StuckReadingsResult StuckRunsByDefinition(std::vector<double>& z, std::size_t min_run) {
+  StuckReadingsResult r;
+  r.min_run = min_run;
+  std::size_t start = 0;
+  for (std::size_t i = 1; i <= z.size(); ++i) {
+    if (i < z.size() && std::isfinite(z[start]) && z[i] == z[start]) continue;
+    if (std::isfinite(z[start])) {
+      r.valid += i - start;
+      if (min_run >= 2 && i - start >= min_run) {
+        for (std::size_t k = start; k < i; ++k) z[k] = kNaN;
+        r.dropped += i - start;
+        ++r.runs;
+        r.longest_run = std::max(r.longest_run, i - start);
+      }
+    }
+    start = i;
+  }
+  return r;
+}
+
+TEST(StuckReadings, DropsTheSameRunsAsOnePassWhereverTheMiddleFalls) {
+  // Runs across the middle, ending and starting at it, a scan that is one run, invalid samples
+  // inside and beside runs, and -0 beside +0 (equal readings).
+  std::vector<std::vector<double>> scans;
+  std::mt19937 rng(14);
+  std::uniform_int_distribution<int> level(0, 2);
+  for (std::size_t n : {1u, 2u, 7u, 40u, 41u, 1000u}) {
+    std::vector<double> z(n);
+    for (double& v : z) v = 0.001 * level(rng);
+    scans.push_back(z);
+  }
+  std::vector<double> across(100, 0.5);
+  for (std::size_t i = 0; i < 30; ++i) across[i] = 0.001 * static_cast<double>(i);
+  scans.push_back(across);                        // a run from 30 to the end, through the middle
+  scans.push_back(std::vector<double>(64, 2.0));  // one run
+  std::vector<double> gaps(90, 1.0);
+  gaps[45] = kNaN;
+  gaps[44] = -0.0;
+  gaps[43] = 0.0;
+  gaps[46] = std::numeric_limits<double>::infinity();
+  scans.push_back(gaps);
+  for (const std::size_t min_run : {0u, 2u, 3u, 16u}) {
+    for (const std::vector<double>& scan : scans) {
+      std::vector<double> expected_z = scan, z = scan;
+      const StuckReadingsResult expected = StuckRunsByDefinition(expected_z, min_run);
+      const StuckReadingsResult got = DropStuckReadings(z, min_run);
+      EXPECT_EQ(got.dropped, expected.dropped) << scan.size() << ", " << min_run;
+      EXPECT_EQ(got.runs, expected.runs) << scan.size() << ", " << min_run;
+      EXPECT_EQ(got.longest_run, expected.longest_run) << scan.size() << ", " << min_run;
+      EXPECT_EQ(got.valid, expected.valid) << scan.size() << ", " << min_run;
+      EXPECT_EQ(got.min_run, min_run);
+      for (std::size_t i = 0; i < z.size(); ++i) {
+        EXPECT_EQ(std::isnan(z[i]), std::isnan(expected_z[i])) << "sample " << i << " of " << z.size();
+      }
+    }
   }
 }
 

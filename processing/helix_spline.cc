@@ -234,17 +234,20 @@ int HelixSpline::Support(double u) const {
   return count;
 }
 
-double HelixSpline::CovarianceFactorOfSum(const std::function<void(const TermSink&)>& terms) const {
+double HelixSpline::CovarianceFactorOfSum(const std::function<void(const TermSink&)>& terms,
+                                          std::size_t block_rows) const {
   // v = sum_k w_k b(u_k) goes forward through the factor a block of rows at a time, each block
-  // summed from its own pass over the terms: no vector as long as the spline is held beside the
-  // callers' terms (6 MB at 1e8 samples). Each entry of v sums its terms in their order, as a whole
-  // vector would.
-  constexpr std::size_t kBlockRows = std::size_t{1} << 17;
+  // summed from its own pass over the terms: on a long spline no vector as long as it is held
+  // beside the callers' terms (6 MB at 1e8 samples), for a pass over the terms per block (about
+  // 10 ms at 1e7 samples, where v is held whole). Each entry of v sums its terms in their order, as
+  // a whole vector would.
   const std::size_t n = normal_.size();
-  std::vector<double> v(std::min(n, kBlockRows));
+  if (block_rows == 0) block_rows = n <= (std::size_t{1} << 19) ? n : std::size_t{1} << 17;
+  block_rows = std::max<std::size_t>(1, block_rows);
+  std::vector<double> v(std::min(n, block_rows));
   BandedSpd::ForwardPass pass;
-  for (std::size_t first = 0; first < n; first += kBlockRows) {
-    const std::size_t end = std::min(n, first + kBlockRows);
+  for (std::size_t first = 0; first < n; first += block_rows) {
+    const std::size_t end = std::min(n, first + block_rows);
     std::fill(v.begin(), v.end(), 0.0);
     terms([&](double u, double weight) {
       const Basis b = BasisAt(u);

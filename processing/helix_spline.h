@@ -46,7 +46,11 @@ class HelixSpline {
   // sum_a sum_b w_a w_b Cov(g(u_a), g(u_b)) / sigma^2 for the (u, w) pairs that `terms` passes to
   // the function it is given: one forward pass of the banded factor.
   using TermSink = std::function<void(double u_deg, double weight)>;
-  [[nodiscard]] double CovarianceFactorOfSum(const std::function<void(const TermSink&)>& terms) const;
+  // `block_rows` > 0 passes the sum through the factor in blocks of that many rows, one pass over
+  // the terms each (the same number); 0 holds it whole up to 2^19 rows (4 MB) and in blocks of
+  // 2^17 beyond, where the spline is long and the callers' terms are many.
+  [[nodiscard]] double CovarianceFactorOfSum(const std::function<void(const TermSink&)>& terms,
+                                             std::size_t block_rows = 0) const;
   // Frees what only Value() and Support() read, the coefficients and the cell counts (8 MB at 1e8
   // samples), when a wheel map has taken its sections: it keeps the spline for the variances.
   void ReleaseValues();

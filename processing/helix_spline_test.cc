@@ -169,6 +169,17 @@ TEST(HelixSpline, AgreesWithADenseQrSolveOfTheSamePenalisedProblem) {
     for (const auto& [u, w] : terms) add(u, w);
   });
   EXPECT_NEAR(factor, expected, 1e-10 * expected);
+  // In blocks of rows, down to one row a block (the terms' basis rows straddle the blocks): the
+  // same sums in the same order.
+  for (const std::size_t block_rows : {1u, 2u, 5u, 64u}) {
+    EXPECT_EQ(spline.CovarianceFactorOfSum(
+                  [&](const HelixSpline::TermSink& add) {
+                    for (const auto& [u, w] : terms) add(u, w);
+                  },
+                  block_rows),
+              factor)
+        << "blocks of " << block_rows;
+  }
 }
 
 TEST(HelixSpline, SupportCountsTheValidSamplesInTheTwoNearestKnotIntervals) {

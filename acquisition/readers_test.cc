@@ -3,6 +3,7 @@
 
 #include <cmath>
 #include <fstream>
+#include <limits>
 #include <nlohmann/json.hpp>
 
 #include "acquisition/scan_reader.h"
@@ -128,6 +129,23 @@ TEST(Readers, ShippedPaperScanMatchesItsTruthFile) {
   EXPECT_EQ(*scan.metadata.spindle_rpm, truth["settings"]["spindle_rpm_nominal"].get<double>());
   EXPECT_EQ(*scan.metadata.sample_period_s, truth["settings"]["sample_period_s"].get<double>());
   EXPECT_EQ(*scan.metadata.feed_mm_per_min, truth["settings"]["feed_mm_per_min"].get<double>());
+}
+
+TEST(Scan, WideningToDoubleKeepsTheReadingsAndFreesTheFloats) {
+  Scan scan;
+  scan.z_float_mm = {1.5f, std::numeric_limits<float>::quiet_NaN(), -0.25f, 1e-7f};
+  const std::vector<float> floats = scan.z_float_mm;
+  scan.WidenToDouble();
+  ASSERT_EQ(scan.z_mm.size(), floats.size());
+  for (std::size_t i = 0; i < floats.size(); ++i) {
+    if (std::isnan(floats[i])) {
+      EXPECT_TRUE(std::isnan(scan.z_mm[i]));
+    } else {
+      EXPECT_EQ(scan.z_mm[i], static_cast<double>(floats[i]));
+    }
+  }
+  EXPECT_FALSE(scan.holds_float());
+  EXPECT_EQ(scan.z_float_mm.capacity(), 0u);  // the float copy's memory is given back
 }
 
 }  // namespace

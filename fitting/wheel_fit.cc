@@ -5,13 +5,16 @@
 #include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 #include <numbers>
 #include <numeric>
 #include <span>
 #include <utility>
 
+#include "core/check.h"
 #include "core/error.h"
+#include "core/free_memory.h"
 #include "core/interrupt.h"
 #include "core/parallel.h"
 #include "fitting/circle_fit.h"
@@ -22,11 +25,16 @@ namespace {
 constexpr const char* kStage = "fitting";
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
+// What the means and their sigmas need of one phase's fit. Of the circle's sensitivities only
+// the two rows the sigmas of the means propagate are kept (8 MB at 1e8 samples instead of 17).
 struct PhaseSolution {
   PhaseFit fit;
-  CircleFit circle;
-  std::vector<double> u_deg;  // helix points used, for propagation
+  std::vector<std::uint32_t> points;  // the section's points in the fit, by index
+  // Rows: d(centre axial)/d(rho_k), d(radius)/d(rho_k) for the points in that order.
+  Eigen::Matrix<double, 2, Eigen::Dynamic> sensitivity;
 };
+constexpr int kAxialRow = 0;
+constexpr int kRadiusRow = 1;
 
 // The section's covariance from the points' own sigmas (noise along rho, independent between
 // turns) through the fit's first-order sensitivity: C = S diag(sigma^2) S^T; chi2 with the same
@@ -66,6 +74,7 @@ void SetPhaseFit(const CircleFit& c, PhaseFit& fit) {
 // Fits the section's points with |y - center| <= half (all points for FitSpan::kFull).
 PhaseSolution FitSection(const processing::Section& section, double center_mm, double half_mm, bool full,
                          const WheelFitOptions& options) {
+  ARCWHEEL_CHECK(section.y_mm.size() <= UINT32_MAX) << section.y_mm.size() << " section points";
   PhaseSolution out;
   std::vector<double> y, rho, sigma;
   for (std::size_t k = 0; k < section.y_mm.size(); ++k) {
@@ -73,7 +82,7 @@ PhaseSolution FitSection(const processing::Section& section, double center_mm, d
     y.push_back(section.y_mm[k]);
     rho.push_back(section.rho_mm[k]);
     sigma.push_back(section.sigma_mm[k]);
-    out.u_deg.push_back(section.u_deg[k]);
+    out.points.push_back(static_cast<std::uint32_t>(k));
   }
   PhaseFit& fit = out.fit;
   fit.points = static_cast<int>(y.size());
@@ -87,13 +96,18 @@ PhaseSolution FitSection(const processing::Section& section, double center_mm, d
     return out;
   }
   // The section's circle is the unweighted geometric least-squares circle (formats.md 3.1).
-  out.circle = FitCircle(y, rho, {}, options.circle);
-  if (!out.circle.IsUsable()) {
-    fit.flag = out.circle.message;
+  CircleFit circle = FitCircle(y, rho, {}, options.circle);
+  if (!circle.IsUsable()) {
+    fit.flag = circle.message;
     return out;
   }
-  PropagatePointSigmas(y, rho, sigma, out.circle);
-  SetPhaseFit(out.circle, fit);
+  PropagatePointSigmas(y, rho, sigma, circle);
+  SetPhaseFit(circle, fit);
+  if (fit.usable) {
+    out.sensitivity.resize(2, circle.sensitivity_to_y.cols());
+    out.sensitivity.row(kAxialRow) = circle.sensitivity_to_y.row(0);
+    out.sensitivity.row(kRadiusRow) = circle.sensitivity_to_y.row(2);
+  }
   return out;
 }
 
@@ -104,16 +118,19 @@ double Median(std::vector<double> values) {
   return *middle;
 }
 
-// Variance of the mean of parameter `row` over the usable phases, exactly through the helix
-// spline (neighbouring phases share spline coefficients, so their errors correlate).
+// Variance of the mean of parameter `row` (kAxialRow, kRadiusRow) over the usable phases,
+// exactly through the helix spline (neighbouring phases share spline coefficients, so their
+// errors correlate).
 double SigmaOfMean(const std::vector<PhaseSolution>& solutions, int row, const processing::WheelMap& map) {
   int usable = 0;
   for (const auto& s : solutions) usable += s.fit.usable ? 1 : 0;
   const double factor = map.spline->CovarianceFactorOfSum([&](const processing::HelixSpline::TermSink& add) {
-    for (const auto& s : solutions) {
+    for (std::size_t j = 0; j < solutions.size(); ++j) {
+      const PhaseSolution& s = solutions[j];
       if (!s.fit.usable) continue;
-      for (std::size_t k = 0; k < s.u_deg.size(); ++k) {
-        add(s.u_deg[k], s.circle.sensitivity_to_y(row, static_cast<Eigen::Index>(k)) / usable);
+      const std::vector<double>& u_deg = map.sections[j].u_deg;
+      for (std::size_t k = 0; k < s.points.size(); ++k) {
+        add(u_deg[s.points[k]], s.sensitivity(row, static_cast<Eigen::Index>(k)) / usable);
       }
     }
   });
@@ -253,8 +270,8 @@ void SummarisePhases(const std::vector<PhaseSolution>& solutions, const processi
       std::sqrt(std::max(0.0, out.arc_radius_std_mm * out.arc_radius_std_mm -
                                   out.arc_radius_noise_std_mm * out.arc_radius_noise_std_mm));
   out.median_chi2_per_dof = Median(chi2);
-  out.mean_arc_radius_sigma_mm = SigmaOfMean(solutions, 2, map);
-  out.mean_center_axial_sigma_mm = SigmaOfMean(solutions, 0, map);
+  out.mean_arc_radius_sigma_mm = SigmaOfMean(solutions, kRadiusRow, map);
+  out.mean_center_axial_sigma_mm = SigmaOfMean(solutions, kAxialRow, map);
   const std::size_t n_phase = map.n_phase();
   if (out.usable_phases < static_cast<int>(n_phase)) {
     out.warnings.push_back(fmt::format("{} of {} phases were not usable and are left out of the means",
@@ -352,10 +369,13 @@ FitSpan ParseFitSpan(const std::string& name) {
 
 WheelFit FitWheel(const processing::WheelMap& map, const WheelFitOptions& options) {
   ThrowIfProblems(ErrorCode::kInvalidOption, kStage, options.Problems());
-  const CenteredFits fits = FitPhasesInCenteredBand(map, options);
   WheelFit out;
-  SetBand(map, fits, options, out);
-  SummarisePhases(fits.solutions, map, out);
+  {
+    const CenteredFits fits = FitPhasesInCenteredBand(map, options);
+    SetBand(map, fits, options, out);
+    SummarisePhases(fits.solutions, map, out);
+  }  // the fits' sensitivities go before the map-wide arrays below are made
+  ReturnFreedMemory();
   SetRunoutAndRoundness(map, options, out);
   SetProfileError(map, out);
   SetFormError(map, out);

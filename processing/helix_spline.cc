@@ -37,7 +37,7 @@ std::size_t CountCells(double u_last, double u0, double h) {
 HelixSpline::Basis HelixSpline::BasisAt(double u) const {
   const double s = (u - u0_) / h_;
   double cell = std::floor(s);
-  const double max_cell = static_cast<double>(cell_counts_.size() - 1);
+  const double max_cell = static_cast<double>(cells_ - 1);
   cell = std::clamp(cell, 0.0, max_cell);
   const double f = s - cell;
   Basis b;
@@ -65,6 +65,7 @@ void HelixSpline::Fit(std::span<const T> z, const HelixGeometry& geometry) {
   u_last_ = geometry.PhaseAt(last - 1);
   u0_ = std::floor(u_first_ / h_) * h_;
   const std::size_t cells = CountCells(u_last_, u0_, h_);
+  cells_ = cells;
   cell_counts_.assign(cells, 0);
   const std::size_t n = cells + 3;
   normal_ = BandedSpd(n);
@@ -109,7 +110,11 @@ void HelixSpline::Fit(std::span<const T> z, const HelixGeometry& geometry) {
   }
   normal_.Solve(rhs);
   coefficients_ = std::move(rhs);
-  normal_.ComputeSelectedInverse();
+}
+
+void HelixSpline::ReleaseValues() {
+  std::vector<double>().swap(coefficients_);
+  std::vector<int>().swap(cell_counts_);
 }
 
 void HelixSpline::AddSharedRows(SharedRows& shared, std::size_t from, std::size_t to,
@@ -162,25 +167,60 @@ void HelixSpline::Accumulate(std::span<const T> z, const HelixGeometry& geometry
 }
 
 double HelixSpline::Value(double u) const {
+  ARCWHEEL_CHECK(!coefficients_.empty()) << "the spline's values were released";
   const Basis b = BasisAt(u);
   double value = 0.0;
   for (int a = 0; a < 4; ++a) value += b.w[a] * coefficients_[b.first + a];
   return value;
 }
 
-double HelixSpline::VarianceFactor(double u) const {
-  ARCWHEEL_CHECK(normal_.HasSelectedInverse()) << "the spline's variance factors were released";
-  const Basis b = BasisAt(u);
+double HelixSpline::VarianceFactorAt(const Basis& b, const BandedSpd::InverseBlock& inverse) {
   // The inverse is symmetric: the diagonal once, each entry above it twice.
   double v = 0.0;
   for (int a = 0; a < 4; ++a) {
-    v += b.w[a] * b.w[a] * normal_.InverseInBand(b.first + a, 0);
-    for (int c = a + 1; c < 4; ++c) v += 2.0 * b.w[a] * b.w[c] * normal_.InverseInBand(b.first + a, c - a);
+    v += b.w[a] * b.w[a] * inverse.InverseInBand(b.first + a, 0);
+    for (int c = a + 1; c < 4; ++c) v += 2.0 * b.w[a] * b.w[c] * inverse.InverseInBand(b.first + a, c - a);
   }
   return v;
 }
 
+void HelixSpline::VarianceFactors(std::span<const std::span<const double>> u_lists,
+                                  std::span<const std::span<double>> factors) const {
+  ARCWHEEL_CHECK(u_lists.size() == factors.size())
+      << u_lists.size() << " lists, " << factors.size() << " outputs";
+  // Points not yet given their factor: [0, remaining[k]) of list k. A point is due in the block
+  // that holds the first of its four coefficients; the lists ascend, so their last points come
+  // first in the downward sweep.
+  std::vector<std::size_t> remaining(u_lists.size());
+  for (std::size_t k = 0; k < u_lists.size(); ++k) {
+    ARCWHEEL_CHECK(u_lists[k].size() == factors[k].size()) << "list " << k;
+    ARCWHEEL_CHECK(std::is_sorted(u_lists[k].begin(), u_lists[k].end()))
+        << "list " << k << " does not ascend";
+    remaining[k] = u_lists[k].size();
+  }
+  // 128 kB of the inverse at a time.
+  constexpr std::size_t kBlockRows = 4096;
+  normal_.SweepSelectedInverse(kBlockRows, [&](const BandedSpd::InverseBlock& block) {
+    for (std::size_t k = 0; k < u_lists.size(); ++k) {
+      for (std::size_t& p = remaining[k]; p > 0; --p) {
+        const Basis b = BasisAt(u_lists[k][p - 1]);
+        if (b.first < block.first) break;
+        factors[k][p - 1] = VarianceFactorAt(b, block);
+      }
+    }
+  });
+}
+
+double HelixSpline::VarianceFactor(double u) const {
+  double factor = 0.0;
+  const std::span<const double> list(&u, 1);
+  const std::span<double> out(&factor, 1);
+  VarianceFactors(std::span(&list, 1), std::span(&out, 1));
+  return factor;
+}
+
 int HelixSpline::Support(double u) const {
+  ARCWHEEL_CHECK(!cell_counts_.empty()) << "the spline's cell counts were released";
   const double s = (u - u0_) / h_;
   const auto cell = static_cast<long>(std::floor(s));
   const double f = s - static_cast<double>(cell);
@@ -194,13 +234,32 @@ int HelixSpline::Support(double u) const {
   return count;
 }
 
-double HelixSpline::CovarianceFactorOfSum(const std::function<void(const TermSink&)>& terms) const {
-  std::vector<double> v(coefficients_.size(), 0.0);
-  terms([&](double u, double weight) {
-    const Basis b = BasisAt(u);
-    for (int a = 0; a < 4; ++a) v[b.first + a] += weight * b.w[a];
-  });
-  return normal_.InverseQuadraticForm(v);
+double HelixSpline::CovarianceFactorOfSum(const std::function<void(const TermSink&)>& terms,
+                                          std::size_t block_rows) const {
+  // v = sum_k w_k b(u_k) goes forward through the factor a block of rows at a time, each block
+  // summed from its own pass over the terms: on a long spline no vector as long as it is held
+  // beside the callers' terms (6 MB at 1e8 samples), for a pass over the terms per block (about
+  // 10 ms at 1e7 samples, where v is held whole). Each entry of v sums its terms in their order, as
+  // a whole vector would.
+  const std::size_t n = normal_.size();
+  if (block_rows == 0) block_rows = n <= (std::size_t{1} << 19) ? n : std::size_t{1} << 17;
+  block_rows = std::max<std::size_t>(1, block_rows);
+  std::vector<double> v(std::min(n, block_rows));
+  BandedSpd::ForwardPass pass;
+  for (std::size_t first = 0; first < n; first += block_rows) {
+    const std::size_t end = std::min(n, first + block_rows);
+    std::fill(v.begin(), v.end(), 0.0);
+    terms([&](double u, double weight) {
+      const Basis b = BasisAt(u);
+      if (b.first + BandedSpd::kBand < first || b.first >= end) return;
+      for (std::size_t a = 0; a < 4; ++a) {
+        const std::size_t row = b.first + a;
+        if (row >= first && row < end) v[row - first] += weight * b.w[a];
+      }
+    });
+    normal_.InverseQuadraticFormRows(std::span(v).first(end - first), pass);
+  }
+  return pass.sum;
 }
 
 }  // namespace arcwheel::processing

@@ -9,9 +9,11 @@
 // VarianceFactor() how well they are known.
 //
 // Uncertainty: with white noise of sigma per sample, Var g(u) = sigma^2 b(u)^T (A^T A)^-1 b(u),
-// b(u) the four basis values; VarianceFactor() returns the factor after sigma^2. Values at the
-// same phase on different turns are 360 knots apart and uncorrelated for all practical purposes;
-// CovarianceFactorOfSum() gives the exact variance factor of any weighted sum of spline values.
+// b(u) the four basis values; VarianceFactors() returns the factor after sigma^2, from the band
+// of (A^T A)^-1 (the selected inverse), computed in blocks as it goes and never held whole. Values
+// at the same phase on different turns are 360 knots apart and uncorrelated for all practical
+// purposes; CovarianceFactorOfSum() gives the exact variance factor of any weighted sum of spline
+// values.
 
 #include <cstddef>
 #include <functional>
@@ -32,16 +34,26 @@ class HelixSpline {
   HelixSpline(std::span<const float> rho_mm, const HelixGeometry& geometry, double knot_step_deg);
 
   [[nodiscard]] double Value(double u_deg) const;
+  // Var g(u) / sigma^2 at every u of each list (each in ascending order), into the entry of
+  // `factors` at the same place (each as long as its list): one backward sweep of the selected
+  // inverse for all of them.
+  void VarianceFactors(std::span<const std::span<const double>> u_lists,
+                       std::span<const std::span<double>> factors) const;
+  // The same for one point: a whole sweep per call (VarianceFactors for many points).
   [[nodiscard]] double VarianceFactor(double u_deg) const;
   // Valid samples in the two knot intervals around u.
   [[nodiscard]] int Support(double u_deg) const;
   // sum_a sum_b w_a w_b Cov(g(u_a), g(u_b)) / sigma^2 for the (u, w) pairs that `terms` passes to
   // the function it is given: one forward pass of the banded factor.
   using TermSink = std::function<void(double u_deg, double weight)>;
-  [[nodiscard]] double CovarianceFactorOfSum(const std::function<void(const TermSink&)>& terms) const;
-  // Frees the selected inverse when no more VarianceFactor() is needed (a wheel map keeps the
-  // spline for CovarianceFactorOfSum only): 23 MB at 1e8 samples.
-  void ReleaseVarianceFactors() { normal_.ReleaseSelectedInverse(); }
+  // `block_rows` > 0 passes the sum through the factor in blocks of that many rows, one pass over
+  // the terms each (the same number); 0 holds it whole up to 2^19 rows (4 MB) and in blocks of
+  // 2^17 beyond, where the spline is long and the callers' terms are many.
+  [[nodiscard]] double CovarianceFactorOfSum(const std::function<void(const TermSink&)>& terms,
+                                             std::size_t block_rows = 0) const;
+  // Frees what only Value() and Support() read, the coefficients and the cell counts (8 MB at 1e8
+  // samples), when a wheel map has taken its sections: it keeps the spline for the variances.
+  void ReleaseValues();
 
   [[nodiscard]] double first_phase_deg() const { return u_first_; }
   [[nodiscard]] double last_phase_deg() const { return u_last_; }
@@ -53,6 +65,7 @@ class HelixSpline {
     double w[4] = {0, 0, 0, 0};
   };
   [[nodiscard]] Basis BasisAt(double u_deg) const;
+  [[nodiscard]] static double VarianceFactorAt(const Basis& b, const BandedSpd::InverseBlock& inverse);
   // The rows [begin, end) of the normal equations that both halves of the scan reach, as the upper
   // half sums them (row r of the block is row begin + r).
   struct SharedRows {
@@ -75,6 +88,7 @@ class HelixSpline {
   double h_ = 1.0;   // knot spacing
   double u_first_ = 0.0;
   double u_last_ = 0.0;
+  std::size_t cells_ = 0;  // knot intervals
   std::vector<double> coefficients_;
   std::vector<int> cell_counts_;
   BandedSpd normal_;

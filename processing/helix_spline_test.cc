@@ -7,6 +7,7 @@
 #include <limits>
 #include <numbers>
 #include <random>
+#include <span>
 #include <vector>
 
 #include "acquisition/scan.h"
@@ -140,6 +141,24 @@ TEST(HelixSpline, AgreesWithADenseQrSolveOfTheSamePenalisedProblem) {
     EXPECT_NEAR(spline.Value(u), dense.Value(u), 1e-10 * largest_value) << "u = " << u;
     EXPECT_NEAR(spline.VarianceFactor(u), dense.VarianceFactor(u), 1e-10 * largest_variance) << "u = " << u;
   }
+  // Many points at once, as a wheel map asks for its sections: three ascending lists (one empty)
+  // whose points interleave along the helix, answered in one sweep.
+  std::vector<std::vector<double>> lists(3);
+  for (double u = spline.first_phase_deg(); u <= spline.last_phase_deg(); u += 0.37) {
+    lists[static_cast<std::size_t>(std::lround(u / 0.37)) % 2].push_back(u);
+  }
+  std::vector<std::vector<double>> factors = {
+      std::vector<double>(lists[0].size(), -1.0), std::vector<double>(lists[1].size(), -1.0), {}};
+  const std::vector<std::span<const double>> list_views(lists.begin(), lists.end());
+  const std::vector<std::span<double>> factor_views(factors.begin(), factors.end());
+  spline.VarianceFactors(list_views, factor_views);
+  for (std::size_t k = 0; k < 2; ++k) {
+    ASSERT_GT(lists[k].size(), 100u);
+    for (std::size_t p = 0; p < lists[k].size(); ++p) {
+      EXPECT_NEAR(factors[k][p], dense.VarianceFactor(lists[k][p]), 1e-10 * largest_variance)
+          << "u = " << lists[k][p];
+    }
+  }
   // The variance factor of a weighted sum: w^T B (S^T S)^-1 B^T w.
   const std::vector<std::pair<double, double>> terms = {
       {40.0, 0.5}, {41.2, -1.0}, {400.0, 2.0}, {700.1, 0.3}};
@@ -150,6 +169,17 @@ TEST(HelixSpline, AgreesWithADenseQrSolveOfTheSamePenalisedProblem) {
     for (const auto& [u, w] : terms) add(u, w);
   });
   EXPECT_NEAR(factor, expected, 1e-10 * expected);
+  // In blocks of rows, down to one row a block (the terms' basis rows straddle the blocks): the
+  // same sums in the same order.
+  for (const std::size_t block_rows : {1u, 2u, 5u, 64u}) {
+    EXPECT_EQ(spline.CovarianceFactorOfSum(
+                  [&](const HelixSpline::TermSink& add) {
+                    for (const auto& [u, w] : terms) add(u, w);
+                  },
+                  block_rows),
+              factor)
+        << "blocks of " << block_rows;
+  }
 }
 
 TEST(HelixSpline, SupportCountsTheValidSamplesInTheTwoNearestKnotIntervals) {

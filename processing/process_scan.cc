@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "core/error.h"
+#include "core/free_memory.h"
 #include "core/interrupt.h"
 #include "processing/noise.h"
 #include "processing/stuck_readings.h"
@@ -64,11 +65,10 @@ void CheckOptions(const acquisition::Scan& scan, const ProcessOptions& options) 
   }
 }
 
-// Step 1: the valid samples and the span from the first to the last of them.
+// Step 1: the span from the first to the last valid sample (DropStuckSensorRuns counts them).
 template <typename T>
 void FindValidSpan(const std::vector<T>& rho, ProcessedScan& out) {
   const auto finite = [](T v) { return std::isfinite(static_cast<double>(v)); };
-  out.valid_samples = static_cast<std::size_t>(std::count_if(rho.begin(), rho.end(), finite));
   const auto first = std::find_if(rho.begin(), rho.end(), finite);
   const auto last = std::find_if(rho.rbegin(), rho.rend(), finite);
   out.first_valid = static_cast<std::size_t>(first - rho.begin());
@@ -80,6 +80,7 @@ template <typename T>
 void DropStuckSensorRuns(const acquisition::Scan& scan, std::vector<T>& rho, double stuck_run_deg,
                          ProcessedScan& out) {
   out.stuck = DropStuckReadings(rho, StuckRunSamples(scan, stuck_run_deg));
+  out.valid_samples = out.stuck.valid;
   if (out.stuck.dropped > 0 && out.stuck.dropped == out.valid_samples) {
     throw Error(
         ErrorCode::kBadInput, kStage,
@@ -226,6 +227,7 @@ ProcessedScan ProcessReadings(acquisition::Scan& scan, std::vector<T>& rho, cons
   ChooseSpeed(scan, std::span<const T>(rho), options, out);
   ThrowIfInterrupted();
 
+  ReturnFreedMemory();  // the speed estimate's and the despiker's arrays
   const HelixGeometry geometry(scan, out.rpm_used);
   out.map = BuildWheelMap(std::span<const T>(rho), geometry, out.noise_sigma_mm, out.despike.indices,
                           options.map, &clock);

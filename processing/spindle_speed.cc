@@ -10,6 +10,7 @@
 
 #include "core/check.h"
 #include "core/error.h"
+#include "core/parallel.h"
 #include "processing/helix_geometry.h"
 
 namespace arcwheel::processing {
@@ -143,13 +144,23 @@ std::vector<TurnHarmonics> FitTurns(const acquisition::Scan& scan, std::span<con
   const PhaseBins binned = BinByPhase(scan, z, rpm, bins);
   const auto window = static_cast<std::size_t>(kTurnsPerWindow);
   const std::size_t stride = window * (spacing > 0 ? spacing : SpreadSpacing(binned.turns));
-  std::vector<TurnHarmonics> result;
-  for (std::size_t first = 0; first + window <= binned.turns && result.size() < kMaxWindows;
+  std::vector<std::size_t> firsts;
+  std::vector<std::vector<std::size_t>> cells;
+  for (std::size_t first = 0; first + window <= binned.turns && firsts.size() < kMaxWindows;
        first += stride) {
-    const std::vector<std::size_t> cells = CoveredWindowCells(binned, first);
-    if (cells.empty()) continue;
-    result.push_back(FitWindow(binned, cells, first, harmonics));
+    std::vector<std::size_t> covered = CoveredWindowCells(binned, first);
+    if (covered.empty()) continue;
+    firsts.push_back(first);
+    cells.push_back(std::move(covered));
   }
+  // The windows' fits are independent: two workers take alternate ones.
+  std::vector<TurnHarmonics> result(firsts.size());
+  constexpr int kWorkers = 2;
+  RunOnWorkers(kWorkers, [&](int worker) {
+    for (auto w = static_cast<std::size_t>(worker); w < firsts.size(); w += kWorkers) {
+      result[w] = FitWindow(binned, cells[w], firsts[w], harmonics);
+    }
+  });
   return result;
 }
 

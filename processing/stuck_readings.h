@@ -16,10 +16,12 @@ struct StuckReadingsResult {
   std::size_t dropped = 0;      // samples set to NaN
   std::size_t runs = 0;         // how many runs
   std::size_t longest_run = 0;  // samples in the longest run dropped
+  std::size_t valid = 0;        // valid samples before any was dropped (counted in the same pass)
 };
 
 // Sets to NaN every run of `min_run` or more consecutive valid samples with exactly equal values
 // (bitwise, as the sensor wrote them); an invalid sample ends a run. `min_run` < 2 drops nothing.
+// Two workers take the two halves of the scan, split where a run starts.
 StuckReadingsResult DropStuckReadings(std::span<double> z_mm, std::size_t min_run);
 StuckReadingsResult DropStuckReadings(std::span<float> z_mm, std::size_t min_run);
 

@@ -9,6 +9,7 @@
 #include <numeric>
 
 #include "core/error.h"
+#include "core/free_memory.h"
 #include "core/interrupt.h"
 #include "core/parallel.h"
 #include "processing/cubic_interpolation.h"
@@ -29,27 +30,49 @@ double ChooseKnotStep(const MapOptions& options, const HelixGeometry& geometry, 
   return step;
 }
 
+// The spline at one phase node on every turn it covers, in the order of the helix (ascending u);
+// sigmas are set by SetSectionSigmas.
 Section SampleSection(const HelixSpline& spline, const HelixGeometry& geometry, double phase_deg,
-                      double noise_sigma_mm, int min_support) {
+                      int min_support) {
   Section section;
   const double first = spline.first_phase_deg();
   const double last = spline.last_phase_deg();
   double u = phase_deg + 360.0 * std::ceil((first - phase_deg) / 360.0);
+  // Room for a point on every turn (and one spare): no arrays left behind by growing.
+  const auto turns = static_cast<std::size_t>(std::max(0.0, (last - u) / 360.0)) + 2;
+  section.u_deg.reserve(turns);
+  section.y_mm.reserve(turns);
+  section.rho_mm.reserve(turns);
+  section.sigma_mm.reserve(turns);
   for (; u <= last; u += 360.0) {
     if (spline.Support(u) < min_support) continue;
     section.u_deg.push_back(u);
     section.y_mm.push_back(geometry.AxialAtPhase(u));
     section.rho_mm.push_back(spline.Value(u));
-    section.sigma_mm.push_back(noise_sigma_mm * std::sqrt(std::max(0.0, spline.VarianceFactor(u))));
-  }
-  // Order by axial position (the feed may run towards -y).
-  if (section.y_mm.size() > 1 && section.y_mm.front() > section.y_mm.back()) {
-    std::reverse(section.u_deg.begin(), section.u_deg.end());
-    std::reverse(section.y_mm.begin(), section.y_mm.end());
-    std::reverse(section.rho_mm.begin(), section.rho_mm.end());
-    std::reverse(section.sigma_mm.begin(), section.sigma_mm.end());
   }
   return section;
+}
+
+// Every section point's sigma, from one sweep of the spline's variances over all sections; then
+// each section in the order of its axial positions (the feed may run towards -y).
+void SetSectionSigmas(const HelixSpline& spline, double noise_sigma_mm, std::vector<Section>& sections) {
+  std::vector<std::span<const double>> u_lists;
+  std::vector<std::span<double>> factors;
+  for (Section& section : sections) {
+    section.sigma_mm.resize(section.u_deg.size());
+    u_lists.emplace_back(section.u_deg);
+    factors.emplace_back(section.sigma_mm);
+  }
+  spline.VarianceFactors(u_lists, factors);
+  for (Section& section : sections) {
+    for (double& sigma : section.sigma_mm) sigma = noise_sigma_mm * std::sqrt(std::max(0.0, sigma));
+    if (section.y_mm.size() > 1 && section.y_mm.front() > section.y_mm.back()) {
+      std::reverse(section.u_deg.begin(), section.u_deg.end());
+      std::reverse(section.y_mm.begin(), section.y_mm.end());
+      std::reverse(section.rho_mm.begin(), section.rho_mm.end());
+      std::reverse(section.sigma_mm.begin(), section.sigma_mm.end());
+    }
+  }
 }
 
 // Leaves out the section points whose sigma exceeds `ratio` times the median point's. They rest
@@ -118,7 +141,10 @@ class CellOfSample {
     if (!(t > -0.5) || !(t < static_cast<double>(n_y_))) return -1;  // round(-0.4) is -0: row 0
     const long m = RoundHalfAway(t);
     if (m >= n_y_) return -1;
-    const long j = RoundHalfAway(PhaseInTurn(u_deg) / phase_step_) % n_phase_;
+    // The phase in the turn lies in [0, 360): its node is 0 .. n_phase, and n_phase is node 0
+    // (a comparison instead of a 64-bit division per sample).
+    long j = RoundHalfAway(PhaseInTurn(u_deg) / phase_step_);
+    if (j == n_phase_) j = 0;
     return j * n_y_ + m;
   }
 
@@ -175,9 +201,10 @@ WheelMap Build(std::span<const T> rho, const HelixGeometry& geometry, double noi
   map.sections.resize(n_phase);
   for (std::size_t j = 0; j < n_phase; ++j) {
     map.phase_deg[j] = 360.0 * static_cast<double>(j) / options.phases;
-    map.sections[j] = SampleSection(*spline, geometry, map.phase_deg[j], noise_sigma_mm, options.min_support);
+    map.sections[j] = SampleSection(*spline, geometry, map.phase_deg[j], options.min_support);
   }
-  spline->ReleaseVarianceFactors();  // the section sigmas were the last use
+  spline->ReleaseValues();  // the sections were their last use
+  SetSectionSigmas(*spline, noise_sigma_mm, map.sections);
   DropImpreciseSectionPoints(map.sections, options.max_sigma_ratio);
   double y_low = -std::numeric_limits<double>::infinity();
   double y_high = std::numeric_limits<double>::infinity();
@@ -204,6 +231,7 @@ WheelMap Build(std::span<const T> rho, const HelixGeometry& geometry, double noi
   if (clock != nullptr) clock->Start("coverage counts");
   CountCoverage(rho, geometry, despiked, y_low, map);
   map.spline = std::move(spline);
+  ReturnFreedMemory();  // the spline's values, the sections' sigmas copied for their median
   if (clock != nullptr) clock->Stop();
   return map;
 }

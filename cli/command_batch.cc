@@ -233,16 +233,21 @@ void CheckProcessOptions(const std::vector<std::string>& options, const fs::path
   CLI::App app{"arcwheel", "arcwheel"};
   app.require_subcommand(1);
   AddProcessCommand(app);
-  app.get_subcommand("process")->callback(std::function<void()>{});
+  // Runs once every option is converted and checked, before the process command's own callback:
+  // stop there, the options are valid.
+  app.parse_complete_callback([] { throw CLI::Success(); });
   std::vector<std::string> arguments = {"process", some_scan.string(), "-o", "unused"};
   arguments.insert(arguments.end(), options.begin(), options.end());
   std::reverse(arguments.begin(), arguments.end());  // CLI11 takes them last first
   try {
     app.parse(arguments);
+  } catch (const CLI::Success&) {
+    return;
   } catch (const CLI::ParseError& error) {
     throw Error(ErrorCode::kInvalidOption, kStage,
                 fmt::format("the process options after --: {}", error.what()));
   }
+  throw Error(ErrorCode::kInternal, kStage, "the process options were not checked");
 }
 
 // ------------------------------------------------------------------------------------------------

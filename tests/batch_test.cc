@@ -252,15 +252,42 @@ TEST(Batch, TakesAListFileAndPassesTheProcessOptionsThrough) {
   }
 }
 
+// On a terminal (a pseudo-terminal from util-linux's `script`), one refreshed bar with the counts,
+// the rate and the time left; in a file, one plain line per scan and no escape codes.
+TEST(Batch, ShowsABarOnATerminalAndPlainLinesOtherwise) {
+  TempDir dir;
+  fs::create_directories(dir / "scans");
+  Simulate(dir / "scans" / "one.h5", 1, 55.0);
+  Simulate(dir / "scans" / "two.h5", 2, 56.0);
+  const std::string batch = std::string(std::getenv("ARCWHEEL_BINARY")) + " batch " +
+                            (dir / "scans").string() + " -j 2 -o " + (dir / "tty").string() +
+                            " -- --no-model";
+  ASSERT_EQ(testing::Shell("script -qec '" + batch + "' /dev/null > " + (dir / "tty.txt").string() + " 2>&1"),
+            0)
+      << ReadText(dir / "tty.txt");
+  const std::string on_terminal = ReadText(dir / "tty.txt");
+  EXPECT_THAT(on_terminal, HasSubstr("\r\033[Kbatch ["));
+  EXPECT_THAT(on_terminal, HasSubstr("2/2 scans, 0 failed, "));
+  EXPECT_THAT(on_terminal, HasSubstr(" scans/s, about "));
+  EXPECT_THAT(on_terminal, ::testing::Not(HasSubstr("] done one")));
+
+  const auto plain = RunArcwheel("batch " + (dir / "scans").string() + " -j 2 -o " + (dir / "file").string() +
+                                 " -- --no-model");
+  ASSERT_EQ(plain.exit_status, 0) << plain.output;
+  EXPECT_THAT(plain.output, HasSubstr("] done one in "));
+  EXPECT_THAT(plain.output, HasSubstr("] done two in "));
+  EXPECT_THAT(plain.output, ::testing::Not(HasSubstr("\033")));
+}
+
 // SIGINT to the batch while its children run: they are stopped, no partial result folder is left,
 // the index lists what finished, the exit status is 130; the next run finishes the rest.
 TEST(Batch, AnInterruptedBatchLeavesNoPartialResultAndTheNextRunFinishes) {
   TempDir dir;
   fs::create_directories(dir / "scans");
-  // 6e5 samples: about a second each to process.
+  // 3e5 samples: about half a second each to process (seconds under ASan).
   for (int i = 0; i < 4; ++i) {
     Simulate(dir / "scans" / ("long_" + std::to_string(i) + ".h5"), 10 + i, 55.0, "",
-             "--sample-period-s 2e-5");
+             "--sample-period-s 4e-5");
   }
   const std::string binary = std::getenv("ARCWHEEL_BINARY");
   const std::string scans = (dir / "scans").string();

@@ -252,6 +252,43 @@ TEST(Batch, TakesAListFileAndPassesTheProcessOptionsThrough) {
   }
 }
 
+// The emitted array script, run task by task as Slurm would run it (SLURM_ARRAY_TASK_ID set, no
+// Slurm needed: tests/slurm/run_slurm_test.sh runs it under a real one), then --index-only.
+TEST(Batch, TheSlurmScriptRunsOneScanPerTaskAndTheIndexFollows) {
+  TempDir dir;
+  fs::create_directories(dir / "scans");
+  Simulate(dir / "scans" / "one.h5", 1, 54.0);
+  Simulate(dir / "scans" / "two.csv", 2, 56.0);
+  const std::string batch = "batch " + (dir / "scans").string() + " -o " + (dir / "out").string();
+  const auto emit = RunArcwheel(batch + " --emit-slurm " + (dir / "job.sh").string() +
+                                " --sbatch=--time=5 -- --phases 90 --no-model");
+  ASSERT_EQ(emit.exit_status, 0) << emit.output;
+  const std::string script = ReadText(dir / "job.sh");
+  EXPECT_THAT(script, HasSubstr("#SBATCH --array=0-1\n"));
+  EXPECT_THAT(script, HasSubstr("#SBATCH --time=5\n"));
+  EXPECT_THAT(script, HasSubstr("#SBATCH --output=" + (dir / "out").string() + "/logs/slurm-%A_%a.out\n"));
+  EXPECT_FALSE(fs::exists(dir / "out" / "one")) << "emitting runs nothing";
+  for (int task = 0; task < 2; ++task) {
+    EXPECT_EQ(
+        testing::Shell("SLURM_ARRAY_TASK_ID=" + std::to_string(task) + " bash " + (dir / "job.sh").string() +
+                       " > " + (dir / ("task" + std::to_string(task) + ".txt")).string() + " 2>&1"),
+        0)
+        << ReadText(dir / ("task" + std::to_string(task) + ".txt"));
+  }
+  EXPECT_FALSE(fs::exists(dir / "out" / "index.json")) << "the tasks write no index";
+  EXPECT_EQ(ReadJson(dir / "out" / "one" / "summary.json")["processing"]["phases"], 90);
+  const auto index = RunArcwheel(batch + " --index-only -- --phases 90 --no-model");
+  EXPECT_EQ(index.exit_status, 0) << index.output;
+  const json rows = ReadJson(dir / "out" / "index.json")["scans"];
+  ASSERT_EQ(rows.size(), 2u);
+  for (const json& row : rows) {
+    EXPECT_EQ(row["status"], "done") << row.dump();
+    const Truth truth = ReadTruth(row["scan"].get<std::string>() + ".truth.json");
+    EXPECT_NEAR(row["mean_arc_radius_mm"].get<double>(), truth.mean_arc_radius_mm,
+                3 * row["mean_arc_radius_sigma_mm"].get<double>());
+  }
+}
+
 // On a terminal (a pseudo-terminal from util-linux's `script`), one refreshed bar with the counts,
 // the rate and the time left; in a file, one plain line per scan and no escape codes.
 TEST(Batch, ShowsABarOnATerminalAndPlainLinesOtherwise) {

@@ -316,6 +316,54 @@ TEST(Batch, ShowsABarOnATerminalAndPlainLinesOtherwise) {
   EXPECT_THAT(plain.output, ::testing::Not(HasSubstr("\033")));
 }
 
+// The pid of the running `arcwheel process` of `scan`, 0 when there is none (yet).
+pid_t ProcessChildOf(const fs::path& scan) {
+  for (const fs::directory_entry& entry : fs::directory_iterator("/proc")) {
+    const std::string name = entry.path().filename().string();
+    if (name.find_first_not_of("0123456789") != std::string::npos) continue;
+    const std::string cmdline = ReadText(entry.path() / "cmdline");
+    if (cmdline.find(std::string("process") + '\0' + scan.string()) != std::string::npos) {
+      return static_cast<pid_t>(std::stoi(name));
+    }
+  }
+  return 0;
+}
+
+// A child that dies (SIGKILL stands in for a crash) costs only its own scan: the batch records
+// the signal, removes what the child left in its folder and goes on.
+TEST(Batch, AChildKilledPartWayIsRecordedAndLeavesNoFolder) {
+  TempDir dir;
+  fs::create_directories(dir / "scans");
+  Simulate(dir / "scans" / "a_long.h5", 1, 55.0, "", "--sample-period-s 4e-5");
+  Simulate(dir / "scans" / "b_short.h5", 2, 56.0);
+  const std::string command = "batch " + (dir / "scans").string() + " -o " + (dir / "out").string();
+  // The batch runs in the background of a shell; this test kills its first child.
+  ASSERT_EQ(
+      testing::Shell("(" + std::string(std::getenv("ARCWHEEL_BINARY")) + " " + command + " > " +
+                     (dir / "batch.txt").string() + " 2>&1; echo $? > " + (dir / "status").string() + ") &"),
+      0);
+  pid_t child = 0;
+  for (int i = 0; i < 1000 && child == 0; ++i) {
+    child = ProcessChildOf(dir / "scans" / "a_long.h5");
+    if (child == 0) std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  ASSERT_NE(child, 0) << "the first child did not start within 10 s";
+  ::kill(child, SIGKILL);
+  for (int i = 0; i < 3000 && !fs::exists(dir / "status"); ++i) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  ASSERT_TRUE(fs::exists(dir / "status")) << "the batch did not end within 30 s";
+  EXPECT_EQ(ReadText(dir / "status"), "6\n") << ReadText(dir / "batch.txt");
+  const json index = ReadJson(dir / "out" / "index.json");
+  const json& killed = index["scans"][0];
+  EXPECT_EQ(killed["status"], "failed");
+  EXPECT_EQ(killed["exit_code"], 128 + SIGKILL);
+  EXPECT_THAT(killed["message"].get<std::string>(), HasSubstr("killed by signal 9"));
+  EXPECT_FALSE(fs::exists(dir / "out" / "a_long"));
+  EXPECT_EQ(index["scans"][1]["status"], "done");
+  EXPECT_EQ(testing::ListFolder(dir / "out" / "b_short"), "step_inputs.json\nsummary.json\nwheel_map.h5\n");
+}
+
 // SIGINT to the batch while its children run: they are stopped, no partial result folder is left,
 // the index lists what finished, the exit status is 130; the next run finishes the rest.
 TEST(Batch, AnInterruptedBatchLeavesNoPartialResultAndTheNextRunFinishes) {

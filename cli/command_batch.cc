@@ -148,8 +148,6 @@ std::vector<fs::path> Glob(const std::string& pattern) {
   return paths;
 }
 
-std::vector<fs::path> ExpandInput(const std::string& input);
-
 // `@LIST`: one scan path a line; blank lines and lines starting with '#' are skipped, relative
 // paths are relative to the list's folder.
 std::vector<fs::path> ScansOfList(const fs::path& list) {

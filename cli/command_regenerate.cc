@@ -15,12 +15,12 @@
 #include <vector>
 
 #include "cli/commands.h"
+#include "cli/step_inputs.h"
 #include "cli/steps.h"
 #include "core/atomic_file.h"
 #include "core/error.h"
 #include "core/hdf5.h"
 #include "core/json_text.h"
-#include "core/sha256.h"
 #include "core/version.h"
 #include "grinding/job.h"
 #include "grinding/prediction.h"
@@ -39,8 +39,6 @@ namespace fs = std::filesystem;
 using nlohmann::json;
 
 constexpr const char* kRegenerateStage = "regenerate";
-// In each step folder: the SHA-256 of the step's input files and its options, written last.
-constexpr const char* kStepInputsFileName = "step_inputs.json";
 // In OUTDIR: the headline numbers of a finished regeneration, written last.
 constexpr const char* kRecordFileName = "regenerate.json";
 constexpr const char* kNominalPathFileName = "nominal_path_prediction.h5";
@@ -69,44 +67,12 @@ const ChainStepSpec kToolpathStep{2, "toolpath", {kToolpathSummaryFileName, kPre
 const ChainStepSpec kPolishStep{3, "polish", {"polish_summary.json", "residual_map.h5", "polish.mod"}};
 constexpr int kStepCount = 4;  // and the report
 
-// What a step depends on: file SHA-256s and options. Equal inputs give equal outputs.
-json StepInputs(const std::vector<std::pair<std::string, fs::path>>& files, const json& options) {
-  json inputs = {{"arcwheel_version", kVersion},
-                 {"options", options},
-                 {"sha256", json::object()},
-                 {"paths", json::object()}};
-  for (const auto& [name, path] : files) {
-    inputs["sha256"][name] = Sha256OfFile(path);
-    inputs["paths"][name] = fs::absolute(path).string();
-  }
-  return inputs;
-}
-
-// True when the folder holds every output of the step and the inputs it was made from are
-// `inputs` (paths aside: a moved but unchanged file is the same input).
-bool UpToDate(const fs::path& folder, const ChainStepSpec& step, const json& inputs) {
-  for (const std::string& name : step.outputs) {
-    if (!fs::exists(folder / name)) return false;
-  }
-  const fs::path recorded_path = folder / kStepInputsFileName;
-  if (!fs::exists(recorded_path)) return false;
-  try {
-    const json recorded = ReadJsonFile(recorded_path, kRegenerateStage);
-    for (const char* key : {"arcwheel_version", "options", "sha256"}) {
-      if (!recorded.contains(key) || recorded.at(key) != inputs.at(key)) return false;
-    }
-    return true;
-  } catch (const Error&) {
-    return false;  // unreadable: redo the step
-  }
-}
-
 // Runs a step unless its inputs are unchanged. A failing step leaves no folder of its own; the
 // message names the step, and the error keeps its code (so the exit status).
 bool RunOrReuse(const fs::path& outdir, const ChainStepSpec& step, const json& inputs,
                 const std::function<void(const fs::path&)>& run) {
   const fs::path folder = outdir / step.id;
-  if (UpToDate(folder, step, inputs)) {
+  if (UpToDate(folder, step.outputs, inputs)) {
     fmt::print("step {}/{} {}: inputs unchanged, outputs in {} reused\n", step.number, kStepCount, step.id,
                folder.string());
     return false;

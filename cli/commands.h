@@ -3,6 +3,9 @@
 // its work and throws arcwheel::Error on failure; main() maps the error to the exit status.
 
 #include <CLI/CLI.hpp>
+#include <stdexcept>
+#include <string>
+#include <vector>
 
 namespace arcwheel::cli {
 
@@ -18,5 +21,18 @@ void AddPolishCommand(CLI::App& app);
 void AddCompareCommand(CLI::App& app);
 void AddHistoryCommand(CLI::App& app);
 void AddRegenerateCommand(CLI::App& app);
+void AddBatchCommand(CLI::App& app);
+
+// `arcwheel batch ... -- OPTIONS`: the arguments after `--`, which main() takes off the command
+// line before parsing (CLI11 would not hand them to the subcommand as they are).
+void SetBatchProcessOptions(std::vector<std::string> options);
+
+// Exit status of a command that ran to its end while some of its items failed (`batch`: some scans
+// have no result; its index names them). Not an Error: nothing about the run itself was wrong.
+inline constexpr int kSomeFailedExitStatus = 6;
+class SomeFailed : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
 
 }  // namespace arcwheel::cli

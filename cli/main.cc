@@ -3,6 +3,7 @@
 #include <fmt/core.h>
 
 #include <CLI/CLI.hpp>
+#include <algorithm>
 #include <cstdio>
 #include <cstdlib>
 #include <exception>
@@ -37,12 +38,14 @@ const std::vector<Command> kCommands = {
     {"headcenter", arcwheel::cli::AddHeadcenterCommand},
     {"polish", arcwheel::cli::AddPolishCommand},
     {"regenerate", arcwheel::cli::AddRegenerateCommand},
+    {"batch", arcwheel::cli::AddBatchCommand},
 };
 
 constexpr const char* kExitCodes =
     "Exit status: 0 ok; 1 unknown command or usage; 2 invalid option; 3 bad input file;\n"
-    "4 I/O failure (cannot read, write or rename); 5 no usable fit; 70 internal error;\n"
-    "130 interrupted (SIGINT/SIGTERM). A failed run leaves no new or partial output file.";
+    "4 I/O failure (cannot read, write or rename); 5 no usable fit; 6 batch: some scans have no\n"
+    "result (the index names them); 70 internal error; 130 interrupted (SIGINT/SIGTERM).\n"
+    "A failed run leaves no new or partial output file.";
 
 // After a failed write (a full disk) HDF5 keeps the broken file open and its exit handler
 // crashes closing it again. Our own cleanup (temporary files) has run during unwinding, so a failed
@@ -50,6 +53,23 @@ constexpr const char* kExitCodes =
 [[noreturn]] void ExitWithoutLibraryCleanup(int status) {
   std::fflush(nullptr);
   std::_Exit(status);
+}
+
+// The arguments, with those after `batch ... --` handed to the batch command: they are process
+// options, passed to each child unchanged.
+std::vector<std::string> ArgumentsForCli11(int argc, char** argv) {
+  std::vector<std::string> arguments(argv + 1, argv + argc);
+  const auto command = std::find_if(arguments.begin(), arguments.end(),
+                                    [](const std::string& a) { return a.empty() || a[0] != '-'; });
+  if (command != arguments.end() && *command == "batch") {
+    const auto separator = std::find(command, arguments.end(), std::string("--"));
+    if (separator != arguments.end()) {
+      arcwheel::cli::SetBatchProcessOptions({separator + 1, arguments.end()});
+      arguments.erase(separator, arguments.end());
+    }
+  }
+  std::reverse(arguments.begin(), arguments.end());  // CLI11 takes them last first
+  return arguments;
 }
 
 }  // namespace
@@ -71,7 +91,7 @@ int main(int argc, char** argv) {
   arcwheel::InstallInterruptHandlers();
 
   try {
-    app.parse(argc, argv);
+    app.parse(ArgumentsForCli11(argc, argv));
   } catch (const CLI::CallForHelp&) {
     fmt::print("{}", app.help());
     return 0;
@@ -87,6 +107,9 @@ int main(int argc, char** argv) {
                unknown_command ? "run `arcwheel help` for the list of commands"
                                : "run `arcwheel COMMAND --help` for its options");
     return unknown_command ? 1 : arcwheel::ExitStatus(ErrorCode::kInvalidOption);
+  } catch (const arcwheel::cli::SomeFailed& failed) {
+    fmt::print(stderr, "arcwheel: {}\n", failed.what());
+    ExitWithoutLibraryCleanup(arcwheel::cli::kSomeFailedExitStatus);
   } catch (const arcwheel::Error& error) {
     if (no_catch) throw;
     fmt::print(stderr, "arcwheel: {}: {}\n", arcwheel::ErrorCodeName(error.code()), error.what());

@@ -11,6 +11,7 @@
 #include <cstdint>
 #include <map>
 #include <numbers>
+#include <numeric>
 
 #include "core/check.h"
 #include "core/error.h"
@@ -334,11 +335,14 @@ constexpr int kParts = 8;
 
 // The samples (per sample, NaN = invalid), read through the helix geometry on every pass (no copy
 // of the scan).
+struct HelixCells;
+
 template <typename Sample>
 struct Samples {
   std::span<const Sample> rho_mm;
   const processing::HelixGeometry& geometry;
   double band_low_mm, band_high_mm;
+  const HelixCells* cells = nullptr;  // when set, the passes run on these instead of the samples
 };
 
 // What a pass over the samples accumulates.
@@ -390,6 +394,240 @@ CellSums CellSumsFor(const Grid& grid, double low_y_mm, double high_y_mm) {
   cells.sum.assign(grid.n_phase * static_cast<std::size_t>(cells.axial_cells), 0.0);
   cells.count.assign(cells.sum.size(), 0);
   return cells;
+}
+
+// The binned fit (docs/wheel_model.md, "Binned fit"). On a helix from the scan's settings the
+// phase and the axial position are linear in the sample index, so the samples of a cell (a run on
+// one turn within one knot interval) lie on a segment of a line in (phase, axial). Every sum of
+// the normal equations over the cell is then taken from three weighted points on that line: the
+// three-point Gauss rule of the samples' positions, which sums every polynomial of the position up
+// to degree 5 as the samples do, with pseudo-values that give the sums of z, z d and z d^2 (d the
+// position) as the samples' z do. The sums are exact where the model is a polynomial of degree 2
+// along the cell; the error comes from its third derivative along a cell (docs: measured).
+struct HelixCell {
+  std::uint64_t first = 0;        // index of its first sample; it ends where the next cell begins
+  std::uint32_t count = 0;        // valid samples in the band
+  float rss_offset_mm2 = 0;       // the cell's sum of squares less the points' (constant in the model)
+  double z_mean_mm = 0;           // the mean z of its samples
+  std::array<float, 3> node{};    // the points' positions, index - first (within 2.5e-4)
+  std::array<float, 3> weight{};  // the points' weights (they sum to count; unused points 0)
+  // Each point's pseudo-value less z_mean_mm; after the fit, the model there less z_mean_mm,
+  // which the residual map interpolates.
+  std::array<float, 3> value_mm{};
+  [[nodiscard]] std::size_t points() const { return std::min<std::size_t>(count, 3); }
+};
+
+// Each part's cells, in the order of their samples, and the axial range of its samples.
+struct HelixCells {
+  std::array<std::vector<HelixCell>, kParts> parts;
+  PartRanges ranges;
+};
+
+// A cell ends at the turn's end, at every knot of the fine fit's functions and of a 64-knot grid
+// (so that it spans at most 1/64 turn whatever the knots), and after this many samples.
+constexpr std::uint64_t kMaxCellSpan = 4096;
+constexpr int kCellsPerTurn = 64;
+
+// The knot counts at whose knots cells end: kCellsPerTurn and those of the fine fit's functions
+// that do not divide it.
+std::vector<double> CellCutsPerDeg(const Layout& fine) {
+  std::vector<double> per_deg = {kCellsPerTurn / 360.0};
+  for (const int knots : {fine.radius.knots, fine.axial.knots, fine.runout.knots}) {
+    if (knots > 1 && kCellsPerTurn % knots != 0) per_deg.push_back(knots / 360.0);
+  }
+  return per_deg;
+}
+
+// The sums of a closed cell's samples about their mean position d and mean z.
+struct CentralMoments {
+  double n = 0, d2 = 0, d3 = 0, d4 = 0, d5 = 0, zd = 0, zd2 = 0, z2 = 0;
+};
+
+// The three-point Gauss rule of positions with these central moments: nodes x (sorted) and
+// weights w with sum w x^j = the samples' sum d^j for j = 0..5.
+void GaussRule(const CentralMoments& m, std::array<double, 3>& x, std::array<double, 3>& w) {
+  // In units of the positions' standard deviation: moments 1, 0, 1, m3, m4, m5 per sample.
+  const double sigma = std::sqrt(m.d2 / m.n);
+  const double m3 = m.d3 / (m.n * sigma * sigma * sigma), m4 = m.d4 / (m.n * std::pow(sigma, 4)),
+               m5 = m.d5 / (m.n * std::pow(sigma, 5));
+  // The monic cubic orthogonal to 1, x and x^2 under the samples' positions: x^3 + a x^2 + b x + c.
+  Eigen::Matrix3d hankel;
+  hankel << 1.0, 0.0, 1.0, 0.0, 1.0, m3, 1.0, m3, m4;
+  const Eigen::Vector3d cba = hankel.partialPivLu().solve(Eigen::Vector3d(-m3, -m4, -m5));
+  const double c = cba[0], b = cba[1], a = cba[2];
+  // Its three real roots (trigonometric form of the depressed cubic t^3 + p t + q).
+  const double p = b - a * a / 3.0, q = 2.0 * a * a * a / 27.0 - a * b / 3.0 + c;
+  const double r = 2.0 * std::sqrt(std::max(-p / 3.0, 0.0));
+  const double cos3 = r > 0.0 ? std::clamp(3.0 * q / (p * r), -1.0, 1.0) : 0.0;
+  const double theta = std::acos(cos3) / 3.0;
+  for (std::size_t k = 0; k < 3; ++k) {
+    x[k] = r * std::cos(theta - 2.0 * std::numbers::pi * static_cast<double>(k) / 3.0) - a / 3.0;
+  }
+  std::sort(x.begin(), x.end());
+  Eigen::Matrix3d vandermonde;
+  for (int j = 0; j < 3; ++j) {
+    for (int k = 0; k < 3; ++k) vandermonde(j, k) = std::pow(x[static_cast<std::size_t>(k)], j);
+  }
+  const Eigen::Vector3d weights = vandermonde.partialPivLu().solve(Eigen::Vector3d(m.n, 0.0, m.n));
+  for (std::size_t k = 0; k < 3; ++k) {
+    w[k] = weights[static_cast<Eigen::Index>(k)];
+    x[k] *= sigma;
+  }
+}
+
+// A cell of the samples first..last (those valid and in the band; n of them, their positions
+// summing to sum_s and their z to sum_z_mm), from a second look at its samples (still in cache).
+template <typename Sample>
+HelixCell CloseCell(const Samples<Sample>& samples, std::uint64_t first, std::uint64_t last, double n,
+                    double sum_s, double sum_z_mm) {
+  HelixCell cell;
+  cell.first = first;
+  cell.count = static_cast<std::uint32_t>(n);
+  const double center = sum_s / n;
+  cell.z_mean_mm = sum_z_mm / n;
+  CentralMoments m;
+  m.n = n;
+  std::size_t seen = 0;
+  for (std::uint64_t i = first; i <= last; ++i) {
+    const auto rho = static_cast<double>(samples.rho_mm[i]);
+    if (!std::isfinite(rho)) continue;
+    const double y = samples.geometry.AxialAt(i);
+    if (y < samples.band_low_mm || y > samples.band_high_mm) continue;
+    const double d = static_cast<double>(i - first) - center, e = rho - cell.z_mean_mm;
+    if (seen < 3) {  // a cell of up to three samples keeps them as its points
+      cell.node[seen] = static_cast<float>(i - first);
+      cell.weight[seen] = 1.0f;
+      cell.value_mm[seen] = static_cast<float>(e);
+    }
+    ++seen;
+    const double d2 = d * d;
+    m.d2 += d2;
+    m.d3 += d2 * d;
+    m.d4 += d2 * d2;
+    m.d5 += d2 * d2 * d;
+    m.zd += e * d;
+    m.zd2 += e * d2;
+    m.z2 += e * e;
+  }
+  if (seen <= 3) return cell;
+  std::array<double, 3> x{}, w{};
+  GaussRule(m, x, w);
+  // Pseudo-values v / w: sum v = 0 (about the mean), sum v x = sum (z - mean) d, sum v x^2 =
+  // sum (z - mean) d^2.
+  Eigen::Matrix3d vandermonde;
+  for (int k = 0; k < 3; ++k) {
+    const double xk = x[static_cast<std::size_t>(k)];
+    vandermonde.col(k) << 1.0, xk, xk * xk;
+  }
+  const Eigen::Vector3d v = vandermonde.partialPivLu().solve(Eigen::Vector3d(0.0, m.zd, m.zd2));
+  double carried = 0.0;
+  for (std::size_t k = 0; k < 3; ++k) {
+    const double vk = v[static_cast<Eigen::Index>(k)];
+    cell.node[k] = static_cast<float>(center + x[k]);
+    cell.weight[k] = static_cast<float>(w[k]);
+    cell.value_mm[k] = static_cast<float>(vk / w[k]);
+    carried += vk * vk / w[k];
+  }
+  cell.rss_offset_mm2 = static_cast<float>(m.z2 - carried);
+  return cell;
+}
+
+// One part's samples into cells: the binned fit's one pass before the residual map's.
+template <typename Sample>
+void BinPart(const Samples<Sample>& samples, const std::vector<double>& cuts_per_deg, int part,
+             std::vector<HelixCell>& cells, double& low_y_mm, double& high_y_mm) {
+  const std::size_t total = samples.rho_mm.size();
+  const std::size_t begin = total * static_cast<std::size_t>(part) / kParts;
+  const std::size_t end = total * static_cast<std::size_t>(part + 1) / kParts;
+  const processing::HelixGeometry& geometry = samples.geometry;
+  if (begin < end) {  // a cell per cut per turn, and per kMaxCellSpan samples
+    const double turns = std::abs(geometry.PhaseAt(end - 1) - geometry.PhaseAt(begin)) / 360.0 + 1.0;
+    const double cuts = 360.0 * std::accumulate(cuts_per_deg.begin(), cuts_per_deg.end(), 0.0);
+    cells.reserve(static_cast<std::size_t>(
+        std::min(turns * cuts + static_cast<double>((end - begin) / kMaxCellSpan) + 1.0,
+                 static_cast<double>(end - begin))));
+  }
+  double low = std::numeric_limits<double>::infinity(), high = -low;
+  double n = 0.0, sum_s = 0.0, sum_z = 0.0;
+  std::uint64_t first = 0, last = 0;
+  std::array<long, 5> key{}, open_key{};  // the turn, then the interval of each cut
+  for (std::size_t i = begin; i < end; ++i) {
+    const auto rho = static_cast<double>(samples.rho_mm[i]);
+    if (!std::isfinite(rho)) continue;
+    const double y = geometry.AxialAt(i);
+    if (y < samples.band_low_mm || y > samples.band_high_mm) continue;
+    low = std::min(low, y);
+    high = std::max(high, y);
+    const double u = geometry.PhaseAt(i);
+    const double c = processing::PhaseInTurn(u);
+    key[0] = processing::RoundHalfAway((u - c) * (1.0 / 360.0));
+    for (std::size_t k = 0; k < cuts_per_deg.size(); ++k) key[k + 1] = static_cast<long>(c * cuts_per_deg[k]);
+    if (n > 0.0 && (key != open_key || i - first >= kMaxCellSpan)) {
+      cells.push_back(CloseCell(samples, first, last, n, sum_s, sum_z));
+      n = 0.0;
+    }
+    if (n == 0.0) {
+      open_key = key;
+      first = i;
+      sum_s = sum_z = 0.0;
+    }
+    last = i;
+    n += 1.0;
+    sum_s += static_cast<double>(i - first);
+    sum_z += rho;
+  }
+  if (n > 0.0) cells.push_back(CloseCell(samples, first, last, n, sum_s, sum_z));
+  low_y_mm = low;
+  high_y_mm = high;
+}
+
+template <typename Sample>
+HelixCells BinSamples(const Samples<Sample>& samples, const Layout& fine) {
+  HelixCells cells;
+  const std::vector<double> cuts_per_deg = CellCutsPerDeg(fine);
+  ARCWHEEL_CHECK(cuts_per_deg.size() <= 4) << cuts_per_deg.size();
+  const int workers = std::min(WorkerCount(0), kParts);
+  RunOnWorkers(workers, [&](int worker) {
+    for (int part = worker; part < kParts; part += workers) {
+      const auto p = static_cast<std::size_t>(part);
+      BinPart(samples, cuts_per_deg, part, cells.parts[p], cells.ranges.low_y_mm[p],
+              cells.ranges.high_y_mm[p]);
+    }
+  });
+  return cells;
+}
+
+// One part's cells as weighted points: J^T J, J^T r and r^T r of its samples, exact where the
+// model is quadratic along each cell. The points' rows are scaled by the root of their weights.
+void AccumulateCellsPart(const std::vector<HelixCell>& cells, const processing::HelixGeometry& geometry,
+                         const RowModel& model, NormalEquations& normal, bool normal_matrix) {
+  BlockAccumulator block(model, normal, normal_matrix);
+  double rss = 0.0;
+  std::size_t used = 0;
+  std::array<Row, 3> rows;
+  for (const HelixCell& cell : cells) {
+    const std::size_t points = cell.points();
+    const auto base = static_cast<double>(cell.first);
+    bool inside = true;
+    for (std::size_t k = 0; k < points && inside; ++k) {
+      const double at = base + cell.node[k];
+      const double c = processing::PhaseInTurn(geometry.PhaseAtIndex(at));
+      inside = model.Evaluate(c, geometry.AxialAtIndex(at), cell.z_mean_mm + cell.value_mm[k], rows[k]);
+    }
+    if (!inside) continue;
+    for (std::size_t k = 0; k < points; ++k) {
+      Row& row = rows[k];
+      const double root = std::sqrt(static_cast<double>(cell.weight[k]));
+      for (double& value : row.value) value *= root;
+      row.residual *= root;
+      block.Add(row);
+      rss += row.residual * row.residual;
+    }
+    rss += cell.rss_offset_mm2;
+    used += cell.count;
+  }
+  normal.rss += rss;
+  normal.samples += used;
 }
 
 // One part's share of a pass.
@@ -444,6 +682,8 @@ template <typename Sample>
 PassResult Accumulate(const Samples<Sample>& samples, const Layout& layout, const VectorXd& theta,
                       const PassRequest& request, const PartRanges* previous = nullptr) {
   ARCWHEEL_CHECK(request.grid == nullptr || previous != nullptr) << "a residual map needs the parts' ranges";
+  ARCWHEEL_CHECK(samples.cells == nullptr || (request.grid == nullptr && request.stride == 1))
+      << "the cells make neither a residual map nor a subsample";
   const int n = layout.size();
   const RowModel model(layout, theta);
   std::vector<NormalEquations> parts(kParts);
@@ -461,10 +701,15 @@ PassResult Accumulate(const Samples<Sample>& samples, const Layout& layout, cons
       NormalEquations& normal = parts[p];
       if (request.normal_matrix) normal.jtj = MatrixXd::Zero(n, n);
       normal.jtr = VectorXd::Zero(n);
+      if (samples.cells != nullptr) {
+        AccumulateCellsPart(samples.cells->parts[p], samples.geometry, model, normal, request.normal_matrix);
+        continue;
+      }
       AccumulatePart(samples, model, request, part, normal, result.cells.empty() ? nullptr : &result.cells[p],
                      result.ranges.low_y_mm[p], result.ranges.high_y_mm[p]);
     }
   });
+  if (samples.cells != nullptr) result.ranges = samples.cells->ranges;
   result.normal = std::move(parts[0]);
   for (std::size_t part = 1; part < parts.size(); ++part) result.normal.Add(parts[part]);
   result.normal.Symmetrise();
@@ -490,6 +735,104 @@ std::vector<double> ResidualMap(const Grid& grid, const std::vector<CellSums>& p
     sum[cell] = count[cell] > 0 ? sum[cell] / static_cast<double>(count[cell]) * 1e3 : kNaN;
   }
   return sum;
+}
+
+// After the fit: the model at each cell's points less the cell's mean z (HelixCell::value_mm), for
+// the residual map; a cell whose points lie beyond the arc is left out of it (count 0).
+void StoreModelAtPoints(HelixCells& cells, const processing::HelixGeometry& geometry, const Layout& layout,
+                        const VectorXd& theta) {
+  const RowModel model(layout, theta);
+  const int workers = std::min(WorkerCount(0), kParts);
+  RunOnWorkers(workers, [&](int worker) {
+    Row row;
+    for (int part = worker; part < kParts; part += workers) {
+      for (HelixCell& cell : cells.parts[static_cast<std::size_t>(part)]) {
+        for (std::size_t k = 0; k < cell.points(); ++k) {
+          const double at = static_cast<double>(cell.first) + cell.node[k];
+          const double c = processing::PhaseInTurn(geometry.PhaseAtIndex(at));
+          if (!model.Evaluate(c, geometry.AxialAtIndex(at), cell.z_mean_mm + cell.value_mm[k], row)) {
+            cell.count = 0;
+            break;
+          }
+          cell.value_mm[k] = static_cast<float>(cell.value_mm[k] - row.residual);
+        }
+      }
+    }
+  });
+}
+
+// The model along a cell, less its mean z, at d = index - first: the polynomial through
+// its points (of degree 2 with three; exact but for the model's third derivative along the cell).
+struct CellPolynomial {
+  double x0 = 0, x1 = 0, f0 = 0, slope = 0, curvature = 0;
+  CellPolynomial() = default;
+  explicit CellPolynomial(const HelixCell& cell) : x0(cell.node[0]), f0(cell.value_mm[0]) {
+    if (cell.points() < 2) return;
+    x1 = cell.node[1];
+    slope = (cell.value_mm[1] - f0) / (x1 - x0);  // divided differences
+    if (cell.points() < 3) return;
+    const double slope12 = (cell.value_mm[2] - cell.value_mm[1]) / (cell.node[2] - x1);
+    curvature = (slope12 - slope) / (cell.node[2] - x0);
+  }
+  [[nodiscard]] double At(double d) const { return f0 + (d - x0) * (slope + (d - x1) * curvature); }
+};
+
+// One part's residuals per cell of the map's grid, from its samples and the polynomials of the
+// cells they were binned into.
+template <typename Sample>
+void CellResidualsPart(const Samples<Sample>& samples, const std::vector<HelixCell>& cells, const Grid& grid,
+                       int part, CellSums& sums) {
+  if (sums.axial_cells == 0 || cells.empty()) return;
+  const std::size_t total = samples.rho_mm.size();
+  const std::size_t begin = total * static_cast<std::size_t>(part) / kParts;
+  const std::size_t end = total * static_cast<std::size_t>(part + 1) / kParts;
+  const processing::HelixGeometry& geometry = samples.geometry;
+  const double per_phase_cell = 1.0 / grid.phase_step_deg, per_axial_cell = 1.0 / grid.y_step_mm;
+  std::size_t at = 0;  // the cell of sample i: the last that begins at or before it
+  CellPolynomial model(cells[0]);
+  for (std::size_t i = begin; i < end; ++i) {
+    const auto rho = static_cast<double>(samples.rho_mm[i]);
+    if (!std::isfinite(rho)) continue;
+    const double y = geometry.AxialAt(i);
+    if (y < samples.band_low_mm || y > samples.band_high_mm) continue;
+    if (at + 1 < cells.size() && i >= cells[at + 1].first) {
+      while (at + 1 < cells.size() && i >= cells[at + 1].first) ++at;
+      model = CellPolynomial(cells[at]);
+    }
+    const HelixCell& cell = cells[at];
+    if (cell.count == 0) continue;
+    const double residual = rho - cell.z_mean_mm - model.At(static_cast<double>(i - cell.first));
+    const double c = processing::PhaseInTurn(geometry.PhaseAt(i));
+    auto p = static_cast<std::size_t>(processing::RoundHalfAway(c * per_phase_cell));
+    if (p >= grid.n_phase) p -= grid.n_phase;  // c rounds up to the turn's end
+    const long a = processing::RoundHalfAway((y - grid.y0_mm) * per_axial_cell) - sums.first_axial;
+    if (a < 0 || a >= sums.axial_cells) continue;
+    const std::size_t index = p * static_cast<std::size_t>(sums.axial_cells) + static_cast<std::size_t>(a);
+    sums.sum[index] += residual;
+    ++sums.count[index];
+  }
+}
+
+// The residual map of the binned fit at theta: one more pass over the samples, each residual
+// against its cell's parabola. Releases the cells before the map is summed.
+template <typename Sample>
+std::vector<double> CellResidualMap(const Samples<Sample>& samples, HelixCells& cells, const Grid& grid,
+                                    const Layout& layout, const VectorXd& theta) {
+  if (grid.empty()) return {};
+  StoreModelAtPoints(cells, samples.geometry, layout, theta);
+  std::vector<CellSums> sums;
+  for (std::size_t part = 0; part < kParts; ++part) {
+    sums.push_back(CellSumsFor(grid, cells.ranges.low_y_mm[part], cells.ranges.high_y_mm[part]));
+  }
+  const int workers = std::min(WorkerCount(0), kParts);
+  RunOnWorkers(workers, [&](int worker) {
+    for (int part = worker; part < kParts; part += workers) {
+      const auto p = static_cast<std::size_t>(part);
+      CellResidualsPart(samples, cells.parts[p], grid, part, sums[p]);
+    }
+  });
+  for (std::vector<HelixCell>& part : cells.parts) std::vector<HelixCell>().swap(part);
+  return ResidualMap(grid, sums);
 }
 
 // The constraints on p: its integrals against 1, u and u^2 over the band vanish. Returns an
@@ -951,7 +1294,7 @@ std::size_t WarmUpStride(std::size_t total, std::size_t warm_start_samples) {
 // the warm-up, every Gauss-Newton iteration passes over every sample, and the residual map takes
 // a pass of its own.
 template <typename Sample>
-Fitted FitAndChoose(const Samples<Sample>& samples, const Grid& grid, const WheelFit& fit,
+Fitted FitAndChoose(const Samples<Sample>& samples_in, const Grid& grid, const WheelFit& fit,
                     const WheelModelOptions& options, double half_width_mm, WheelModel& model) {
   const std::vector<int> choices[3] = {KnotCandidates(options.radius_knots, true),
                                        KnotCandidates(options.axial_knots, true),
@@ -961,7 +1304,14 @@ Fitted FitAndChoose(const Samples<Sample>& samples, const Grid& grid, const Whee
   const MatrixXd null_space = ProfileNullSpace(fine.profile, half_width_mm);
   const MatrixXd fine_reduction = Reduction(fine, fine.knots(), null_space);
   VectorXd start = StartingPoint(fine, fit);
-  const std::size_t stride = WarmUpStride(samples.rho_mm.size(), options.warm_start_samples);
+  // Binned: every pass but the residual map's runs on the cells, so no warm-up is needed.
+  HelixCells cells;
+  const bool binned =
+      samples_in.rho_mm.size() > options.binned_above_samples && samples_in.geometry.from_settings();
+  if (binned) cells = BinSamples(samples_in, fine);
+  Samples<Sample> samples = samples_in;
+  if (binned) samples.cells = &cells;
+  const std::size_t stride = binned ? 1 : WarmUpStride(samples.rho_mm.size(), options.warm_start_samples);
   const bool warm = stride > 1;
   if (warm) {
     const Solution subsample = Converge(
@@ -1004,6 +1354,8 @@ Fitted FitAndChoose(const Samples<Sample>& samples, const Grid& grid, const Whee
   }
   if (warm) {
     fitted.residual_um = ResidualMap(grid, best.cells);
+  } else if (binned) {
+    fitted.residual_um = CellResidualMap(samples_in, cells, grid, fitted.layout, best.theta);
   } else {
     // As the fit was defined: the residuals at the solution, one more pass.
     const PassResult pass =

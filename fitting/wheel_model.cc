@@ -475,8 +475,8 @@ void GaussRule(const CentralMoments& m, std::array<double, 3>& x, std::array<dou
   }
 }
 
-// A cell of the samples first..last (those valid and in the band; n of them, their positions
-// summing to sum_s and their z to sum_z_mm), from a second look at its samples (still in cache).
+// A cell of the valid samples first..last (all in the band; n of them, their positions summing
+// to sum_s and their z to sum_z_mm), from a second look at its samples (still in cache).
 template <typename Sample>
 HelixCell CloseCell(const Samples<Sample>& samples, std::uint64_t first, std::uint64_t last, double n,
                     double sum_s, double sum_z_mm) {
@@ -491,8 +491,6 @@ HelixCell CloseCell(const Samples<Sample>& samples, std::uint64_t first, std::ui
   for (std::uint64_t i = first; i <= last; ++i) {
     const auto rho = static_cast<double>(samples.rho_mm[i]);
     if (!std::isfinite(rho)) continue;
-    const double y = samples.geometry.AxialAt(i);
-    if (y < samples.band_low_mm || y > samples.band_high_mm) continue;
     const double d = static_cast<double>(i - first) - center, e = rho - cell.z_mean_mm;
     if (seen < 3) {  // a cell of up to three samples keeps them as its points
       cell.node[seen] = static_cast<float>(i - first);
@@ -532,13 +530,60 @@ HelixCell CloseCell(const Samples<Sample>& samples, std::uint64_t first, std::ui
   return cell;
 }
 
+// The samples of begin..end in the band, as an index range: on a helix from the settings the
+// axial position is monotonic in the index (each operation of AxialAt rounds monotonically), so
+// the band holds a run of them, found by bisection with the same test as a pass over each sample.
+template <typename Sample>
+std::pair<std::size_t, std::size_t> BandRun(const Samples<Sample>& samples, std::size_t begin,
+                                            std::size_t end) {
+  if (begin >= end) return {begin, begin};
+  const processing::HelixGeometry& geometry = samples.geometry;
+  const auto below = [&](std::size_t i) { return geometry.AxialAt(i) < samples.band_low_mm; };
+  const auto above = [&](std::size_t i) { return geometry.AxialAt(i) > samples.band_high_mm; };
+  // The first index in begin..end where `test` holds, for a test that holds from some index on.
+  const auto first_where = [&](const auto& test) {
+    std::size_t low = begin, high = end;
+    while (low < high) {
+      const std::size_t mid = low + (high - low) / 2;
+      if (test(mid)) {
+        high = mid;
+      } else {
+        low = mid + 1;
+      }
+    }
+    return low;
+  };
+  const bool rising = geometry.AxialAt(end - 1) >= geometry.AxialAt(begin);
+  const std::size_t first = rising ? first_where([&](std::size_t i) { return !below(i); })
+                                   : first_where([&](std::size_t i) { return !above(i); });
+  const std::size_t last = rising ? first_where(above) : first_where(below);
+  return {first, std::max(first, last)};
+}
+
+// The index after `i` at which the next cell begins: the first sample past the next knot of any
+// cut (the phase is linear in the index), at most kMaxCellSpan on.
+std::size_t CellEnd(const processing::HelixGeometry& geometry, const std::vector<double>& cuts_per_deg,
+                    std::size_t i) {
+  const double deg_per_sample = geometry.PhaseAtIndex(1.0) - geometry.PhaseAtIndex(0.0);
+  std::size_t end = i + kMaxCellSpan;
+  if (deg_per_sample == 0.0) return end;
+  const double phase = geometry.PhaseAtIndex(static_cast<double>(i));
+  for (const double per_deg : cuts_per_deg) {
+    const double knot = std::floor(phase * per_deg) + (deg_per_sample > 0.0 ? 1.0 : 0.0);
+    const double at = std::ceil((knot / per_deg - phase) / deg_per_sample);
+    if (at >= 1.0 && at < static_cast<double>(kMaxCellSpan))
+      end = std::min(end, i + static_cast<std::size_t>(at));
+  }
+  return std::max(end, i + 1);
+}
+
 // One part's samples into cells: the binned fit's one pass before the residual map's.
 template <typename Sample>
 void BinPart(const Samples<Sample>& samples, const std::vector<double>& cuts_per_deg, int part,
              std::vector<HelixCell>& cells, double& low_y_mm, double& high_y_mm) {
   const std::size_t total = samples.rho_mm.size();
-  const std::size_t begin = total * static_cast<std::size_t>(part) / kParts;
-  const std::size_t end = total * static_cast<std::size_t>(part + 1) / kParts;
+  const auto [begin, end] = BandRun(samples, total * static_cast<std::size_t>(part) / kParts,
+                                    total * static_cast<std::size_t>(part + 1) / kParts);
   const processing::HelixGeometry& geometry = samples.geometry;
   if (begin < end) {  // a cell per cut per turn, and per kMaxCellSpan samples
     const double turns = std::abs(geometry.PhaseAt(end - 1) - geometry.PhaseAt(begin)) / 360.0 + 1.0;
@@ -548,35 +593,28 @@ void BinPart(const Samples<Sample>& samples, const std::vector<double>& cuts_per
                  static_cast<double>(end - begin))));
   }
   double low = std::numeric_limits<double>::infinity(), high = -low;
-  double n = 0.0, sum_s = 0.0, sum_z = 0.0;
-  std::uint64_t first = 0, last = 0;
-  std::array<long, 5> key{}, open_key{};  // the turn, then the interval of each cut
-  for (std::size_t i = begin; i < end; ++i) {
-    const auto rho = static_cast<double>(samples.rho_mm[i]);
-    if (!std::isfinite(rho)) continue;
-    const double y = geometry.AxialAt(i);
-    if (y < samples.band_low_mm || y > samples.band_high_mm) continue;
-    low = std::min(low, y);
-    high = std::max(high, y);
-    const double u = geometry.PhaseAt(i);
-    const double c = processing::PhaseInTurn(u);
-    key[0] = processing::RoundHalfAway((u - c) * (1.0 / 360.0));
-    for (std::size_t k = 0; k < cuts_per_deg.size(); ++k) key[k + 1] = static_cast<long>(c * cuts_per_deg[k]);
-    if (n > 0.0 && (key != open_key || i - first >= kMaxCellSpan)) {
+  for (std::size_t from = begin; from < end;) {
+    const std::size_t to = std::min(CellEnd(geometry, cuts_per_deg, from), end);
+    double n = 0.0, sum_s = 0.0, sum_z = 0.0;
+    std::size_t first = to, last = to;
+    for (std::size_t i = from; i < to; ++i) {
+      const auto rho = static_cast<double>(samples.rho_mm[i]);
+      if (!std::isfinite(rho)) continue;
+      if (n == 0.0) first = i;
+      last = i;
+      n += 1.0;
+      sum_s += static_cast<double>(i - first);
+      sum_z += rho;
+    }
+    if (n > 0.0) {
       cells.push_back(CloseCell(samples, first, last, n, sum_s, sum_z));
-      n = 0.0;
+      for (const std::size_t i : {first, last}) {
+        low = std::min(low, geometry.AxialAt(i));
+        high = std::max(high, geometry.AxialAt(i));
+      }
     }
-    if (n == 0.0) {
-      open_key = key;
-      first = i;
-      sum_s = sum_z = 0.0;
-    }
-    last = i;
-    n += 1.0;
-    sum_s += static_cast<double>(i - first);
-    sum_z += rho;
+    from = to;
   }
-  if (n > 0.0) cells.push_back(CloseCell(samples, first, last, n, sum_s, sum_z));
   low_y_mm = low;
   high_y_mm = high;
 }
@@ -720,7 +758,8 @@ PassResult Accumulate(const Samples<Sample>& samples, const Layout& layout, cons
 std::vector<double> ResidualMap(const Grid& grid, const std::vector<CellSums>& parts) {
   if (grid.empty()) return {};
   std::vector<double> sum(grid.size(), 0.0);
-  std::vector<std::uint64_t> count(grid.size(), 0);
+  std::vector<std::uint32_t> count(grid.size(),
+                                   0);  // as CellSums::count: a cell holds fewer than 2^32 samples
   for (const CellSums& part : parts) {
     for (std::size_t p = 0; p < grid.n_phase; ++p) {
       for (long a = 0; a < part.axial_cells; ++a) {
@@ -778,38 +817,61 @@ struct CellPolynomial {
 };
 
 // One part's residuals per cell of the map's grid, from its samples and the polynomials of the
-// cells they were binned into.
+// cells they were binned into (a cell's samples run to the next cell's first). Within a cell the
+// phase and the axial position are monotonic in the index, so its samples fall into the map's
+// cells in runs: each run's end is found by bisection with the per-sample rule, and its residuals
+// are summed without it.
 template <typename Sample>
 void CellResidualsPart(const Samples<Sample>& samples, const std::vector<HelixCell>& cells, const Grid& grid,
                        int part, CellSums& sums) {
   if (sums.axial_cells == 0 || cells.empty()) return;
   const std::size_t total = samples.rho_mm.size();
-  const std::size_t begin = total * static_cast<std::size_t>(part) / kParts;
-  const std::size_t end = total * static_cast<std::size_t>(part + 1) / kParts;
+  const std::size_t end = BandRun(samples, total * static_cast<std::size_t>(part) / kParts,
+                                  total * static_cast<std::size_t>(part + 1) / kParts)
+                              .second;
   const processing::HelixGeometry& geometry = samples.geometry;
   const double per_phase_cell = 1.0 / grid.phase_step_deg, per_axial_cell = 1.0 / grid.y_step_mm;
-  std::size_t at = 0;  // the cell of sample i: the last that begins at or before it
-  CellPolynomial model(cells[0]);
-  for (std::size_t i = begin; i < end; ++i) {
-    const auto rho = static_cast<double>(samples.rho_mm[i]);
-    if (!std::isfinite(rho)) continue;
-    const double y = geometry.AxialAt(i);
-    if (y < samples.band_low_mm || y > samples.band_high_mm) continue;
-    if (at + 1 < cells.size() && i >= cells[at + 1].first) {
-      while (at + 1 < cells.size() && i >= cells[at + 1].first) ++at;
-      model = CellPolynomial(cells[at]);
-    }
-    const HelixCell& cell = cells[at];
-    if (cell.count == 0) continue;
-    const double residual = rho - cell.z_mean_mm - model.At(static_cast<double>(i - cell.first));
+  // The map's cell of sample i as the pass over every sample finds it: (phase, axial - first_axial).
+  const auto map_cell = [&](std::size_t i) {
     const double c = processing::PhaseInTurn(geometry.PhaseAt(i));
     auto p = static_cast<std::size_t>(processing::RoundHalfAway(c * per_phase_cell));
     if (p >= grid.n_phase) p -= grid.n_phase;  // c rounds up to the turn's end
-    const long a = processing::RoundHalfAway((y - grid.y0_mm) * per_axial_cell) - sums.first_axial;
-    if (a < 0 || a >= sums.axial_cells) continue;
-    const std::size_t index = p * static_cast<std::size_t>(sums.axial_cells) + static_cast<std::size_t>(a);
-    sums.sum[index] += residual;
-    ++sums.count[index];
+    const long a =
+        processing::RoundHalfAway((geometry.AxialAt(i) - grid.y0_mm) * per_axial_cell) - sums.first_axial;
+    return std::pair<std::size_t, long>{p, a};
+  };
+  for (std::size_t k = 0; k < cells.size(); ++k) {
+    const HelixCell& cell = cells[k];
+    if (cell.count == 0) continue;
+    const CellPolynomial model(cell);
+    const std::size_t to = k + 1 < cells.size() ? cells[k + 1].first : end;
+    for (std::size_t from = cell.first; from < to;) {
+      const std::pair<std::size_t, long> key = map_cell(from);
+      std::size_t low = from + 1, high = to;  // the run ends at the first index of another cell
+      while (low < high) {
+        const std::size_t mid = low + (high - low) / 2;
+        if (map_cell(mid) != key) {
+          high = mid;
+        } else {
+          low = mid + 1;
+        }
+      }
+      if (key.second >= 0 && key.second < sums.axial_cells) {
+        double sum = 0.0;
+        std::uint32_t count = 0;
+        for (std::size_t i = from; i < low; ++i) {
+          const auto rho = static_cast<double>(samples.rho_mm[i]);
+          if (!std::isfinite(rho)) continue;
+          sum += rho - cell.z_mean_mm - model.At(static_cast<double>(i - cell.first));
+          ++count;
+        }
+        const std::size_t index =
+            key.first * static_cast<std::size_t>(sums.axial_cells) + static_cast<std::size_t>(key.second);
+        sums.sum[index] += sum;
+        sums.count[index] += count;
+      }
+      from = low;
+    }
   }
 }
 

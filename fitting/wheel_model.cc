@@ -405,15 +405,13 @@ CellSums CellSumsFor(const Grid& grid, double low_y_mm, double high_y_mm) {
 // position) as the samples' z do. The sums are exact where the model is a polynomial of degree 2
 // along the cell; the error comes from its third derivative along a cell (docs: measured).
 struct HelixCell {
-  std::uint64_t first = 0;        // index of its first sample; it ends where the next cell begins
-  std::uint32_t count = 0;        // valid samples in the band
-  float rss_offset_mm2 = 0;       // the cell's sum of squares less the points' (constant in the model)
-  double z_mean_mm = 0;           // the mean z of its samples
-  std::array<float, 3> node{};    // the points' positions, index - first (within 2.5e-4)
-  std::array<float, 3> weight{};  // the points' weights (they sum to count; unused points 0)
-  // Each point's pseudo-value less z_mean_mm; after the fit, the model there less z_mean_mm,
-  // which the residual map interpolates.
-  std::array<float, 3> value_mm{};
+  std::uint64_t first = 0;          // index of its first sample; it ends where the next cell begins
+  std::uint32_t count = 0;          // valid samples in the band
+  float rss_offset_mm2 = 0;         // the cell's sum of squares less the points' (constant in the model)
+  double z_mean_mm = 0;             // the mean z of its samples
+  std::array<float, 3> node{};      // the points' positions, index - first (within 2.5e-4)
+  std::array<float, 3> weight{};    // the points' weights (they sum to count; unused points 0)
+  std::array<float, 3> value_mm{};  // each point's pseudo-value less z_mean_mm
   [[nodiscard]] std::size_t points() const { return std::min<std::size_t>(count, 3); }
 };
 
@@ -776,54 +774,46 @@ std::vector<double> ResidualMap(const Grid& grid, const std::vector<CellSums>& p
   return sum;
 }
 
-// After the fit: the model at each cell's points less the cell's mean z (HelixCell::value_mm), for
-// the residual map; a cell whose points lie beyond the arc is left out of it (count 0).
-void StoreModelAtPoints(HelixCells& cells, const processing::HelixGeometry& geometry, const Layout& layout,
-                        const VectorXd& theta) {
-  const RowModel model(layout, theta);
-  const int workers = std::min(WorkerCount(0), kParts);
-  RunOnWorkers(workers, [&](int worker) {
-    Row row;
-    for (int part = worker; part < kParts; part += workers) {
-      for (HelixCell& cell : cells.parts[static_cast<std::size_t>(part)]) {
-        for (std::size_t k = 0; k < cell.points(); ++k) {
-          const double at = static_cast<double>(cell.first) + cell.node[k];
-          const double c = processing::PhaseInTurn(geometry.PhaseAtIndex(at));
-          if (!model.Evaluate(c, geometry.AxialAtIndex(at), cell.z_mean_mm + cell.value_mm[k], row)) {
-            cell.count = 0;
-            break;
-          }
-          cell.value_mm[k] = static_cast<float>(cell.value_mm[k] - row.residual);
-        }
-      }
-    }
-  });
-}
-
-// The model along a cell, less its mean z, at d = index - first: the polynomial through
-// its points (of degree 2 with three; exact but for the model's third derivative along the cell).
-struct CellPolynomial {
+// The model along a run of samples first..last (a fraction of a degree of phase): the parabola
+// through its values at the run's ends and middle, whose error, of the model's third derivative
+// along the run times its length cubed, is some 1e-6 um. Valid is false where a point lies beyond
+// the arc.
+struct RunModel {
   double x0 = 0, x1 = 0, f0 = 0, slope = 0, curvature = 0;
-  CellPolynomial() = default;
-  explicit CellPolynomial(const HelixCell& cell) : x0(cell.node[0]), f0(cell.value_mm[0]) {
-    if (cell.points() < 2) return;
-    x1 = cell.node[1];
-    slope = (cell.value_mm[1] - f0) / (x1 - x0);  // divided differences
-    if (cell.points() < 3) return;
-    const double slope12 = (cell.value_mm[2] - cell.value_mm[1]) / (cell.node[2] - x1);
-    curvature = (slope12 - slope) / (cell.node[2] - x0);
+  bool valid = true;
+  RunModel(const RowModel& model, const processing::HelixGeometry& geometry, std::size_t first,
+           std::size_t last) {
+    const std::array<double, 3> x = {static_cast<double>(first), 0.5 * static_cast<double>(first + last),
+                                     static_cast<double>(last)};
+    const std::size_t points = std::min<std::size_t>(last - first + 1, 3);
+    std::array<double, 3> f{};
+    Row row;
+    for (std::size_t k = 0; k < points; ++k) {
+      const double at = points == 2 && k == 1 ? x[2] : x[k];
+      const double c = processing::PhaseInTurn(geometry.PhaseAtIndex(at));
+      valid = valid && model.Evaluate(c, geometry.AxialAtIndex(at), 0.0, row);
+      f[k] = -row.residual;
+    }
+    x0 = x[0];
+    f0 = f[0];
+    if (points == 2) slope = (f[1] - f0) / (x[2] - x0);
+    if (points < 3) return;
+    x1 = x[1];
+    slope = (f[1] - f0) / (x1 - x0);  // divided differences
+    curvature = ((f[2] - f[1]) / (x[2] - x1) - slope) / (x[2] - x0);
   }
-  [[nodiscard]] double At(double d) const { return f0 + (d - x0) * (slope + (d - x1) * curvature); }
+  [[nodiscard]] double At(double index) const {
+    return f0 + (index - x0) * (slope + (index - x1) * curvature);
+  }
 };
 
-// One part's residuals per cell of the map's grid, from its samples and the polynomials of the
-// cells they were binned into (a cell's samples run to the next cell's first). Within a cell the
-// phase and the axial position are monotonic in the index, so its samples fall into the map's
-// cells in runs: each run's end is found by bisection with the per-sample rule, and its residuals
-// are summed without it.
+// One part's residuals per cell of the map's grid. Within a helix cell (its samples run to the
+// next cell's first) the phase and the axial position are monotonic in the index, so its samples
+// fall into the map's cells in runs: each run's end is found by bisection with the per-sample
+// rule, and its residuals are summed against the model along the run (RunModel).
 template <typename Sample>
-void CellResidualsPart(const Samples<Sample>& samples, const std::vector<HelixCell>& cells, const Grid& grid,
-                       int part, CellSums& sums) {
+void CellResidualsPart(const Samples<Sample>& samples, const std::vector<HelixCell>& cells,
+                       const RowModel& model, const Grid& grid, int part, CellSums& sums) {
   if (sums.axial_cells == 0 || cells.empty()) return;
   const std::size_t total = samples.rho_mm.size();
   const std::size_t end = BandRun(samples, total * static_cast<std::size_t>(part) / kParts,
@@ -842,8 +832,6 @@ void CellResidualsPart(const Samples<Sample>& samples, const std::vector<HelixCe
   };
   for (std::size_t k = 0; k < cells.size(); ++k) {
     const HelixCell& cell = cells[k];
-    if (cell.count == 0) continue;
-    const CellPolynomial model(cell);
     const std::size_t to = k + 1 < cells.size() ? cells[k + 1].first : end;
     for (std::size_t from = cell.first; from < to;) {
       const std::pair<std::size_t, long> key = map_cell(from);
@@ -856,13 +844,14 @@ void CellResidualsPart(const Samples<Sample>& samples, const std::vector<HelixCe
           low = mid + 1;
         }
       }
-      if (key.second >= 0 && key.second < sums.axial_cells) {
+      const RunModel run(model, geometry, from, low - 1);
+      if (run.valid && key.second >= 0 && key.second < sums.axial_cells) {
         double sum = 0.0;
         std::uint32_t count = 0;
         for (std::size_t i = from; i < low; ++i) {
           const auto rho = static_cast<double>(samples.rho_mm[i]);
           if (!std::isfinite(rho)) continue;
-          sum += rho - cell.z_mean_mm - model.At(static_cast<double>(i - cell.first));
+          sum += rho - run.At(static_cast<double>(i));
           ++count;
         }
         const std::size_t index =
@@ -876,12 +865,12 @@ void CellResidualsPart(const Samples<Sample>& samples, const std::vector<HelixCe
 }
 
 // The residual map of the binned fit at theta: one more pass over the samples, each residual
-// against its cell's parabola. Releases the cells before the map is summed.
+// against the model along its run. Releases the cells before the map is summed.
 template <typename Sample>
 std::vector<double> CellResidualMap(const Samples<Sample>& samples, HelixCells& cells, const Grid& grid,
                                     const Layout& layout, const VectorXd& theta) {
   if (grid.empty()) return {};
-  StoreModelAtPoints(cells, samples.geometry, layout, theta);
+  const RowModel model(layout, theta);
   std::vector<CellSums> sums;
   for (std::size_t part = 0; part < kParts; ++part) {
     sums.push_back(CellSumsFor(grid, cells.ranges.low_y_mm[part], cells.ranges.high_y_mm[part]));
@@ -890,7 +879,7 @@ std::vector<double> CellResidualMap(const Samples<Sample>& samples, HelixCells& 
   RunOnWorkers(workers, [&](int worker) {
     for (int part = worker; part < kParts; part += workers) {
       const auto p = static_cast<std::size_t>(part);
-      CellResidualsPart(samples, cells.parts[p], grid, part, sums[p]);
+      CellResidualsPart(samples, cells.parts[p], model, grid, part, sums[p]);
     }
   });
   for (std::vector<HelixCell>& part : cells.parts) std::vector<HelixCell>().swap(part);

@@ -275,8 +275,11 @@ void ExpectSameModel(const WheelModel& fast, const WheelModel& reference, const 
              "mean Ra", tol);
   ExpectNear(fast.arc_radius_range_mm, reference.arc_radius_range_mm, reference.arc_radius_range_sigma_mm,
              "Ra range", tol);
-  // The chi-square's own sigma is sqrt(2 dof).
-  ExpectNear(fast.variation_chi2, reference.variation_chi2, std::sqrt(2.0 * reference.variation_dof), "chi2",
+  // The chi-square's own sigma: sqrt(2 (dof + 2 lambda)), lambda (the non-centrality) estimated
+  // by chi2 - dof; sqrt(2 dof) for a constant radius.
+  const double dof = reference.variation_dof;
+  const double lambda = std::max(reference.variation_chi2 - dof, 0.0);
+  ExpectNear(fast.variation_chi2, reference.variation_chi2, std::sqrt(2.0 * (dof + 2.0 * lambda)), "chi2",
              tol);
   EXPECT_EQ(fast.variation_significant, reference.variation_significant);
   EXPECT_NEAR(fast.residual_rms_um, reference.residual_rms_um, tol.rms_relative * reference.residual_rms_um);

@@ -65,7 +65,7 @@ struct WheelModel {
   double center_axial_reference_mm = 0;  // mean a, the band's centre
   std::size_t samples = 0;               // samples in the band that the fit used
   int parameters = 0;                    // free parameters (the constraints on p taken off)
-  int iterations = 0;                    // Gauss-Newton passes over every sample (the warm-up's not counted)
+  int iterations = 0;                    // Gauss-Newton passes (binned: over the cells), warm-up aside
   double residual_rms_um = 0;            // of the fit, against the scan's noise estimate:
   double noise_sigma_um = 0;
   double mean_arc_radius_mm = 0, mean_arc_radius_sigma_mm = 0;  // the mean of Ra(c) over a turn

@@ -774,43 +774,44 @@ std::vector<double> ResidualMap(const Grid& grid, const std::vector<CellSums>& p
   return sum;
 }
 
-// The model along a run of samples first..last (a fraction of a degree of phase): the parabola
-// through its values at the run's ends and middle, whose error, of the model's third derivative
-// along the run times its length cubed, is some 1e-6 um. Valid is false where a point lies beyond
-// the arc.
-struct RunModel {
-  double x0 = 0, x1 = 0, f0 = 0, slope = 0, curvature = 0;
+// The model along the samples first..last of a helix cell (at most 1/64 turn): the cubic through
+// its values at four Chebyshev points of the span (at the samples themselves when there are no
+// more than four), whose error, of the model's fourth derivative along the cell, is some 1e-5 um
+// on a lobed wheel. Valid is false where a point lies beyond the arc.
+struct SpanModel {
+  std::array<double, 4> x{}, c{};  // the points (sample indices) and Newton's coefficients
+  std::size_t points = 0;
   bool valid = true;
-  RunModel(const RowModel& model, const processing::HelixGeometry& geometry, std::size_t first,
-           std::size_t last) {
-    const std::array<double, 3> x = {static_cast<double>(first), 0.5 * static_cast<double>(first + last),
-                                     static_cast<double>(last)};
-    const std::size_t points = std::min<std::size_t>(last - first + 1, 3);
-    std::array<double, 3> f{};
+  SpanModel(const RowModel& model, const processing::HelixGeometry& geometry, std::size_t first,
+            std::size_t last) {
+    points = std::min<std::size_t>(last - first + 1, 4);
+    const double mid = 0.5 * static_cast<double>(first + last),
+                 half = 0.5 * static_cast<double>(last - first);
     Row row;
     for (std::size_t k = 0; k < points; ++k) {
-      const double at = points == 2 && k == 1 ? x[2] : x[k];
-      const double c = processing::PhaseInTurn(geometry.PhaseAtIndex(at));
-      valid = valid && model.Evaluate(c, geometry.AxialAtIndex(at), 0.0, row);
-      f[k] = -row.residual;
+      x[k] = points < 4 || last - first < 4
+                 ? static_cast<double>(first + k)
+                 : mid + half * std::cos((2.0 * static_cast<double>(k) + 1.0) * std::numbers::pi / 8.0);
+      const double phase = processing::PhaseInTurn(geometry.PhaseAtIndex(x[k]));
+      valid = valid && model.Evaluate(phase, geometry.AxialAtIndex(x[k]), 0.0, row);
+      c[k] = -row.residual;
     }
-    x0 = x[0];
-    f0 = f[0];
-    if (points == 2) slope = (f[1] - f0) / (x[2] - x0);
-    if (points < 3) return;
-    x1 = x[1];
-    slope = (f[1] - f0) / (x1 - x0);  // divided differences
-    curvature = ((f[2] - f[1]) / (x[2] - x1) - slope) / (x[2] - x0);
+    for (std::size_t j = 1; j < points; ++j) {  // divided differences
+      for (std::size_t k = points - 1; k >= j; --k) c[k] = (c[k] - c[k - 1]) / (x[k] - x[k - j]);
+    }
   }
   [[nodiscard]] double At(double index) const {
-    return f0 + (index - x0) * (slope + (index - x1) * curvature);
+    double value = c[points - 1];
+    for (std::size_t k = points - 1; k-- > 0;) value = c[k] + (index - x[k]) * value;
+    return value;
   }
 };
 
 // One part's residuals per cell of the map's grid. Within a helix cell (its samples run to the
 // next cell's first) the phase and the axial position are monotonic in the index, so its samples
-// fall into the map's cells in runs: each run's end is found by bisection with the per-sample
-// rule, and its residuals are summed against the model along the run (RunModel).
+// fall into the map's cells in runs: each run's end is predicted from the rates and checked with
+// the per-sample rule (found by bisection where the guess was off), and its residuals are summed
+// against the model along the cell (SpanModel).
 template <typename Sample>
 void CellResidualsPart(const Samples<Sample>& samples, const std::vector<HelixCell>& cells,
                        const RowModel& model, const Grid& grid, int part, CellSums& sums) {
@@ -821,6 +822,21 @@ void CellResidualsPart(const Samples<Sample>& samples, const std::vector<HelixCe
                               .second;
   const processing::HelixGeometry& geometry = samples.geometry;
   const double per_phase_cell = 1.0 / grid.phase_step_deg, per_axial_cell = 1.0 / grid.y_step_mm;
+  // Map cells per sample along the phase and the axis.
+  const double phase_rate = (geometry.PhaseAtIndex(1.0) - geometry.PhaseAtIndex(0.0)) * per_phase_cell;
+  const double axial_rate = (geometry.AxialAtIndex(1.0) - geometry.AxialAtIndex(0.0)) * per_axial_cell;
+  // Where the rates put the next map cell's first sample after `from`: a guess, checked below.
+  const auto predicted_end = [&](std::size_t from) {
+    const double at[2] = {processing::PhaseInTurn(geometry.PhaseAt(from)) * per_phase_cell,
+                          (geometry.AxialAt(from) - grid.y0_mm) * per_axial_cell};
+    const double rate[2] = {phase_rate, axial_rate};
+    double steps = static_cast<double>(kMaxCellSpan);
+    for (int k = 0; k < 2; ++k) {
+      if (rate[k] > 0.0) steps = std::min(steps, (std::floor(at[k] + 0.5) + 0.5 - at[k]) / rate[k]);
+      if (rate[k] < 0.0) steps = std::min(steps, (at[k] - std::ceil(at[k] - 0.5) + 0.5) / -rate[k]);
+    }
+    return from + std::max<std::size_t>(1, static_cast<std::size_t>(std::ceil(steps)));
+  };
   // The map's cell of sample i as the pass over every sample finds it: (phase, axial - first_axial).
   const auto map_cell = [&](std::size_t i) {
     const double c = processing::PhaseInTurn(geometry.PhaseAt(i));
@@ -833,10 +849,16 @@ void CellResidualsPart(const Samples<Sample>& samples, const std::vector<HelixCe
   for (std::size_t k = 0; k < cells.size(); ++k) {
     const HelixCell& cell = cells[k];
     const std::size_t to = k + 1 < cells.size() ? cells[k + 1].first : end;
+    const SpanModel span(model, geometry, cell.first, to - 1);
     for (std::size_t from = cell.first; from < to;) {
       const std::pair<std::size_t, long> key = map_cell(from);
-      std::size_t low = from + 1, high = to;  // the run ends at the first index of another cell
-      while (low < high) {
+      // The run ends at the first index of another map cell: where predicted, if the rule agrees
+      // there and one sample before; else found by bisection.
+      const std::size_t guess = std::min(predicted_end(from), to);
+      const bool guessed =
+          (guess == to || map_cell(guess) != key) && (guess - 1 == from || map_cell(guess - 1) == key);
+      std::size_t low = guessed ? guess : from + 1, high = to;
+      while (!guessed && low < high) {
         const std::size_t mid = low + (high - low) / 2;
         if (map_cell(mid) != key) {
           high = mid;
@@ -844,14 +866,13 @@ void CellResidualsPart(const Samples<Sample>& samples, const std::vector<HelixCe
           low = mid + 1;
         }
       }
-      const RunModel run(model, geometry, from, low - 1);
-      if (run.valid && key.second >= 0 && key.second < sums.axial_cells) {
+      if (span.valid && key.second >= 0 && key.second < sums.axial_cells) {
         double sum = 0.0;
         std::uint32_t count = 0;
         for (std::size_t i = from; i < low; ++i) {
           const auto rho = static_cast<double>(samples.rho_mm[i]);
           if (!std::isfinite(rho)) continue;
-          sum += rho - run.At(static_cast<double>(i));
+          sum += rho - span.At(static_cast<double>(i));
           ++count;
         }
         const std::size_t index =
@@ -865,7 +886,7 @@ void CellResidualsPart(const Samples<Sample>& samples, const std::vector<HelixCe
 }
 
 // The residual map of the binned fit at theta: one more pass over the samples, each residual
-// against the model along its run. Releases the cells before the map is summed.
+// against the model along its cell. Releases the cells before the map is summed.
 template <typename Sample>
 std::vector<double> CellResidualMap(const Samples<Sample>& samples, HelixCells& cells, const Grid& grid,
                                     const Layout& layout, const VectorXd& theta) {

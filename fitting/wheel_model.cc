@@ -1302,6 +1302,9 @@ Knots ChooseKnots(const Solution& fine, const Layout& fine_layout, const std::ve
                   const MatrixXd& null_space) {
   Knots best = fine_layout.knots();
   int Knots::*const members[3] = {&Knots::radius, &Knots::axial, &Knots::runout};
+  // The second round meets some trials of the first again (and each round its best so far): the
+  // criterion is a function of the knots, so it is computed once for each.
+  std::map<std::array<int, 3>, double> known;
   for (int round = 0; round < 2; ++round) {
     for (int f = 0; f < 3; ++f) {
       double least = std::numeric_limits<double>::infinity();
@@ -1309,7 +1312,9 @@ Knots ChooseKnots(const Solution& fine, const Layout& fine_layout, const std::ve
       for (const int k : choices[f]) {
         Knots trial = best;
         trial.*members[f] = k;
-        const double bic = Bic(fine, fine_layout, trial, null_space);
+        const auto [entry, added] = known.try_emplace({trial.radius, trial.axial, trial.runout}, 0.0);
+        if (added) entry->second = Bic(fine, fine_layout, trial, null_space);
+        const double bic = entry->second;
         if (bic < least) {
           least = bic;
           chosen = k;

@@ -72,9 +72,10 @@ void BM_ProcessEndToEnd(benchmark::State& state) {
 
 // The wheel model's fit alone (fitting/wheel_model.h), on a scan already processed and fitted per
 // phase, with the knots chosen from the data as `process` does. Arguments: samples; 1 to read
-// them as float32 (as a float32 file holds them), 0 as double; 1 for the warm-up on a subsample
-// (the default), 0 for every Gauss-Newton iteration over every sample. Wall time (the
-// median of 5) and the CPU time of the whole process; the scans are made once per process.
+// them as float32 (as a float32 file holds them), 0 as double; the method: 2 as `process` fits
+// (binned above WheelModelOptions::binned_above_samples), 1 every sample with the warm-up on a
+// subsample, 0 every Gauss-Newton iteration over every sample. Wall time (the median of 5) and
+// the CPU time of the whole process; the scans are made once per process.
 struct ModelInput {
   acquisition::Scan scan;
   processing::ProcessedScan processed;
@@ -99,6 +100,7 @@ void BM_WheelModel(benchmark::State& state) {
   const ModelInput& input = ModelInputWith(static_cast<long>(state.range(0)));
   const processing::HelixGeometry geometry(input.scan, input.processed.rpm_used);
   fitting::WheelModelOptions options;
+  if (state.range(2) < 2) options.binned_above_samples = std::numeric_limits<std::size_t>::max();
   if (state.range(2) == 0) options.warm_start_samples = 0;
   fitting::WheelModel model;
   for (auto _ : state) {
@@ -111,14 +113,15 @@ void BM_WheelModel(benchmark::State& state) {
   state.counters["knots_Ra_a_b"] = model.radius_knots * 10000 + model.axial_knots * 100 + model.runout_knots;
 }
 BENCHMARK(BM_WheelModel)
+    ->Args({1'000'000, 0, 2})
+    ->Args({1'000'000, 1, 2})
     ->Args({1'000'000, 0, 1})
-    ->Args({1'000'000, 1, 1})
-    ->Args({1'000'000, 0, 0})
-    ->Args({10'000'000, 0, 1})
+    ->Args({10'000'000, 0, 2})
+    ->Args({10'000'000, 1, 2})
     ->Args({10'000'000, 1, 1})
-    ->Args({10'000'000, 0, 0})
+    ->Args({100'000'000, 1, 2})
     ->Args({100'000'000, 1, 1})
-    ->ArgNames({"samples", "float32", "warm"})
+    ->ArgNames({"samples", "float32", "method"})
     ->Unit(benchmark::kMillisecond)
     ->Iterations(1)
     ->Repetitions(5)

@@ -11,6 +11,7 @@
 #include <cstdint>
 #include <map>
 #include <numbers>
+#include <numeric>
 
 #include "core/check.h"
 #include "core/error.h"
@@ -334,11 +335,14 @@ constexpr int kParts = 8;
 
 // The samples (per sample, NaN = invalid), read through the helix geometry on every pass (no copy
 // of the scan).
+struct HelixCells;
+
 template <typename Sample>
 struct Samples {
   std::span<const Sample> rho_mm;
   const processing::HelixGeometry& geometry;
   double band_low_mm, band_high_mm;
+  const HelixCells* cells = nullptr;  // when set, the passes run on these instead of the samples
 };
 
 // What a pass over the samples accumulates.
@@ -390,6 +394,276 @@ CellSums CellSumsFor(const Grid& grid, double low_y_mm, double high_y_mm) {
   cells.sum.assign(grid.n_phase * static_cast<std::size_t>(cells.axial_cells), 0.0);
   cells.count.assign(cells.sum.size(), 0);
   return cells;
+}
+
+// The binned fit (docs/wheel_model.md, "Binned fit"). On a helix from the scan's settings the
+// phase and the axial position are linear in the sample index, so the samples of a cell (a run on
+// one turn within one knot interval) lie on a segment of a line in (phase, axial). Every sum of
+// the normal equations over the cell is then taken from three weighted points on that line: the
+// three-point Gauss rule of the samples' positions, which sums every polynomial of the position up
+// to degree 5 as the samples do, with pseudo-values that give the sums of z, z d and z d^2 (d the
+// position) as the samples' z do. The sums are exact where the model is a polynomial of degree 2
+// along the cell; the error comes from its third derivative along a cell (docs: measured).
+struct HelixCell {
+  std::uint64_t first = 0;          // index of its first sample; it ends where the next cell begins
+  std::uint32_t count = 0;          // valid samples in the band
+  float rss_offset_mm2 = 0;         // the cell's sum of squares less the points' (constant in the model)
+  double z_mean_mm = 0;             // the mean z of its samples
+  std::array<float, 3> node{};      // the points' positions, index - first (within 2.5e-4)
+  std::array<float, 3> weight{};    // the points' weights (they sum to count; unused points 0)
+  std::array<float, 3> value_mm{};  // each point's pseudo-value less z_mean_mm
+  [[nodiscard]] std::size_t points() const { return std::min<std::size_t>(count, 3); }
+};
+
+// Each part's cells, in the order of their samples, and the axial range of its samples.
+struct HelixCells {
+  std::array<std::vector<HelixCell>, kParts> parts;
+  PartRanges ranges;
+};
+
+// A cell ends at the turn's end, at every knot of the fine fit's functions and of a 64-knot grid
+// (so that it spans at most 1/64 turn whatever the knots), and after this many samples.
+constexpr std::uint64_t kMaxCellSpan = 4096;
+constexpr int kCellsPerTurn = 64;
+
+// The knot counts at whose knots cells end: kCellsPerTurn and those of the fine fit's functions
+// that do not divide it.
+std::vector<double> CellCutsPerDeg(const Layout& fine) {
+  std::vector<double> per_deg = {kCellsPerTurn / 360.0};
+  for (const int knots : {fine.radius.knots, fine.axial.knots, fine.runout.knots}) {
+    if (knots > 1 && kCellsPerTurn % knots != 0) per_deg.push_back(knots / 360.0);
+  }
+  return per_deg;
+}
+
+// The sums of a closed cell's samples about their mean position d and mean z.
+struct CentralMoments {
+  double n = 0, d2 = 0, d3 = 0, d4 = 0, d5 = 0, zd = 0, zd2 = 0, z2 = 0;
+};
+
+// The three-point Gauss rule of positions with these central moments: nodes x (sorted) and
+// weights w with sum w x^j = the samples' sum d^j for j = 0..5.
+void GaussRule(const CentralMoments& m, std::array<double, 3>& x, std::array<double, 3>& w) {
+  // In units of the positions' standard deviation: moments 1, 0, 1, m3, m4, m5 per sample.
+  const double sigma = std::sqrt(m.d2 / m.n);
+  const double m3 = m.d3 / (m.n * sigma * sigma * sigma), m4 = m.d4 / (m.n * std::pow(sigma, 4)),
+               m5 = m.d5 / (m.n * std::pow(sigma, 5));
+  // The monic cubic orthogonal to 1, x and x^2 under the samples' positions: x^3 + a x^2 + b x + c.
+  Eigen::Matrix3d hankel;
+  hankel << 1.0, 0.0, 1.0, 0.0, 1.0, m3, 1.0, m3, m4;
+  const Eigen::Vector3d cba = hankel.partialPivLu().solve(Eigen::Vector3d(-m3, -m4, -m5));
+  const double c = cba[0], b = cba[1], a = cba[2];
+  // Its three real roots (trigonometric form of the depressed cubic t^3 + p t + q).
+  const double p = b - a * a / 3.0, q = 2.0 * a * a * a / 27.0 - a * b / 3.0 + c;
+  const double r = 2.0 * std::sqrt(std::max(-p / 3.0, 0.0));
+  const double cos3 = r > 0.0 ? std::clamp(3.0 * q / (p * r), -1.0, 1.0) : 0.0;
+  const double theta = std::acos(cos3) / 3.0;
+  for (std::size_t k = 0; k < 3; ++k) {
+    x[k] = r * std::cos(theta - 2.0 * std::numbers::pi * static_cast<double>(k) / 3.0) - a / 3.0;
+  }
+  std::sort(x.begin(), x.end());
+  Eigen::Matrix3d vandermonde;
+  for (int j = 0; j < 3; ++j) {
+    for (int k = 0; k < 3; ++k) vandermonde(j, k) = std::pow(x[static_cast<std::size_t>(k)], j);
+  }
+  const Eigen::Vector3d weights = vandermonde.partialPivLu().solve(Eigen::Vector3d(m.n, 0.0, m.n));
+  for (std::size_t k = 0; k < 3; ++k) {
+    w[k] = weights[static_cast<Eigen::Index>(k)];
+    x[k] *= sigma;
+  }
+}
+
+// A cell of the valid samples first..last (all in the band; n of them, their positions summing
+// to sum_s and their z to sum_z_mm), from a second look at its samples (still in cache).
+template <typename Sample>
+HelixCell CloseCell(const Samples<Sample>& samples, std::uint64_t first, std::uint64_t last, double n,
+                    double sum_s, double sum_z_mm) {
+  HelixCell cell;
+  cell.first = first;
+  cell.count = static_cast<std::uint32_t>(n);
+  const double center = sum_s / n;
+  cell.z_mean_mm = sum_z_mm / n;
+  CentralMoments m;
+  m.n = n;
+  std::size_t seen = 0;
+  for (std::uint64_t i = first; i <= last; ++i) {
+    const auto rho = static_cast<double>(samples.rho_mm[i]);
+    if (!std::isfinite(rho)) continue;
+    const double d = static_cast<double>(i - first) - center, e = rho - cell.z_mean_mm;
+    if (seen < 3) {  // a cell of up to three samples keeps them as its points
+      cell.node[seen] = static_cast<float>(i - first);
+      cell.weight[seen] = 1.0f;
+      cell.value_mm[seen] = static_cast<float>(e);
+    }
+    ++seen;
+    const double d2 = d * d;
+    m.d2 += d2;
+    m.d3 += d2 * d;
+    m.d4 += d2 * d2;
+    m.d5 += d2 * d2 * d;
+    m.zd += e * d;
+    m.zd2 += e * d2;
+    m.z2 += e * e;
+  }
+  if (seen <= 3) return cell;
+  std::array<double, 3> x{}, w{};
+  GaussRule(m, x, w);
+  // Pseudo-values v / w: sum v = 0 (about the mean), sum v x = sum (z - mean) d, sum v x^2 =
+  // sum (z - mean) d^2.
+  Eigen::Matrix3d vandermonde;
+  for (int k = 0; k < 3; ++k) {
+    const double xk = x[static_cast<std::size_t>(k)];
+    vandermonde.col(k) << 1.0, xk, xk * xk;
+  }
+  const Eigen::Vector3d v = vandermonde.partialPivLu().solve(Eigen::Vector3d(0.0, m.zd, m.zd2));
+  double carried = 0.0;
+  for (std::size_t k = 0; k < 3; ++k) {
+    const double vk = v[static_cast<Eigen::Index>(k)];
+    cell.node[k] = static_cast<float>(center + x[k]);
+    cell.weight[k] = static_cast<float>(w[k]);
+    cell.value_mm[k] = static_cast<float>(vk / w[k]);
+    carried += vk * vk / w[k];
+  }
+  cell.rss_offset_mm2 = static_cast<float>(m.z2 - carried);
+  return cell;
+}
+
+// The samples of begin..end in the band, as an index range: on a helix from the settings the
+// axial position is monotonic in the index (each operation of AxialAt rounds monotonically), so
+// the band holds a run of them, found by bisection with the same test as a pass over each sample.
+template <typename Sample>
+std::pair<std::size_t, std::size_t> BandRun(const Samples<Sample>& samples, std::size_t begin,
+                                            std::size_t end) {
+  if (begin >= end) return {begin, begin};
+  const processing::HelixGeometry& geometry = samples.geometry;
+  const auto below = [&](std::size_t i) { return geometry.AxialAt(i) < samples.band_low_mm; };
+  const auto above = [&](std::size_t i) { return geometry.AxialAt(i) > samples.band_high_mm; };
+  // The first index in begin..end where `test` holds, for a test that holds from some index on.
+  const auto first_where = [&](const auto& test) {
+    std::size_t low = begin, high = end;
+    while (low < high) {
+      const std::size_t mid = low + (high - low) / 2;
+      if (test(mid)) {
+        high = mid;
+      } else {
+        low = mid + 1;
+      }
+    }
+    return low;
+  };
+  const bool rising = geometry.AxialAt(end - 1) >= geometry.AxialAt(begin);
+  const std::size_t first = rising ? first_where([&](std::size_t i) { return !below(i); })
+                                   : first_where([&](std::size_t i) { return !above(i); });
+  const std::size_t last = rising ? first_where(above) : first_where(below);
+  return {first, std::max(first, last)};
+}
+
+// The index after `i` at which the next cell begins: the first sample past the next knot of any
+// cut (the phase is linear in the index), at most kMaxCellSpan on.
+std::size_t CellEnd(const processing::HelixGeometry& geometry, const std::vector<double>& cuts_per_deg,
+                    std::size_t i) {
+  const double deg_per_sample = geometry.PhaseAtIndex(1.0) - geometry.PhaseAtIndex(0.0);
+  std::size_t end = i + kMaxCellSpan;
+  if (deg_per_sample == 0.0) return end;
+  const double phase = geometry.PhaseAtIndex(static_cast<double>(i));
+  for (const double per_deg : cuts_per_deg) {
+    const double knot = std::floor(phase * per_deg) + (deg_per_sample > 0.0 ? 1.0 : 0.0);
+    const double at = std::ceil((knot / per_deg - phase) / deg_per_sample);
+    if (at >= 1.0 && at < static_cast<double>(kMaxCellSpan))
+      end = std::min(end, i + static_cast<std::size_t>(at));
+  }
+  return std::max(end, i + 1);
+}
+
+// One part's samples into cells: the binned fit's one pass before the residual map's.
+template <typename Sample>
+void BinPart(const Samples<Sample>& samples, const std::vector<double>& cuts_per_deg, int part,
+             std::vector<HelixCell>& cells, double& low_y_mm, double& high_y_mm) {
+  const std::size_t total = samples.rho_mm.size();
+  const auto [begin, end] = BandRun(samples, total * static_cast<std::size_t>(part) / kParts,
+                                    total * static_cast<std::size_t>(part + 1) / kParts);
+  const processing::HelixGeometry& geometry = samples.geometry;
+  if (begin < end) {  // a cell per cut per turn, and per kMaxCellSpan samples
+    const double turns = std::abs(geometry.PhaseAt(end - 1) - geometry.PhaseAt(begin)) / 360.0 + 1.0;
+    const double cuts = 360.0 * std::accumulate(cuts_per_deg.begin(), cuts_per_deg.end(), 0.0);
+    cells.reserve(static_cast<std::size_t>(
+        std::min(turns * cuts + static_cast<double>((end - begin) / kMaxCellSpan) + 1.0,
+                 static_cast<double>(end - begin))));
+  }
+  double low = std::numeric_limits<double>::infinity(), high = -low;
+  for (std::size_t from = begin; from < end;) {
+    const std::size_t to = std::min(CellEnd(geometry, cuts_per_deg, from), end);
+    double n = 0.0, sum_s = 0.0, sum_z = 0.0;
+    std::size_t first = to, last = to;
+    for (std::size_t i = from; i < to; ++i) {
+      const auto rho = static_cast<double>(samples.rho_mm[i]);
+      if (!std::isfinite(rho)) continue;
+      if (n == 0.0) first = i;
+      last = i;
+      n += 1.0;
+      sum_s += static_cast<double>(i - first);
+      sum_z += rho;
+    }
+    if (n > 0.0) {
+      cells.push_back(CloseCell(samples, first, last, n, sum_s, sum_z));
+      for (const std::size_t i : {first, last}) {
+        low = std::min(low, geometry.AxialAt(i));
+        high = std::max(high, geometry.AxialAt(i));
+      }
+    }
+    from = to;
+  }
+  low_y_mm = low;
+  high_y_mm = high;
+}
+
+template <typename Sample>
+HelixCells BinSamples(const Samples<Sample>& samples, const Layout& fine) {
+  HelixCells cells;
+  const std::vector<double> cuts_per_deg = CellCutsPerDeg(fine);
+  ARCWHEEL_CHECK(cuts_per_deg.size() <= 4) << cuts_per_deg.size();
+  const int workers = std::min(WorkerCount(0), kParts);
+  RunOnWorkers(workers, [&](int worker) {
+    for (int part = worker; part < kParts; part += workers) {
+      const auto p = static_cast<std::size_t>(part);
+      BinPart(samples, cuts_per_deg, part, cells.parts[p], cells.ranges.low_y_mm[p],
+              cells.ranges.high_y_mm[p]);
+    }
+  });
+  return cells;
+}
+
+// One part's cells as weighted points: J^T J, J^T r and r^T r of its samples, exact where the
+// model is quadratic along each cell. The points' rows are scaled by the root of their weights.
+void AccumulateCellsPart(const std::vector<HelixCell>& cells, const processing::HelixGeometry& geometry,
+                         const RowModel& model, NormalEquations& normal, bool normal_matrix) {
+  BlockAccumulator block(model, normal, normal_matrix);
+  double rss = 0.0;
+  std::size_t used = 0;
+  std::array<Row, 3> rows;
+  for (const HelixCell& cell : cells) {
+    const std::size_t points = cell.points();
+    const auto base = static_cast<double>(cell.first);
+    bool inside = true;
+    for (std::size_t k = 0; k < points && inside; ++k) {
+      const double at = base + cell.node[k];
+      const double c = processing::PhaseInTurn(geometry.PhaseAtIndex(at));
+      inside = model.Evaluate(c, geometry.AxialAtIndex(at), cell.z_mean_mm + cell.value_mm[k], rows[k]);
+    }
+    if (!inside) continue;
+    for (std::size_t k = 0; k < points; ++k) {
+      Row& row = rows[k];
+      const double root = std::sqrt(static_cast<double>(cell.weight[k]));
+      for (double& value : row.value) value *= root;
+      row.residual *= root;
+      block.Add(row);
+      rss += row.residual * row.residual;
+    }
+    rss += cell.rss_offset_mm2;
+    used += cell.count;
+  }
+  normal.rss += rss;
+  normal.samples += used;
 }
 
 // One part's share of a pass.
@@ -444,6 +718,8 @@ template <typename Sample>
 PassResult Accumulate(const Samples<Sample>& samples, const Layout& layout, const VectorXd& theta,
                       const PassRequest& request, const PartRanges* previous = nullptr) {
   ARCWHEEL_CHECK(request.grid == nullptr || previous != nullptr) << "a residual map needs the parts' ranges";
+  ARCWHEEL_CHECK(samples.cells == nullptr || (request.grid == nullptr && request.stride == 1))
+      << "the cells make neither a residual map nor a subsample";
   const int n = layout.size();
   const RowModel model(layout, theta);
   std::vector<NormalEquations> parts(kParts);
@@ -461,10 +737,15 @@ PassResult Accumulate(const Samples<Sample>& samples, const Layout& layout, cons
       NormalEquations& normal = parts[p];
       if (request.normal_matrix) normal.jtj = MatrixXd::Zero(n, n);
       normal.jtr = VectorXd::Zero(n);
+      if (samples.cells != nullptr) {
+        AccumulateCellsPart(samples.cells->parts[p], samples.geometry, model, normal, request.normal_matrix);
+        continue;
+      }
       AccumulatePart(samples, model, request, part, normal, result.cells.empty() ? nullptr : &result.cells[p],
                      result.ranges.low_y_mm[p], result.ranges.high_y_mm[p]);
     }
   });
+  if (samples.cells != nullptr) result.ranges = samples.cells->ranges;
   result.normal = std::move(parts[0]);
   for (std::size_t part = 1; part < parts.size(); ++part) result.normal.Add(parts[part]);
   result.normal.Symmetrise();
@@ -475,7 +756,8 @@ PassResult Accumulate(const Samples<Sample>& samples, const Layout& layout, cons
 std::vector<double> ResidualMap(const Grid& grid, const std::vector<CellSums>& parts) {
   if (grid.empty()) return {};
   std::vector<double> sum(grid.size(), 0.0);
-  std::vector<std::uint64_t> count(grid.size(), 0);
+  std::vector<std::uint32_t> count(grid.size(),
+                                   0);  // as CellSums::count: a cell holds fewer than 2^32 samples
   for (const CellSums& part : parts) {
     for (std::size_t p = 0; p < grid.n_phase; ++p) {
       for (long a = 0; a < part.axial_cells; ++a) {
@@ -490,6 +772,139 @@ std::vector<double> ResidualMap(const Grid& grid, const std::vector<CellSums>& p
     sum[cell] = count[cell] > 0 ? sum[cell] / static_cast<double>(count[cell]) * 1e3 : kNaN;
   }
   return sum;
+}
+
+// The model along the samples first..last of a helix cell (at most 1/64 turn): the cubic through
+// its values at four Chebyshev points of the span (at the samples themselves when there are no
+// more than four), whose error, of the model's fourth derivative along the cell, is some 1e-5 um
+// on a lobed wheel. Valid is false where a point lies beyond the arc.
+struct SpanModel {
+  std::array<double, 4> x{}, c{};  // the points (sample indices) and Newton's coefficients
+  std::size_t points = 0;
+  bool valid = true;
+  SpanModel(const RowModel& model, const processing::HelixGeometry& geometry, std::size_t first,
+            std::size_t last) {
+    points = std::min<std::size_t>(last - first + 1, 4);
+    const double mid = 0.5 * static_cast<double>(first + last),
+                 half = 0.5 * static_cast<double>(last - first);
+    Row row;
+    for (std::size_t k = 0; k < points; ++k) {
+      x[k] = points < 4 || last - first < 4
+                 ? static_cast<double>(first + k)
+                 : mid + half * std::cos((2.0 * static_cast<double>(k) + 1.0) * std::numbers::pi / 8.0);
+      const double phase = processing::PhaseInTurn(geometry.PhaseAtIndex(x[k]));
+      valid = valid && model.Evaluate(phase, geometry.AxialAtIndex(x[k]), 0.0, row);
+      c[k] = -row.residual;
+    }
+    for (std::size_t j = 1; j < points; ++j) {  // divided differences
+      for (std::size_t k = points - 1; k >= j; --k) c[k] = (c[k] - c[k - 1]) / (x[k] - x[k - j]);
+    }
+  }
+  [[nodiscard]] double At(double index) const {
+    double value = c[points - 1];
+    for (std::size_t k = points - 1; k-- > 0;) value = c[k] + (index - x[k]) * value;
+    return value;
+  }
+};
+
+// One part's residuals per cell of the map's grid. Within a helix cell (its samples run to the
+// next cell's first) the phase and the axial position are monotonic in the index, so its samples
+// fall into the map's cells in runs: each run's end is predicted from the rates and checked with
+// the per-sample rule (found by bisection where the guess was off), and its residuals are summed
+// against the model along the cell (SpanModel).
+template <typename Sample>
+void CellResidualsPart(const Samples<Sample>& samples, const std::vector<HelixCell>& cells,
+                       const RowModel& model, const Grid& grid, int part, CellSums& sums) {
+  if (sums.axial_cells == 0 || cells.empty()) return;
+  const std::size_t total = samples.rho_mm.size();
+  const std::size_t end = BandRun(samples, total * static_cast<std::size_t>(part) / kParts,
+                                  total * static_cast<std::size_t>(part + 1) / kParts)
+                              .second;
+  const processing::HelixGeometry& geometry = samples.geometry;
+  const double per_phase_cell = 1.0 / grid.phase_step_deg, per_axial_cell = 1.0 / grid.y_step_mm;
+  // Map cells per sample along the phase and the axis.
+  const double phase_rate = (geometry.PhaseAtIndex(1.0) - geometry.PhaseAtIndex(0.0)) * per_phase_cell;
+  const double axial_rate = (geometry.AxialAtIndex(1.0) - geometry.AxialAtIndex(0.0)) * per_axial_cell;
+  // Where the rates put the next map cell's first sample after `from`: a guess, checked below.
+  const auto predicted_end = [&](std::size_t from) {
+    const double at[2] = {processing::PhaseInTurn(geometry.PhaseAt(from)) * per_phase_cell,
+                          (geometry.AxialAt(from) - grid.y0_mm) * per_axial_cell};
+    const double rate[2] = {phase_rate, axial_rate};
+    double steps = static_cast<double>(kMaxCellSpan);
+    for (int k = 0; k < 2; ++k) {
+      if (rate[k] > 0.0) steps = std::min(steps, (std::floor(at[k] + 0.5) + 0.5 - at[k]) / rate[k]);
+      if (rate[k] < 0.0) steps = std::min(steps, (at[k] - std::ceil(at[k] - 0.5) + 0.5) / -rate[k]);
+    }
+    return from + std::max<std::size_t>(1, static_cast<std::size_t>(std::ceil(steps)));
+  };
+  // The map's cell of sample i as the pass over every sample finds it: (phase, axial - first_axial).
+  const auto map_cell = [&](std::size_t i) {
+    const double c = processing::PhaseInTurn(geometry.PhaseAt(i));
+    auto p = static_cast<std::size_t>(processing::RoundHalfAway(c * per_phase_cell));
+    if (p >= grid.n_phase) p -= grid.n_phase;  // c rounds up to the turn's end
+    const long a =
+        processing::RoundHalfAway((geometry.AxialAt(i) - grid.y0_mm) * per_axial_cell) - sums.first_axial;
+    return std::pair<std::size_t, long>{p, a};
+  };
+  for (std::size_t k = 0; k < cells.size(); ++k) {
+    const HelixCell& cell = cells[k];
+    const std::size_t to = k + 1 < cells.size() ? cells[k + 1].first : end;
+    const SpanModel span(model, geometry, cell.first, to - 1);
+    for (std::size_t from = cell.first; from < to;) {
+      const std::pair<std::size_t, long> key = map_cell(from);
+      // The run ends at the first index of another map cell: where predicted, if the rule agrees
+      // there and one sample before; else found by bisection.
+      const std::size_t guess = std::min(predicted_end(from), to);
+      const bool guessed =
+          (guess == to || map_cell(guess) != key) && (guess - 1 == from || map_cell(guess - 1) == key);
+      std::size_t low = guessed ? guess : from + 1, high = to;
+      while (!guessed && low < high) {
+        const std::size_t mid = low + (high - low) / 2;
+        if (map_cell(mid) != key) {
+          high = mid;
+        } else {
+          low = mid + 1;
+        }
+      }
+      if (span.valid && key.second >= 0 && key.second < sums.axial_cells) {
+        double sum = 0.0;
+        std::uint32_t count = 0;
+        for (std::size_t i = from; i < low; ++i) {
+          const auto rho = static_cast<double>(samples.rho_mm[i]);
+          if (!std::isfinite(rho)) continue;
+          sum += rho - span.At(static_cast<double>(i));
+          ++count;
+        }
+        const std::size_t index =
+            key.first * static_cast<std::size_t>(sums.axial_cells) + static_cast<std::size_t>(key.second);
+        sums.sum[index] += sum;
+        sums.count[index] += count;
+      }
+      from = low;
+    }
+  }
+}
+
+// The residual map of the binned fit at theta: one more pass over the samples, each residual
+// against the model along its cell. Releases the cells before the map is summed.
+template <typename Sample>
+std::vector<double> CellResidualMap(const Samples<Sample>& samples, HelixCells& cells, const Grid& grid,
+                                    const Layout& layout, const VectorXd& theta) {
+  if (grid.empty()) return {};
+  const RowModel model(layout, theta);
+  std::vector<CellSums> sums;
+  for (std::size_t part = 0; part < kParts; ++part) {
+    sums.push_back(CellSumsFor(grid, cells.ranges.low_y_mm[part], cells.ranges.high_y_mm[part]));
+  }
+  const int workers = std::min(WorkerCount(0), kParts);
+  RunOnWorkers(workers, [&](int worker) {
+    for (int part = worker; part < kParts; part += workers) {
+      const auto p = static_cast<std::size_t>(part);
+      CellResidualsPart(samples, cells.parts[p], model, grid, part, sums[p]);
+    }
+  });
+  for (std::vector<HelixCell>& part : cells.parts) std::vector<HelixCell>().swap(part);
+  return ResidualMap(grid, sums);
 }
 
 // The constraints on p: its integrals against 1, u and u^2 over the band vanish. Returns an
@@ -887,6 +1302,9 @@ Knots ChooseKnots(const Solution& fine, const Layout& fine_layout, const std::ve
                   const MatrixXd& null_space) {
   Knots best = fine_layout.knots();
   int Knots::*const members[3] = {&Knots::radius, &Knots::axial, &Knots::runout};
+  // The second round meets some trials of the first again (and each round its best so far): the
+  // criterion is a function of the knots, so it is computed once for each.
+  std::map<std::array<int, 3>, double> known;
   for (int round = 0; round < 2; ++round) {
     for (int f = 0; f < 3; ++f) {
       double least = std::numeric_limits<double>::infinity();
@@ -894,7 +1312,9 @@ Knots ChooseKnots(const Solution& fine, const Layout& fine_layout, const std::ve
       for (const int k : choices[f]) {
         Knots trial = best;
         trial.*members[f] = k;
-        const double bic = Bic(fine, fine_layout, trial, null_space);
+        const auto [entry, added] = known.try_emplace({trial.radius, trial.axial, trial.runout}, 0.0);
+        if (added) entry->second = Bic(fine, fine_layout, trial, null_space);
+        const double bic = entry->second;
         if (bic < least) {
           least = bic;
           chosen = k;
@@ -951,7 +1371,7 @@ std::size_t WarmUpStride(std::size_t total, std::size_t warm_start_samples) {
 // the warm-up, every Gauss-Newton iteration passes over every sample, and the residual map takes
 // a pass of its own.
 template <typename Sample>
-Fitted FitAndChoose(const Samples<Sample>& samples, const Grid& grid, const WheelFit& fit,
+Fitted FitAndChoose(const Samples<Sample>& samples_in, const Grid& grid, const WheelFit& fit,
                     const WheelModelOptions& options, double half_width_mm, WheelModel& model) {
   const std::vector<int> choices[3] = {KnotCandidates(options.radius_knots, true),
                                        KnotCandidates(options.axial_knots, true),
@@ -961,7 +1381,14 @@ Fitted FitAndChoose(const Samples<Sample>& samples, const Grid& grid, const Whee
   const MatrixXd null_space = ProfileNullSpace(fine.profile, half_width_mm);
   const MatrixXd fine_reduction = Reduction(fine, fine.knots(), null_space);
   VectorXd start = StartingPoint(fine, fit);
-  const std::size_t stride = WarmUpStride(samples.rho_mm.size(), options.warm_start_samples);
+  // Binned: every pass but the residual map's runs on the cells, so no warm-up is needed.
+  HelixCells cells;
+  const bool binned =
+      samples_in.rho_mm.size() > options.binned_above_samples && samples_in.geometry.from_settings();
+  if (binned) cells = BinSamples(samples_in, fine);
+  Samples<Sample> samples = samples_in;
+  if (binned) samples.cells = &cells;
+  const std::size_t stride = binned ? 1 : WarmUpStride(samples.rho_mm.size(), options.warm_start_samples);
   const bool warm = stride > 1;
   if (warm) {
     const Solution subsample = Converge(
@@ -1004,6 +1431,8 @@ Fitted FitAndChoose(const Samples<Sample>& samples, const Grid& grid, const Whee
   }
   if (warm) {
     fitted.residual_um = ResidualMap(grid, best.cells);
+  } else if (binned) {
+    fitted.residual_um = CellResidualMap(samples_in, cells, grid, fitted.layout, best.theta);
   } else {
     // As the fit was defined: the residuals at the solution, one more pass.
     const PassResult pass =

@@ -37,6 +37,12 @@ struct WheelModelOptions {
   // 0 (or a scan under 4 times this size) skips it, so that every Gauss-Newton iteration passes
   // over every sample. Either way the result is the least-squares optimum over every sample.
   std::size_t warm_start_samples = 100000;
+  // On a scan of more samples than this whose phase and axial position follow from its settings
+  // (no time, axial or encoder column), the fit runs on per-cell moments of the samples (a cell: a
+  // run of samples on one turn within one knot interval) after one pass over them, and the
+  // residual map takes one more: the normal equations are then exact to second order in the
+  // cell's length (docs/wheel_model.md, "Binned fit", states the error). The maximum never bins.
+  std::size_t binned_above_samples = 500000;
   [[nodiscard]] std::vector<std::string> Problems() const;
 };
 
@@ -59,7 +65,7 @@ struct WheelModel {
   double center_axial_reference_mm = 0;  // mean a, the band's centre
   std::size_t samples = 0;               // samples in the band that the fit used
   int parameters = 0;                    // free parameters (the constraints on p taken off)
-  int iterations = 0;                    // Gauss-Newton passes over every sample (the warm-up's not counted)
+  int iterations = 0;                    // Gauss-Newton passes (binned: over the cells), warm-up aside
   double residual_rms_um = 0;            // of the fit, against the scan's noise estimate:
   double noise_sigma_um = 0;
   double mean_arc_radius_mm = 0, mean_arc_radius_sigma_mm = 0;  // the mean of Ra(c) over a turn

@@ -55,6 +55,18 @@ class HelixGeometry {
   [[nodiscard]] double AxialAt(std::size_t i) const {
     return y_mm_ != nullptr ? (*y_mm_)[i] : start_y_mm_ + feed_mm_per_min_ * TimeAt(i) / 60.0;
   }
+  // True when the phase and axial position follow from the scan's settings alone (no time, axial
+  // or encoder column): both are then linear in the sample index.
+  [[nodiscard]] bool from_settings() const {
+    return t_s_ == nullptr && y_mm_ == nullptr && unwrapped_deg_.empty();
+  }
+  // PhaseAt and AxialAt at a fractional sample index, by the same arithmetic (from_settings() only).
+  [[nodiscard]] double PhaseAtIndex(double index) const {
+    return start_phase_deg_ + 6.0 * rpm_ * (index * sample_period_s_);
+  }
+  [[nodiscard]] double AxialAtIndex(double index) const {
+    return start_y_mm_ + feed_mm_per_min_ * (index * sample_period_s_) / 60.0;
+  }
   // Axial position where the helix passes unwrapped phase u (linear between samples).
   [[nodiscard]] double AxialAtPhase(double u_deg) const;
   // Mean advance per turn (mm); negative if the wheel moves towards -y.

@@ -740,6 +740,19 @@ std::string ShellQuote(const std::string& text) {
   return quoted;
 }
 
+// An #SBATCH option's value as sbatch reads it: inside double quotes a space does not end the
+// value, and a backslash keeps the next character (a quote, a backslash, or a '#', which would
+// otherwise start a comment even inside quotes).
+std::string SbatchQuote(const std::string& text) {
+  std::string quoted = "\"";
+  for (char c : text) {
+    if (c == '"' || c == '\\' || c == '#') quoted += '\\';
+    quoted += c;
+  }
+  quoted += '"';
+  return quoted;
+}
+
 std::string QuotedList(const std::vector<std::string>& words) {
   std::string text;
   for (const std::string& word : words) {
@@ -771,10 +784,11 @@ std::string SlurmScript(const BatchArgs& args, const std::vector<Scan>& scans) {
       "#SBATCH --ntasks=1\n"
       "#SBATCH --cpus-per-task=1\n"
       "#SBATCH --chdir={}\n"
-      "#SBATCH --output={}/{}/slurm-%A_%a.out\n",
+      "#SBATCH --output={}\n",
       kVersion, scans.size(), ShellQuote(fs::absolute(args.emit_slurm).string()),
       ShellQuote(fs::current_path().string()), ShellQuote(binary), QuotedList(inputs), ShellQuote(outdir),
-      options, scans.size() - 1, fs::current_path().string(), outdir, kLogsFolder);
+      options, scans.size() - 1, SbatchQuote(fs::current_path().string()),
+      SbatchQuote((fs::path(outdir) / kLogsFolder / "slurm-%A_%a.out").string()));
   for (const std::string& line : args.sbatch_lines) script += "#SBATCH " + line + "\n";
   script += "set -euo pipefail\nscans=(\n";
   for (const Scan& scan : scans) script += "  " + ShellQuote(fs::absolute(scan.path).string()) + "\n";

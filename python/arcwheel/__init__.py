@@ -14,6 +14,11 @@ import dataclasses
 import os
 from typing import Any, Optional, Union
 
+# Imported here, before any call: the extension would otherwise import numpy the first time it
+# returns an array, after the work, where a Ctrl-C that arrives then interrupts numpy's own
+# import half way and leaves it broken for the rest of the session.
+import numpy  # noqa: F401
+
 from . import _arcwheel
 from ._arcwheel import (
     PROCESS_OPTIONS,

@@ -5,8 +5,8 @@ import subprocess
 import sys
 import textwrap
 
-# The child simulates a scan of 1e6 samples, which takes about a second to process, then sends itself SIGINT
-# shortly after process() has started, and reports how it ended and how long after the signal.
+# The child simulates a scan of 1e6 samples, which takes some 0.2-0.5 s to process, then sends itself
+# SIGINT 0.05 s after process() has started, and reports how it ended and how long after the signal.
 CHILD = textwrap.dedent("""
     import os, signal, threading, time
     import arcwheel
@@ -16,7 +16,7 @@ CHILD = textwrap.dedent("""
     def interrupt():
         sent.append(time.monotonic())
         os.kill(os.getpid(), signal.SIGINT)
-    threading.Timer(0.2, interrupt).start()
+    threading.Timer(0.05, interrupt).start()
     start = time.monotonic()
     try:
         arcwheel.process(scan)

@@ -28,7 +28,7 @@ work=$(mktemp -d /tmp/arcwheel-slurm.XXXXXX)
 chmod 755 "$work"
 pids=()
 show_logs() {
-  for log in "$work"/*.log "$work"/*.out "$work"/out/logs/*; do
+  for log in "$work"/*.log "$work"/*.out "$work"/*/logs/*; do
     [[ -f "$log" ]] || continue
     echo "----- $log (last 30 lines)" >&2
     tail -n 30 "$log" >&2
@@ -136,20 +136,23 @@ for i in 0 1 2; do
   "$binary" simulate "$work/scans/wheel_$i.$ext" --feed-mm-per-min 400 --noise-um 0.5 --seed $((40 + i)) \
     --arc-radius-mm "${radii[$i]}" >/dev/null
 done
-"$binary" batch "$work/scans" -o "$work/out" --emit-slurm "$work/job.sh" -- --phases 180
+# The results go to a folder whose name has a space and a '#', which the script's #SBATCH lines
+# must quote for sbatch.
+out="$work/batch out #1"
+"$binary" batch "$work/scans" -o "$out" --emit-slurm "$work/job.sh" -- --phases 180
 job_id=$(timeout "$timeout_s" sbatch --parsable --wait "$work/job.sh") || {
   echo "slurm test: sbatch --wait failed or took over ${timeout_s} s" >&2
   squeue >&2 || true
   exit 1
 }
 echo "slurm test: array job $job_id ended after $((SECONDS - start)) s"
-"$binary" batch "$work/scans" -o "$work/out" --index-only -- --phases 180
+"$binary" batch "$work/scans" -o "$out" --index-only -- --phases 180
 
 # The index: three results, each from the Slurm task (its log), with the truth's arc radius.
-python3 - "$work" <<'PY'
+python3 - "$out" <<'PY'
 import json, pathlib, statistics, sys
-work = pathlib.Path(sys.argv[1])
-index = json.loads((work / "out" / "index.json").read_text())
+out = pathlib.Path(sys.argv[1])
+index = json.loads((out / "index.json").read_text())
 rows = index["scans"]
 assert len(rows) == 3, rows
 for row in rows:
@@ -162,7 +165,7 @@ for row in rows:
     summary = json.loads((pathlib.Path(row["result"]) / "summary.json").read_text())
     assert summary["processing"]["phases"] == 180, summary["processing"]
     print(f"slurm test: {scan.name}: {got:.5f} mm, truth {want:.5f} mm, sigma {sigma:.5f} mm")
-tasks = sorted((work / "out" / "logs").glob("slurm-*_*.out"))
+tasks = sorted((out / "logs").glob("slurm-*_*.out"))
 assert len(tasks) == 3, tasks
 PY
 echo "slurm test: passed in $((SECONDS - start)) s"

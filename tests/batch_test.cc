@@ -266,7 +266,8 @@ TEST(Batch, TheSlurmScriptRunsOneScanPerTaskAndTheIndexFollows) {
   const std::string script = ReadText(dir / "job.sh");
   EXPECT_THAT(script, HasSubstr("#SBATCH --array=0-1\n"));
   EXPECT_THAT(script, HasSubstr("#SBATCH --time=5\n"));
-  EXPECT_THAT(script, HasSubstr("#SBATCH --output=\"" + (dir / "out").string() + "/logs/slurm-%A_%a.out\"\n"));
+  EXPECT_THAT(script,
+              HasSubstr("#SBATCH --output=\"" + (dir / "out").string() + "/logs/slurm-%A_%a.out\"\n"));
   EXPECT_FALSE(fs::exists(dir / "out" / "one")) << "emitting runs nothing";
   for (int task = 0; task < 2; ++task) {
     EXPECT_EQ(

@@ -17,7 +17,7 @@ namespace arcwheel::fitting {
 struct RunRecord {
   std::string input_path;
   std::string input_sha256;
-  std::string input_format;  // "hdf5" or "csv"
+  std::string input_format;  // "hdf5", "csv", or "memory" for a scan no reader made
   acquisition::ScanMetadata metadata;
   bool has_encoder = false;
   // Every processing parameter as used, in the order to print.

@@ -26,7 +26,15 @@ RunRecord MakeRecord(const std::string& scan_path, const ProcessPipelineOptions&
   bool latin1_path = false;
   record.input_path = AsUtf8(scan_path, latin1_path);
   const std::string extension = std::filesystem::path(scan_path).extension().string();
-  record.input_format = extension == ".h5" || extension == ".hdf5" ? "hdf5" : "csv";
+  // The readers choose by extension (acquisition/scan_reader.h); a scan that no reader made (one
+  // simulated in memory and handed over from Python) says so rather than borrow a file format.
+  if (extension == ".h5" || extension == ".hdf5") {
+    record.input_format = "hdf5";
+  } else if (extension == ".csv" || extension == ".txt") {
+    record.input_format = "csv";
+  } else {
+    record.input_format = "memory";
+  }
   record.metadata = scan.metadata;
   record.has_encoder = scan.has_encoder();
   const auto& p = options.processing;

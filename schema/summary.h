@@ -25,7 +25,7 @@ inline constexpr std::string_view kInput = "input";
 namespace input {
 inline constexpr std::string_view kPath = "path";
 inline constexpr std::string_view kSha256 = "sha256";
-inline constexpr std::string_view kFormat = "format";  // "hdf5" or "csv"
+inline constexpr std::string_view kFormat = "format";  // "hdf5", "csv" or "memory"
 inline constexpr std::string_view kSamples = "samples";
 inline constexpr std::string_view kValidSamples = "valid_samples";
 inline constexpr std::string_view kDespikedSamples = "despiked_samples";

@@ -58,6 +58,14 @@ def test_a_scan_in_memory_gives_the_results_of_its_file(simulated, processed):
     assert len(processed.summary["input"]["sha256"]) == 64
 
 
+def test_the_record_names_a_scan_that_no_file_holds():
+    from conftest import WHEEL
+    scan, _ = arcwheel.simulate(**WHEEL)
+    result = arcwheel.process(scan, phases=90, no_model=True)
+    assert result.summary["input"]["format"] == "memory"
+    assert result.summary["input"]["sha256"] == ""
+
+
 def test_the_arrays_are_numpy_arrays_of_the_map_shape(processed):
     m, f, a = processed.map, processed.fits, processed.axial
     n_phase, n_y = 180, len(m["y_mm"])

@@ -137,21 +137,176 @@ class CellOfSample {
         axial_step_(axial_step_mm) {}
 
   [[nodiscard]] long operator()(double u_deg, double y_mm) const {
-    const double t = (y_mm - y_low_) / axial_step_;
-    if (!(t > -0.5) || !(t < static_cast<double>(n_y_))) return -1;  // round(-0.4) is -0: row 0
-    const long m = RoundHalfAway(t);
-    if (m >= n_y_) return -1;
-    // The phase in the turn lies in [0, 360): its node is 0 .. n_phase, and n_phase is node 0
-    // (a comparison instead of a 64-bit division per sample).
-    long j = RoundHalfAway(PhaseInTurn(u_deg) / phase_step_);
-    if (j == n_phase_) j = 0;
-    return j * n_y_ + m;
+    const long m = AxialNode(y_mm);
+    if (m < 0 || m >= n_y_) return -1;
+    return PhaseNode(u_deg) * n_y_ + m;
   }
+
+  // The axial node nearest y: -1 below the map, n_y above it (both non-decreasing in y).
+  [[nodiscard]] long AxialNode(double y_mm) const {
+    const double t = (y_mm - y_low_) / axial_step_;
+    if (!(t > -0.5)) return -1;  // round(-0.4) is -0: row 0
+    if (!(t < static_cast<double>(n_y_))) return n_y_;
+    return std::min(RoundHalfAway(t), n_y_);
+  }
+
+  // The phase in the turn lies in [0, 360): its node is 0 .. n_phase, and n_phase is node 0
+  // (a comparison instead of a 64-bit division per sample).
+  [[nodiscard]] long PhaseNode(double u_deg) const {
+    const long j = RoundHalfAway(PhaseInTurn(u_deg) / phase_step_);
+    return j == n_phase_ ? 0 : j;
+  }
+
+  [[nodiscard]] long n_phase() const { return n_phase_; }
+  [[nodiscard]] long n_y() const { return n_y_; }
+  [[nodiscard]] double phase_step() const { return phase_step_; }
+  [[nodiscard]] double axial_step() const { return axial_step_; }
+  [[nodiscard]] double y_low() const { return y_low_; }
 
  private:
   long n_phase_, n_y_;
   double phase_step_, y_low_, axial_step_;
 };
+
+// Where a sample lies by CellOfSample: its phase node, its axial node (-1 below, n_y above) and
+// its unwrapped phase and axial position in axial steps from the first node.
+struct SampleCell {
+  long phase_node = 0;
+  long axial_node = 0;
+  double u_deg = 0.0;
+  double t = 0.0;
+};
+
+// Counts the samples of a scan whose phase and axial position follow from its settings
+// (HelixGeometry::from_settings) run by run: a run is a stretch of samples in one cell, and it
+// adds its finite samples at once. Every run is proven with the per-sample rule at its ends: u and
+// y are then monotone in the sample index (products and sums of monotone roundings), so the axial
+// node is monotone, and the phase node steps around the turn in one direction; two samples in the
+// same cell less than 180 deg apart (n_phase >= 4, so leaving a cell and coming back takes 270 deg)
+// have every sample between them in that cell too.
+template <typename T>
+class RunCounter {
+ public:
+  RunCounter(std::span<const T> rho, const HelixGeometry& geometry, const CellOfSample& cell_of)
+      : rho_(rho), geometry_(geometry), cell_of_(cell_of) {
+    const double n = std::max(1.0, static_cast<double>(geometry.size()) - 1.0);
+    // Per-sample advances, only to guess where a run ends (each guess is checked).
+    phase_step_per_sample_ = (geometry.PhaseAtIndex(n) - geometry.PhaseAtIndex(0.0)) / n;
+    axial_nodes_per_sample_ =
+        (geometry.AxialAtIndex(n) - geometry.AxialAtIndex(0.0)) / n / cell_of.axial_step();
+  }
+
+  // Runs pay when they are long: a run costs a few evaluations of the per-sample rule.
+  [[nodiscard]] bool Pays() const { return std::abs(phase_step_per_sample_) < 0.25 * cell_of_.phase_step(); }
+
+  void Count(std::size_t begin, std::size_t end, std::vector<int>& counts) const {
+    std::size_t i = begin;
+    while (i < end) {
+      const SampleCell first = At(i);
+      const std::size_t last = LastInRun(i, first, end - 1);
+      if (first.axial_node >= 0 && first.axial_node < cell_of_.n_y()) {
+        const auto cell = static_cast<std::size_t>(first.phase_node * cell_of_.n_y() + first.axial_node);
+        counts[cell] += FiniteIn(i, last + 1);
+      }
+      i = last + 1;
+    }
+  }
+
+ private:
+  [[nodiscard]] SampleCell At(std::size_t i) const {
+    const double u = geometry_.PhaseAt(i);
+    const double y = geometry_.AxialAt(i);
+    return {cell_of_.PhaseNode(u), cell_of_.AxialNode(y), u, (y - cell_of_.y_low()) / cell_of_.axial_step()};
+  }
+
+  [[nodiscard]] bool InRun(std::size_t k, const SampleCell& first) const {
+    const SampleCell at = At(k);
+    return at.phase_node == first.phase_node && at.axial_node == first.axial_node &&
+           std::abs(at.u_deg - first.u_deg) < 180.0;
+  }
+
+  // The last sample of the run that starts at i, in [i, last]: from a guess, by galloping and
+  // bisection on InRun (true from i up to the run's end, false after it).
+  [[nodiscard]] std::size_t LastInRun(std::size_t i, const SampleCell& first, std::size_t last) const {
+    std::size_t good = i;
+    std::size_t bad = last + 1;  // past the end: never evaluated
+    const std::size_t guess = std::clamp(i + SamplesLeftGuess(first), i, last);
+    if (guess > i) (InRun(guess, first) ? good : bad) = guess;
+    if (bad == last + 1) {
+      for (std::size_t step = 1; good < last; step *= 2) {
+        const std::size_t probe = std::min(last, good + step);
+        if (!InRun(probe, first)) {
+          bad = probe;
+          break;
+        }
+        good = probe;
+      }
+      if (good == last) return last;
+    } else {
+      for (std::size_t step = 1; bad - good > 1; step *= 2) {
+        const std::size_t probe = bad - std::min(step, bad - good - 1);
+        if (InRun(probe, first)) {
+          good = probe;
+          break;
+        }
+        bad = probe;
+      }
+    }
+    while (bad - good > 1) {
+      const std::size_t mid = good + (bad - good) / 2;
+      (InRun(mid, first) ? good : bad) = mid;
+    }
+    return good;
+  }
+
+  // Samples after the first of a run to the nearer of the next phase and axial cell boundaries.
+  [[nodiscard]] std::size_t SamplesLeftGuess(const SampleCell& first) const {
+    const double left = std::min(PhaseSamplesLeft(first), AxialSamplesLeft(first));
+    if (!(left >= 0.0)) return 0;
+    return left < 1e15 ? static_cast<std::size_t>(left) : std::size_t{1} << 50;
+  }
+
+  [[nodiscard]] double PhaseSamplesLeft(const SampleCell& first) const {
+    const double rate = phase_step_per_sample_;
+    if (rate == 0.0) return std::numeric_limits<double>::infinity();
+    const double c = PhaseInTurn(first.u_deg);
+    // The node before folding (n_phase at the end of a turn): its cell spans +- half a step.
+    const double node = std::round(c / cell_of_.phase_step());
+    const double boundary = (node + (rate > 0.0 ? 0.5 : -0.5)) * cell_of_.phase_step();
+    return (boundary - c) / rate;
+  }
+
+  [[nodiscard]] double AxialSamplesLeft(const SampleCell& first) const {
+    const double rate = axial_nodes_per_sample_;
+    const long m = first.axial_node;
+    if (rate == 0.0 || (rate > 0.0 && m >= cell_of_.n_y()) || (rate < 0.0 && m < 0)) {
+      return std::numeric_limits<double>::infinity();
+    }
+    const double boundary = static_cast<double>(m) + (rate > 0.0 ? 0.5 : -0.5);
+    return (boundary - first.t) / rate;
+  }
+
+  [[nodiscard]] int FiniteIn(std::size_t begin, std::size_t end) const {
+    int finite = 0;
+    for (std::size_t k = begin; k < end; ++k) finite += std::isfinite(static_cast<double>(rho_[k])) ? 1 : 0;
+    return finite;
+  }
+
+  std::span<const T> rho_;
+  const HelixGeometry& geometry_;
+  const CellOfSample& cell_of_;
+  double phase_step_per_sample_ = 0.0;
+  double axial_nodes_per_sample_ = 0.0;
+};
+
+// True when RunCounter applies: phase and axial position linear in the sample index, and finite
+// at both ends (so at every sample: both are monotone).
+bool CountableByRuns(const HelixGeometry& geometry) {
+  if (!geometry.from_settings() || geometry.size() == 0) return false;
+  const std::size_t last = geometry.size() - 1;
+  return std::isfinite(geometry.PhaseAt(0)) && std::isfinite(geometry.PhaseAt(last)) &&
+         std::isfinite(geometry.AxialAt(0)) && std::isfinite(geometry.AxialAt(last));
+}
 
 // Coverage diagnostics: raw and despiked samples per cell around each node. Two workers count the
 // two halves of the scan (integer sums: the same on any machine).
@@ -162,10 +317,16 @@ void CountCoverage(std::span<const T> rho, const HelixGeometry& geometry,
   const std::size_t cells = map.n_phase() * map.n_y();
   std::vector<int> upper(cells, 0);
   map.sample_count.assign(cells, 0);
+  const RunCounter<T> runs(rho, geometry, cell_of);
+  const bool by_runs = CountableByRuns(geometry) && runs.Pays();
   RunOnWorkers(2, [&](int half) {
     std::vector<int>& counts = half == 0 ? map.sample_count : upper;
     const std::size_t begin = half == 0 ? 0 : rho.size() / 2;
     const std::size_t end = half == 0 ? rho.size() / 2 : rho.size();
+    if (by_runs) {
+      runs.Count(begin, end, counts);
+      return;
+    }
     for (std::size_t i = begin; i < end; ++i) {
       if (!std::isfinite(static_cast<double>(rho[i]))) continue;
       if (const long cell = cell_of(geometry.PhaseAt(i), geometry.AxialAt(i)); cell >= 0) {

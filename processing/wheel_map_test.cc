@@ -2,8 +2,11 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <numeric>
+#include <random>
+#include <span>
 #include <vector>
 
 #include "acquisition/simulate.h"
@@ -141,6 +144,102 @@ TEST(BuildWheelMap, LeavesCellsWithoutSamplesEmptyAndKeepsTheRest) {
   // No section point rests on the gap.
   for (const Section& section : map.sections) {
     for (const double y : section.y_mm) EXPECT_FALSE(y > kGapLowMm + 0.05 && y < kGapHighMm - 0.05) << y;
+  }
+}
+
+// The coverage counts by the plain per-sample rule: each finite sample in the cell of the phase
+// node nearest fmod(u, 360) (by std::lround) and the axial node nearest y.
+std::vector<int> PlainCoverage(std::span<const double> rho, const HelixGeometry& geometry,
+                               const WheelMap& map, std::span<const std::size_t> only) {
+  std::vector<int> counts(map.n_phase() * map.n_y(), 0);
+  const double phase_step = 360.0 / static_cast<double>(map.n_phase());
+  const auto count = [&](std::size_t i) {
+    double c = std::fmod(geometry.PhaseAt(i), 360.0);
+    if (c < 0.0) c += 360.0;
+    const auto j = static_cast<std::size_t>(std::lround(c / phase_step)) % map.n_phase();
+    const long m = std::lround((geometry.AxialAt(i) - map.y_mm.front()) / map.axial_step_mm);
+    if (m >= 0 && m < static_cast<long>(map.n_y())) ++counts[j * map.n_y() + static_cast<std::size_t>(m)];
+  };
+  if (!only.empty()) {
+    for (const std::size_t i : only) count(i);
+    return counts;
+  }
+  for (std::size_t i = 0; i < rho.size(); ++i) {
+    if (std::isfinite(rho[i])) count(i);
+  }
+  return counts;
+}
+
+// One helix of the coverage test: the small scan's readings laid on a helix of other settings.
+struct CoverageCase {
+  double rpm = 500.0;
+  double sample_period_s = 1e-4;
+  double feed_mm_per_min = 250.0;
+  double start_phase_deg = 0.7;
+  int phases = 36;
+  double axial_step_mm = 0.0;
+};
+
+void ExpectPlainCoverage(const CoverageCase& c, double dropout_fraction, std::mt19937_64& random) {
+  acquisition::ScanSettings settings = SmallScan();
+  settings.sample_period_s = 1e-4;
+  acquisition::Scan scan = acquisition::SimulateScan(acquisition::LobedTestWheel(), settings).scan;
+  scan.metadata.sample_period_s = c.sample_period_s;
+  scan.metadata.start_phase_deg = c.start_phase_deg;
+  scan.metadata.feed_mm_per_min = c.feed_mm_per_min;
+  if (c.feed_mm_per_min < 0) scan.metadata.start_y_mm = settings.end_y_mm;
+  std::bernoulli_distribution dropped(dropout_fraction);
+  std::uniform_int_distribution<std::size_t> any_sample(0, scan.size() - 1);
+  for (double& z : scan.z_mm) {
+    if (dropped(random)) z = std::nan("");
+  }
+  const std::size_t block = any_sample(random);  // a longer dropout
+  for (std::size_t i = block; i < std::min(scan.size(), block + 700); ++i) scan.z_mm[i] = std::nan("");
+  std::vector<std::size_t> despiked;
+  for (int k = 0; k < 50; ++k) despiked.push_back(any_sample(random));
+  std::sort(despiked.begin(), despiked.end());
+
+  const HelixGeometry geometry(scan, c.rpm);
+  ASSERT_TRUE(geometry.from_settings());
+  const WheelMap map = BuildWheelMap(scan.z_mm, geometry, 1e-3, despiked,
+                                     {.phases = c.phases, .axial_step_mm = c.axial_step_mm});
+  EXPECT_EQ(map.sample_count, PlainCoverage(scan.z_mm, geometry, map, {}))
+      << "rpm " << c.rpm << ", period " << c.sample_period_s << ", feed " << c.feed_mm_per_min << ", start "
+      << c.start_phase_deg << ", phases " << c.phases;
+  EXPECT_EQ(map.despiked_count, PlainCoverage(scan.z_mm, geometry, map, despiked));
+  EXPECT_GT(std::accumulate(map.sample_count.begin(), map.sample_count.end(), 0),
+            static_cast<int>(scan.size() / 2));
+}
+
+TEST(BuildWheelMap, CountsCoverageAsThePlainPerSampleRuleOnRandomHelices) {
+  std::mt19937_64 random(14);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  const int phase_counts[] = {4, 7, 36, 360, 1000};
+  for (int trial = 0; trial < 16; ++trial) {
+    CoverageCase c;
+    c.rpm = 300.0 + 500.0 * unit(random);
+    c.sample_period_s = 1e-4 * (0.5 + unit(random));
+    c.feed_mm_per_min = (trial % 3 == 0 ? -1.0 : 1.0) * (150.0 + 200.0 * unit(random));
+    c.start_phase_deg = 1440.0 * unit(random) - 720.0;
+    c.phases = phase_counts[trial % 5];
+    c.axial_step_mm = trial % 4 == 1 ? 0.13 + 0.5 * unit(random) : 0.0;
+    ExpectPlainCoverage(c, trial % 2 == 0 ? 0.0 : 0.05, random);
+  }
+}
+
+// Samples exactly on phase cell boundaries: 1024 phases (a step of 45/256 deg) and 375/2048 deg a
+// sample from a boundary put every 48th sample on one (the rule rounds half away from zero), also
+// on the turns below u = 0 and with the feed towards -y.
+TEST(BuildWheelMap, CountsCoverageAsThePlainPerSampleRuleOnCellBoundaries) {
+  std::mt19937_64 random(7);
+  for (const double start : {45.0 / 256.0, 45.0 / 256.0 - 720.0, 45.0 / 256.0 + 3600.0}) {
+    for (const double feed : {250.0, -250.0}) {
+      const CoverageCase c{.sample_period_s = std::ldexp(1.0, -14),
+                           .feed_mm_per_min = feed,
+                           .start_phase_deg = start,
+                           .phases = 1024};
+      ExpectPlainCoverage(c, 0.01, random);
+    }
   }
 }
 

@@ -49,31 +49,101 @@ struct PhaseBins {
   std::vector<int> count;
 };
 
+// Bins the valid samples of turns [first, first + turns) of the scan into `out` (cell k * bins + b
+// holds bin b of turn first + k), reading every `stride`-th sample from `begin`.
 template <typename T>
-PhaseBins BinByPhase(const acquisition::Scan& scan, std::span<const T> z, double rpm, int bins) {
-  const HelixGeometry geometry(scan, rpm);
+void BinTurns(const HelixGeometry& geometry, std::span<const T> z, std::size_t begin, std::size_t stride,
+              std::size_t first, PhaseBins& out) {
   const double u0 = geometry.PhaseAt(0);
-  PhaseBins out;
-  out.turns = static_cast<std::size_t>(std::floor((geometry.PhaseAt(scan.size() - 1) - u0) / 360.0)) + 1;
-  out.bins = static_cast<std::size_t>(bins);
   const std::size_t nb = out.bins;
-  out.sum.assign(out.turns * nb, 0.0);
-  out.position.assign(out.turns * nb, 0.0);
-  out.count.assign(out.turns * nb, 0);
-  // Bins need a few samples each, not thirty: long scans are read with a stride.
-  const std::size_t sample_stride = std::max<std::size_t>(1, z.size() / (out.turns * nb * 4));
-  for (std::size_t i = 0; i < z.size(); i += sample_stride) {
-    if (!std::isfinite(z[i])) continue;
+  const auto bins = static_cast<double>(nb);
+  for (std::size_t i = begin; i < z.size(); i += stride) {
     const double turn_position = (geometry.PhaseAt(i) - u0) / 360.0;
     const auto k = static_cast<std::size_t>(turn_position);
+    if (k >= first + out.turns) break;  // the phase increases with i
+    if (!std::isfinite(z[i])) continue;
     const double fraction = turn_position - static_cast<double>(k);
     const auto b = std::min(nb - 1, static_cast<std::size_t>(fraction * bins));
-    out.sum[k * nb + b] += z[i];
-    out.position[k * nb + b] += fraction;
-    ++out.count[k * nb + b];
+    const std::size_t cell = (k - first) * nb + b;
+    out.sum[cell] += z[i];
+    out.position[cell] += fraction;
+    ++out.count[cell];
   }
-  return out;
 }
+
+// The scan binned by phase at one speed, one window of turns at a time. Windows far apart are all
+// a long scan needs (at most kMaxWindows of kTurnsPerWindow turns), so a scan whose phase follows
+// from its settings is binned only over the windows asked for, from the first sample of each
+// (found by bisection); other scans are binned whole once. Either way every cell sums the same
+// samples in the same order.
+template <typename T>
+class WindowBinner {
+ public:
+  WindowBinner(const acquisition::Scan& scan, std::span<const T> z, double rpm, int bins)
+      : geometry_(scan, rpm), z_(z), bins_(static_cast<std::size_t>(bins)) {
+    const double u0 = geometry_.PhaseAt(0);
+    turns_ = static_cast<std::size_t>(std::floor((geometry_.PhaseAt(scan.size() - 1) - u0) / 360.0)) + 1;
+    // Bins need a few samples each, not thirty: long scans are read with a stride.
+    stride_ = std::max<std::size_t>(1, z.size() / (turns_ * bins_ * 4));
+    if (!geometry_.from_settings()) {
+      whole_ = Empty(turns_);
+      BinTurns(geometry_, z_, 0, stride_, 0, whole_);
+    }
+  }
+
+  [[nodiscard]] std::size_t turns() const { return turns_; }
+
+  // Turns [first, first + kTurnsPerWindow): cell k * bins + b holds bin b of turn first + k.
+  [[nodiscard]] PhaseBins Window(std::size_t first) const {
+    const auto window = static_cast<std::size_t>(kTurnsPerWindow);
+    PhaseBins out = Empty(window);
+    if (whole_.turns > 0) {
+      const auto from = static_cast<long>(first * bins_);
+      const auto to = static_cast<long>((first + window) * bins_);
+      std::copy(whole_.sum.begin() + from, whole_.sum.begin() + to, out.sum.begin());
+      std::copy(whole_.position.begin() + from, whole_.position.begin() + to, out.position.begin());
+      std::copy(whole_.count.begin() + from, whole_.count.begin() + to, out.count.begin());
+      return out;
+    }
+    BinTurns(geometry_, z_, stride_ * FirstStrideInTurn(first), stride_, first, out);
+    return out;
+  }
+
+ private:
+  [[nodiscard]] PhaseBins Empty(std::size_t turns) const {
+    PhaseBins out;
+    out.turns = turns;
+    out.bins = bins_;
+    out.sum.assign(turns * bins_, 0.0);
+    out.position.assign(turns * bins_, 0.0);
+    out.count.assign(turns * bins_, 0);
+    return out;
+  }
+
+  // The first j with sample j * stride in turn `first` or later (the phase increases with j).
+  [[nodiscard]] std::size_t FirstStrideInTurn(std::size_t first) const {
+    const double u0 = geometry_.PhaseAt(0);
+    std::size_t lo = 0;
+    std::size_t hi = (z_.size() + stride_ - 1) / stride_;
+    while (lo < hi) {
+      const std::size_t mid = lo + (hi - lo) / 2;
+      const auto k = static_cast<std::size_t>((geometry_.PhaseAt(mid * stride_) - u0) / 360.0);
+      if (k < first) {
+        lo = mid + 1;
+      } else {
+        hi = mid;
+      }
+    }
+    return lo;
+  }
+
+  HelixGeometry geometry_;
+  std::span<const T> z_;
+  std::size_t bins_ = 0;
+  std::size_t turns_ = 0;
+  std::size_t stride_ = 1;
+  PhaseBins whole_;
+};
 
 // The filled cells of the window of turns starting at `first`; empty unless every turn of it has
 // at least 90 % of its bins filled.
@@ -93,10 +163,10 @@ std::vector<std::size_t> CoveredWindowCells(const PhaseBins& bins, std::size_t f
   return cells;
 }
 
-// Fits one window's cells with sum_j p_j tau^j + sum_h (A_h cos(h theta) + B_h sin(h theta)).
-// Each bin enters at the mean position of its own samples, not at its centre: with a non-integer
-// number of samples per bin the two differ, and the arc's slope through a turn would turn that
-// difference into a phase that drifts along the axis.
+// Fits the cells of the window of turns from `first` (binned by WindowBinner::Window) with sum_j p_j tau^j +
+// sum_h (A_h cos(h theta) + B_h sin(h theta)). Each bin enters at the mean position of its own samples, not
+// at its centre: with a non-integer number of samples per bin the two differ, and the arc's slope through a
+// turn would turn that difference into a phase that drifts along the axis.
 TurnHarmonics FitWindow(const PhaseBins& bins, const std::vector<std::size_t>& cells, std::size_t first,
                         int harmonics) {
   const std::size_t nb = bins.bins;
@@ -107,7 +177,7 @@ TurnHarmonics FitWindow(const PhaseBins& bins, const std::vector<std::size_t>& c
   for (Eigen::Index r = 0; r < rows; ++r) {
     const std::size_t cell = cells[static_cast<std::size_t>(r)];
     const double fraction = bins.position[cell] / bins.count[cell];
-    const double in_window = static_cast<double>(cell / nb - first) + fraction;
+    const double in_window = static_cast<double>(cell / nb) + fraction;
     const double tau = (in_window - 0.5 * kTurnsPerWindow) / kTurnsPerWindow;
     const double theta = 2.0 * std::numbers::pi * fraction;
     double power = 1.0;
@@ -141,16 +211,19 @@ TurnHarmonics FitWindow(const PhaseBins& bins, const std::vector<std::size_t>& c
 template <typename T>
 std::vector<TurnHarmonics> FitTurns(const acquisition::Scan& scan, std::span<const T> z, double rpm, int bins,
                                     int harmonics, std::size_t spacing) {
-  const PhaseBins binned = BinByPhase(scan, z, rpm, bins);
+  const WindowBinner<T> binner(scan, z, rpm, bins);
   const auto window = static_cast<std::size_t>(kTurnsPerWindow);
-  const std::size_t stride = window * (spacing > 0 ? spacing : SpreadSpacing(binned.turns));
+  const std::size_t stride = window * (spacing > 0 ? spacing : SpreadSpacing(binner.turns()));
   std::vector<std::size_t> firsts;
+  std::vector<PhaseBins> binned;
   std::vector<std::vector<std::size_t>> cells;
-  for (std::size_t first = 0; first + window <= binned.turns && firsts.size() < kMaxWindows;
+  for (std::size_t first = 0; first + window <= binner.turns() && firsts.size() < kMaxWindows;
        first += stride) {
-    std::vector<std::size_t> covered = CoveredWindowCells(binned, first);
+    PhaseBins window_bins = binner.Window(first);
+    std::vector<std::size_t> covered = CoveredWindowCells(window_bins, 0);
     if (covered.empty()) continue;
     firsts.push_back(first);
+    binned.push_back(std::move(window_bins));
     cells.push_back(std::move(covered));
   }
   // The windows' fits are independent: two workers take alternate ones.
@@ -158,7 +231,7 @@ std::vector<TurnHarmonics> FitTurns(const acquisition::Scan& scan, std::span<con
   constexpr int kWorkers = 2;
   RunOnWorkers(kWorkers, [&](int worker) {
     for (auto w = static_cast<std::size_t>(worker); w < firsts.size(); w += kWorkers) {
-      result[w] = FitWindow(binned, cells[w], firsts[w], harmonics);
+      result[w] = FitWindow(binned[w], cells[w], firsts[w], harmonics);
     }
   });
   return result;

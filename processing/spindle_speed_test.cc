@@ -69,6 +69,30 @@ TEST(EstimateSpindleSpeed, KeepsTheNominalSpeedWhenTheSpindleRunsAtIt) {
   EXPECT_EQ(estimate.used_rpm, 500.0);
 }
 
+// A scan with a time column is binned whole; one whose phase follows from its settings only over
+// the windows fitted. With the time column holding exactly the settings' times the two must agree
+// to the last bit: 400 turns (more than the 64 windows of 4 turns) at 3000 samples a turn (every
+// second sample binned).
+TEST(EstimateSpindleSpeed, BinsOnlyTheFittedWindowsToTheSameBitsAsTheWholeScan) {
+  acquisition::ScanSettings settings = ScanWithSpeedError(0.001, 3);
+  settings.sample_period_s = 4e-5;
+  settings.feed_mm_per_min = 0.04 * settings.spindle_rpm_nominal;
+  settings.start_y_mm = -8.0;
+  settings.end_y_mm = 8.0;
+  acquisition::Scan scan = acquisition::SimulateScan(acquisition::LobedTestWheel(), settings).scan;
+  const SpindleSpeedEstimate by_windows = EstimateSpindleSpeed(scan, scan.z_mm, SpindleSpeedOptions{});
+  scan.t_s.resize(scan.size());
+  for (std::size_t i = 0; i < scan.size(); ++i)
+    scan.t_s[i] = static_cast<double>(i) * settings.sample_period_s;
+  const SpindleSpeedEstimate whole = EstimateSpindleSpeed(scan, scan.z_mm, SpindleSpeedOptions{});
+
+  ASSERT_TRUE(whole.available);
+  EXPECT_EQ(by_windows.fitted_rpm, whole.fitted_rpm);
+  EXPECT_EQ(by_windows.sigma_rpm, whole.sigma_rpm);
+  EXPECT_EQ(by_windows.turns_used, whole.turns_used);
+  EXPECT_NEAR(whole.fitted_rpm, 500.5, 3.0 * whole.sigma_rpm);
+}
+
 TEST(EstimateSpindleSpeed, GivesUpOnAScanTooShortForFourWindows) {
   acquisition::ScanSettings settings = ScanWithSpeedError(0.002, 1);
   settings.end_y_mm = settings.start_y_mm + 10 * 0.15;  // 10 turns

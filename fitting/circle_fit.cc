@@ -91,9 +91,9 @@ void PolishByGaussNewton(const std::vector<double>& x, const std::vector<double>
                          const std::vector<double>& w, double p[3]) {
   const auto n = static_cast<Eigen::Index>(x.size());
   double cost = WeightedCost(x, y, w, p);
+  Eigen::MatrixXd jacobian(n, 3);
+  Eigen::VectorXd residual(n);
   for (int iteration = 0; iteration < 5; ++iteration) {
-    Eigen::MatrixXd jacobian(n, 3);
-    Eigen::VectorXd residual(n);
     for (Eigen::Index i = 0; i < n; ++i) {
       const auto k = static_cast<std::size_t>(i);
       const double dx = x[k] - p[0];
@@ -185,12 +185,9 @@ void SetSolution(const ScaledPoints& s, const double p[3], CircleFit& fit) {
     high = i == 0 ? residual_mm : std::max(high, residual_mm);
   }
   // How the solution moves when the points move along y (the sensor's direction), to first order:
-  // dp = -(J^T J)^-1 J^T diag(w_i dy_i / d_i) dy.
-  Eigen::VectorXd along_y(static_cast<Eigen::Index>(n));
-  for (std::size_t i = 0; i < n; ++i) {
-    along_y(static_cast<Eigen::Index>(i)) = w[i] * (y[i] - p[1]) / std::hypot(x[i] - p[0], y[i] - p[1]);
-  }
+  // dp = -(J^T J)^-1 J^T diag(w_i dy_i / d_i) dy, where w_i dy_i / d_i is -J(i, 1) (to the bit).
   const Eigen::Matrix3d normal = jacobian.transpose() * jacobian;
+  const Eigen::VectorXd along_y = -jacobian.col(1);
   fit.sensitivity_to_y = -normal.ldlt().solve(jacobian.transpose() * along_y.asDiagonal());
   fit.center_mm = {s.cx + p[0] * s.scale, s.cy + p[1] * s.scale};
   fit.radius_mm = p[2] * s.scale;
@@ -199,21 +196,35 @@ void SetSolution(const ScaledPoints& s, const double p[3], CircleFit& fit) {
   fit.chi2 = rss_weighted;
 }
 
-// Sets fit.covariance from Ceres' (J^T J)^-1 at p. Returns false if it cannot be computed.
-bool SetCovariance(ceres::Problem& problem, const double* p, const CircleFitOptions& options,
+// Sets fit.covariance to (J^T J)^-1 from the Jacobian at the solution by the computation of
+// Ceres' DENSE_SVD covariance (ceres::Covariance with null_space_rank 0), without its problem
+// set-up: the SVD of J (Eigen's BDCSVD, which runs a JacobiSVD with a column-pivoting QR for three
+// columns), V diag(1 / s_i^2) V^T. Returns false, as Ceres does, if (s_i / s_max)^2 is below
+// min_reciprocal_condition_number = 1e-14 for some singular value s_i.
+// The Jacobian is the one Ceres evaluated (CircleResiduals at p), so the result is Ceres' to the bit.
+bool SetCovariance(const CircleResiduals& residuals, const double p[3], const CircleFitOptions& options,
                    CircleFit& fit) {
-  ceres::Covariance::Options covariance_options;
-  covariance_options.algorithm_type = ceres::DENSE_SVD;
-  covariance_options.min_reciprocal_condition_number = 1e-14;
-  covariance_options.null_space_rank = 0;
-  ceres::Covariance covariance(covariance_options);
-  const std::vector<std::pair<const double*, const double*>> blocks = {{p, p}};
-  double scaled[9];
-  if (!covariance.Compute(blocks, &problem) || !covariance.GetCovarianceBlock(p, p, scaled)) return false;
-  // Scaling by `scale` leaves the Jacobian unchanged (d(r/scale)/d(p/scale) = dr/dp), so Ceres'
+  constexpr double kMinReciprocalConditionNumber = 1e-14;
+  using RowMajorMatrix = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
+  RowMajorMatrix jacobian(fit.n, 3);
+  Eigen::VectorXd values(fit.n);
+  const double* parameters[] = {p};
+  double* jacobians[] = {jacobian.data()};
+  residuals.Evaluate(parameters, values.data(), jacobians);
+  const Eigen::JacobiSVD<RowMajorMatrix, Eigen::ColPivHouseholderQRPreconditioner> svd(jacobian,
+                                                                                       Eigen::ComputeThinV);
+  const Eigen::VectorXd singular_values = svd.singularValues();
+  const double max_singular_value = singular_values[0];
+  const double min_singular_value_ratio = std::sqrt(kMinReciprocalConditionNumber);
+  Eigen::Vector3d inverse_squared_singular_values;
+  for (int i = 0; i < 3; ++i) {
+    if (singular_values[i] / max_singular_value < min_singular_value_ratio) return false;
+    inverse_squared_singular_values[i] = 1.0 / (singular_values[i] * singular_values[i]);
+  }
+  // Scaling by `scale` leaves the Jacobian unchanged (d(r/scale)/d(p/scale) = dr/dp), so
   // (J^T J)^-1 is already the covariance in mm^2 for residuals of unit variance: exact when the
   // weights are 1/sigma, else scaled by the residual variance.
-  fit.covariance = Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(scaled);
+  fit.covariance = svd.matrixV() * inverse_squared_singular_values.asDiagonal() * svd.matrixV().transpose();
   if (!options.weights_are_inverse_sigmas) {
     const auto n = static_cast<std::size_t>(fit.n);
     fit.covariance *= n > 3 ? fit.chi2 / static_cast<double>(n - 3) : 0.0;
@@ -258,7 +269,7 @@ CircleFit FitCircle(std::span<const double> x_in, std::span<const double> y_in,
   fit.iterations = static_cast<int>(summary.iterations.size());
   PolishByGaussNewton(points.x, points.y, points.w, p);
   SetSolution(points, p, fit);
-  if (!SetCovariance(problem, p, options, fit)) {
+  if (!SetCovariance(CircleResiduals(points.x, points.y, points.w), p, options, fit)) {
     return Degenerate(fit, "the points do not determine the circle (ill-conditioned)");
   }
   if (summary.termination_type == ceres::CONVERGENCE || summary.termination_type == ceres::USER_SUCCESS) {

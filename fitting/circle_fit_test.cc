@@ -100,6 +100,57 @@ TEST(FitCircle, RadiusSigmaMatchesTheScatterOverManyNoisyArcs) {
   EXPECT_NEAR(std::sqrt(var) / mean_sigma, 1.0, 0.12);
 }
 
+// The covariance is the textbook s^2 (J^T J)^-1, with J the Jacobian of the geometric residuals
+// d_i - r in mm at the fitted circle and s^2 = RSS / (n - 3), formed here independently.
+TEST(FitCircle, CovarianceIsTheResidualVarianceTimesTheInverseNormalMatrix) {
+  std::mt19937 rng(11);
+  std::normal_distribution<double> noise(0.0, 1e-3);
+  std::vector<double> x, y;
+  for (int i = 0; i < 40; ++i) {
+    const double t = (-12.0 + 24.0 * i / 39.0) * std::numbers::pi / 180.0;
+    x.push_back(-3.0 + (55.4 + noise(rng)) * std::sin(t));
+    y.push_back(-199.5 + (55.4 + noise(rng)) * std::cos(t));
+  }
+  const CircleFit fit = FitCircle(x, y, {}, {});
+  ASSERT_TRUE(fit.IsUsable()) << fit.message;
+  Eigen::MatrixXd jacobian(40, 3);
+  double rss = 0.0;
+  for (int i = 0; i < 40; ++i) {
+    const double dx = x[static_cast<std::size_t>(i)] - fit.center_mm.x();
+    const double dy = y[static_cast<std::size_t>(i)] - fit.center_mm.y();
+    const double d = std::sqrt(dx * dx + dy * dy);
+    jacobian.row(i) << -dx / d, -dy / d, -1.0;
+    rss += (d - fit.radius_mm) * (d - fit.radius_mm);
+  }
+  const Eigen::Matrix3d expected = rss / 37.0 * (jacobian.transpose() * jacobian).inverse();
+  for (int r = 0; r < 3; ++r) {
+    for (int c = 0; c < 3; ++c) {
+      EXPECT_NEAR(fit.covariance(r, c), expected(r, c), 1e-7 * std::abs(expected(r, c)) + 1e-20) << r << c;
+    }
+  }
+}
+
+// The reciprocal condition number (s_min / s_max)^2 of the Jacobian of 21 points on an arc grows as
+// the arc's angle^4: for a 0.1 deg arc it is 3.9e-15 (as Ceres' covariance reports it), below the
+// 1e-14 under which the fit refuses; for a 1 deg arc it is 3.9e-11.
+TEST(FitCircle, RefusesAnArcTooShortToDetermineTheCircle) {
+  const auto arc = [](double arc_deg) {
+    std::vector<double> x, y;
+    for (int i = 0; i <= 20; ++i) {
+      const double t = (-0.5 + i / 20.0) * arc_deg * std::numbers::pi / 180.0;
+      x.push_back(55.0 * std::sin(t));
+      y.push_back(55.0 * std::cos(t));
+    }
+    return FitCircle(x, y, {}, {});
+  };
+  const CircleFit too_short = arc(0.1);
+  EXPECT_EQ(too_short.status, FitStatus::kDegenerate);
+  EXPECT_EQ(too_short.message, "the points do not determine the circle (ill-conditioned)");
+  const CircleFit long_enough = arc(1.0);
+  EXPECT_EQ(long_enough.status, FitStatus::kConverged) << long_enough.message;
+  EXPECT_NEAR(long_enough.radius_mm, 55.0, 1e-6);
+}
+
 TEST(FitCircle, RefusesCollinearAndTooFewPoints) {
   const std::vector<double> x = {0, 1, 2, 3}, y = {0, 1, 2, 3};
   EXPECT_FALSE(FitCircle(x, y, {}, {}).IsUsable());

@@ -137,16 +137,29 @@ double SigmaOfMean(const std::vector<PhaseSolution>& solutions, int row, const p
   return map.noise_sigma_mm * std::sqrt(std::max(0.0, factor));
 }
 
+// cos and sin of each phase, computed once for all the axial nodes.
+struct PhaseHarmonic {
+  double cos = 0.0, sin = 0.0;
+};
+
+std::vector<PhaseHarmonic> PhaseHarmonics(const processing::WheelMap& map) {
+  std::vector<PhaseHarmonic> out(map.n_phase());
+  for (std::size_t j = 0; j < out.size(); ++j) {
+    const double c = map.phase_deg[j] * std::numbers::pi / 180.0;
+    out[j] = {std::cos(c), std::sin(c)};
+  }
+  return out;
+}
+
 // Peak-to-valley after removing mean and first harmonic (least squares) over the phases given.
-double Roundness(const std::vector<double>& phase_deg, const std::vector<double>& rho) {
+double Roundness(const std::vector<PhaseHarmonic>& phase, const std::vector<double>& rho) {
   const auto n = static_cast<Eigen::Index>(rho.size());
   Eigen::MatrixXd design(n, 3);
   Eigen::VectorXd values(n);
   for (Eigen::Index i = 0; i < n; ++i) {
-    const double c = phase_deg[static_cast<std::size_t>(i)] * std::numbers::pi / 180.0;
     design(i, 0) = 1.0;
-    design(i, 1) = std::cos(c);
-    design(i, 2) = std::sin(c);
+    design(i, 1) = phase[static_cast<std::size_t>(i)].cos;
+    design(i, 2) = phase[static_cast<std::size_t>(i)].sin;
     values(i) = rho[static_cast<std::size_t>(i)];
   }
   const Eigen::VectorXd residual = values - design * design.colPivHouseholderQr().solve(values);
@@ -286,13 +299,17 @@ bool InBand(double y_mm, const WheelFit& fit) {
 // Runout and roundness over the map's axial nodes in the band.
 void SetRunoutAndRoundness(const processing::WheelMap& map, const WheelFitOptions& options, WheelFit& out) {
   const std::size_t n_phase = map.n_phase();
+  const std::vector<PhaseHarmonic> harmonics = PhaseHarmonics(map);
+  std::vector<PhaseHarmonic> phase;
+  std::vector<double> rho;
   for (std::size_t m = 0; m < map.n_y(); ++m) {
     const double y = map.y_mm[m];
     if (!InBand(y, out)) continue;
-    std::vector<double> phase, rho;
+    phase.clear();
+    rho.clear();
     for (std::size_t j = 0; j < n_phase; ++j) {
       if (std::isfinite(map.rho(j, m))) {
-        phase.push_back(map.phase_deg[j]);
+        phase.push_back(harmonics[j]);
         rho.push_back(map.rho(j, m));
       }
     }

@@ -68,7 +68,6 @@ class SharedArrays {
     if (entry == nullptr) return std::nullopt;
     std::vector<T> values;
     values.reserve(entry->count);
-    AdviseLargePages(values.data(), entry->count * sizeof(T));
     MoveOut(*entry, [&](const void* data, std::size_t count) {
       const T* first = static_cast<const T*>(data);
       values.insert(values.end(), first, first + count);
@@ -96,9 +95,6 @@ class SharedArrays {
   void MarkComplete();
   [[nodiscard]] bool ReadDirectory();
   [[nodiscard]] const Entry* Find(const std::string& name, std::size_t value_bytes) const;
-  // Asks the system to back the `bytes` at `data` (a new, untouched allocation) with large pages:
-  // the copy out then takes one page fault per 2 MiB, not per 4 KiB.
-  static void AdviseLargePages(void* data, std::size_t bytes);
   void MoveOut(const Entry& entry, const std::function<void(const void*, std::size_t)>& append);
 
   int fd_ = -1;

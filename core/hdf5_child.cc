@@ -206,13 +206,6 @@ const SharedArrays::Entry* SharedArrays::Find(const std::string& name, std::size
   return nullptr;
 }
 
-void SharedArrays::AdviseLargePages(void* data, std::size_t bytes) {
-  const auto first = (reinterpret_cast<std::uintptr_t>(data) + kPage - 1) / kPage * kPage;
-  const auto last = (reinterpret_cast<std::uintptr_t>(data) + bytes) / kPage * kPage;
-  // Only a hint: without transparent huge pages (or on another system) nothing changes.
-  if (last > first) madvise(reinterpret_cast<void*>(first), last - first, MADV_HUGEPAGE);
-}
-
 void SharedArrays::MoveOut(const Entry& entry, const std::function<void(const void*, std::size_t)>& append) {
   const std::size_t bytes = entry.count * entry.value_bytes;
   // Read with pread into a small buffer that stays in cache, not through a mapping of the memory

@@ -100,23 +100,41 @@ void MetadataSetter::SetText(const std::string& name, std::string_view value) {
     throw Error(ErrorCode::kInternal, kStage, "metadata '" + name + "' is not text");
 }
 
+namespace {
+
+// Replaces with NaN every reading that `is_sentinel` matches, that is not finite, or that lies
+// outside [low, high] (compared in double, as for readings held in double). Written without
+// branches so that the compiler vectorizes it: this pass touches every sample of the scan.
+template <typename T, typename IsSentinel>
+void MarkInvalid(std::vector<T>& readings, double low, double high, IsSentinel is_sentinel) {
+  constexpr T kNaN = std::numeric_limits<T>::quiet_NaN();
+  constexpr double kMax = std::numeric_limits<double>::max();
+  for (T& z : readings) {
+    const double value = z;
+    const bool marked = is_sentinel(z);
+    // |value| <= max is false for NaN and +-Inf (a float sensor's over-range reading).
+    const bool finite = std::abs(value) <= kMax;
+    const bool valid = !marked & finite & (value >= low) & (value <= high);
+    z = valid ? z : kNaN;
+  }
+}
+
+}  // namespace
+
 void ApplyInvalidMarkers(Scan& scan, SentinelComparison comparison) {
   const ScanMetadata& m = scan.metadata;
   const double low = m.range_min_mm.value_or(-std::numeric_limits<double>::infinity());
   const double high = m.range_max_mm.value_or(std::numeric_limits<double>::infinity());
   const bool has_sentinel = m.invalid_value.has_value() && comparison != SentinelComparison::kDone;
-  const bool as_float = comparison == SentinelComparison::kAsFloat;
   const double sentinel = m.invalid_value.value_or(0.0);
-  const float sentinel_float = static_cast<float>(sentinel);
   VisitReadings(scan, [&](auto& readings) {
-    for (auto& z : readings) {
-      const bool is_sentinel =
-          has_sentinel && (as_float ? static_cast<float>(z) == sentinel_float : z == sentinel);
-      // +-Inf is a float sensor's over-range reading: an invalid sample, like NaN. The range
-      // limits are compared in double, as for readings held in double.
-      const double value = z;
-      if (is_sentinel || !std::isfinite(value) || !(value >= low && value <= high))
-        z = std::numeric_limits<std::remove_reference_t<decltype(z)>>::quiet_NaN();
+    if (!has_sentinel) {
+      MarkInvalid(readings, low, high, [](auto) { return false; });
+    } else if (comparison == SentinelComparison::kAsFloat) {
+      const float sentinel_float = static_cast<float>(sentinel);
+      MarkInvalid(readings, low, high, [=](auto z) { return static_cast<float>(z) == sentinel_float; });
+    } else {
+      MarkInvalid(readings, low, high, [=](auto z) { return static_cast<double>(z) == sentinel; });
     }
   });
 }

@@ -1,5 +1,6 @@
 #include <fcntl.h>
 #include <fmt/format.h>
+#include <poll.h>
 #include <signal.h>
 #include <sys/mman.h>
 #include <sys/types.h>
@@ -16,6 +17,7 @@
 #include <string>
 #include <system_error>
 #include <thread>
+#include <vector>
 
 #include "core/error.h"
 #include "core/hdf5.h"
@@ -35,8 +37,10 @@ double DefaultTimeoutS(const std::filesystem::path& path) {
 }
 
 // Waits for `child`; its wait status, or nothing once `timeout_s` has passed or a signal asks us
-// to stop (the child is then killed and reaped).
-std::optional<int> WaitFor(pid_t child, double timeout_s) {
+// to stop (the child is then killed and reaped). `exit_pipe` (or -1) is a pipe's read end whose
+// write end only the child holds: it reports end of file the moment the child exits, so the wait
+// ends then, not at the next of a series of growing sleeps (up to 20 ms late).
+std::optional<int> WaitFor(pid_t child, double timeout_s, int exit_pipe) {
   const auto start = std::chrono::steady_clock::now();
   auto pause = std::chrono::microseconds(200);
   for (;;) {
@@ -51,6 +55,18 @@ std::optional<int> WaitFor(pid_t child, double timeout_s) {
       }
       return std::nullopt;
     }
+    if (exit_pipe >= 0) {
+      // At most 20 ms at a time, so that an interrupt is still seen within 20 ms.
+      pollfd exited{.fd = exit_pipe, .events = POLLIN, .revents = 0};
+      if (poll(&exited, 1, 20) > 0) {
+        // The child has closed its end: it is exiting (its memory already given back), and can be
+        // reaped within microseconds. Short sleeps from here on, not a blocking wait, in case a
+        // damaged file made it close the pipe and hang.
+        exit_pipe = -1;
+        pause = std::chrono::microseconds(20);
+      }
+      continue;
+    }
     std::this_thread::sleep_for(pause);
     pause = std::min(pause * 2, std::chrono::microseconds(20000));
   }
@@ -64,10 +80,18 @@ bool RunInChildProcess(const std::filesystem::path& path, const std::function<vo
   if (g_in_child) return false;
   if (timeout_s <= 0.0) timeout_s = DefaultTimeoutS(path);
   std::fflush(nullptr);  // nothing buffered twice
+  int exit_pipe[2] = {-1, -1};
+  if (pipe2(exit_pipe, O_CLOEXEC) != 0) exit_pipe[0] = exit_pipe[1] = -1;  // WaitFor then polls
   const pid_t child = fork();
-  if (child < 0) return false;  // no child to be had: the caller reads, unguarded, as before
+  if (child < 0) {  // no child to be had: the caller reads, unguarded, as before
+    for (const int end : exit_pipe) {
+      if (end >= 0) close(end);
+    }
+    return false;
+  }
   if (child == 0) {
     g_in_child = true;
+    if (exit_pipe[0] >= 0) close(exit_pipe[0]);
     try {
       read();
     } catch (...) {
@@ -75,7 +99,9 @@ bool RunInChildProcess(const std::filesystem::path& path, const std::function<vo
     }
     _exit(0);
   }
-  const std::optional<int> status = WaitFor(child, timeout_s);
+  if (exit_pipe[1] >= 0) close(exit_pipe[1]);
+  const std::optional<int> status = WaitFor(child, timeout_s, exit_pipe[0]);
+  if (exit_pipe[0] >= 0) close(exit_pipe[0]);
   ThrowIfInterrupted();
   const std::string name = fmt::format("'{}'", path.string());
   if (!status) {
@@ -101,12 +127,26 @@ bool RunInChildProcess(const std::filesystem::path& path, const std::function<vo
 // The first page of the memory file: which arrays it holds and where.
 constexpr std::uint32_t kMagic = 0x61726377;  // "arcw"
 constexpr std::size_t kPage = 4096;
-constexpr std::size_t kCopyChunk = 8u << 20;  // bytes copied out before their pages are given back
+// Bytes copied out before their pages are given back: small enough for the copy's buffer to stay
+// in the cache, large enough that the system calls do not count.
+constexpr std::size_t kCopyChunk = 1u << 20;
 
 std::size_t RoundUpToPage(std::size_t bytes) { return (bytes + kPage - 1) / kPage * kPage; }
 
 [[noreturn]] void ThrowSystemError(const std::string& what) {
   throw Error(ErrorCode::kIo, kStage, what + ": " + std::strerror(errno));
+}
+
+// `length` bytes of `fd` from `offset` into `data`; Error{kIo} when they are not all there.
+void ReadExactly(int fd, char* data, std::size_t length, off_t offset) {
+  while (length > 0) {
+    const ssize_t got = pread(fd, data, length, offset);
+    if (got < 0 && errno == EINTR) continue;
+    if (got <= 0) ThrowSystemError("cannot read the shared memory");
+    data += got;
+    length -= static_cast<std::size_t>(got);
+    offset += got;
+  }
 }
 
 }  // namespace
@@ -168,19 +208,20 @@ const SharedArrays::Entry* SharedArrays::Find(const std::string& name, std::size
 
 void SharedArrays::MoveOut(const Entry& entry, const std::function<void(const void*, std::size_t)>& append) {
   const std::size_t bytes = entry.count * entry.value_bytes;
-  if (bytes == 0) return;
-  void* address = mmap(nullptr, bytes, PROT_READ, MAP_SHARED, fd_, static_cast<off_t>(entry.offset));
-  if (address == MAP_FAILED) ThrowSystemError("cannot map the shared memory");
-  // Chunks of whole pages and whole values, each given back to the system once copied, so that
-  // the array is never held twice in full.
+  // Read with pread into a small buffer that stays in cache, not through a mapping of the memory
+  // file: a mapping costs a page fault per 4 KiB read, and unmapping it another pass. Chunks of
+  // whole pages and whole values, each given back to the system once copied, so that the array
+  // is never held twice in full.
   const std::size_t chunk = kCopyChunk / entry.value_bytes * entry.value_bytes;
-  for (std::size_t done = 0; done < bytes; done += chunk) {
+  std::vector<char> buffer(std::min(chunk, bytes));
+  for (std::size_t done = 0; done < bytes;) {
     const std::size_t length = std::min(chunk, bytes - done);
-    append(static_cast<const char*>(address) + done, length / entry.value_bytes);
-    fallocate(fd_, FALLOC_FL_PUNCH_HOLE | FALLOC_FL_KEEP_SIZE, static_cast<off_t>(entry.offset + done),
-              static_cast<off_t>(length));
+    const auto offset = static_cast<off_t>(entry.offset + done);
+    ReadExactly(fd_, buffer.data(), length, offset);
+    append(buffer.data(), length / entry.value_bytes);
+    fallocate(fd_, FALLOC_FL_PUNCH_HOLE | FALLOC_FL_KEEP_SIZE, offset, static_cast<off_t>(length));
+    done += length;
   }
-  munmap(address, bytes);
 }
 
 void ReadFirstInChildProcess(const std::filesystem::path& path, const std::function<void()>& read,

@@ -2,6 +2,7 @@
 // that a read which finishes, or refuses the file, is left to the caller.
 
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <chrono>
 #include <cstddef>
@@ -48,6 +49,19 @@ TEST(ReadFirstInChildProcess, RefusesAReadThatDoesNotFinishInTime) {
   EXPECT_NE(message.find("'scan.h5': libhdf5 had not finished reading it after 0.3 s"), std::string::npos)
       << message;
   EXPECT_LT(waited.count(), 10.0) << "the child is killed at the timeout, not waited for";
+}
+
+TEST(ReadFirstInChildProcess, StillWaitsForAChildThatClosedItsFilesAndHangs) {
+  // The parent learns of the child's exit by a pipe closing; a damaged read that closes the
+  // child's files must not pass for an exit: the child is still killed at the timeout.
+  const std::string message = MessageOf(
+      [] {
+        for (int fd = 3; fd < 1024; ++fd) close(fd);
+        std::this_thread::sleep_for(std::chrono::seconds(30));
+      },
+      0.3);
+  EXPECT_NE(message.find("'scan.h5': libhdf5 had not finished reading it after 0.3 s"), std::string::npos)
+      << message;
 }
 
 TEST(ReadFirstInChildProcess, LeavesAFinishedOrRefusedReadToTheCaller) {

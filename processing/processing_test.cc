@@ -21,12 +21,13 @@ namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
-TEST(BandedSpd, SolveAndSelectedInverseMatchADenseInverse) {
-  const std::size_t n = 40;
-  std::mt19937 rng(3);
+// Fills `banded` with a random diagonally dominant matrix of bandwidth 3 and returns the same
+// matrix dense, for checks against Eigen's dense inverse.
+Eigen::MatrixXd FillRandomBand(BandedSpd& banded, unsigned seed) {
+  const std::size_t n = banded.size();
+  std::mt19937 rng(seed);
   std::uniform_real_distribution<double> unit(-1.0, 1.0);
   Eigen::MatrixXd dense = Eigen::MatrixXd::Zero(n, n);
-  BandedSpd banded(n);
   for (std::size_t i = 0; i < n; ++i) {
     for (std::size_t j = i; j <= std::min(n - 1, i + 3); ++j) {
       const double v = i == j ? 8.0 + unit(rng) : unit(rng);
@@ -35,6 +36,15 @@ TEST(BandedSpd, SolveAndSelectedInverseMatchADenseInverse) {
       banded.Add(i, j, v);
     }
   }
+  return dense;
+}
+
+TEST(BandedSpd, SolveAndSelectedInverseMatchADenseInverse) {
+  const std::size_t n = 40;
+  BandedSpd banded(n);
+  const Eigen::MatrixXd dense = FillRandomBand(banded, 3);
+  std::mt19937 rng(13);
+  std::uniform_real_distribution<double> unit(-1.0, 1.0);
   ASSERT_TRUE(banded.Factorize());
   banded.ComputeSelectedInverse();
   const Eigen::MatrixXd inverse = dense.inverse();
@@ -71,18 +81,10 @@ TEST(BandedSpd, SolveAndSelectedInverseMatchADenseInverse) {
 
 TEST(BandedSpd, SweepInBlocksGivesEveryEntryOfTheSelectedInverseOnce) {
   const std::size_t n = 23;
-  std::mt19937 rng(5);
-  std::uniform_real_distribution<double> unit(-1.0, 1.0);
-  Eigen::MatrixXd dense = Eigen::MatrixXd::Zero(n, n);
   BandedSpd banded(n);
-  for (std::size_t i = 0; i < n; ++i) {
-    for (std::size_t j = i; j <= std::min(n - 1, i + 3); ++j) {
-      const double v = i == j ? 8.0 + unit(rng) : unit(rng);
-      dense(static_cast<Eigen::Index>(i), static_cast<Eigen::Index>(j)) = v;
-      dense(static_cast<Eigen::Index>(j), static_cast<Eigen::Index>(i)) = v;
-      banded.Add(i, j, v);
-    }
-  }
+  const Eigen::MatrixXd dense = FillRandomBand(banded, 5);
+  std::mt19937 rng(15);
+  std::uniform_real_distribution<double> unit(-1.0, 1.0);
   ASSERT_TRUE(banded.Factorize());
   const Eigen::MatrixXd inverse = dense.inverse();
   banded.ComputeSelectedInverse();

@@ -1,11 +1,9 @@
 // `arcwheel batch` end to end: a folder of simulated scans with two bad files among them, the
 // index against each scan's truth, a rerun that reuses what finished, an interrupted batch.
 
-#include <fcntl.h>
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 #include <signal.h>
-#include <spawn.h>
 #include <sys/wait.h>
 
 #include <chrono>
@@ -20,8 +18,6 @@
 #include <vector>
 
 #include "core/testing/testing.h"
-
-extern char** environ;
 
 namespace arcwheel {
 namespace {
@@ -375,28 +371,8 @@ TEST(Batch, AnInterruptedBatchLeavesNoPartialResultAndTheNextRunFinishes) {
     Simulate(dir / "scans" / ("long_" + std::to_string(i) + ".h5"), 10 + i, 55.0, "",
              "--sample-period-s 4e-5");
   }
-  const std::string binary = std::getenv("ARCWHEEL_BINARY");
-  const std::string scans = (dir / "scans").string();
-  const std::string out = (dir / "out").string();
-  const char* argv[] = {binary.c_str(), "batch", scans.c_str(), "-o", out.c_str(), "-j", "2", nullptr};
-  posix_spawn_file_actions_t files;
-  posix_spawn_file_actions_init(&files);
-  posix_spawn_file_actions_addopen(&files, STDERR_FILENO, (dir / "stderr.txt").c_str(),
-                                   O_WRONLY | O_CREAT | O_TRUNC, 0644);
-  // SIGINT blocked until the batch has installed its handler (a loaded machine): the outcome does
-  // not depend on timing.
-  posix_spawnattr_t attributes;
-  posix_spawnattr_init(&attributes);
-  sigset_t blocked;
-  sigemptyset(&blocked);
-  sigaddset(&blocked, SIGINT);
-  posix_spawnattr_setsigmask(&attributes, &blocked);
-  posix_spawnattr_setflags(&attributes, POSIX_SPAWN_SETSIGMASK);
-  pid_t pid = 0;
-  ASSERT_EQ(posix_spawn(&pid, binary.c_str(), &files, &attributes, const_cast<char* const*>(argv), environ),
-            0);
-  posix_spawnattr_destroy(&attributes);
-  posix_spawn_file_actions_destroy(&files);
+  const pid_t pid = testing::SpawnArcwheel(
+      {"batch", (dir / "scans").string(), "-o", (dir / "out").string(), "-j", "2"}, dir / "stderr.txt");
   // The first child's log appears when it starts.
   for (int i = 0; i < 1000 && !fs::exists(dir / "out" / "logs" / "long_0.log"); ++i) {
     std::this_thread::sleep_for(std::chrono::milliseconds(10));
@@ -424,7 +400,8 @@ TEST(Batch, AnInterruptedBatchLeavesNoPartialResultAndTheNextRunFinishes) {
     }
   }
 
-  const auto next = RunArcwheel("batch " + scans + " -o " + out + " -j 2");
+  const auto next =
+      RunArcwheel("batch " + (dir / "scans").string() + " -o " + (dir / "out").string() + " -j 2");
   EXPECT_EQ(next.exit_status, 0) << next.output;
   EXPECT_THAT(next.output, HasSubstr(std::to_string(4 - finished) + " done, " + std::to_string(finished) +
                                      " reused, 0 failed"));

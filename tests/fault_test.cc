@@ -5,7 +5,6 @@
 #include <fmt/format.h>
 #include <gtest/gtest.h>
 #include <signal.h>
-#include <spawn.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -16,8 +15,6 @@
 #include <thread>
 
 #include "core/testing/testing.h"
-
-extern char** environ;
 
 namespace arcwheel {
 namespace {
@@ -61,23 +58,8 @@ TEST(Faults, InterruptDuringProcessingLeavesEarlierOutputsIntact) {
   const std::string summary_before = ReadText(dir / "out" / "summary.json");
   const std::string map_before = ReadText(dir / "out" / "wheel_map.h5");
 
-  const std::string binary = std::getenv("ARCWHEEL_BINARY");
-  const std::string scan = (dir / "long.h5").string();
-  const std::string out = (dir / "out").string();
-  const char* argv[] = {binary.c_str(), "process", "-q", scan.c_str(), "-o", out.c_str(), nullptr};
-  // The child starts with SIGINT blocked, so a signal sent before it has installed its handler
-  // (a loaded machine) waits for it instead of killing it: the outcome does not depend on timing.
-  posix_spawnattr_t attributes;
-  posix_spawnattr_init(&attributes);
-  sigset_t blocked;
-  sigemptyset(&blocked);
-  sigaddset(&blocked, SIGINT);
-  posix_spawnattr_setsigmask(&attributes, &blocked);
-  posix_spawnattr_setflags(&attributes, POSIX_SPAWN_SETSIGMASK);
-  pid_t pid = 0;
-  ASSERT_EQ(posix_spawn(&pid, binary.c_str(), nullptr, &attributes, const_cast<char* const*>(argv), environ),
-            0);
-  posix_spawnattr_destroy(&attributes);
+  const pid_t pid =
+      testing::SpawnArcwheel({"process", "-q", (dir / "long.h5").string(), "-o", (dir / "out").string()});
   std::this_thread::sleep_for(std::chrono::milliseconds(250));
   ::kill(pid, SIGINT);
   int status = 0;

@@ -1,6 +1,9 @@
 #include "core/testing/testing.h"
 
+#include <fcntl.h>
 #include <gtest/gtest.h>
+#include <signal.h>
+#include <spawn.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -13,6 +16,8 @@
 #include <sstream>
 #include <stdexcept>
 #include <vector>
+
+extern char** environ;
 
 namespace arcwheel::testing {
 namespace fs = std::filesystem;
@@ -32,6 +37,33 @@ TempDir::~TempDir() {
 fs::path SourceDir() {
   if (const char* dir = std::getenv("ARCWHEEL_SOURCE_DIR")) return dir;
   return fs::current_path();
+}
+
+pid_t SpawnArcwheel(const std::vector<std::string>& arguments, const std::filesystem::path& stderr_path) {
+  const char* binary = std::getenv("ARCWHEEL_BINARY");
+  if (binary == nullptr) throw std::runtime_error("ARCWHEEL_BINARY is not set (run the tests through ctest)");
+  std::vector<char*> argv = {const_cast<char*>(binary)};
+  for (const std::string& argument : arguments) argv.push_back(const_cast<char*>(argument.c_str()));
+  argv.push_back(nullptr);
+  posix_spawn_file_actions_t files;
+  posix_spawn_file_actions_init(&files);
+  if (!stderr_path.empty()) {
+    posix_spawn_file_actions_addopen(&files, STDERR_FILENO, stderr_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC,
+                                     0644);
+  }
+  posix_spawnattr_t attributes;
+  posix_spawnattr_init(&attributes);
+  sigset_t blocked;
+  sigemptyset(&blocked);
+  sigaddset(&blocked, SIGINT);
+  posix_spawnattr_setsigmask(&attributes, &blocked);
+  posix_spawnattr_setflags(&attributes, POSIX_SPAWN_SETSIGMASK);
+  pid_t pid = 0;
+  const int failed = posix_spawn(&pid, binary, &files, &attributes, argv.data(), environ);
+  posix_spawnattr_destroy(&attributes);
+  posix_spawn_file_actions_destroy(&files);
+  if (failed != 0) throw std::runtime_error(std::string("cannot start ") + binary);
+  return pid;
 }
 
 CommandResult RunArcwheel(const std::string& arguments) {

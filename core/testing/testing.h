@@ -3,10 +3,12 @@
 // other commands, reading files back and catching the Error a call throws.
 
 #include <gtest/gtest.h>
+#include <sys/types.h>
 
 #include <filesystem>
 #include <functional>
 #include <string>
+#include <vector>
 
 #include "core/error.h"
 
@@ -35,6 +37,13 @@ struct CommandResult {
 };
 // Runs the arcwheel binary (ARCWHEEL_BINARY, set by CTest) with `arguments` through the shell.
 [[nodiscard]] CommandResult RunArcwheel(const std::string& arguments);
+
+// Starts the arcwheel binary with `arguments` (no shell) and returns its process id without
+// waiting. SIGINT starts blocked, so that a signal sent before the program has installed its
+// handler (a loaded machine) waits for it instead of killing it: an interrupt test's outcome then
+// does not depend on timing. Its stderr goes to `stderr_path` when one is given.
+[[nodiscard]] pid_t SpawnArcwheel(const std::vector<std::string>& arguments,
+                                  const std::filesystem::path& stderr_path = {});
 
 // The message of the Error that `run` throws, checking (as a test failure) that its code is
 // `code`; "accepted" if it throws nothing.

@@ -167,13 +167,17 @@ Scan ReadHdf5Scan(const std::filesystem::path& path, const ReadOptions& options)
   // The data are read once, in the child process that guards against libhdf5 crashing on a
   // damaged file; here only the header is read again (what the child has already read safely).
   hdf5::SharedArrays arrays;
-  const bool handed = hdf5::ReadInChildProcess(path, arrays, [&](hdf5::SharedArrays& shared) {
-    const hdf5::File file = hdf5::File::OpenReadOnly(path);
-    const Scan header = ReadHeader(file);
-    ReadColumns(file, header.metadata, options, [&](const std::string& name, std::size_t count, auto type) {
-      return shared.Allocate<decltype(type)>(name, count);
-    });
-  });
+  const bool handed = hdf5::ReadInChildProcess(
+      path, arrays,
+      [&](hdf5::SharedArrays& shared) {
+        const hdf5::File file = hdf5::File::OpenReadOnly(path);
+        const Scan header = ReadHeader(file);
+        ReadColumns(file, header.metadata, options,
+                    [&](const std::string& name, std::size_t count, auto type) {
+                      return shared.Allocate<decltype(type)>(name, count);
+                    });
+      },
+      0.0, options.while_reading);
   const hdf5::File file = hdf5::File::OpenReadOnly(path);
   if (!handed) return ReadHdf5Scan(file, options);
   Scan scan = ReadHeader(file);
@@ -203,7 +207,10 @@ Scan ReadScan(const std::filesystem::path& path, const ReadOptions& options) {
   std::string extension = path.extension().string();
   for (char& c : extension) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
   if (extension == ".h5" || extension == ".hdf5") return ReadHdf5Scan(path, options);
-  if (extension == ".csv" || extension == ".txt") return ReadCsvScan(path);
+  if (extension == ".csv" || extension == ".txt") {
+    if (options.while_reading) options.while_reading();
+    return ReadCsvScan(path);
+  }
   throw Error(ErrorCode::kBadInput, "acquisition",
               "'" + path.string() + "': unknown scan file type '" + extension +
                   "' (expected .h5, .hdf5, .csv or .txt)");

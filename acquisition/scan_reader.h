@@ -9,6 +9,7 @@
 // dataset.
 
 #include <filesystem>
+#include <functional>
 
 #include "acquisition/scan.h"
 #include "core/hdf5.h"
@@ -18,6 +19,9 @@ namespace arcwheel::acquisition {
 struct ReadOptions {
   // float32 readings stay float32 (Scan::z_float_mm): half the memory, the same results.
   bool keep_float32 = false;
+  // Work for this process while the file is read: called once, while a child process reads an
+  // HDF5 file (after its fork, so it may start threads), else just before the read.
+  std::function<void()> while_reading;
 };
 
 // By extension: .h5/.hdf5 -> ReadHdf5Scan, .csv/.txt -> ReadCsvScan; else Error{kBadInput}.

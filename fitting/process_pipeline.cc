@@ -157,12 +157,17 @@ ProcessPipelineResult RunProcessPipeline(const std::string& scan_path, const std
   progress.Update("reading", 0.0);
   // ReadScan forks (an HDF5 file is read first in a child process, core/hdf5_child.cc), and no
   // thread may be alive at fork(): the input's SHA-256 starts after it, on the second core while
-  // the first one processes.
+  // the child reads (this process only waits for it then).
   StageClock clock;
   clock.Start("reading");
-  acquisition::Scan scan = acquisition::ReadScan(scan_path, {.keep_float32 = true});
+  std::future<std::string> sha256;
+  const auto start_hash = [&] {
+    sha256 = std::async(std::launch::async, [scan_path] { return Sha256OfFile(scan_path); });
+  };
+  acquisition::Scan scan =
+      acquisition::ReadScan(scan_path, {.keep_float32 = true, .while_reading = start_hash});
   clock.Stop();
-  auto sha256 = std::async(std::launch::async, [scan_path] { return Sha256OfFile(scan_path); });
+  if (!sha256.valid()) start_hash();  // a reader that had nothing to overlap
   return RunOnScan(std::move(scan), scan_path, std::move(sha256), outdir, options, progress,
                    std::move(clock));
 }

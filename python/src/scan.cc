@@ -89,7 +89,8 @@ void BindScan(py::module_& module) {
   module.def(
       "read_scan",
       [](const std::filesystem::path& path, bool keep_float32) {
-        return RunReleased([&] { return acquisition::ReadScan(path, {.keep_float32 = keep_float32}); });
+        return RunReleased(
+            [&] { return acquisition::ReadScan(path, {.keep_float32 = keep_float32, .while_reading = {}}); });
       },
       py::arg("path"), py::arg("keep_float32") = true,
       "Reads a raw scan (.h5/.hdf5 or .csv/.txt, formats.md section 2). float32 readings stay "

@@ -73,6 +73,31 @@ TEST(FitCircle, TwentyMillimetreChordOnTheWheelsArc) {
   EXPECT_NEAR(fit.center_mm.y(), -199.5, 1e-11);
 }
 
+// Phases of the wheel map: 600 points over a 16 mm band of a 55 mm arc with 0.3 um errors, whose
+// least-squares circle is exact by construction. |p_i - c| - r cancels about five digits there, so
+// near the minimum the cost cannot tell apart circles 1e-5 sigma apart, and where the damped
+// steps stop depends on rounding; the fit must still find the minimum, to 1e-6 of its sigma.
+TEST(FitCircle, ShortNoisyArcsGiveTheExactCircleToAMillionthOfTheirSigma) {
+  for (int k = 0; k < 20; ++k) {
+    SCOPED_TRACE(k);
+    const double center_x = 0.4 + 0.01 * k;
+    const double radius = 55.0 + 0.001 * k;
+    std::vector<double> x, y;
+    ExactArc({.center_x = center_x,
+              .center_y = -radius,
+              .radius = radius,
+              .arc_deg = 2.0 * std::asin(8.0 / radius) * 180.0 / std::numbers::pi,
+              .error_um = 0.3,
+              .count = 600 + k},
+             x, y);
+    const CircleFit fit = FitCircle(x, y, {}, {});
+    ASSERT_TRUE(fit.IsUsable()) << fit.message;
+    EXPECT_NEAR(fit.radius_mm, radius, 1e-6 * fit.radius_sigma_mm());
+    EXPECT_NEAR(fit.center_mm.x(), center_x, 1e-6 * std::sqrt(fit.covariance(0, 0)));
+    EXPECT_NEAR(fit.center_mm.y(), -radius, 1e-6 * std::sqrt(fit.covariance(1, 1)));
+  }
+}
+
 TEST(FitCircle, RadiusSigmaMatchesTheScatterOverManyNoisyArcs) {
   std::mt19937 rng(7);
   std::normal_distribution<double> noise(0.0, 1e-3);

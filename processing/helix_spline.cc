@@ -34,6 +34,52 @@ std::size_t CountCells(double u_last, double u0, double h) {
 
 }  // namespace
 
+// The weights of uniform_cubic_bspline.h as polynomials in t = f - 1/2 (times 6), lowest power
+// first: centred, so that no power of t exceeds 1/2 and the sums of products below cancel no more
+// than the products themselves would.
+constexpr double kWeightPolynomials[4][4] = {
+    {0.125, -0.75, 1.5, -1.0}, {2.875, -3.75, -1.5, 3.0}, {2.875, 3.75, -1.5, -3.0}, {0.125, 0.75, 1.5, 1.0}};
+
+void HelixSpline::PowerSums::Add(double t, double z) {
+  const double t2 = t * t;
+  const double t3 = t2 * t;
+  ++count;
+  t_powers[1] += t;
+  t_powers[2] += t2;
+  t_powers[3] += t3;
+  t_powers[4] += t2 * t2;
+  t_powers[5] += t2 * t3;
+  t_powers[6] += t3 * t3;
+  z_t_powers[0] += z;
+  z_t_powers[1] += z * t;
+  z_t_powers[2] += z * t2;
+  z_t_powers[3] += z * t3;
+}
+
+void HelixSpline::PowerSums::AddTo(std::size_t first, BandedSpd& normal, std::vector<double>& rhs,
+                                   std::vector<int>& counts) const {
+  // sum_i w_a(t_i) w_c(t_i) = sum_{k,l} W[a][k] W[c][l] sum_i t_i^(k+l) / 36, and
+  // sum_i w_a(t_i) z_i = sum_k W[a][k] sum_i z_i t_i^k / 6.
+  double t_sums[7];
+  t_sums[0] = static_cast<double>(count);
+  for (int m = 1; m < 7; ++m) t_sums[m] = t_powers[m];
+  counts[first] += count;
+  for (int a = 0; a < 4; ++a) {
+    const double* wa = kWeightPolynomials[a];
+    rhs[first + a] +=
+        (wa[0] * z_t_powers[0] + wa[1] * z_t_powers[1] + wa[2] * z_t_powers[2] + wa[3] * z_t_powers[3]) / 6.0;
+    for (int c = a; c < 4; ++c) {
+      const double* wc = kWeightPolynomials[c];
+      double product = 0.0;
+      for (int k = 0; k < 4; ++k) {
+        product += wa[k] * (wc[0] * t_sums[k] + wc[1] * t_sums[k + 1] + wc[2] * t_sums[k + 2] +
+                            wc[3] * t_sums[k + 3]);
+      }
+      normal.Add(first + a, first + c, product / 36.0);
+    }
+  }
+}
+
 HelixSpline::Basis HelixSpline::BasisAt(double u) const {
   const double s = (u - u0_) / h_;
   double cell = std::floor(s);
@@ -139,31 +185,39 @@ template <typename T>
 void HelixSpline::Accumulate(std::span<const T> z, const HelixGeometry& geometry, std::size_t begin,
                              std::size_t end, std::vector<double>& rhs, SharedRows* shared) {
   bool rows_of_its_own_added = shared == nullptr;
-  for (std::size_t i = begin; i < end; ++i) {
-    const double value = z[i];
-    if (!std::isfinite(value)) continue;
-    const Basis b = BasisAt(geometry.PhaseAt(i));
-    if (!rows_of_its_own_added && b.first >= shared->end) {
+  // The samples of one knot interval in a row are summed as powers of t (below), and the
+  // interval's sums go into the normal equations when the next interval begins.
+  const auto add_interval = [&](std::size_t cell, const PowerSums& sums) {
+    if (!rows_of_its_own_added && cell >= shared->end) {
       // The block's rows from `end` on are this half's alone: they go in now, before the samples
-      // after them, so that every row sums its samples in their order.
+      // after them, so that every row sums its intervals in their order.
       AddSharedRows(*shared, shared->end, shared->end + BandedSpd::kBand, rhs);
       rows_of_its_own_added = true;
     }
-    if (shared != nullptr && b.first < shared->end) {
-      const std::size_t r = b.first - shared->begin;
-      ++shared->counts[r];
-      for (int a = 0; a < 4; ++a) {
-        shared->rhs[r + a] += b.w[a] * value;
-        for (int c = a; c < 4; ++c) shared->normal.Add(r + a, r + c, b.w[a] * b.w[c]);
-      }
-      continue;
+    if (shared != nullptr && cell < shared->end) {
+      sums.AddTo(cell - shared->begin, shared->normal, shared->rhs, shared->counts);
+    } else {
+      sums.AddTo(cell, normal_, rhs, cell_counts_);
     }
-    ++cell_counts_[b.first];
-    for (int a = 0; a < 4; ++a) {
-      rhs[b.first + a] += b.w[a] * value;
-      for (int c = a; c < 4; ++c) normal_.Add(b.first + a, b.first + c, b.w[a] * b.w[c]);
+  };
+  const double max_cell = static_cast<double>(cells_ - 1);
+  std::size_t cell = 0;
+  PowerSums sums;
+  for (std::size_t i = begin; i < end; ++i) {
+    const double value = z[i];
+    if (!std::isfinite(value)) continue;
+    // BasisAt's interval and fraction, by its arithmetic.
+    const double s = (geometry.PhaseAt(i) - u0_) / h_;
+    const double interval = std::clamp(std::floor(s), 0.0, max_cell);
+    const auto this_cell = static_cast<std::size_t>(interval);
+    if (this_cell != cell && sums.count > 0) {
+      add_interval(cell, sums);
+      sums = {};
     }
+    cell = this_cell;
+    sums.Add(s - interval - 0.5, value);
   }
+  if (sums.count > 0) add_interval(cell, sums);
 }
 
 double HelixSpline::Value(double u) const {

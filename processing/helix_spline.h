@@ -76,6 +76,20 @@ class HelixSpline {
   };
   template <typename T>
   void Fit(std::span<const T> z, const HelixGeometry& geometry);
+  // The sums over the samples of one knot interval from which its terms of the normal equations
+  // follow: t = (fraction of the interval) - 1/2, sum_i t_i^m (m <= 6, m = 0 the count) and
+  // sum_i z_i t_i^m (m <= 3). Two to three times fewer operations a sample than adding each
+  // sample's sixteen products; the same terms to rounding (1e-15 relative).
+  struct PowerSums {
+    int count = 0;
+    double t_powers[7] = {};
+    double z_t_powers[4] = {};
+    void Add(double t, double z);
+    // Adds the interval's terms to rows first .. first + 3 of `normal` and `rhs`, its count to
+    // counts[first].
+    void AddTo(std::size_t first, BandedSpd& normal, std::vector<double>& rhs,
+               std::vector<int>& counts) const;
+  };
   // Adds samples [begin, end) to the normal equations, right-hand side and cell counts; with
   // `shared`, those whose interval starts in its rows go there instead.
   template <typename T>

@@ -182,6 +182,30 @@ TEST(HelixSpline, AgreesWithADenseQrSolveOfTheSamePenalisedProblem) {
   }
 }
 
+// The normal equations are summed a knot interval at a time from powers of the fraction (the
+// samples of a 1e7-sample scan come 33 to an interval, 140 at 1e8): the spline must stay the
+// least-squares one to 1e-12, here with 50 samples an interval, invalid ones among them, and
+// values far from zero (the sums of z t^k must not cancel digits away).
+TEST(HelixSpline, ManySamplesAKnotIntervalGiveTheDenseSolutionTo1e12) {
+  std::mt19937 rng(7);
+  std::normal_distribution<double> noise(0.0, 3e-4);
+  std::vector<double> z(5400);
+  for (std::size_t i = 0; i < z.size(); ++i) {
+    const double u = 3.1 + 0.1 * static_cast<double>(i);
+    z[i] = 12.5 + 0.02 * std::sin(u * std::numbers::pi / 45.0) + noise(rng);
+  }
+  for (const std::size_t i : {0u, 999u, 1000u, 1001u, 4321u}) z[i] = kNaN;
+  const acquisition::Scan scan = ScanOfReadings(z, 60.0, 0.1 / 360.0, 3.1);
+  const HelixGeometry geometry(scan, 60.0);
+  const HelixSpline spline(scan.z_mm, geometry, 5.0);
+  const DenseSpline dense = SolveDensely(scan, 5.0);
+  int compared = 0;
+  for (double u = spline.first_phase_deg(); u <= spline.last_phase_deg(); u += 0.37, ++compared) {
+    EXPECT_NEAR(spline.Value(u), dense.Value(u), 1e-12 * std::abs(dense.Value(u))) << "u = " << u;
+  }
+  EXPECT_GT(compared, 1000);
+}
+
 TEST(HelixSpline, SupportCountsTheValidSamplesInTheTwoNearestKnotIntervals) {
   std::vector<double> z(300, 0.0);
   for (std::size_t i = 100; i < 120; ++i) z[i] = kNaN;

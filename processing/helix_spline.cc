@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 
 #include "core/check.h"
 #include "core/error.h"
@@ -39,22 +40,6 @@ std::size_t CountCells(double u_last, double u0, double h) {
 // than the products themselves would.
 constexpr double kWeightPolynomials[4][4] = {
     {0.125, -0.75, 1.5, -1.0}, {2.875, -3.75, -1.5, 3.0}, {2.875, 3.75, -1.5, -3.0}, {0.125, 0.75, 1.5, 1.0}};
-
-void HelixSpline::PowerSums::Add(double t, double z) {
-  const double t2 = t * t;
-  const double t3 = t2 * t;
-  ++count;
-  t_powers[1] += t;
-  t_powers[2] += t2;
-  t_powers[3] += t3;
-  t_powers[4] += t2 * t2;
-  t_powers[5] += t2 * t3;
-  t_powers[6] += t3 * t3;
-  z_t_powers[0] += z;
-  z_t_powers[1] += z * t;
-  z_t_powers[2] += z * t2;
-  z_t_powers[3] += z * t3;
-}
 
 void HelixSpline::PowerSums::AddTo(std::size_t first, BandedSpd& normal, std::vector<double>& rhs,
                                    std::vector<int>& counts) const {
@@ -206,9 +191,11 @@ void HelixSpline::Accumulate(std::span<const T> z, const HelixGeometry& geometry
   for (std::size_t i = begin; i < end; ++i) {
     const double value = z[i];
     if (!std::isfinite(value)) continue;
-    // BasisAt's interval and fraction, by its arithmetic.
+    // BasisAt's interval and fraction. s > -1 (u0 is the knot at or below the first phase), where
+    // truncation and clamping to 0 give BasisAt's clamp(floor(s), 0, cells - 1), without the
+    // compare-and-mask sequence that floor takes on the baseline x86-64 (no SSE4.1 rounding).
     const double s = (geometry.PhaseAt(i) - u0_) / h_;
-    const double interval = std::clamp(std::floor(s), 0.0, max_cell);
+    const double interval = std::min(static_cast<double>(static_cast<std::int64_t>(s)), max_cell);
     const auto this_cell = static_cast<std::size_t>(interval);
     if (this_cell != cell && sums.count > 0) {
       add_interval(cell, sums);

@@ -84,7 +84,21 @@ class HelixSpline {
     int count = 0;
     double t_powers[7] = {};
     double z_t_powers[4] = {};
-    void Add(double t, double z);
+    void Add(double t, double z) {
+      const double t2 = t * t;
+      const double t3 = t2 * t;
+      ++count;
+      t_powers[1] += t;
+      t_powers[2] += t2;
+      t_powers[3] += t3;
+      t_powers[4] += t2 * t2;
+      t_powers[5] += t2 * t3;
+      t_powers[6] += t3 * t3;
+      z_t_powers[0] += z;
+      z_t_powers[1] += z * t;
+      z_t_powers[2] += z * t2;
+      z_t_powers[3] += z * t3;
+    }
     // Adds the interval's terms to rows first .. first + 3 of `normal` and `rhs`, its count to
     // counts[first].
     void AddTo(std::size_t first, BandedSpd& normal, std::vector<double>& rhs,

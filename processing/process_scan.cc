@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <span>
+#include <string>
 #include <type_traits>
 #include <vector>
 
@@ -63,6 +64,29 @@ void CheckOptions(const acquisition::Scan& scan, const ProcessOptions& options) 
     throw Error(ErrorCode::kInvalidOption, kStage,
                 "'" + scan.path + "' has no angle column for --rpm-source encoder");
   }
+}
+
+// A helix sampled fewer times a turn than this tells nothing of the wheel's phase: the map's
+// sections, the spline's knots and the speed estimate's phase bins all need several samples a
+// turn. Real scans take hundreds (a 50 kHz sensor on a wheel at 6000 rpm: 500).
+constexpr double kMinSamplesPerTurn = 16.0;
+
+// Refuses a scan whose settings give fewer than kMinSamplesPerTurn samples a turn (a spindle speed
+// in the wrong unit, say): left to the steps, its turns would outnumber its samples.
+void CheckSamplesPerTurn(const acquisition::Scan& scan) {
+  if (scan.size() < 2 || (!scan.has_encoder() && !scan.metadata.spindle_rpm)) return;
+  const HelixGeometry geometry(scan, scan.metadata.spindle_rpm.value_or(0.0));
+  const double turns = std::abs(geometry.PhaseAt(scan.size() - 1) - geometry.PhaseAt(0)) / 360.0;
+  const double samples_per_turn = static_cast<double>(scan.size() - 1) / turns;
+  if (samples_per_turn >= kMinSamplesPerTurn) return;
+  const std::string settings = scan.has_encoder()
+                                   ? std::string("by its angle column")
+                                   : fmt::format("at spindle_rpm {:g}", *scan.metadata.spindle_rpm);
+  throw Error(ErrorCode::kBadInput, kStage,
+              fmt::format("'{}': {:.3g} samples a turn {} over {:.4g} turns; a helical scan needs at least "
+                          "{:g} a turn to resolve the wheel's phase (is spindle_rpm in rev/min and "
+                          "sample_period_s in seconds?)",
+                          scan.path, samples_per_turn, settings, turns, kMinSamplesPerTurn));
 }
 
 // Step 1: the span from the first to the last valid sample (DropStuckSensorRuns counts them).
@@ -238,6 +262,7 @@ ProcessedScan ProcessReadings(acquisition::Scan& scan, std::vector<T>& rho, cons
 
 ProcessedScan ProcessScanInPlace(acquisition::Scan& scan, const ProcessOptions& options) {
   CheckOptions(scan, options);
+  CheckSamplesPerTurn(scan);
   // Steps that change readings by arithmetic work in double, so that their results do not depend
   // on how the file stored the readings.
   if (options.beam_offset_mm != 0.0 || options.despike.method == DespikeMethod::kMovingMean) {

@@ -203,6 +203,24 @@ TEST(NumericHazards, AScanWithoutVarianceIsRefusedClearly) {
                 "collinear");
 }
 
+// A speed in the wrong unit (rev/s for rev/min read as 1e12, say) made the helix outnumber its
+// samples in turns, and the speed estimate looped over 2e11 empty turns without end.
+TEST(NumericHazards, FewerThanSixteenSamplesATurnAreRefusedNamingTheSettings) {
+  acquisition::Scan scan = acquisition::SimulateScan(EccentricWheel(), NoisyScan()).scan;
+  scan.path = "fast.h5";
+  scan.metadata.spindle_rpm = 1e12;
+  ExpectRefused([&] { (void)processing::ProcessScan(scan, {}); }, ErrorCode::kBadInput,
+                "'fast.h5': 6e-07 samples a turn at spindle_rpm 1e+12");
+  // 1200 samples a turn at 500 rpm; 16 a turn at 37500 rpm is the least that is taken.
+  scan.metadata.spindle_rpm = 37500.0 * 1.01;
+  ExpectRefused([&] { (void)processing::ProcessScan(scan, {}); }, ErrorCode::kBadInput,
+                "15.8 samples a turn");
+  scan.metadata.spindle_rpm = 37500.0 * 0.99;
+  processing::ProcessOptions nominal;
+  nominal.rpm_source = processing::RpmSource::kNominal;
+  EXPECT_NO_THROW((void)processing::ProcessScan(scan, nominal));
+}
+
 // --- fits that do not converge ----------------------------------------------------------------
 
 TEST(NumericHazards, ACircleFitThatRunsOutOfIterationsSaysSoAndIsNotUsable) {

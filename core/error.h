@@ -30,11 +30,14 @@ enum class ErrorCode {
 class Error : public std::runtime_error {
  public:
   Error(ErrorCode code, std::string_view stage, const std::string& detail)
-      : std::runtime_error(std::string(stage) + ": " + detail), code_(code) {}
+      : std::runtime_error(std::string(stage) + ": " + detail), code_(code), stage_(stage) {}
   [[nodiscard]] ErrorCode code() const noexcept { return code_; }
+  // The stage id that prefixes what(), e.g. "acquisition.validate".
+  [[nodiscard]] const std::string& stage() const noexcept { return stage_; }
 
  private:
   ErrorCode code_;
+  std::string stage_;
 };
 
 // Every problem of an options struct's Problems(), in the order found, on one line:

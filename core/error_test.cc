@@ -19,6 +19,7 @@ TEST(ThrowIfProblems, ThrowsOneErrorListingEveryProblemInOrderWithTheCodeAndStag
     ADD_FAILURE() << "no problems reported";
   } catch (const Error& e) {
     EXPECT_EQ(e.code(), ErrorCode::kInvalidOption);
+    EXPECT_EQ(e.stage(), "test.stage");
     EXPECT_EQ(std::string(e.what()),
               "test.stage: --a = -1 violates > 0; b = 7 violates <= 5; c = nan violates finite");
   }
@@ -32,6 +33,12 @@ TEST(ThrowIfProblems, KeepsTheCodeItIsGiven) {
     EXPECT_EQ(e.code(), ErrorCode::kBadInput);
     EXPECT_EQ(std::string(e.what()), "test.stage: x = 0 violates > 0");
   }
+}
+
+TEST(Error, KeepsItsStageApartFromTheMessage) {
+  const Error error(ErrorCode::kBadInput, "acquisition.validate", "'C: scans/w1.h5': spindle_rpm missing");
+  EXPECT_EQ(error.stage(), "acquisition.validate");
+  EXPECT_EQ(std::string(error.what()), "acquisition.validate: 'C: scans/w1.h5': spindle_rpm missing");
 }
 
 TEST(JoinProblems, JoinsWithASemicolonAndLeavesOneProblemAlone) {

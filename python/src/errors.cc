@@ -19,12 +19,6 @@ py::dict& ErrorClasses() {
   return *classes;
 }
 
-// The stage id: Error's message is "stage: detail".
-std::string StageOf(std::string_view message) {
-  const std::size_t colon = message.find(": ");
-  return std::string(colon == std::string_view::npos ? std::string_view() : message.substr(0, colon));
-}
-
 void RaiseError(const Error& error) {
   if (error.code() == ErrorCode::kInterrupted) {
     PyErr_SetString(PyExc_KeyboardInterrupt, error.what());
@@ -34,7 +28,7 @@ void RaiseError(const Error& error) {
   py::object type = py::reinterpret_borrow<py::object>(PyExc_RuntimeError);
   if (ErrorClasses().contains(py::int_(status))) type = ErrorClasses()[py::int_(status)];
   const py::object instance =
-      type(error.what(), py::arg("stage") = StageOf(error.what()), py::arg("exit_code") = status,
+      type(error.what(), py::arg("stage") = error.stage(), py::arg("exit_code") = status,
            py::arg("meaning") = std::string(ErrorCodeName(error.code())));
   PyErr_SetObject(type.ptr(), instance.ptr());
 }

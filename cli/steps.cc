@@ -2,13 +2,11 @@
 
 #include <fmt/core.h>
 
-#include <CLI/CLI.hpp>
 #include <chrono>
 #include <string>
-#include <vector>
 
-#include "cli/commands.h"
-#include "core/error.h"
+#include "core/progress.h"
+#include "fitting/process_pipeline.h"
 
 namespace arcwheel::cli {
 namespace {
@@ -20,18 +18,9 @@ double StepSecondsSince(std::chrono::steady_clock::time_point start) {
 }  // namespace
 
 void RunProcessStep(const std::filesystem::path& scan, const std::filesystem::path& output) {
-  // command_process.cc keeps its pipeline (options, run record, model, writers) inside the
-  // command; running that command here keeps one definition of what `process` writes.
-  CLI::App app{"arcwheel", "arcwheel"};
-  app.require_subcommand(1);
-  AddProcessCommand(app);
-  // CLI11 takes an argument vector in reverse order.
-  std::vector<std::string> arguments = {scan.string(), output.string(), "-o", "-q", "process"};
-  try {
-    app.parse(arguments);
-  } catch (const CLI::ParseError& error) {
-    throw Error(ErrorCode::kInvalidOption, "process", error.what());
-  }
+  // The pipeline `arcwheel process -q SCAN -o OUTPUT` runs, with its default options.
+  Progress quiet(false);
+  (void)fitting::RunProcessPipeline(scan.string(), output, {}, quiet);
 }
 
 ToolpathStepResult RunToolpathStep(const std::filesystem::path& job_path,

@@ -11,8 +11,8 @@
 
 namespace arcwheel::cli {
 
-// `arcwheel process SCAN -o OUTDIR -q`: runs the process command's own definition in-process
-// (its options at their defaults), so that the files are those `arcwheel process` writes.
+// `arcwheel process SCAN -o OUTDIR -q`: the pipeline the command runs (fitting/process_pipeline.h),
+// its options at their defaults, so that the files are those `arcwheel process` writes.
 void RunProcessStep(const std::filesystem::path& scan, const std::filesystem::path& output);
 
 struct ToolpathStepResult {

@@ -21,6 +21,10 @@ std::string Number(double value) {
   return text;
 }
 
+// Axial positions beyond 1 km are a unit mistake; there the spacing of doubles (1.2e-10 mm at
+// 1e6 mm) starts to eat into the nanometres the arc fits resolve, and at 1e15 mm it is 0.125 mm.
+constexpr double kMaxAxialMm = 1e6;
+
 void CheckColumn(const Scan& scan, const std::vector<double>& column, const char* name) {
   if (column.empty()) return;
   if (column.size() != scan.size()) {
@@ -117,6 +121,12 @@ void ValidateScan(const Scan& scan) {
   }
   const double axial_span_mm =
       scan.has_axial() ? std::abs(scan.y_mm[i1] - scan.y_mm[i0]) : *meta.feed_mm_per_min * duration_s / 60.0;
+  double farthest_mm = std::abs(meta.start_y_mm) + (scan.has_axial() ? 0.0 : axial_span_mm);
+  for (const double y : scan.y_mm) farthest_mm = std::max(farthest_mm, std::abs(y));
+  if (farthest_mm > kMaxAxialMm) {
+    Refuse(scan, "its axial positions reach " + Number(farthest_mm) + " mm; beyond " + Number(kMaxAxialMm) +
+                     " mm a double no longer resolves the nanometres the arc fits need (a unit mistake?)");
+  }
   const double pitch_mm = axial_span_mm / turns;
   if (!(axial_span_mm >= 3.0 * pitch_mm) || !(pitch_mm > 0.0)) {
     Refuse(scan, "its valid samples span " + Number(axial_span_mm) +

@@ -12,7 +12,9 @@ HelixGeometry::HelixGeometry(const acquisition::Scan& scan, double spindle_rpm) 
   if (scan.has_time()) t_s_ = &scan.t_s;
   if (scan.has_axial()) y_mm_ = &scan.y_mm;
   sample_period_s_ = meta.sample_period_s.value_or(0.0);
-  start_phase_deg_ = meta.start_phase_deg;
+  // Whole turns of the start phase change nothing but the digits left for the phase's fraction
+  // (at 1e18 deg the spacing of doubles is 128 deg); fmod takes them off exactly.
+  start_phase_deg_ = std::fmod(meta.start_phase_deg, 360.0);
   start_y_mm_ = meta.start_y_mm;
   feed_mm_per_min_ = meta.feed_mm_per_min.value_or(0.0);
   rpm_ = spindle_rpm;

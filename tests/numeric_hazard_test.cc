@@ -203,8 +203,8 @@ TEST(NumericHazards, AScanWithoutVarianceIsRefusedClearly) {
                 "collinear");
 }
 
-// A speed in the wrong unit (rev/s for rev/min read as 1e12, say) made the helix outnumber its
-// samples in turns, and the speed estimate looped over 2e11 empty turns without end.
+// A speed in the wrong unit (1e12 rpm, say) made the helix outnumber its samples in turns, and
+// the speed estimate looped over 2e11 empty turns without end.
 TEST(NumericHazards, FewerThanSixteenSamplesATurnAreRefusedNamingTheSettings) {
   acquisition::Scan scan = acquisition::SimulateScan(EccentricWheel(), NoisyScan()).scan;
   scan.path = "fast.h5";
@@ -219,6 +219,40 @@ TEST(NumericHazards, FewerThanSixteenSamplesATurnAreRefusedNamingTheSettings) {
   processing::ProcessOptions nominal;
   nominal.rpm_source = processing::RpmSource::kNominal;
   EXPECT_NO_THROW((void)processing::ProcessScan(scan, nominal));
+}
+
+// An axial position in the wrong unit (nanometres as millimetres) left the coordinate 0.125 mm
+// coarse at 1e15 mm, and the radius came out 0.65 um off and the runout three times too large,
+// with nothing said.
+TEST(NumericHazards, AxialPositionsBeyondAKilometreAreRefused) {
+  acquisition::Scan scan = acquisition::SimulateScan(EccentricWheel(), NoisyScan()).scan;
+  scan.path = "far.h5";
+  scan.metadata.start_y_mm = 1e15;
+  ExpectRefused([&] { acquisition::ValidateScan(scan); }, ErrorCode::kBadInput,
+                "'far.h5': its axial positions reach 1e+15 mm");
+  scan.metadata.start_y_mm = -1e6 + 20.0;
+  EXPECT_NO_THROW(acquisition::ValidateScan(scan));
+  scan.y_mm.assign(scan.size(), 0.0);
+  for (std::size_t i = 0; i < scan.size(); ++i) scan.y_mm[i] = 2e6 + 1e-3 * static_cast<double>(i);
+  ExpectRefused([&] { acquisition::ValidateScan(scan); }, ErrorCode::kBadInput, "reach 2000");
+}
+
+// Whole turns added to the start phase change nothing: at 1e18 deg the spacing of doubles is
+// 128 deg, and the mean radius came out 4.7 um (13 sigma) off.
+TEST(NumericHazards, WholeTurnsInTheStartPhaseChangeNoResult) {
+  ScanSettings settings = NoisyScan();
+  settings.start_phase_deg = 128.0;
+  const acquisition::Scan scan = acquisition::SimulateScan(EccentricWheel(), settings).scan;
+  acquisition::Scan turned = scan;
+  turned.metadata.start_phase_deg = 128.0 + 360.0 * std::ldexp(1.0, 50);  // exactly representable
+  ASSERT_EQ(std::fmod(turned.metadata.start_phase_deg, 360.0), 128.0);
+  processing::ProcessOptions nominal;
+  nominal.rpm_source = processing::RpmSource::kNominal;
+  const fitting::WheelFit plain = fitting::FitWheel(processing::ProcessScan(scan, nominal).map, NarrowBand());
+  const fitting::WheelFit far = fitting::FitWheel(processing::ProcessScan(turned, nominal).map, NarrowBand());
+  EXPECT_NEAR(plain.mean_arc_radius_mm, kTrueRadiusMm, 3.0 * plain.mean_arc_radius_sigma_mm);
+  EXPECT_EQ(far.mean_arc_radius_mm, plain.mean_arc_radius_mm);
+  EXPECT_EQ(far.max_runout_um, plain.max_runout_um);
 }
 
 // --- fits that do not converge ----------------------------------------------------------------

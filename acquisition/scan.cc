@@ -47,6 +47,17 @@ void CheckIncreasing(const Scan& scan, const std::vector<double>& column, const 
   }
 }
 
+// An encoder wrapped at 2 pi rather than 360 steps back by less than half a turn in degrees, so
+// it reads as an angle that does not increase: say what it looks like.
+std::string RadiansHint(const std::vector<double>& angle) {
+  const auto [low, high] = std::minmax_element(angle.begin(), angle.end());
+  constexpr double kTwoPi = 6.283185307179586;
+  if (*low >= 0.0 && *high <= kTwoPi * (1.0 + 1e-9)) {
+    return "; every value lies within 0 .. 2 pi: radians? The angle column is in degrees";
+  }
+  return "";
+}
+
 void CheckPositive(const Scan& scan, const std::optional<double>& value, const char* name) {
   if (value && !(*value > 0.0 && std::isfinite(*value))) {
     Refuse(scan, std::string(name) + " must be positive and finite, got " + Number(*value));
@@ -108,7 +119,8 @@ void ValidateScan(const Scan& scan) {
       if (step < -180.0) step += 360.0;
       if (step <= 0.0) {
         Refuse(scan, "column 'angle' does not increase at sample " + std::to_string(i) + " (" +
-                         Number(scan.angle_deg[i - 1]) + " then " + Number(scan.angle_deg[i]) + ")");
+                         Number(scan.angle_deg[i - 1]) + " then " + Number(scan.angle_deg[i]) + ")" +
+                         RadiansHint(scan.angle_deg));
       }
       unwrapped += step;
     }

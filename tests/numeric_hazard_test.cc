@@ -63,6 +63,16 @@ void ExpectRefused(const std::function<void()>& run, ErrorCode code, const std::
   }
 }
 
+// The message of the Error that `run` throws, or "" when it throws none.
+std::string ReasonOf(const std::function<void()>& run) {
+  try {
+    run();
+  } catch (const Error& e) {
+    return e.what();
+  }
+  return "";
+}
+
 // Samples 0.1 s apart at 500 rpm: a few samples cover the two turns a scan needs.
 const std::string kCsvHeader = "# spindle_rpm: 500\n# feed_mm_per_min: 100\n# sample_period_s: 0.1\n";
 
@@ -150,6 +160,12 @@ TEST(NumericHazards, DuplicatedOrBackwardEncoderIsRefusedButAWrappedEncoderIsNot
   backward.angle_deg[5000] -= 30.0;  // a jump back that is not a wrap
   ExpectRefused([&] { (void)processing::ProcessScan(backward, {}); }, ErrorCode::kBadInput,
                 "does not increase");
+  EXPECT_EQ(ReasonOf([&] { acquisition::ValidateScan(backward); }).find("radians"), std::string::npos);
+  // The same encoder in radians, wrapped at 2 pi: refused, saying what it looks like.
+  acquisition::Scan radians = wrapped;
+  for (double& angle : radians.angle_deg) angle *= std::numbers::pi / 180.0;
+  ExpectRefused([&] { acquisition::ValidateScan(radians); }, ErrorCode::kBadInput,
+                "every value lies within 0 .. 2 pi: radians? The angle column is in degrees");
 }
 
 // --- a stuck sensor and sections without variance ------------------------------------------------

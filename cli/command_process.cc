@@ -61,13 +61,14 @@ void PrintModelHeadline(const fitting::WheelModel& m) {
 
 // One line per stage on stderr, so that the outputs and the headline stay as they are.
 void PrintTimings(const StageClock& clock) {
-  double total_s = 0.0;
+  double total_s = 0.0, total_cpu_s = 0.0;
   for (const StageClock::Stage& stage : clock.stages()) {
-    fmt::print(stderr, "timing  {:<32} {:8.3f} s   peak memory {:7.1f} MiB\n", stage.name, stage.seconds,
-               stage.peak_memory_mib);
+    fmt::print(stderr, "timing  {:<32} {:8.3f} s   cpu {:7.3f} s   peak memory {:7.1f} MiB\n", stage.name,
+               stage.seconds, stage.cpu_seconds, stage.peak_memory_mib);
     total_s += stage.seconds;
+    total_cpu_s += stage.cpu_seconds;
   }
-  fmt::print(stderr, "timing  {:<32} {:8.3f} s\n", "total", total_s);
+  fmt::print(stderr, "timing  {:<32} {:8.3f} s   cpu {:7.3f} s\n", "total", total_s, total_cpu_s);
 }
 
 void Run(ProcessArgs& args) {
@@ -155,7 +156,8 @@ void AddProcessCommand(CLI::App& app) {
       ->capture_default_str();
   cmd->add_flag("--no-model", args->pipeline.no_model, "skip the wheel model (docs/wheel_model.md)");
   cmd->add_flag("-q,--quiet", args->quiet, "no progress and no headline");
-  cmd->add_flag("--timings", args->timings, "print the wall time of each stage on stderr");
+  cmd->add_flag("--timings", args->timings,
+                "print each stage's wall time, CPU time and peak memory so far on stderr");
   cmd->callback([args] { Run(*args); });
 }
 

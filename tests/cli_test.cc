@@ -4,7 +4,10 @@
 
 #include <fstream>
 #include <nlohmann/json.hpp>
+#include <regex>
+#include <sstream>
 #include <string>
+#include <vector>
 
 #include "acquisition/simulate.h"
 #include "core/testing/testing.h"
@@ -44,6 +47,44 @@ TEST(Cli, SimulateThenProcessWritesTheContractKeys) {
               4 * s["mean_arc_radius_sigma_mm"].get<double>());
   // Runout of a pure 4 um eccentricity is 8 um, plus the noise's peak-to-valley.
   EXPECT_NEAR(s["max_runout_um"].get<double>(), 8.0, 1.5);
+}
+
+// --timings: a line per stage, in the order they ran, with wall time, CPU time of all threads and
+// the peak memory so far; the total line sums the stages.
+TEST(Cli, ProcessTimingsListEveryStageAndSumThem) {
+  TempDir dir;
+  ASSERT_EQ(RunArcwheel("simulate " + (dir / "scan.h5").string() + " --noise-um 0.3").exit_status, 0);
+  const auto run =
+      RunArcwheel("process -q --timings " + (dir / "scan.h5").string() + " -o " + (dir / "out").string());
+  ASSERT_EQ(run.exit_status, 0) << run.output;
+  std::istringstream lines(run.output);
+  std::vector<std::string> stages;
+  double wall_s = 0.0, cpu_s = 0.0;
+  const std::regex timing_line(R"(timing  (.+?) +([0-9.]+) s   cpu +([0-9.]+) s(.*))");
+  for (std::string line; std::getline(lines, line);) {
+    if (line.rfind("timing", 0) != 0) continue;
+    std::smatch match;
+    ASSERT_TRUE(std::regex_match(line, match, timing_line)) << line;
+    const std::string name = match[1];
+    const double wall = std::stod(match[2]);
+    const double cpu = std::stod(match[3]);
+    if (name == "total") {
+      EXPECT_NEAR(wall, wall_s, 1e-3 * static_cast<double>(stages.size())) << line;
+      EXPECT_NEAR(cpu, cpu_s, 1e-3 * static_cast<double>(stages.size())) << line;
+      EXPECT_EQ(match[4], "") << line;
+    } else {
+      EXPECT_NE(match[4].str().find("peak memory"), std::string::npos) << line;
+      stages.push_back(name);
+      wall_s += wall;
+      cpu_s += cpu;
+    }
+  }
+  const std::vector<std::string> expected = {
+      "reading",        "valid span",   "stuck readings",        "noise and despike",
+      "spindle speed",  "helix spline", "sections and map",      "coverage counts",
+      "per-phase fits", "wheel model",  "releasing the samples", "waiting for the SHA-256",
+      "writing"};
+  EXPECT_EQ(stages, expected) << run.output;
 }
 
 TEST(Cli, ProcessWithReportWritesBothReportsBesideTheOutputs) {

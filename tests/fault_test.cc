@@ -10,7 +10,10 @@
 
 #include <chrono>
 #include <cstdlib>
+#include <fstream>
 #include <map>
+#include <optional>
+#include <sstream>
 #include <string>
 #include <thread>
 
@@ -47,10 +50,29 @@ testing::CommandResult RunWithFileSizeLimit(const std::string& arguments, int li
   return result;
 }
 
+// The CPU seconds the running process `pid` has used (all its threads), from /proc; nothing once
+// it has ended.
+std::optional<double> CpuSecondsOf(pid_t pid) {
+  std::ifstream in(fmt::format("/proc/{}/stat", pid));
+  std::string stat;
+  std::getline(in, stat);
+  const std::size_t name_end = stat.rfind(')');
+  if (name_end == std::string::npos) return std::nullopt;
+  std::istringstream fields(stat.substr(name_end + 2));
+  std::string state;
+  fields >> state;
+  if (state == "Z" || state == "X") return std::nullopt;
+  std::string skipped;
+  for (int field = 4; field < 14; ++field) fields >> skipped;  // ppid .. cmajflt
+  long user_ticks = 0, system_ticks = 0;
+  fields >> user_ticks >> system_ticks;
+  return static_cast<double>(user_ticks + system_ticks) / static_cast<double>(::sysconf(_SC_CLK_TCK));
+}
+
 TEST(Faults, InterruptDuringProcessingLeavesEarlierOutputsIntact) {
   TempDir dir;
   PrepareEarlierOutputs(dir);
-  // 4e6 samples: about half a second of processing, interrupted after a quarter.
+  // 4e6 samples: about 0.2 s of CPU in the Release build, several times that with sanitizers.
   ASSERT_EQ(RunArcwheel("simulate " + (dir / "long.h5").string() +
                         " --sample-period-s 1e-5 --feed-mm-per-min 33 --noise-um 0.3 --radial-harmonic 1:3")
                 .exit_status,
@@ -60,7 +82,12 @@ TEST(Faults, InterruptDuringProcessingLeavesEarlierOutputsIntact) {
 
   const pid_t pid =
       testing::SpawnArcwheel({"process", "-q", (dir / "long.h5").string(), "-o", (dir / "out").string()});
-  std::this_thread::sleep_for(std::chrono::milliseconds(250));
+  // Interrupted once it has spent 50 ms of CPU, past start-up and into the processing: measured in
+  // CPU rather than wall time, so that neither a faster build nor a loaded machine moves the moment.
+  std::optional<double> cpu_s;
+  while ((cpu_s = CpuSecondsOf(pid)) && *cpu_s < 0.05)
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  EXPECT_TRUE(cpu_s.has_value()) << "the run ended before it had spent 50 ms of CPU";
   ::kill(pid, SIGINT);
   int status = 0;
   ASSERT_EQ(::waitpid(pid, &status, 0), pid);

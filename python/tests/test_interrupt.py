@@ -5,18 +5,19 @@ import subprocess
 import sys
 import textwrap
 
-# The child simulates a scan of 1e6 samples, which takes some 0.2-0.5 s to process, then sends itself
-# SIGINT 0.05 s after process() has started, and reports how it ended and how long after the signal.
+# The child simulates a scan of 1.3e7 samples, which takes some 0.17 s to process in memory on a quiet
+# machine (longer when loaded), then sends itself SIGINT 0.02 s after process() has started, and
+# reports how it ended and how long after the signal.
 CHILD = textwrap.dedent("""
     import os, signal, threading, time
     import arcwheel
     signal.signal(signal.SIGINT, signal.default_int_handler)  # a parent may have ignored it
-    scan, _ = arcwheel.simulate(sample_period_s=12.5e-6, noise_um=0.5)
+    scan, _ = arcwheel.simulate(sample_period_s=1e-6, noise_um=0.5)
     sent = []
     def interrupt():
         sent.append(time.monotonic())
         os.kill(os.getpid(), signal.SIGINT)
-    threading.Timer(0.05, interrupt).start()
+    threading.Timer(0.02, interrupt).start()
     start = time.monotonic()
     try:
         arcwheel.process(scan)

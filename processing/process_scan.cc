@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 #include <span>
 #include <string>
 #include <type_traits>
@@ -45,17 +46,23 @@ void CorrectBeamOffset(std::vector<double>& rho, double offset_mm, double apex_r
   }
 }
 
-// Samples in `stuck_run_deg` of a turn (at least 16), from the scan's own timing; 0 when the run
-// is disabled or the scan gives no way to tell a turn (it is refused further on).
-std::size_t StuckRunSamples(const acquisition::Scan& scan, double stuck_run_deg) {
-  if (stuck_run_deg <= 0.0 || scan.size() < 2) return 0;
-  if (!scan.has_encoder() && !scan.metadata.spindle_rpm) return 0;
+// Samples a turn over the whole scan, from its own timing (the nominal speed, or the encoder);
+// nothing when the scan gives no way to tell a turn (it is refused further on). One geometry, which
+// with an encoder unwraps the whole angle column, serves every use.
+std::optional<double> SamplesPerTurn(const acquisition::Scan& scan) {
+  if (scan.size() < 2 || (!scan.has_encoder() && !scan.metadata.spindle_rpm)) return std::nullopt;
   const HelixGeometry geometry(scan, scan.metadata.spindle_rpm.value_or(0.0));
   const double turns = (geometry.PhaseAt(scan.size() - 1) - geometry.PhaseAt(0)) / 360.0;
-  if (!(turns > 0.0)) return 0;
-  const double samples_per_turn = static_cast<double>(scan.size()) / turns;
-  return std::max<std::size_t>(16,
-                               static_cast<std::size_t>(std::ceil(samples_per_turn * stuck_run_deg / 360.0)));
+  if (!(turns > 0.0)) return std::nullopt;
+  return static_cast<double>(scan.size()) / turns;
+}
+
+// Samples in `stuck_run_deg` of a turn (at least 16); 0 when the run is disabled or the scan
+// gives no way to tell a turn.
+std::size_t StuckRunSamples(std::optional<double> samples_per_turn, double stuck_run_deg) {
+  if (stuck_run_deg <= 0.0 || !samples_per_turn) return 0;
+  return std::max<std::size_t>(
+      16, static_cast<std::size_t>(std::ceil(*samples_per_turn * stuck_run_deg / 360.0)));
 }
 
 void CheckOptions(const acquisition::Scan& scan, const ProcessOptions& options) {
@@ -73,12 +80,8 @@ constexpr double kMinSamplesPerTurn = 16.0;
 
 // Refuses a scan whose settings give fewer than kMinSamplesPerTurn samples a turn (a spindle speed
 // in the wrong unit, say): left to the steps, its turns would outnumber its samples.
-void CheckSamplesPerTurn(const acquisition::Scan& scan) {
-  if (scan.size() < 2 || (!scan.has_encoder() && !scan.metadata.spindle_rpm)) return;
-  const HelixGeometry geometry(scan, scan.metadata.spindle_rpm.value_or(0.0));
-  const double turns = std::abs(geometry.PhaseAt(scan.size() - 1) - geometry.PhaseAt(0)) / 360.0;
-  const double samples_per_turn = static_cast<double>(scan.size() - 1) / turns;
-  if (samples_per_turn >= kMinSamplesPerTurn) return;
+void CheckSamplesPerTurn(const acquisition::Scan& scan, std::optional<double> samples_per_turn) {
+  if (!samples_per_turn || *samples_per_turn >= kMinSamplesPerTurn) return;
   const std::string settings = scan.has_encoder()
                                    ? std::string("by its angle column")
                                    : fmt::format("at spindle_rpm {:g}", *scan.metadata.spindle_rpm);
@@ -86,7 +89,8 @@ void CheckSamplesPerTurn(const acquisition::Scan& scan) {
               fmt::format("'{}': {:.3g} samples a turn {} over {:.4g} turns; a helical scan needs at least "
                           "{:g} a turn to resolve the wheel's phase (is spindle_rpm in rev/min and "
                           "sample_period_s in seconds?)",
-                          scan.path, samples_per_turn, settings, turns, kMinSamplesPerTurn));
+                          scan.path, *samples_per_turn, settings,
+                          static_cast<double>(scan.size()) / *samples_per_turn, kMinSamplesPerTurn));
 }
 
 // Step 1: the span from the first to the last valid sample (DropStuckSensorRuns counts them).
@@ -101,9 +105,9 @@ void FindValidSpan(const std::vector<T>& rho, ProcessedScan& out) {
 
 // Drops runs of equal readings (a stuck sensor); refuses a scan that is nothing else.
 template <typename T>
-void DropStuckSensorRuns(const acquisition::Scan& scan, std::vector<T>& rho, double stuck_run_deg,
+void DropStuckSensorRuns(const acquisition::Scan& scan, std::vector<T>& rho, std::size_t min_run,
                          ProcessedScan& out) {
-  out.stuck = DropStuckReadings(rho, StuckRunSamples(scan, stuck_run_deg));
+  out.stuck = DropStuckReadings(rho, min_run);
   out.valid_samples = out.stuck.valid;
   if (out.stuck.dropped > 0 && out.stuck.dropped == out.valid_samples) {
     throw Error(
@@ -230,7 +234,8 @@ namespace {
 
 // The steps on the readings, in float or double as the scan holds them.
 template <typename T>
-ProcessedScan ProcessReadings(acquisition::Scan& scan, std::vector<T>& rho, const ProcessOptions& options) {
+ProcessedScan ProcessReadings(acquisition::Scan& scan, std::vector<T>& rho, const ProcessOptions& options,
+                              std::optional<double> samples_per_turn) {
   ProcessedScan out;
   StageClock& clock = out.timings;
   out.samples = scan.size();
@@ -241,7 +246,7 @@ ProcessedScan ProcessReadings(acquisition::Scan& scan, std::vector<T>& rho, cons
   ThrowIfInterrupted();
 
   clock.Start("stuck readings");
-  DropStuckSensorRuns(scan, rho, options.stuck_run_deg, out);
+  DropStuckSensorRuns(scan, rho, StuckRunSamples(samples_per_turn, options.stuck_run_deg), out);
   clock.Start("noise and despike");
   DespikeAndEstimateNoise(rho, options.despike, out);
   ThrowIfInterrupted();
@@ -262,13 +267,15 @@ ProcessedScan ProcessReadings(acquisition::Scan& scan, std::vector<T>& rho, cons
 
 ProcessedScan ProcessScanInPlace(acquisition::Scan& scan, const ProcessOptions& options) {
   CheckOptions(scan, options);
-  CheckSamplesPerTurn(scan);
+  const std::optional<double> samples_per_turn = SamplesPerTurn(scan);
+  CheckSamplesPerTurn(scan, samples_per_turn);
   // Steps that change readings by arithmetic work in double, so that their results do not depend
   // on how the file stored the readings.
   if (options.beam_offset_mm != 0.0 || options.despike.method == DespikeMethod::kMovingMean) {
     scan.WidenToDouble();
   }
-  return acquisition::VisitReadings(scan, [&](auto& rho) { return ProcessReadings(scan, rho, options); });
+  return acquisition::VisitReadings(
+      scan, [&](auto& rho) { return ProcessReadings(scan, rho, options, samples_per_turn); });
 }
 
 }  // namespace arcwheel::processing

@@ -234,6 +234,19 @@ void ExpectNear(double fast, double reference, double sigma, const std::string& 
   EXPECT_NEAR(fast, reference, tolerance) << what;
 }
 
+// The model from float32 samples is the one from the same values widened to double, to the bit
+// (residuals where the double fit gives one).
+void ExpectBitForBit(const WheelModel& from_float, const WheelModel& from_double) {
+  EXPECT_EQ(from_float.coefficients, from_double.coefficients);
+  EXPECT_EQ(from_float.covariance, from_double.covariance);
+  ASSERT_EQ(from_float.residual_um.size(), from_double.residual_um.size());
+  for (std::size_t i = 0; i < from_float.residual_um.size(); ++i) {
+    if (!std::isnan(from_double.residual_um[i])) {
+      EXPECT_EQ(from_float.residual_um[i], from_double.residual_um[i]);
+    }
+  }
+}
+
 void ExpectSameModel(const WheelModel& fast, const WheelModel& reference, const Tolerance& tol = kWarmStart) {
   ASSERT_TRUE(fast.fitted);
   ASSERT_TRUE(reference.fitted);
@@ -341,14 +354,7 @@ TEST(WheelModelWarmStart, GivesTheFitOverEverySampleWithTheKnotsChosen) {
   const WheelModel from_float =
       FitWheelModel(std::span<const float>(narrow), geometry, processed.map, fit, fast_options);
   const WheelModel from_double = FitWheelModel(widened, geometry, processed.map, fit, fast_options);
-  EXPECT_EQ(from_float.coefficients, from_double.coefficients);
-  EXPECT_EQ(from_float.covariance, from_double.covariance);
-  ASSERT_EQ(from_float.residual_um.size(), from_double.residual_um.size());
-  for (std::size_t i = 0; i < from_float.residual_um.size(); ++i) {
-    if (!std::isnan(from_double.residual_um[i])) {
-      EXPECT_EQ(from_float.residual_um[i], from_double.residual_um[i]);
-    }
-  }
+  ExpectBitForBit(from_float, from_double);
   // And as from the double samples, to float32's rounding of the scan.
   ExpectSameModel(from_float, fast);
 }
@@ -417,14 +423,7 @@ TEST(WheelModelBinned, GivesTheFitOverEverySampleToAHundredthOfItsSigmaWithTheKn
   const WheelModel from_float =
       FitWheelModel(std::span<const float>(narrow), geometry, processed.map, scanned.fit, Binned({}));
   const WheelModel from_double = FitWheelModel(widened, geometry, processed.map, scanned.fit, Binned({}));
-  EXPECT_EQ(from_float.coefficients, from_double.coefficients);
-  EXPECT_EQ(from_float.covariance, from_double.covariance);
-  ASSERT_EQ(from_float.residual_um.size(), from_double.residual_um.size());
-  for (std::size_t i = 0; i < from_float.residual_um.size(); ++i) {
-    if (!std::isnan(from_double.residual_um[i])) {
-      EXPECT_EQ(from_float.residual_um[i], from_double.residual_um[i]);
-    }
-  }
+  ExpectBitForBit(from_float, from_double);
 }
 
 // The same with the knots given (the fine fit is then the final one; 12 knots for a, which do not

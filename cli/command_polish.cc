@@ -8,8 +8,8 @@
 #include <vector>
 
 #include "cli/commands.h"
-#include "cli/steps.h"
 #include "reports/polish_report.h"
+#include "workflows/steps.h"
 
 namespace arcwheel::cli {
 
@@ -30,7 +30,7 @@ void AddPolishCommand(CLI::App& app) {
       ->delimiter(',')
       ->check(CLI::IsMember({"html", "pdf"}));
   command->callback([arguments] {
-    (void)RunPolishStep(arguments->job, std::nullopt, arguments->output);
+    (void)workflows::RunPolishStep(arguments->job, std::nullopt, arguments->output);
     if (!arguments->report_formats.empty()) {
       // Drawn from the files just written, exactly as `arcwheel report OUTDIR` would.
       const reports::WrittenPolishReports written = reports::WritePolishReports(arguments->output);

@@ -8,14 +8,15 @@
 #include <vector>
 
 #include "cli/commands.h"
+#include "core/number_format.h"
 #include "core/progress.h"
 #include "core/stage_clock.h"
-#include "fitting/process_pipeline.h"
 #include "fitting/wheel_model.h"
 #include "reports/report.h"
 #include "reports/tolerances.h"
 #include "schema/summary.h"
 #include "schema/wheel_map.h"
+#include "workflows/process_pipeline.h"
 
 namespace arcwheel::cli {
 namespace {
@@ -23,7 +24,7 @@ namespace {
 struct ProcessArgs {
   std::string scan_path;
   std::string outdir;
-  fitting::ProcessPipelineOptions pipeline;
+  workflows::ProcessPipelineOptions pipeline;
   std::vector<std::string> report_formats;
   std::string tolerance_file;
   bool quiet = false;
@@ -35,28 +36,31 @@ void PrintHeadline(const ProcessArgs& args, const processing::ProcessedScan& p, 
   fmt::print("summary: {}\nmap:     {}\n", (out / schema::summary::kFileName).string(),
              (out / schema::wheel_map::kFileName).string());
   fmt::print("samples {} (valid {}, despiked {}); noise {:.3f} um; spindle {:.4f} rpm ({})\n", p.samples,
-             p.valid_samples, p.despike.rejected, p.noise_sigma_mm * 1000.0, p.rpm_used,
+             p.valid_samples, p.despike.rejected, Shown(p.noise_sigma_mm * 1000.0), Shown(p.rpm_used),
              p.phase_source == processing::PhaseSource::kEncoder     ? "encoder"
              : p.phase_source == processing::PhaseSource::kEstimated ? "estimated from the data"
                                                                      : "nominal");
   fmt::print("mean arc radius      {:.5f} +- {:.5f} mm (1 sigma), {} of {} phases usable\n",
-             f.mean_arc_radius_mm, f.mean_arc_radius_sigma_mm, f.usable_phases, f.phases.size());
+             Shown(f.mean_arc_radius_mm), Shown(f.mean_arc_radius_sigma_mm), f.usable_phases,
+             f.phases.size());
   fmt::print("arc radius range     {:.5f} mm ({:.3f} %); real spread beyond noise {:.5f} mm\n",
-             f.arc_radius_range_mm, f.arc_radius_fluctuation_pct, f.arc_radius_excess_std_mm);
-  fmt::print("arc centre axial     {:.5f} mm, deviation {:.5f} mm\n", f.mean_center_axial_mm,
-             f.center_axial_deviation_mm);
-  fmt::print("max arc error        {:.3f} um in the band [{:.3f}, {:.3f}] mm\n", f.max_arc_error_um,
-             f.band_low_mm, f.band_high_mm);
-  fmt::print("max runout           {:.3f} um (wheel + spindle error motion)\n", f.max_runout_um);
-  fmt::print("max roundness        {:.3f} um\n", f.max_roundness_um);
+             Shown(f.arc_radius_range_mm), Shown(f.arc_radius_fluctuation_pct),
+             Shown(f.arc_radius_excess_std_mm));
+  fmt::print("arc centre axial     {:.5f} mm, deviation {:.5f} mm\n", Shown(f.mean_center_axial_mm),
+             Shown(f.center_axial_deviation_mm));
+  fmt::print("max arc error        {:.3f} um in the band [{:.3f}, {:.3f}] mm\n", Shown(f.max_arc_error_um),
+             Shown(f.band_low_mm), Shown(f.band_high_mm));
+  fmt::print("max runout           {:.3f} um (wheel + spindle error motion)\n", Shown(f.max_runout_um));
+  fmt::print("max roundness        {:.3f} um\n", Shown(f.max_roundness_um));
 }
 
 void PrintModelHeadline(const fitting::WheelModel& m) {
-  fmt::print("model arc radius     {:.5f} +- {:.5f} mm, range {:.5f} +- {:.5f} mm\n", m.mean_arc_radius_mm,
-             m.mean_arc_radius_sigma_mm, m.arc_radius_range_mm, m.arc_radius_range_sigma_mm);
+  fmt::print("model arc radius     {:.5f} +- {:.5f} mm, range {:.5f} +- {:.5f} mm\n",
+             Shown(m.mean_arc_radius_mm), Shown(m.mean_arc_radius_sigma_mm), Shown(m.arc_radius_range_mm),
+             Shown(m.arc_radius_range_sigma_mm));
   fmt::print("model radius varies  {} (chi-square {:.1f} on {} dof, p = {:.2g}); knots Ra/a/b {}/{}/{}\n",
-             m.variation_significant ? "yes" : "no", m.variation_chi2, m.variation_dof, m.variation_p_value,
-             m.radius_knots, m.axial_knots, m.runout_knots);
+             m.variation_significant ? "yes" : "no", Shown(m.variation_chi2), m.variation_dof,
+             Shown(m.variation_p_value), m.radius_knots, m.axial_knots, m.runout_knots);
 }
 
 // One line per stage on stderr, so that the outputs and the headline stay as they are.
@@ -64,17 +68,18 @@ void PrintTimings(const StageClock& clock) {
   double total_s = 0.0, total_cpu_s = 0.0;
   for (const StageClock::Stage& stage : clock.stages()) {
     fmt::print(stderr, "timing  {:<32} {:8.3f} s   cpu {:7.3f} s   peak memory {:7.1f} MiB\n", stage.name,
-               stage.seconds, stage.cpu_seconds, stage.peak_memory_mib);
+               Shown(stage.seconds), Shown(stage.cpu_seconds), Shown(stage.peak_memory_mib));
     total_s += stage.seconds;
     total_cpu_s += stage.cpu_seconds;
   }
-  fmt::print(stderr, "timing  {:<32} {:8.3f} s   cpu {:7.3f} s\n", "total", total_s, total_cpu_s);
+  fmt::print(stderr, "timing  {:<32} {:8.3f} s   cpu {:7.3f} s\n", "total", Shown(total_s),
+             Shown(total_cpu_s));
 }
 
 void Run(ProcessArgs& args) {
   Progress progress(!args.quiet);
-  const fitting::ProcessPipelineResult result =
-      fitting::RunProcessPipeline(args.scan_path, args.outdir, args.pipeline, progress);
+  const workflows::ProcessPipelineResult result =
+      workflows::RunProcessPipeline(args.scan_path, args.outdir, args.pipeline, progress);
   progress.Done();
   if (args.timings) PrintTimings(result.clock);
   if (!args.quiet) PrintHeadline(args, result.processed, result.fit);

@@ -5,8 +5,8 @@
 #include <string>
 
 #include "cli/commands.h"
-#include "cli/steps.h"
 #include "grinding/job.h"
+#include "workflows/steps.h"
 
 namespace arcwheel::cli {
 
@@ -41,9 +41,10 @@ void AddToolpathCommand(CLI::App& app) {
   command->callback([arguments] {
     std::optional<std::filesystem::path> wheel;
     if (!arguments->wheel.empty()) wheel = arguments->wheel;
-    (void)RunToolpathStep(arguments->job, wheel, arguments->max_wheel_change_mm, arguments->output,
-                          arguments->wheel_profile == "model" ? grinding::WheelProfileSource::kModel
-                                                              : grinding::WheelProfileSource::kMeanProfile);
+    (void)workflows::RunToolpathStep(arguments->job, wheel, arguments->max_wheel_change_mm, arguments->output,
+                                     arguments->wheel_profile == "model"
+                                         ? grinding::WheelProfileSource::kModel
+                                         : grinding::WheelProfileSource::kMeanProfile);
   });
 }
 

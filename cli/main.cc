@@ -7,6 +7,8 @@
 #include <cstdio>
 #include <cstdlib>
 #include <exception>
+#include <limits>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -55,12 +57,58 @@ constexpr const char* kExitCodes =
   std::_Exit(status);
 }
 
+// Edit distance between two command names: the nearest known command to a mistyped one.
+size_t EditDistance(const std::string& a, const std::string& b) {
+  std::vector<size_t> row(b.size() + 1);
+  for (size_t j = 0; j <= b.size(); ++j) row[j] = j;
+  for (size_t i = 1; i <= a.size(); ++i) {
+    size_t diagonal = row[0];
+    row[0] = i;
+    for (size_t j = 1; j <= b.size(); ++j) {
+      const size_t above = row[j];
+      row[j] = std::min({row[j] + 1, row[j - 1] + 1, diagonal + (a[i - 1] == b[j - 1] ? 0 : 1)});
+      diagonal = above;
+    }
+  }
+  return row[b.size()];
+}
+
+// "unknown command 'batchx'; did you mean 'batch'?", the suggestion only where a command is a few
+// typing errors away (at most a third of the word's letters, and at least one).
+std::string UnknownCommand(const CLI::App& app, const std::string& typed) {
+  std::string nearest;
+  size_t best = std::numeric_limits<size_t>::max();
+  for (const CLI::App* command : app.get_subcommands([](const CLI::App*) { return true; })) {
+    const size_t distance = EditDistance(typed, command->get_name());
+    if (distance < best) best = distance, nearest = command->get_name();
+  }
+  const std::string suggestion =
+      best <= std::max<size_t>(1, typed.size() / 3) ? fmt::format("; did you mean '{}'?", nearest) : "";
+  return fmt::format("arcwheel: unknown command '{}'{} (`arcwheel help` lists the commands)\n", typed,
+                     suggestion);
+}
+
+bool HasCommand(const CLI::App& app, const std::string& name) {
+  for (const CLI::App* command : app.get_subcommands([](const CLI::App*) { return true; })) {
+    if (command->get_name() == name) return true;
+  }
+  return false;
+}
+
+// The command word: the first argument that is not a flag of arcwheel itself.
+std::optional<size_t> CommandIndex(const std::vector<std::string>& arguments) {
+  for (size_t i = 0; i < arguments.size(); ++i) {
+    if (arguments[i].empty() || arguments[i][0] != '-') return i;
+  }
+  return std::nullopt;
+}
+
 // The arguments, with those after `batch ... --` handed to the batch command: they are process
 // options, passed to each child unchanged.
 std::vector<std::string> ArgumentsForCli11(int argc, char** argv) {
   std::vector<std::string> arguments(argv + 1, argv + argc);
-  const auto command = std::find_if(arguments.begin(), arguments.end(),
-                                    [](const std::string& a) { return a.empty() || a[0] != '-'; });
+  const std::optional<size_t> index = CommandIndex(arguments);
+  const auto command = index ? arguments.begin() + static_cast<std::ptrdiff_t>(*index) : arguments.end();
   if (command != arguments.end() && *command == "batch") {
     const auto separator = std::find(command, arguments.end(), std::string("--"));
     if (separator != arguments.end()) {
@@ -85,10 +133,37 @@ int main(int argc, char** argv) {
   app.add_subcommand("version", "print the arcwheel version")->callback([] {
     fmt::print("arcwheel {}\n", arcwheel::kVersion);
   });
-  app.add_subcommand("help", "list the commands; `arcwheel COMMAND --help` for one")->callback([&app] {
-    fmt::print("{}", app.help());
-  });
+  app.add_subcommand("help", "list the commands; `arcwheel help COMMAND` for one command's options");
   arcwheel::InstallInterruptHandlers();
+
+  // What a newcomer types first, answered before CLI11 sees it: `arcwheel`, `arcwheel help
+  // [COMMAND]` and a mistyped command.
+  std::vector<std::string> words(argv + 1, argv + argc);
+  const std::optional<size_t> command = CommandIndex(words);
+  if (!command) {
+    const bool asks_for_something = std::any_of(words.begin(), words.end(), [](const std::string& word) {
+      return word == "-h" || word == "--help" || word == "--help-all" || word == "--version";
+    });
+    if (!asks_for_something) {
+      fmt::print(stderr, "{}", app.help());
+      return 1;
+    }
+  } else if (words[*command] == "help") {
+    if (*command + 1 >= words.size()) {
+      fmt::print("{}", app.help());
+      return 0;
+    }
+    const std::string& topic = words[*command + 1];
+    if (!HasCommand(app, topic)) {
+      fmt::print(stderr, "{}", UnknownCommand(app, topic));
+      return 1;
+    }
+    fmt::print("{}", app.get_subcommand(topic)->help(app.get_name()));
+    return 0;
+  } else if (!HasCommand(app, words[*command])) {
+    fmt::print(stderr, "{}", UnknownCommand(app, words[*command]));
+    return 1;
+  }
 
   try {
     app.parse(ArgumentsForCli11(argc, argv));

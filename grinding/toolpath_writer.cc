@@ -16,6 +16,7 @@
 #include "core/check.h"
 #include "core/error.h"
 #include "core/version.h"
+#include "schema/toolpath_outputs.h"
 
 namespace arcwheel::grinding {
 namespace {
@@ -154,50 +155,54 @@ void WriteHeaders(const Job& job, std::ofstream* csv, std::ofstream* gcode, std:
 
 // The nominal and the measured arc radius side by side (docs/grinding.md, toolpath_summary.json).
 nlohmann::json ArcRadiusJson(const WheelChange& c) {
+  namespace key = schema::toolpath::summary::arc_radius;
   nlohmann::json j;
-  j["nominal_mm"] = c.nominal_arc_radius_mm ? nlohmann::json(*c.nominal_arc_radius_mm) : nlohmann::json();
-  j["measured_mm"] = c.measured_arc_radius_mm;
-  j["measured_sigma_mm"] = c.measured_sigma_mm;
-  j["difference_mm"] = c.nominal_arc_radius_mm ? nlohmann::json(c.DifferenceMm()) : nlohmann::json();
-  j["max_change_mm"] = c.max_change_mm;
-  j["used"] = "measured";
+  j[key::kNominalMm] = c.nominal_arc_radius_mm ? nlohmann::json(*c.nominal_arc_radius_mm) : nlohmann::json();
+  j[key::kMeasuredMm] = c.measured_arc_radius_mm;
+  j[key::kMeasuredSigmaMm] = c.measured_sigma_mm;
+  j[key::kDifferenceMm] = c.nominal_arc_radius_mm ? nlohmann::json(c.DifferenceMm()) : nlohmann::json();
+  j[key::kMaxChangeMm] = c.max_change_mm;
+  j[key::kUsed] = "measured";
   return j;
 }
 
 nlohmann::json SummaryJson(const Job& job, const ToolpathRunReport& report,
                            const std::vector<std::string>& files) {
+  namespace key = schema::toolpath::summary;
   nlohmann::json j;
-  j["arcwheel_version"] = kVersion;
-  j["job"] = nlohmann::json::parse(job.resolved_json);
-  j["job_path"] = job.source.string();
-  j["surface"] = job.surface->Describe();
-  j["wheel"] = job.wheel.description;
-  if (job.wheel_change) j["arc_radius"] = ArcRadiusJson(*job.wheel_change);
+  j[key::kArcwheelVersion] = kVersion;
+  j[key::kJob] = nlohmann::json::parse(job.resolved_json);
+  j[key::kJobPath] = job.source.string();
+  j[key::kSurface] = job.surface->Describe();
+  j[key::kWheel] = job.wheel.description;
+  if (job.wheel_change) j[key::kArcRadius] = ArcRadiusJson(*job.wheel_change);
   if (job.wheel_summary)
-    j["wheel_profile"] = job.wheel_profile == WheelProfileSource::kModel ? "model" : "mean";
+    j[key::kWheelProfile] = job.wheel_profile == WheelProfileSource::kModel ? "model" : "mean";
   const ToolpathSummary& t = report.toolpath;
-  j["toolpath"] = {{"passes", t.passes},
-                   {"rows_per_pass", t.rows_per_pass},
-                   {"control_points", t.control_points},
-                   {"first_row_yw_mm", t.first_row_yw_mm},
-                   {"row_pitch_mm", t.row_pitch_mm},
-                   {"max_row_deviation_mm", t.max_row_deviation_mm},
-                   {"gouge_checks", t.gouge_checks},
-                   {"min_gouge_gap_um", 1e3 * t.min_gouge_gap_mm},
-                   {"min_clearance_curvature_per_mm", t.min_local_clearance_per_mm}};
+  namespace path = key::toolpath;
+  j[key::kToolpath] = {{path::kPasses, t.passes},
+                       {path::kRowsPerPass, t.rows_per_pass},
+                       {path::kControlPoints, t.control_points},
+                       {path::kFirstRowYwMm, t.first_row_yw_mm},
+                       {path::kRowPitchMm, t.row_pitch_mm},
+                       {path::kMaxRowDeviationMm, t.max_row_deviation_mm},
+                       {path::kGougeChecks, t.gouge_checks},
+                       {path::kMinGougeGapUm, 1e3 * t.min_gouge_gap_mm},
+                       {path::kMinClearanceCurvaturePerMm, t.min_local_clearance_per_mm}};
   if (report.predicted) {
     const FormPrediction& p = report.prediction;
-    j["prediction"] = {{"arc_radius_error_mm", job.prediction.arc_radius_error_mm},
-                       {"arc_radius_error_source", job.arc_radius_error_source},
-                       {"keep_total_radius", job.prediction.keep_total_radius},
-                       {"pv_um", p.pv_um},
-                       {"rms_um", p.rms_um},
-                       {"pv_after_tilt_um", p.pv_after_tilt_um},
-                       {"rms_after_tilt_um", p.rms_after_tilt_um},
-                       {"ripple_pv_um", p.ripple_pv_um},
-                       {"profile_pv_um", p.profile_pv_um}};
+    namespace prediction = key::prediction;
+    j[key::kPrediction] = {{prediction::kArcRadiusErrorMm, job.prediction.arc_radius_error_mm},
+                           {prediction::kArcRadiusErrorSource, job.arc_radius_error_source},
+                           {prediction::kKeepTotalRadius, job.prediction.keep_total_radius},
+                           {prediction::kPvUm, p.pv_um},
+                           {prediction::kRmsUm, p.rms_um},
+                           {prediction::kPvAfterTiltUm, p.pv_after_tilt_um},
+                           {prediction::kRmsAfterTiltUm, p.rms_after_tilt_um},
+                           {prediction::kRipplePvUm, p.ripple_pv_um},
+                           {prediction::kProfilePvUm, p.profile_pv_um}};
   }
-  j["files"] = files;
+  j[key::kFiles] = files;
   return j;
 }
 
@@ -290,15 +295,16 @@ ToolpathRunReport RunToolpathJob(const Job& job, const std::filesystem::path& ou
   if (job.predict) {
     report.prediction = PredictFormError(*job.surface, job.aperture, job.wheel, job.prediction);
     report.predicted = true;
-    const auto h5_path = stage("prediction.h5", true);
+    const auto h5_path = stage(std::string(schema::toolpath::kPredictionFileName), true);
     WritePredictionHdf5(report.prediction, *h5_path, job.surface->Describe(), job.wheel.description);
   }
-  files.push_back("toolpath_summary.json");
-  const std::filesystem::path summary_path = outputs.Stage(output_folder / "toolpath_summary.json");
+  files.emplace_back(schema::toolpath::kSummaryFileName);
+  const std::filesystem::path summary_path =
+      outputs.Stage(output_folder / schema::toolpath::kSummaryFileName);
   {
     std::ofstream summary = OpenStaged(summary_path);
     summary << SummaryJson(job, report, files).dump(2) << "\n";
-    CloseChecked(summary, output_folder / "toolpath_summary.json");
+    CloseChecked(summary, output_folder / schema::toolpath::kSummaryFileName);
   }
   outputs.Commit();
   return report;

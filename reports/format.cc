@@ -4,6 +4,8 @@
 
 #include <cmath>
 
+#include "core/number_format.h"
+
 namespace arcwheel::reports {
 namespace {
 
@@ -14,22 +16,11 @@ std::string WithMinus(std::string text) {
   return "−" + text.substr(1);
 }
 
-std::string DropTrailingZeros(std::string text) {
-  const std::size_t exponent = text.find('e');
-  std::string mantissa = text.substr(0, exponent);
-  const std::string tail = exponent == std::string::npos ? "" : text.substr(exponent);
-  if (mantissa.find('.') != std::string::npos) {
-    mantissa.erase(mantissa.find_last_not_of('0') + 1);
-    if (mantissa.back() == '.') mantissa.pop_back();
-  }
-  return mantissa + tail;
-}
-
 }  // namespace
 
 std::string FormatFixed(double value, int decimals) {
   if (!std::isfinite(value)) return "n/a";
-  return WithMinus(fmt::format("{:.{}f}", value, decimals));
+  return WithMinus(ShowFixed(value, decimals));
 }
 
 std::string FormatValue(double value, Unit unit) {
@@ -45,8 +36,7 @@ std::string FormatWithSigma(double value, double sigma, Unit unit) {
 
 std::string FormatSignificant(double value, int digits) {
   if (!std::isfinite(value)) return "n/a";
-  if (value == std::trunc(value) && std::abs(value) < 1e15) return WithMinus(fmt::format("{:.0f}", value));
-  return WithMinus(DropTrailingZeros(fmt::format("{:.{}g}", value, digits)));
+  return WithMinus(ShowSignificant(value, digits));
 }
 
 std::string FormatDuration(double seconds) {

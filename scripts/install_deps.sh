@@ -1,9 +1,15 @@
 #!/usr/bin/env bash
-# Installs the Debian packages listed in scripts/packages.txt that are not installed yet.
-# Idempotent: does nothing (and needs no network) when everything is present.
+# Installs the Debian packages listed in scripts/packages.txt that are not installed yet; with
+# --binary-only, only those that building and running the `arcwheel` binary needs (the list's
+# first part, scripts/demo.sh). Idempotent: does nothing (and needs no network) when everything is
+# present.
 set -euo pipefail
 here=$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)
-mapfile -t wanted < <(grep -v '^\s*#' "$here/packages.txt" | grep -v '^\s*$')
+list=$(cat "$here/packages.txt")
+if [[ "${1:-}" == "--binary-only" ]]; then
+  list=$(sed '/^# -- binary only above/q' "$here/packages.txt")
+fi
+mapfile -t wanted < <(grep -v '^\s*#' <<<"$list" | grep -v '^\s*$')
 missing=()
 for package in "${wanted[@]}"; do
   status=$(dpkg-query -W -f='${Status}' "$package" 2>/dev/null || true)

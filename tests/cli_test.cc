@@ -288,7 +288,43 @@ TEST(Cli, TheSameInputGivesByteIdenticalFiles) {
 TEST(Cli, UnknownCommandPointsToHelp) {
   const auto run = RunArcwheel("frobnicate");
   EXPECT_EQ(run.exit_status, 1);
-  EXPECT_NE(run.output.find("arcwheel help"), std::string::npos);
+  EXPECT_NE(run.output.find("unknown command 'frobnicate' (`arcwheel help`"), std::string::npos)
+      << run.output;
+}
+
+TEST(Cli, AMistypedCommandIsAnsweredWithTheNearestOne) {
+  const auto run = RunArcwheel("batchx");
+  EXPECT_EQ(run.exit_status, 1);
+  EXPECT_NE(run.output.find("unknown command 'batchx'; did you mean 'batch'?"), std::string::npos)
+      << run.output;
+  const auto help = RunArcwheel("help regenrate");
+  EXPECT_EQ(help.exit_status, 1);
+  EXPECT_NE(help.output.find("did you mean 'regenerate'?"), std::string::npos) << help.output;
+}
+
+// The commands the table holds, each with its one-line help, as a newcomer's first two tries show
+// them: `arcwheel help` (exit 0) and a bare `arcwheel` (exit 1, a usage error).
+TEST(Cli, HelpAndABareCallListEveryCommand) {
+  const auto help = RunArcwheel("help");
+  const auto bare = RunArcwheel("");
+  EXPECT_EQ(help.exit_status, 0);
+  EXPECT_EQ(bare.exit_status, 1);
+  for (const char* command :
+       {"simulate", "process", "fit", "toolpath", "report", "compare", "history", "frame", "transform",
+        "headcenter", "polish", "regenerate", "batch", "version", "help"}) {
+    const std::string line = "\n  " + std::string(command) + " ";
+    EXPECT_NE(help.output.find(line), std::string::npos) << command << " missing from:\n" << help.output;
+    EXPECT_NE(bare.output.find(line), std::string::npos) << command << " missing from:\n" << bare.output;
+  }
+}
+
+TEST(Cli, HelpOfACommandIsThatCommandsHelp) {
+  const auto help = RunArcwheel("help process");
+  const auto own = RunArcwheel("process --help");
+  EXPECT_EQ(help.exit_status, 0);
+  EXPECT_EQ(own.exit_status, 0);
+  EXPECT_NE(help.output.find("--band-half-width-mm"), std::string::npos) << help.output;
+  EXPECT_EQ(help.output, own.output);
 }
 
 }  // namespace

@@ -1,4 +1,4 @@
-// arcwheel.process: the `arcwheel process` pipeline (fitting/process_pipeline.h) with its results
+// arcwheel.process: the `arcwheel process` pipeline (workflows/process_pipeline.h) with its results
 // as a dict of numpy arrays, and optionally the files the command writes.
 
 #include <cmath>
@@ -9,17 +9,17 @@
 
 #include "core/progress.h"
 #include "fitting/outputs.h"
-#include "fitting/process_pipeline.h"
 #include "python/src/bindings.h"
 #include "reports/report.h"
 #include "reports/tolerances.h"
 #include "schema/summary.h"
 #include "schema/wheel_map.h"
+#include "workflows/process_pipeline.h"
 
 namespace arcwheel::python {
 namespace {
 
-using Options = fitting::ProcessPipelineOptions;
+using Options = workflows::ProcessPipelineOptions;
 namespace h5 = schema::wheel_map;
 
 // The options of `arcwheel process` that reach the computation, named as its flags in snake_case.
@@ -146,7 +146,7 @@ py::dict ModelArrays(fitting::WheelModel& m, py::ssize_t n_phase, py::ssize_t n_
 }
 
 // The pieces arcwheel.Result is made of (arcwheel/__init__.py).
-py::dict ResultDict(fitting::ProcessPipelineResult& r) {
+py::dict ResultDict(workflows::ProcessPipelineResult& r) {
   const fitting::WheelModel* model = r.model && r.model->fitted ? &*r.model : nullptr;
   py::dict d;
   d["summary"] = ParseJson(fitting::SummaryJson(r.record, r.processed, r.fit, model));
@@ -180,19 +180,19 @@ py::dict Process(const py::object& scan_or_path, const std::optional<std::filesy
     throw Error(ErrorCode::kInvalidOption, "process", "report and tolerances need output_dir");
   }
   const std::filesystem::path outdir = output_dir.value_or(std::filesystem::path());
-  fitting::ProcessPipelineResult result;
+  workflows::ProcessPipelineResult result;
   if (py::isinstance<acquisition::Scan>(scan_or_path)) {
     // The pipeline works on the readings in place: it gets a copy, and the caller keeps the scan.
     acquisition::Scan scan = scan_or_path.cast<const acquisition::Scan&>();
     result = RunReleased([&] {
       Progress quiet(false);
-      return fitting::RunProcessPipeline(std::move(scan), "", outdir, options, quiet);
+      return workflows::RunProcessPipeline(std::move(scan), "", outdir, options, quiet);
     });
   } else {
     const std::string path = py::str(py::module_::import("os").attr("fspath")(scan_or_path));
     result = RunReleased([&] {
       Progress quiet(false);
-      return fitting::RunProcessPipeline(path, outdir, options, quiet);
+      return workflows::RunProcessPipeline(path, outdir, options, quiet);
     });
   }
   if (report)

@@ -16,13 +16,13 @@
 #include "fitting/wheel_model.h"
 #include "processing/process_scan.h"
 
-namespace arcwheel::fitting {
+namespace arcwheel::workflows {
 
 // Every option of `arcwheel process` that reaches the computation, at the command's defaults.
 struct ProcessPipelineOptions {
   processing::ProcessOptions processing;
-  WheelFitOptions fit;
-  WheelModelOptions model;
+  fitting::WheelFitOptions fit;
+  fitting::WheelModelOptions model;
   bool no_model = false;  // skip the wheel model
   // The choice options as the command line spells them: "median", "moving-mean" or "none";
   // "auto", "nominal", "encoder" or "estimate"; "band" or "full". The pipeline parses them into
@@ -37,17 +37,17 @@ struct ProcessPipelineOptions {
 void ResolveProcessPipelineOptions(ProcessPipelineOptions& options);
 
 struct ProcessPipelineResult {
-  RunRecord record;  // what summary.json says of the input and the parameters
+  fitting::RunRecord record;  // what summary.json says of the input and the parameters
   processing::ProcessedScan processed;
-  WheelFit fit;
-  std::optional<WheelModel> model;  // empty with no_model, or when the model could not be fitted
-  StageClock clock;                 // wall time of each step (`arcwheel process --timings`)
+  fitting::WheelFit fit;
+  std::optional<fitting::WheelModel> model;  // empty with no_model, or when the model could not be fitted
+  StageClock clock;                          // wall time of each step (`arcwheel process --timings`)
 };
 
 // Reads the scan at `scan_path` (acquisition::ReadScan, float32 readings kept as float32),
 // hashes the file on a second thread meanwhile, and runs the pipeline. The record states
 // `scan_path` as given (converted to UTF-8). When `outdir` is not empty, writes
-// OUTDIR/summary.json and OUTDIR/wheel_map.h5 (WriteProcessOutputs: nothing partial on failure).
+// OUTDIR/summary.json and OUTDIR/wheel_map.h5 (fitting::WriteProcessOutputs: nothing partial on failure).
 // Throws Error: kInvalidOption for bad options (before the scan is read), kBadInput/kIo from the
 // reader, kFitFailed when no phase gives a usable fit, kInterrupted when a signal arrives
 // (core/interrupt.h).
@@ -61,4 +61,4 @@ struct ProcessPipelineResult {
                                                        const std::filesystem::path& outdir,
                                                        ProcessPipelineOptions options, Progress& progress);
 
-}  // namespace arcwheel::fitting
+}  // namespace arcwheel::workflows

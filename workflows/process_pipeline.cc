@@ -1,4 +1,4 @@
-#include "fitting/process_pipeline.h"
+#include "workflows/process_pipeline.h"
 
 #include <fmt/core.h>
 
@@ -15,12 +15,12 @@
 #include "processing/helix_geometry.h"
 #include "schema/summary.h"
 
-namespace arcwheel::fitting {
+namespace arcwheel::workflows {
 namespace {
 
-RunRecord MakeRecord(const std::string& scan_path, const ProcessPipelineOptions& options,
-                     const acquisition::Scan& scan) {
-  RunRecord record;
+fitting::RunRecord MakeRecord(const std::string& scan_path, const ProcessPipelineOptions& options,
+                              const acquisition::Scan& scan) {
+  fitting::RunRecord record;
   // The path as the file system gives it may be in a legacy encoding; summary.json must stay UTF-8
   // (docs/inputs.md).
   bool latin1_path = false;
@@ -71,14 +71,15 @@ RunRecord MakeRecord(const std::string& scan_path, const ProcessPipelineOptions&
 
 // The wheel model over every sample in the band (fitting/wheel_model.h). The per-phase fits are
 // the contract's results, so a model that cannot be fitted is a warning, not a failed run.
-std::optional<WheelModel> FitModelUnlessOff(const ProcessPipelineOptions& options,
-                                            const acquisition::Scan& scan,
-                                            processing::ProcessedScan& processed, const WheelFit& fit) {
+std::optional<fitting::WheelModel> FitModelUnlessOff(const ProcessPipelineOptions& options,
+                                                     const acquisition::Scan& scan,
+                                                     processing::ProcessedScan& processed,
+                                                     const fitting::WheelFit& fit) {
   if (options.no_model) return std::nullopt;
   try {
     const processing::HelixGeometry geometry(scan, processed.rpm_used);
     return acquisition::VisitReadings(scan, [&](const auto& rho) {
-      return FitWheelModel(std::span(rho), geometry, processed.map, fit, options.model);
+      return fitting::FitWheelModel(std::span(rho), geometry, processed.map, fit, options.model);
     });
   } catch (const Error& e) {
     if (e.code() != ErrorCode::kFitFailed) throw;
@@ -113,7 +114,7 @@ ProcessPipelineResult RunOnScan(acquisition::Scan scan, const std::string& scan_
   clock.Append(result.processed.timings);
   progress.Update("fitting", 0.7);
   clock.Start("per-phase fits");
-  result.fit = FitWheel(result.processed.map, options.fit);
+  result.fit = fitting::FitWheel(result.processed.map, options.fit);
   // Only the fits' sigmas read the helix spline (23 MB at 1e8 samples): gone before the model.
   result.processed.map.spline.reset();
   clock.Start("wheel model");
@@ -126,8 +127,8 @@ ProcessPipelineResult RunOnScan(acquisition::Scan scan, const std::string& scan_
   ThrowIfInterrupted();
   if (!outdir.empty()) {
     clock.Start("writing");
-    WriteProcessOutputs(outdir, result.record, result.processed, result.fit,
-                        result.model ? &*result.model : nullptr);
+    fitting::WriteProcessOutputs(outdir, result.record, result.processed, result.fit,
+                                 result.model ? &*result.model : nullptr);
   }
   clock.Stop();
   result.clock = std::move(clock);
@@ -144,7 +145,8 @@ void ResolveProcessPipelineOptions(ProcessPipelineOptions& options) {
               processing::ParseDespikeMethod, options.processing.despike.method, problems);
   ParseChoice("--rpm-source", options.rpm_source, "auto, nominal, encoder or estimate",
               processing::ParseRpmSource, options.processing.rpm_source, problems);
-  ParseChoice("--fit-span", options.fit_span, "band or full", ParseFitSpan, options.fit.fit_span, problems);
+  ParseChoice("--fit-span", options.fit_span, "band or full", fitting::ParseFitSpan, options.fit.fit_span,
+              problems);
   for (std::string& problem : options.processing.Problems()) problems.push_back(std::move(problem));
   for (std::string& problem : options.fit.Problems()) problems.push_back(std::move(problem));
   if (!options.no_model) {
@@ -186,4 +188,4 @@ ProcessPipelineResult RunProcessPipeline(acquisition::Scan scan, std::string inp
   return RunOnScan(std::move(scan), scan_path, known.get_future(), outdir, options, progress, StageClock{});
 }
 
-}  // namespace arcwheel::fitting
+}  // namespace arcwheel::workflows

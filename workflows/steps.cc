@@ -1,14 +1,15 @@
-#include "cli/steps.h"
+#include "workflows/steps.h"
 
 #include <fmt/core.h>
 
 #include <chrono>
 #include <string>
 
+#include "core/number_format.h"
 #include "core/progress.h"
-#include "fitting/process_pipeline.h"
+#include "workflows/process_pipeline.h"
 
-namespace arcwheel::cli {
+namespace arcwheel::workflows {
 namespace {
 
 double StepSecondsSince(std::chrono::steady_clock::time_point start) {
@@ -20,7 +21,7 @@ double StepSecondsSince(std::chrono::steady_clock::time_point start) {
 void RunProcessStep(const std::filesystem::path& scan, const std::filesystem::path& output) {
   // The pipeline `arcwheel process -q SCAN -o OUTPUT` runs, with its default options.
   Progress quiet(false);
-  (void)fitting::RunProcessPipeline(scan.string(), output, {}, quiet);
+  (void)RunProcessPipeline(scan.string(), output, {}, quiet);
 }
 
 ToolpathStepResult RunToolpathStep(const std::filesystem::path& job_path,
@@ -33,25 +34,25 @@ ToolpathStepResult RunToolpathStep(const std::filesystem::path& job_path,
   const grinding::Job& job = result.job;
   result.report = grinding::RunToolpathJob(job, output);
   const grinding::ToolpathSummary& t = result.report.toolpath;
-  if (job.wheel_change) fmt::print("{}\n", grinding::ArcRadiusLine(*job.wheel_change));
+  if (job.wheel_change) fmt::print("{}\n", ShowNumbersIn(grinding::ArcRadiusLine(*job.wheel_change)));
   fmt::print(
       "{} control points in {} pass(es) of {} rows; rows straight to {:.2e} mm; "
       "{} gouge checks, smallest gap {:.3f} um\n",
-      t.control_points, t.passes, t.rows_per_pass, t.max_row_deviation_mm, t.gouge_checks,
-      1e3 * t.min_gouge_gap_mm);
+      t.control_points, t.passes, t.rows_per_pass, Shown(t.max_row_deviation_mm), t.gouge_checks,
+      Shown(1e3 * t.min_gouge_gap_mm));
   if (result.report.predicted) {
     const grinding::FormPrediction& p = result.report.prediction;
     fmt::print(
         "predicted form error (arc radius error {:.2g} mm: {}{}): PV {:.3f} um, RMS {:.3f} um; "
         "after tilt PV {:.3f} um, RMS {:.3f} um; runout ripple PV {:.3f} um{}\n",
-        job.prediction.arc_radius_error_mm, job.arc_radius_error_source,
-        job.prediction.runout_radial_um.empty() ? ", no runout" : ", with runout", p.pv_um, p.rms_um,
-        p.pv_after_tilt_um, p.rms_after_tilt_um, p.ripple_pv_um,
+        Shown(job.prediction.arc_radius_error_mm), job.arc_radius_error_source,
+        job.prediction.runout_radial_um.empty() ? ", no runout" : ", with runout", Shown(p.pv_um),
+        Shown(p.rms_um), Shown(p.pv_after_tilt_um), Shown(p.rms_after_tilt_um), Shown(p.ripple_pv_um),
         job.prediction.profile_u_mm.empty()
             ? ""
-            : fmt::format("; profile error p(u) PV {:.3f} um", p.profile_pv_um));
+            : fmt::format("; profile error p(u) PV {:.3f} um", Shown(p.profile_pv_um)));
   }
-  fmt::print("wrote {} in {:.2f} s\n", output.string(), StepSecondsSince(start));
+  fmt::print("wrote {} in {:.2f} s\n", output.string(), Shown(StepSecondsSince(start)));
   return result;
 }
 
@@ -65,12 +66,13 @@ polishing::PolishRunReport RunPolishStep(const std::filesystem::path& job_path,
   fmt::print(
       "{} dwell points; error PV {:.4f} um, RMS {:.4f} um -> predicted residual PV {:.4f} um, "
       "RMS {:.4f} um over {} aperture nodes\n",
-      report.points, d.before.pv_um, d.before.rms_um, d.after.pv_um, d.after.rms_um, d.before.nodes);
+      report.points, Shown(d.before.pv_um), Shown(d.before.rms_um), Shown(d.after.pv_um),
+      Shown(d.after.rms_um), d.before.nodes);
   fmt::print("total dwell {:.1f} s; speeds {:.3f} .. {:.3f} mm/s, up to {:.1f} mm/s^2; {} iterations{}\n",
-             d.total_time_s, report.min_speed_mm_s, report.max_speed_mm_s, d.max_acceleration_mm_s2,
-             d.iterations, d.converged ? "" : " (iteration limit reached)");
-  fmt::print("wrote {} in {:.2f} s\n", output.string(), StepSecondsSince(start));
+             Shown(d.total_time_s), Shown(report.min_speed_mm_s), Shown(report.max_speed_mm_s),
+             Shown(d.max_acceleration_mm_s2), d.iterations, d.converged ? "" : " (iteration limit reached)");
+  fmt::print("wrote {} in {:.2f} s\n", output.string(), Shown(StepSecondsSince(start)));
   return report;
 }
 
-}  // namespace arcwheel::cli
+}  // namespace arcwheel::workflows

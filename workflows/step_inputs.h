@@ -9,7 +9,7 @@
 #include <utility>
 #include <vector>
 
-namespace arcwheel::cli {
+namespace arcwheel::workflows {
 
 // In each result folder: the inputs it was made from, written after every other file.
 inline constexpr const char* kStepInputsFileName = "step_inputs.json";
@@ -25,4 +25,4 @@ inline constexpr const char* kStepInputsFileName = "step_inputs.json";
 [[nodiscard]] bool UpToDate(const std::filesystem::path& folder, const std::vector<std::string>& outputs,
                             const nlohmann::json& inputs);
 
-}  // namespace arcwheel::cli
+}  // namespace arcwheel::workflows

@@ -9,9 +9,9 @@
 #include "grinding/toolpath_writer.h"
 #include "polishing/job.h"
 
-namespace arcwheel::cli {
+namespace arcwheel::workflows {
 
-// `arcwheel process SCAN -o OUTDIR -q`: the pipeline the command runs (fitting/process_pipeline.h),
+// `arcwheel process SCAN -o OUTDIR -q`: the pipeline the command runs (workflows/process_pipeline.h),
 // its options at their defaults, so that the files are those `arcwheel process` writes.
 void RunProcessStep(const std::filesystem::path& scan, const std::filesystem::path& output);
 
@@ -32,4 +32,4 @@ polishing::PolishRunReport RunPolishStep(const std::filesystem::path& job_path,
                                          const std::optional<std::filesystem::path>& error_map,
                                          const std::filesystem::path& output);
 
-}  // namespace arcwheel::cli
+}  // namespace arcwheel::workflows

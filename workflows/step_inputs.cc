@@ -1,11 +1,11 @@
-#include "cli/step_inputs.h"
+#include "workflows/step_inputs.h"
 
 #include "core/error.h"
 #include "core/json_text.h"
 #include "core/sha256.h"
 #include "core/version.h"
 
-namespace arcwheel::cli {
+namespace arcwheel::workflows {
 
 namespace fs = std::filesystem;
 using nlohmann::json;
@@ -39,4 +39,4 @@ bool UpToDate(const fs::path& folder, const std::vector<std::string>& outputs, c
   }
 }
 
-}  // namespace arcwheel::cli
+}  // namespace arcwheel::workflows

@@ -10,12 +10,12 @@
 namespace arcwheel {
 namespace {
 
-// "-0.000" and "+0.000" read as a signed value: a value that rounds to zero has no sign.
+bool RoundsToZero(const std::string& text) { return text.find_first_not_of("+-0.") == std::string::npos; }
+
+// "-0.000" reads as a negative value: a value that rounds to zero has no sign.
 std::string WithoutSignOfZero(std::string text) {
-  if (!text.empty() && (text.front() == '-' || text.front() == '+') &&
-      text.find_first_not_of("+-0.") == std::string::npos) {
+  if (!text.empty() && (text.front() == '-' || text.front() == '+') && RoundsToZero(text))
     return text.substr(1);
-  }
   return text;
 }
 
@@ -53,14 +53,21 @@ std::string FixedCapped(double value, int decimals, const char* sign) {
     decimals = std::max(0, kMaxShownDigits - IntegerDigits(text));
     text = fmt::format(fmt::runtime(std::string("{:") + sign + ".{}f}"), value, decimals);
   }
-  return WithoutSignOfZero(text);
+  return text;
 }
 
 }  // namespace
 
-std::string ShowFixed(double value, int decimals) { return FixedCapped(value, decimals, ""); }
+std::string ShowFixed(double value, int decimals) {
+  return WithoutSignOfZero(FixedCapped(value, decimals, ""));
+}
 
-std::string ShowSigned(double value, int decimals) { return FixedCapped(value, decimals, "+"); }
+std::string ShowSigned(double value, int decimals) {
+  // A change that rounds to zero is "+0.000", whichever side of zero it fell.
+  std::string text = FixedCapped(value, decimals, "+");
+  if (RoundsToZero(text)) text.front() = '+';
+  return text;
+}
 
 std::string ShowSignificant(double value, int digits) {
   if (!std::isfinite(value)) return "n/a";
@@ -92,7 +99,8 @@ std::string ShowNumbersIn(std::string_view text) {
   std::string shown;
   const std::string input(text);
   auto last = input.cbegin();
-  for (auto it = std::sregex_iterator(input.begin(), input.end(), kNumber); it != std::sregex_iterator(); ++it) {
+  for (auto it = std::sregex_iterator(input.begin(), input.end(), kNumber); it != std::sregex_iterator();
+       ++it) {
     const std::string token = it->str();
     shown.append(last, input.cbegin() + it->position());
     shown += SignificantDigitsShown(token) > kMaxShownDigits ? ShowSignificant(std::stod(token)) : token;

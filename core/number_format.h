@@ -22,7 +22,8 @@ inline constexpr int kMaxShownDigits = 7;
 // number of more than seven digits keeps its integer digits ((123456789.4, 2) -> "123456789").
 [[nodiscard]] std::string ShowFixed(double value, int decimals);
 
-// The same with an explicit sign: (0.00123, 4) -> "+0.0012".
+// The same with an explicit sign, for changes: (0.00123, 4) -> "+0.0012"; a change that rounds to
+// zero is "+0.0000" whichever its sign.
 [[nodiscard]] std::string ShowSigned(double value, int decimals);
 
 // At most `digits` (1 to kMaxShownDigits) significant digits, trailing zeros and a bare point

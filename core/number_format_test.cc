@@ -24,9 +24,9 @@ TEST(ShowFixed, CountsTheDigitThatRoundingAdds) {
   EXPECT_EQ(ShowFixed(9999999.6, 1), "10000000");
 }
 
-TEST(ShowFixed, GivesAZeroNoSignAndANonFiniteValueNoNumber) {
+TEST(ShowFixed, GivesAZeroNoMinusAndANonFiniteValueNoNumber) {
   EXPECT_EQ(ShowFixed(-0.0001, 3), "0.000");
-  EXPECT_EQ(ShowSigned(-0.0001, 3), "0.000");
+  EXPECT_EQ(ShowSigned(-0.0001, 3), "+0.000");
   EXPECT_EQ(ShowFixed(std::nan(""), 3), "n/a");
   EXPECT_EQ(ShowFixed(std::numeric_limits<double>::infinity(), 3), "n/a");
 }

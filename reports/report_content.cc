@@ -7,6 +7,7 @@
 #include <ctime>
 #include <limits>
 
+#include "core/number_format.h"
 #include "core/version.h"
 #include "reports/statistics.h"
 #include "schema/summary.h"
@@ -668,7 +669,8 @@ ReportContent ComposeReport(const ReportInputs& inputs, const Tolerances& tolera
   for (ReportFigure& figure : SectionFigures(inputs)) content.figures.push_back(std::move(figure));
   content.figures.push_back(CoverageMap(inputs));
   if (!s.processing.empty()) Flatten(s.processing, "", content.processing);
-  content.warnings = s.warnings;
+  // The warnings are texts of summary.json, which keeps every digit; the report shows seven.
+  for (const std::string& warning : s.warnings) content.warnings.push_back(ShowNumbersIn(warning));
   return content;
 }
 

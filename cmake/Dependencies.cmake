@@ -7,7 +7,7 @@ find_package(CLI11 REQUIRED)
 find_package(fmt REQUIRED)
 find_package(OpenSSL REQUIRED COMPONENTS Crypto)
 find_package(Threads REQUIRED)
-# Boost.Math (header-only): the chi-square distribution of the wheel model's Wald test (fitting/wheel_model.cc).
+# Boost.Math (header-only): the chi-square distribution of the wheel model's Wald test (fitting/wheel_model_knots.cc).
 find_package(Boost 1.74 REQUIRED)
 # OpenCV: only the Delaunay triangulation (cv::Subdiv2D) for scattered error maps (polishing/).
 find_package(OpenCV REQUIRED COMPONENTS core imgproc)

@@ -2,7 +2,7 @@
 // Gridded maps of a surface error over the part frame's (x, y): the form error `arcwheel toolpath`
 // predicts (prediction.h5), the residual `arcwheel polish` predicts (residual_map.h5), and any
 // error map given to `arcwheel polish` as HDF5. The one place that spells their layout
-// (docs/outputs.md, "Grid maps"): the writers (grinding/prediction.cc, polishing/error_map_io.cc)
+// (docs/outputs.md, "Grid maps"): the writers (grinding/prediction.cc, polishing/error_map_hdf5.cc)
 // and the readers (polishing's error-map reader) use these names and LocateGridMap.
 //
 // Layout 1.0, everything at the root:

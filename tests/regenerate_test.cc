@@ -18,6 +18,7 @@
 #include "polishing/error_map_io.h"
 #include "polishing/job.h"
 #include "surfaces/surface.h"
+#include "tests/trial_jobs.h"
 
 namespace arcwheel {
 namespace {
@@ -27,7 +28,9 @@ using nlohmann::json;
 using ::testing::HasSubstr;
 using testing::ReadText;
 using testing::RunArcwheel;
+using testing::SmallTrialPart;
 using testing::TempDir;
+using testing::TrialPolishJob;
 using testing::WriteText;
 
 json ReadJson(const fs::path& path) { return json::parse(ReadText(path)); }
@@ -37,31 +40,6 @@ const fs::path kTrialPart = testing::SourceDir() / "grinding/examples/trial_part
 constexpr double kNominalArcRadiusMm = 55.4423;
 // The dressed wheel of the simulated scan: 0.1 mm larger than nominal.
 constexpr double kDressedArcRadiusMm = 55.5423;
-
-// The trial part with coarser rows, points and map so that the test runs in seconds; the
-// surface, the aperture and the wheel (nominal radius included) are the shipped ones.
-json SmallTrialPart() {
-  json job = ReadJson(kTrialPart);
-  job["path"]["step_over_mm"] = 10.0;
-  job["path"]["point_spacing_mm"] = 10.0;
-  job["gouge_check"] = {{"spacing_mm", 50.0}, {"samples", 9}};
-  job["prediction"]["map_nodes"] = {44, 44};  // a 10 mm grid over 430 mm
-  return job;
-}
-
-// A polishing job for the trial part: a wide Gaussian tool on a raster whose points lie on the
-// map's 10 mm grid. Its error map comes from the chain.
-json TrialPolishJob() {
-  const json part = ReadJson(kTrialPart);
-  return {{"name", "trial part after grinding"},
-          {"surface", part["surface"]},
-          {"aperture", part["aperture"]},
-          {"error_map", json::object()},
-          {"removal_target", {{"uniform_layer_um", 0.2}}},
-          {"removal_function", {{"peak_rate_um_per_s", 0.1}, {"fwhm_mm", 60.0}}},
-          {"path", {{"line_spacing_mm", 10.0}, {"point_spacing_mm", 10.0}, {"extension_mm", 40.0}}},
-          {"machine", {{"max_speed_mm_s", 500.0}}}};
-}
 
 // Height of the trial part (even asphere, R0 4066.172723 mm, k -0.581986, 300 / 300 mm off axis,
 // concave), written out here from method.md A.9 rather than taken from surfaces/.

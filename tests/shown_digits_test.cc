@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "core/testing/testing.h"
+#include "tests/trial_jobs.h"
 
 namespace arcwheel {
 namespace {
@@ -101,27 +102,6 @@ TEST(ShownDigits, TheCheckFlagsAFullPrecisionDoubleAndPassesRoundedOnes) {
               ::testing::ElementsAre("0.123456789"));
 }
 
-// The shipped trial part with coarse rows and map, so that the chain runs in seconds.
-json SmallTrialPart() {
-  json job = json::parse(ReadText(testing::SourceDir() / "grinding/examples/trial_part.json"));
-  job["path"]["step_over_mm"] = 10.0;
-  job["path"]["point_spacing_mm"] = 10.0;
-  job["gouge_check"] = {{"spacing_mm", 50.0}, {"samples", 9}};
-  job["prediction"]["map_nodes"] = {44, 44};
-  return job;
-}
-
-json TrialPolishJob(const json& part) {
-  return {{"name", "trial part after grinding"},
-          {"surface", part["surface"]},
-          {"aperture", part["aperture"]},
-          {"error_map", json::object()},
-          {"removal_target", {{"uniform_layer_um", 0.2}}},
-          {"removal_function", {{"peak_rate_um_per_s", 0.1}, {"fwhm_mm", 60.0}}},
-          {"path", {{"line_spacing_mm", 10.0}, {"point_spacing_mm", 10.0}, {"extension_mm", 40.0}}},
-          {"machine", {{"max_speed_mm_s", 500.0}}}};
-}
-
 void ExpectShortNumbers(const std::string& what, const std::string& text) {
   EXPECT_FALSE(text.empty()) << what << " is empty";
   EXPECT_THAT(OverlongNumbers(text), ::testing::IsEmpty()) << what << ":\n" << text;
@@ -147,9 +127,8 @@ TEST_F(ShownDigitsOfCommands, ProcessAndItsReport) {
 }
 
 TEST_F(ShownDigitsOfCommands, ToolpathPolishAndRegenerateAndTheirReports) {
-  const json part = SmallTrialPart();
-  WriteText(dir_ / "part.json", part.dump(2));
-  WriteText(dir_ / "polish.json", TrialPolishJob(part).dump(2));
+  WriteText(dir_ / "part.json", testing::SmallTrialPart().dump(2));
+  WriteText(dir_ / "polish.json", testing::TrialPolishJob().dump(2));
   const auto regenerate =
       RunArcwheel("regenerate --scan " + scan_.string() + " --job " + (dir_ / "part.json").string() +
                   " --polish " + (dir_ / "polish.json").string() + " -o " + (dir_ / "r").string());

@@ -58,7 +58,7 @@ TEST(PolishReport, PdfCarriesPvRmsBeforeAfterAndTotalTimeRoundedFromTheSummary) 
   Polish(dir / "out", "--report pdf,html");
   EXPECT_EQ(ListFolder(dir / "out"),
             "polish.mod\npolish_report.html\npolish_report.pdf\npolish_summary.json\npolishing_path."
-            "csv\nresidual_map.csv\nresidual_map.h5\n");
+            "csv\nresidual_map.csv\nresidual_map.h5\nrobot_joints.csv\n");
   const std::string summary_text = ReadText(dir / "out" / "polish_summary.json");
   const nlohmann::json summary = nlohmann::json::parse(summary_text);
   const std::string text = PdfText(dir / "out" / "polish_report.pdf");
@@ -186,7 +186,7 @@ TEST(ReportCommand, MakesThePolishReportForAPolishFolder) {
   EXPECT_THAT(result.output, HasSubstr((dir / "out" / "polish_report.pdf").string()));
   EXPECT_EQ(ListFolder(dir / "out"),
             "polish.mod\npolish_report.html\npolish_report.pdf\npolish_summary.json\npolishing_path."
-            "csv\nresidual_map.csv\nresidual_map.h5\n");
+            "csv\nresidual_map.csv\nresidual_map.h5\nrobot_joints.csv\n");
 }
 
 TEST(ReportCommand, RefusesACorruptResidualLineNamingFileAndLineAndKeepsTheEarlierReport) {

@@ -3,7 +3,7 @@
 # built), so the installed package's link interfaces name them, and arcwheelConfig.cmake defines
 # them from the consumer's own find_package(HDF5) and find_library, as cmake/Dependencies.cmake
 # does in the build. Expects HDF5 (C), PkgConfig::FFTW3, FFTW3_THREADS_LIBRARY, Threads, orocos_kdl,
-# urdfdom, KDL_PARSER_LIBRARY and KDL_PARSER_INCLUDE_DIR found.
+# urdfdom, OROCOS_KDL_LIBRARY, KDL_PARSER_LIBRARY and KDL_PARSER_INCLUDE_DIR found.
 if(NOT TARGET arcwheel::hdf5)
   add_library(arcwheel::hdf5 INTERFACE IMPORTED)
   target_include_directories(arcwheel::hdf5 SYSTEM INTERFACE ${HDF5_C_INCLUDE_DIRS} ${HDF5_INCLUDE_DIRS})
@@ -19,5 +19,5 @@ if(NOT TARGET arcwheel::kdl)
   add_library(arcwheel::kdl INTERFACE IMPORTED)
   target_include_directories(arcwheel::kdl SYSTEM INTERFACE ${KDL_PARSER_INCLUDE_DIR} ${urdfdom_INCLUDE_DIRS}
                              ${orocos_kdl_INCLUDE_DIRS})
-  target_link_libraries(arcwheel::kdl INTERFACE ${KDL_PARSER_LIBRARY} ${urdfdom_LIBRARIES} ${orocos_kdl_LIBRARIES})
+  target_link_libraries(arcwheel::kdl INTERFACE ${KDL_PARSER_LIBRARY} ${urdfdom_LIBRARIES} ${OROCOS_KDL_LIBRARY})
 endif()

@@ -15,6 +15,9 @@ find_package(OpenCV REQUIRED COMPONENTS core imgproc)
 # kdl_parser between them. kdl_parser's own CMake package (catkin-generated) looks for ROS's
 # ament tools, which Debian does not ship: its library and header are found directly.
 find_package(orocos_kdl REQUIRED)
+# Its package names the library by a bare name (orocos-kdl): found as a path, as an installed
+# package's link interface needs.
+find_library(OROCOS_KDL_LIBRARY orocos-kdl REQUIRED)
 find_package(urdfdom REQUIRED)
 find_library(KDL_PARSER_LIBRARY kdl_parser REQUIRED)
 find_path(KDL_PARSER_INCLUDE_DIR kdl_parser/kdl_parser.hpp REQUIRED)

@@ -22,6 +22,7 @@ constexpr double kTwoPi = 2.0 * std::numbers::pi;
 struct Failure {
   std::size_t target = 0;
   std::string why;
+  bool speed = false;  // a joint too fast (the target itself is reachable in this configuration)
 };
 
 // A branch's solution of the targets `index` (all, or a subsample when searching placements).
@@ -108,11 +109,13 @@ BranchRun RunBranch(const RobotKinematics& kinematics, const RobotMargins& margi
         path.max_speed_ratio[i] = std::max(path.max_speed_ratio[i], ratio);
         if (ratio > margins.max_joint_speed_ratio) {
           run.failure = Failure{
-              k, fmt::format("joint {} too fast: it turns {:.4f} deg in the {:.4g} s of the segment into the "
-                             "target, {:.1f} deg/s, {:.3f} of its maximum {:.0f} deg/s "
-                             "(robot.max_joint_speed_ratio = {})",
-                             i + 1, moved * kDegPerRad, t, t > 0.0 ? moved / t * kDegPerRad : 0.0, ratio,
-                             limits[i].max_speed_rad_s * kDegPerRad, margins.max_joint_speed_ratio)};
+              k,
+              fmt::format("joint {} too fast: it turns {:.4f} deg in the {:.4g} s of the segment into the "
+                          "target, {:.1f} deg/s, {:.3f} of its maximum {:.0f} deg/s "
+                          "(robot.max_joint_speed_ratio = {})",
+                          i + 1, moved * kDegPerRad, t, t > 0.0 ? moved / t * kDegPerRad : 0.0, ratio,
+                          limits[i].max_speed_rad_s * kDegPerRad, margins.max_joint_speed_ratio),
+              true};
           return run;
         }
       }
@@ -230,7 +233,8 @@ RobotPath SolveRobotPath(const RobotKinematics& kinematics, const RobotMargins& 
     if (k == furthest->target && single.best) alone_cfx = single.best->branch.Cfx();
   }
   const std::string robot = std::string(kinematics.model().name);
-  if (each_alone) {
+  // A joint too fast is not cured by another configuration: named as it is.
+  if (each_alone && !furthest->speed) {
     throw Error(
         ErrorCode::kBadInput, kStage,
         fmt::format("'{}': the path needs a configuration change: no one arm configuration of {} runs "

@@ -90,6 +90,7 @@ TEST(SolveRobotPath, RefusesAJointTooFastForItsSpecifiedSpeed) {
   const auto poses = JointLine({0, 10, 0, 0, 50, 0}, {0, 10, 0, 0, 50, 100}, 11);
   const std::string why = RefusalOf(poses, 0.02, {.max_joint_speed_ratio = 1.0});
   EXPECT_NE(why.find("joint 6 too fast"), std::string::npos) << why;
+  EXPECT_EQ(why.find("configuration change"), std::string::npos) << "no other configuration turns it slower";
   // At 0.05 s (200 deg/s) it runs.
   EXPECT_EQ(RefusalOf(poses, 0.05, {.max_joint_speed_ratio = 1.0}), "");
 }

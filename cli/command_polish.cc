@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "cli/commands.h"
+#include "polishing/job.h"
 #include "reports/polish_report.h"
 #include "workflows/steps.h"
 
@@ -18,18 +19,27 @@ void AddPolishCommand(CLI::App& app) {
     std::string job;
     std::string output;
     std::vector<std::string> report_formats;
+    bool place_workobject = false;
   };
   auto arguments = std::make_shared<Arguments>();
   CLI::App* command = app.add_subcommand(
       "polish", "dwell time, tool frames and an ABB RAPID program that polish an error map away");
   command->add_option("JOB", arguments->job, "job file (JSON, see docs/polishing.md)")->required();
   command->add_option("-o,--output", arguments->output, "output folder")->required();
+  command->add_flag("--place-workobject", arguments->place_workobject,
+                    "propose a work-object origin where the job's robot runs the path with every margin "
+                    "kept, print it and its margins; writes nothing");
   command
       ->add_option("--report", arguments->report_formats,
                    "also render the polishing report: html,pdf (both are written, docs/reports.md)")
       ->delimiter(',')
       ->check(CLI::IsMember({"html", "pdf"}));
   command->callback([arguments] {
+    if (arguments->place_workobject) {
+      const polishing::PolishJob job = polishing::ReadPolishJob(arguments->job);
+      fmt::print("{}", polishing::DescribeProposal(polishing::ProposeWorkObject(job), job));
+      return;
+    }
     (void)workflows::RunPolishStep(arguments->job, std::nullopt, arguments->output);
     if (!arguments->report_formats.empty()) {
       // Drawn from the files just written, exactly as `arcwheel report OUTDIR` would.

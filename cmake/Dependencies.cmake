@@ -11,6 +11,16 @@ find_package(Threads REQUIRED)
 find_package(Boost 1.74 REQUIRED)
 # OpenCV: only the Delaunay triangulation (cv::Subdiv2D) for scattered error maps (polishing/).
 find_package(OpenCV REQUIRED COMPONENTS core imgproc)
+# The robot's kinematics (polishing/robot_kinematics.cc): orocos KDL, the URDF parser urdfdom and
+# kdl_parser between them. kdl_parser's own CMake package (catkin-generated) looks for ROS's
+# ament tools, which Debian does not ship: its library and header are found directly.
+find_package(orocos_kdl REQUIRED)
+# Its package names the library by a bare name (orocos-kdl): found as a path, as an installed
+# package's link interface needs.
+find_library(OROCOS_KDL_LIBRARY orocos-kdl REQUIRED)
+find_package(urdfdom REQUIRED)
+find_library(KDL_PARSER_LIBRARY kdl_parser REQUIRED)
+find_path(KDL_PARSER_INCLUDE_DIR kdl_parser/kdl_parser.hpp REQUIRED)
 if(ARCWHEEL_BUILD_PYTHON)
   # Debian's interpreter, which has numpy, h5py and matplotlib (scripts/packages.txt); a python3
   # earlier on the PATH (pyenv) may lack them.

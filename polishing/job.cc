@@ -165,6 +165,79 @@ ErrorMap ReadErrorMapSection(JsonSection& s, const std::filesystem::path& file) 
   return PlaceInPartFrame(raw, p, file.string());
 }
 
+// The robot section: a known model (or a URDF of it), its base frame in the world, the margins.
+// Range problems, an unknown model, a base frame that is not rigid and a URDF that does not parse
+// are added to `problems`, so that all of them are named together.
+void ReadRobot(JsonSection& s, const std::filesystem::path& job_path, PolishJob& job,
+               std::vector<std::string>& problems) {
+  std::vector<std::string> known;
+  for (const RobotModel& m : RobotModels()) known.emplace_back(m.name);
+  const std::string model = s.String("model", "");
+  job.robot.model = FindRobotModel(model);
+  if (!job.robot.model) {
+    problems.push_back(fmt::format("robot.model = '{}' is not a robot arcwheel knows (known: {})", model,
+                                   fmt::join(known, ", ")));
+  }
+  s.Section("base", false, [&](JsonSection& b) {
+    Eigen::Matrix4d m = Eigen::Matrix4d::Identity();
+    if (b.Has("matrix")) {
+      if (b.Has("origin_mm") || b.Has("quaternion"))
+        b.Fail("matrix", "is an alternative to origin_mm and quaternion: give one or the other");
+      const std::vector<double> v = b.RequiredNumbers("matrix", 16);
+      for (int r = 0; r < 4; ++r)
+        for (int c = 0; c < 4; ++c) m(r, c) = v[static_cast<std::size_t>(4 * r + c)];
+    } else {
+      const std::vector<double> origin = b.Numbers("origin_mm", {0.0, 0.0, 0.0});
+      const std::vector<double> q = b.Numbers("quaternion", {1.0, 0.0, 0.0, 0.0});
+      const double norm = std::sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
+      if (std::abs(norm - 1.0) > 1e-6) {
+        problems.push_back(
+            fmt::format("robot.base.quaternion = [{}] is not a rigid transform: a rotation is a "
+                        "unit quaternion (q1 scalar first), this one has norm {}",
+                        fmt::join(q, ", "), norm));
+      } else {
+        m.topLeftCorner<3, 3>() =
+            Eigen::Quaterniond(q[0] / norm, q[1] / norm, q[2] / norm, q[3] / norm).toRotationMatrix();
+      }
+      m.topRightCorner<3, 1>() = Eigen::Vector3d(origin[0], origin[1], origin[2]);
+    }
+    if (std::optional<std::string> problem = RigidTransformProblem(m)) {
+      problems.push_back(fmt::format("robot.base.matrix is not a rigid transform: it {}", *problem));
+    } else {
+      job.robot.world_from_base.matrix() = m;
+    }
+  });
+  if (s.Has("urdf")) {
+    const std::filesystem::path file = s.String("urdf", "");
+    const std::filesystem::path resolved = file.is_absolute() ? file : job_path.parent_path() / file;
+    std::ifstream in(resolved, std::ios::binary);
+    if (!in)
+      throw Error(ErrorCode::kIo, kStage, fmt::format("cannot open robot.urdf '{}'", resolved.string()));
+    std::ostringstream text;
+    text << in.rdbuf();
+    job.robot.urdf_override = text.str();
+    job.robot.urdf_source = resolved.string();
+  }
+  job.robot.margins.min_joint_margin_deg =
+      s.Number("min_joint_margin_deg", RobotMargins{}.min_joint_margin_deg);
+  job.robot.margins.min_wrist_margin_deg =
+      s.Number("min_wrist_margin_deg", RobotMargins{}.min_wrist_margin_deg);
+  job.robot.margins.max_joint_speed_ratio =
+      s.Number("max_joint_speed_ratio", RobotMargins{}.max_joint_speed_ratio);
+  for (std::string& p : job.robot.margins.Problems()) problems.push_back(std::move(p));
+  if (!job.robot.model) return;
+  if (job.robot.urdf_override.empty())
+    job.robot.urdf_source = fmt::format("{} (built in)", job.robot.model->name);
+  try {
+    job.robot_kinematics = std::make_shared<const RobotKinematics>(
+        *job.robot.model,
+        job.robot.urdf_override.empty() ? std::string(job.robot.model->urdf) : job.robot.urdf_override,
+        job.robot.urdf_source);
+  } catch (const Error& e) {
+    problems.push_back(fmt::format("robot.urdf: {}", e.what()));
+  }
+}
+
 }  // namespace
 
 PolishJob ReadPolishJob(const std::filesystem::path& path,
@@ -209,13 +282,16 @@ PolishJob ReadPolishJob(const std::filesystem::path& path,
     job.work_object.origin_mm = {origin[0], origin[1], origin[2]};
     job.work_object.orientation = ReadQuaternion(c, "quaternion");
   });
+  std::vector<std::string> robot_problems;
+  if (s.Has("robot"))
+    s.Section("robot", false, [&](JsonSection& c) { ReadRobot(c, path, job, robot_problems); });
   s.Finish();
   // The path's defaults come from the removal function's width: with a bad width (already in
   // `problems`) they would only repeat it.
   const bool removal_usable = problems.empty();
   for (std::vector<std::string> more :
        {job.target.Problems(), removal_usable ? job.path.Problems() : std::vector<std::string>{},
-        job.dwell.Problems(), job.tool.Problems(), job.precession.Problems()}) {
+        job.dwell.Problems(), job.tool.Problems(), job.precession.Problems(), robot_problems}) {
     problems.insert(problems.end(), more.begin(), more.end());
   }
   s.ThrowIfProblems(problems);
@@ -302,28 +378,116 @@ std::string ResidualCsv(const ErrorMap& target, const DwellSolution& d) {
 
 }  // namespace
 
-PolishRunReport RunPolishJob(const PolishJob& job, const std::filesystem::path& output_folder) {
+namespace {
+
+// The path, its dwell and the points the robot runs, before anything is written.
+struct Plan {
+  ErrorMap target;
+  PolishRunReport report;
+  std::vector<PolishingPoint> points;
+};
+
+Plan MakePlan(const PolishJob& job) {
   const std::vector<Eigen::Vector2d> path = job.path_pattern == PathPattern::kSpiral
                                                 ? SpiralPath(job.aperture, job.path)
                                                 : RasterPath(job.aperture, job.path);
   CheckOnSurface(job, path);
-  const ErrorMap target = RemovalTarget(job.error_map, job.aperture, job.target);
-  PolishRunReport report;
+  Plan plan;
+  plan.target = RemovalTarget(job.error_map, job.aperture, job.target);
+  PolishRunReport& report = plan.report;
   // The dwell is the time the robot takes on each TCP chord, precession included.
   const std::vector<double> chord_mm = TcpChordsMm(TcpPositionsMm(*job.surface, path, job.precession));
-  report.dwell = SolveDwell(target, job.aperture, path, chord_mm, job.removal, job.dwell);
-  const std::vector<PolishingPoint> points =
-      BuildPolishingPath(*job.surface, path, report.dwell, job.robot_side, job.precession);
-  report.points = points.size();
+  report.dwell = SolveDwell(plan.target, job.aperture, path, chord_mm, job.removal, job.dwell);
+  plan.points = BuildPolishingPath(*job.surface, path, report.dwell, job.robot_side, job.precession);
+  report.points = plan.points.size();
   report.max_speed_mm_s =
       *std::max_element(report.dwell.speed_mm_s.begin() + 1, report.dwell.speed_mm_s.end());
   report.min_speed_mm_s =
       *std::min_element(report.dwell.speed_mm_s.begin() + 1, report.dwell.speed_mm_s.end());
+  return plan;
+}
+
+std::vector<Eigen::Vector3d> TargetPositions(std::span<const PolishingPoint> points) {
+  std::vector<Eigen::Vector3d> out;
+  out.reserve(points.size());
+  for (const PolishingPoint& p : points) out.push_back(p.position_mm);
+  return out;
+}
+
+std::string RobotJointsCsv(const RobotPath& robot) {
+  fmt::memory_buffer out;
+  fmt::format_to(std::back_inserter(out), "{}\n", fmt::join(schema::polish::robot_joints::kColumns, ","));
+  for (std::size_t k = 0; k < robot.joints_rad.size(); ++k) {
+    const JointAngles& q = robot.joints_rad[k];
+    constexpr double kDeg = 180.0 / std::numbers::pi;
+    fmt::format_to(std::back_inserter(out), "{},{},{},{},{},{},{}\n", k + 1, q[0] * kDeg, q[1] * kDeg,
+                   q[2] * kDeg, q[3] * kDeg, q[4] * kDeg, q[5] * kDeg);
+  }
+  return fmt::to_string(out);
+}
+
+}  // namespace
+
+WorkObjectProposal ProposeWorkObject(const PolishJob& job) {
+  if (!job.robot_kinematics) {
+    throw Error(ErrorCode::kInvalidOption, kStage,
+                fmt::format("'{}': --place-workobject needs a robot: the job has no \"robot\" section "
+                            "(docs/polishing.md, \"Robot\")",
+                            job.source.string()));
+  }
+  const Plan plan = MakePlan(job);
+  return ProposeWorkObjectOrigin(*job.robot_kinematics, job.robot.margins, plan.points, job.tool,
+                                 job.work_object, job.robot.world_from_base, plan.report.dwell.dwell_s,
+                                 job.source.string());
+}
+
+std::string DescribeProposal(const WorkObjectProposal& proposal, const PolishJob& job) {
+  const RobotPath& r = proposal.path;
+  const RobotMargins& m = job.robot.margins;
+  std::string out = fmt::format(
+      "{}: work-object origin [{:.1f}, {:.1f}, {:.1f}] mm (world frame; orientation as in the job) runs the "
+      "path in arm configuration cfx {} ({} origins tried)\n"
+      "set \"workobject\": {{\"origin_mm\": [{:.1f}, {:.1f}, {:.1f}]}}\n",
+      job.robot.model->name, proposal.origin_mm.x(), proposal.origin_mm.y(), proposal.origin_mm.z(),
+      r.branch.Cfx(), proposal.candidates, proposal.origin_mm.x(), proposal.origin_mm.y(),
+      proposal.origin_mm.z());
+  for (int i = 0; i < kRobotJoints; ++i) {
+    const auto n = static_cast<std::size_t>(i);
+    out += fmt::format(
+        "joint {}: limits {:.0f} .. {:.0f} deg, smallest margin {:.2f} deg (at least {}), largest "
+        "speed {:.3f} of its maximum (at most {})\n",
+        i + 1, r.limits_deg[n][0], r.limits_deg[n][1], r.min_limit_margin_deg[n], m.min_joint_margin_deg,
+        r.max_speed_ratio[n], m.max_joint_speed_ratio);
+  }
+  out += fmt::format("wrist singularity: |joint 5| >= {:.2f} deg (at least {})\n", r.wrist_margin_deg,
+                     m.min_wrist_margin_deg);
+  return out;
+}
+
+PolishRunReport RunPolishJob(const PolishJob& job, const std::filesystem::path& output_folder) {
+  Plan plan = MakePlan(job);
+  const ErrorMap& target = plan.target;
+  PolishRunReport& report = plan.report;
+  const std::vector<PolishingPoint>& points = plan.points;
+  if (job.robot_kinematics) {
+    // Refused here, before anything is written, when the robot cannot run the path.
+    const std::vector<Eigen::Isometry3d> poses =
+        FlangePosesInBase(points, job.tool, job.work_object, job.robot.world_from_base);
+    const std::vector<Eigen::Vector3d> targets = TargetPositions(points);
+    report.robot = SolveRobotPath(*job.robot_kinematics, job.robot.margins, poses, report.dwell.dwell_s,
+                                  job.source.string(), targets);
+  }
 
   const std::vector<std::string> comments = {fmt::format("arcwheel {} polish, job '{}'", kVersion, job.name),
                                              fmt::format("surface: {}", job.surface->Describe()),
                                              fmt::format("aperture: {}", job.aperture.Describe()),
                                              fmt::format("removal function: {}", job.removal.Describe())};
+  std::vector<std::string> program_comments = comments;
+  if (report.robot) {
+    program_comments.push_back(
+        fmt::format("robot: {}, arm configuration cfx {} held along the path (ConfL \\On)",
+                    job.robot.model->name, report.robot->branch.Cfx()));
+  }
   namespace key = schema::polish::summary;
   const auto figures = [](const auto& f) {
     return json{{key::figures::kPvUm, f.pv_um}, {key::figures::kRmsUm, f.rms_um}};
@@ -345,6 +509,17 @@ PolishRunReport RunPolishJob(const PolishJob& job, const std::filesystem::path& 
         {key::solver::kConverged, report.dwell.converged},
         {key::solver::kNonzeros, report.dwell.nonzeros},
         {key::solver::kShapingRounds, report.dwell.shaping_rounds}}}};
+  if (report.robot) {
+    const RobotPath& r = *report.robot;
+    summary[key::kRobot] = {{key::robot::kModel, job.robot.model->name},
+                            {key::robot::kCfx, r.branch.Cfx()},
+                            {key::robot::kMinLimitMarginDeg, r.min_limit_margin_deg},
+                            {key::robot::kWristMarginDeg, r.wrist_margin_deg},
+                            {key::robot::kMaxJointSpeedRatio, r.max_speed_ratio},
+                            {key::robot::kLargestJointSpeedRatio, r.largest_speed_ratio},
+                            {key::robot::kLargestJointSpeedJoint, r.largest_speed_joint},
+                            {key::robot::kLimitsDeg, r.limits_deg}};
+  }
 
   OutputSet outputs;
   outputs.CreateFolder(output_folder);
@@ -356,7 +531,10 @@ PolishRunReport RunPolishJob(const PolishJob& job, const std::filesystem::path& 
     if (!out) throw Error(ErrorCode::kIo, kStage, fmt::format("cannot write '{}'", temporary.string()));
   };
   write(schema::polish::kPathFileName, PolishingPathCsv(points, comments));
-  write("polish.mod", RapidModule(points, job.tool, job.work_object, "ArcwheelPolish", comments));
+  write("polish.mod", RapidModule(points, job.tool, job.work_object, "ArcwheelPolish", program_comments,
+                                  report.robot ? std::span<const std::array<int, 4>>(report.robot->confdata)
+                                               : std::span<const std::array<int, 4>>()));
+  if (report.robot) write(schema::polish::kRobotJointsFileName, RobotJointsCsv(*report.robot));
   write(schema::polish::kResidualMapFileName, ResidualCsv(target, report.dwell));
   {
     // The residual as a grid map (schema/grid_map.h): an error map for the next polish run.

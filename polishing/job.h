@@ -10,7 +10,10 @@
 
 #include "polishing/dwell.h"
 #include "polishing/error_map_io.h"
+#include "polishing/reachability.h"
 #include "polishing/removal_target.h"
+#include "polishing/robot_kinematics.h"
+#include "polishing/robot_model.h"
 #include "polishing/robot_program.h"
 #include "polishing/tool_frame.h"
 #include "surfaces/surface.h"
@@ -33,6 +36,10 @@ struct PolishJob {
   PathPrecession precession;  // enabled when the job has a "precession" section
   ToolData tool;
   WorkObject work_object;
+  // The robot that runs the program (the "robot" section); without one nothing is checked and
+  // polish.mod leaves the configuration to the controller (ConfL \Off).
+  RobotCell robot;
+  std::shared_ptr<const RobotKinematics> robot_kinematics;  // of robot.model (or robot.urdf)
   // The job with every default filled in, as JSON text (keeps nlohmann/json out of this header).
   std::string resolved_json;
 };
@@ -67,11 +74,23 @@ struct PolishRunReport {
   std::size_t points = 0;
   double max_speed_mm_s = 0.0;
   double min_speed_mm_s = 0.0;
+  std::optional<RobotPath> robot;  // the robot's solution, when the job names a robot
 };
 
 // Solves the dwell and writes OUTDIR/polishing_path.csv, polish.mod (RAPID), residual_map.csv and
-// polish_summary.json, all or none. Throws Error{kBadInput, "polishing.job"} for a map node or a
-// path point off the surface, and whatever SolveDwell throws.
+// polish_summary.json (and robot_joints.csv with a robot), all or none. With a robot the path is
+// solved for it first (SolveRobotPath: reach, joint limits, wrist singularity, one configuration,
+// joint speeds) and refused before anything is written. Throws Error{kBadInput, "polishing.job"}
+// for a map node or a path point off the surface, Error{kBadInput, "polishing.robot"} for a path
+// the robot cannot run, and whatever SolveDwell throws.
 PolishRunReport RunPolishJob(const PolishJob& job, const std::filesystem::path& output_folder);
+
+// `arcwheel polish --place-workobject`: solves the dwell and the path as RunPolishJob does, then
+// proposes a work-object origin (the job's orientation kept) at which the job's robot runs the
+// path with every margin above the job's thresholds (ProposeWorkObjectOrigin). Writes nothing.
+// Throws Error{kInvalidOption, "polishing.job"} when the job names no robot.
+[[nodiscard]] WorkObjectProposal ProposeWorkObject(const PolishJob& job);
+// The proposal as the command prints it: the origin, the job key to set and every margin.
+[[nodiscard]] std::string DescribeProposal(const WorkObjectProposal& proposal, const PolishJob& job);
 
 }  // namespace arcwheel::polishing

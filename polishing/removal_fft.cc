@@ -206,6 +206,57 @@ void FftRemoval::Convolve(bool correlate) const {
   fftw_execute(w.inverse);
 }
 
+double FftRemoval::NormSquaredBound() const {
+  const Workspace& w = *work_;
+  const double n = static_cast<double>(w.Cells());  // the stored spectrum is scaled by 1 / n
+  double most = 0.0;
+  for (const std::complex<double>& k : w.kernel) most = std::max(most, std::norm(k));
+  return most * n * n;
+}
+
+Eigen::VectorXd FftRemoval::InverseFilter(const Eigen::VectorXd& rows, double relative_damping,
+                                          bool extend) const {
+  ARCWHEEL_CHECK(rows.size() == static_cast<Eigen::Index>(row_cell_.size())) << rows.size();
+  Workspace& w = *work_;
+  // Breadth-first from the row cells over the (non-periodic) grid: each cell takes the value of
+  // the row cell it is reached from, its nearest in steps.
+  std::vector<char> filled(w.Cells(), 0);
+  std::vector<int> queue;
+  queue.reserve(w.Cells());
+  double* cells = ClearedGrid();
+  for (std::size_t r = 0; r < row_cell_.size(); ++r) {
+    cells[row_cell_[r]] = rows[static_cast<Eigen::Index>(r)];
+    filled[static_cast<std::size_t>(row_cell_[r])] = 1;
+    queue.push_back(row_cell_[r]);
+  }
+  if (!extend) queue.clear();
+  for (std::size_t head = 0; head < queue.size(); ++head) {
+    const int c = queue[head], i = c % columns_, j = c / columns_;
+    for (const auto& [di, dj] : {std::pair{1, 0}, std::pair{-1, 0}, std::pair{0, 1}, std::pair{0, -1}}) {
+      const int ni = i + di, nj = j + dj;
+      if (ni < 0 || nj < 0 || ni >= columns_ || nj >= rows_) continue;
+      const int n = nj * columns_ + ni;
+      if (filled[static_cast<std::size_t>(n)]) continue;
+      filled[static_cast<std::size_t>(n)] = 1;
+      cells[n] = cells[c];
+      queue.push_back(n);
+    }
+  }
+  fftw_execute(w.forward);
+  const double n = static_cast<double>(w.Cells());
+  const double damping = relative_damping * relative_damping * NormSquaredBound();
+  std::complex<double>* spectrum = w.Spectrum();
+  for (std::size_t k = 0; k < w.HalfCells(); ++k) {
+    const std::complex<double> kernel = w.kernel[k] * n;  // the kernel's own spectrum
+    spectrum[k] *= std::conj(kernel) / ((std::norm(kernel) + damping) * n);
+  }
+  fftw_execute(w.inverse);
+  Eigen::VectorXd dwell(static_cast<Eigen::Index>(point_cell_.size()));
+  for (std::size_t k = 0; k < point_cell_.size(); ++k)
+    dwell[static_cast<Eigen::Index>(k)] = cells[point_cell_[k]];
+  return dwell;
+}
+
 double* FftRemoval::ClearedGrid() const {
   std::fill(work_->grid, work_->grid + work_->Cells(), 0.0);
   return work_->grid;

@@ -45,6 +45,19 @@ class FftRemoval {
   void ApplyTranspose(const Eigen::VectorXd& rows, Eigen::VectorXd& dwell_s) const;
   // Entries of the sparse matrix that these products stand for: (row, point) pairs with a rate > 0.
   [[nodiscard]] long Nonzeros() const { return nonzeros_; }
+  // An upper bound of ||A||^2, the largest eigenvalue of A^T A: the largest |spectrum|^2 of the
+  // kernel (A is the circular convolution between two restrictions, which cannot lengthen a
+  // vector). The Lipschitz constant of the least-squares gradient, without power iterations.
+  [[nodiscard]] double NormSquaredBound() const;
+  // The row values placed on the FFT grid, filtered by the kernel's damped inverse,
+  // conj(K) / (|K|^2 + mu) with mu = (relative_damping max |K|)^2, and read at the points
+  // (RIFTA-style inverse filtering, Wang et al. 2020). With `extend`, every other cell first takes
+  // the value of its nearest row cell (a flat extension beyond the aperture, which the dwell
+  // points outside it need): a dwell that nearly solves A t = rows without bounds. Without, the
+  // other cells stay 0: then it is M A^T rows, M the damped inverse of the kernel's power
+  // spectrum, a preconditioned gradient of the least-squares problem.
+  [[nodiscard]] Eigen::VectorXd InverseFilter(const Eigen::VectorXd& rows, double relative_damping,
+                                              bool extend = true) const;
 
  private:
   struct Workspace;  // FFTW plans and arrays

@@ -130,7 +130,9 @@ std::string PolishingPathCsv(std::span<const PolishingPoint> points, std::span<c
 
 std::string RapidModule(std::span<const PolishingPoint> points, const ToolData& tool,
                         const WorkObject& work_object, const std::string& module_name,
-                        std::span<const std::string> comments) {
+                        std::span<const std::string> comments, std::span<const std::array<int, 4>> confdata) {
+  ARCWHEEL_CHECK(confdata.empty() || confdata.size() == points.size())
+      << confdata.size() << " confdata for " << points.size() << " points";
   fmt::memory_buffer out;
   auto line = [&out](const std::string& text) { fmt::format_to(std::back_inserter(out), "{}\n", text); };
   line(fmt::format("MODULE {}", module_name));
@@ -154,9 +156,10 @@ std::string RapidModule(std::span<const PolishingPoint> points, const ToolData& 
   line(fmt::format("  CONST robtarget pPath{{{}}} := [", points.size()));
   for (std::size_t k = 0; k < points.size(); ++k) {
     const PolishingPoint& p = points[k];
-    line(fmt::format("    [[{:.4f},{:.4f},{:.4f}],{},[0,0,0,0],[9E9,9E9,9E9,9E9,9E9,9E9]]{}",
+    const std::array<int, 4> conf = confdata.empty() ? std::array<int, 4>{0, 0, 0, 0} : confdata[k];
+    line(fmt::format("    [[{:.4f},{:.4f},{:.4f}],{},[{},{},{},{}],[9E9,9E9,9E9,9E9,9E9,9E9]]{}",
                      p.position_mm.x(), p.position_mm.y(), p.position_mm.z(), Quaternion9(p.orientation),
-                     k + 1 < points.size() ? "," : "];"));
+                     conf[0], conf[1], conf[2], conf[3], k + 1 < points.size() ? "," : "];"));
   }
   // speeddata: TCP speed (mm/s), reorientation (deg/s), linear and rotational external axes.
   line(fmt::format("  CONST speeddata vPath{{{}}} := [", points.size()));
@@ -168,7 +171,8 @@ std::string RapidModule(std::span<const PolishingPoint> points, const ToolData& 
   // to segment; the last move is a stop point (fine), so that the program ends with the tool
   // exactly on the last target. Each target is moved to once: no zero-length repeat of the last.
   line("  PROC main()");
-  line("    ConfL \\Off;");
+  // With the robot's solution the configuration is held (and checked by the controller).
+  line(confdata.empty() ? "    ConfL \\Off;" : "    ConfL \\On;");
   line("    FOR i FROM 1 TO nPoints - 1 DO");
   line("      MoveL pPath{i}, vPath{i}, z1, tPolish \\WObj:=wPart;");
   line("    ENDFOR");

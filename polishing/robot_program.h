@@ -5,6 +5,7 @@
 //    point (position and ABB quaternion) and MoveL with per-segment speeddata.
 
 #include <Eigen/Core>
+#include <array>
 #include <span>
 #include <string>
 #include <vector>
@@ -88,9 +89,13 @@ struct WorkObject {
                                            std::span<const std::string> comments);
 
 // RAPID module text. Positions are written to 0.1 um (4 decimals) and quaternions to 9 decimals,
-// as RAPID's num holds about 7 significant digits; the module header says so.
+// as RAPID's num holds about 7 significant digits; the module header says so. `confdata` gives
+// each target's [cf1, cf4, cf6, cfx] (a robot's solution of the path, reachability.h), one per
+// point: the program then runs under ConfL \On, the robot keeping that configuration. Empty: every
+// target [0,0,0,0] under ConfL \Off (the controller picks the configuration nearest its own).
 [[nodiscard]] std::string RapidModule(std::span<const PolishingPoint> points, const ToolData& tool,
                                       const WorkObject& work_object, const std::string& module_name,
-                                      std::span<const std::string> comments);
+                                      std::span<const std::string> comments,
+                                      std::span<const std::array<int, 4>> confdata = {});
 
 }  // namespace arcwheel::polishing

@@ -223,6 +223,37 @@ ReportFigure SpeedPlot(const PolishReportInputs& in) {
   return {caption, plot, 0.42};
 }
 
+// Joints 1 - 6 along the path against their limits (the robot's solution, robot_joints.csv), in
+// two rows of three.
+std::vector<std::vector<ReportFigure>> JointRows(const PolishReportInputs& in) {
+  const PolishSummary& s = in.summary;
+  const RobotJointsTable& t = in.robot_joints;
+  std::vector<std::vector<ReportFigure>> rows(2);
+  for (std::size_t i = 0; i < 6; ++i) {
+    plot::LinePlot plot;
+    plot.title = fmt::format("Joint {}", i + 1);
+    plot.x.label = "target";
+    plot.y.label = fmt::format("joint {} (deg)", i + 1);
+    plot.series.push_back({"angle", t.target, t.joint_deg[i], {}, {}, plot::SeriesColour(0)});
+    const std::vector<double> ends = {t.target.front(), t.target.back()};
+    for (const double limit : s.robot_limits_deg[i]) {
+      plot::Series line{"limit", ends, {limit, limit}, {}, {}, plot::SeriesColour(5)};
+      line.dashed = true;
+      plot.series.push_back(line);
+    }
+    const std::string caption =
+        i == 0 ? fmt::format(
+                     "Joint angles of the {} at each target (cfx {}); dashed: the joint's limits. "
+                     "Smallest margin to a limit: joint 1 {:.1f} deg.",
+                     s.robot_model, s.robot_cfx, s.robot_min_limit_margin_deg[i])
+               : fmt::format(
+                     "Smallest margin to a limit: {:.1f} deg{}.", s.robot_min_limit_margin_deg[i],
+                     i == 4 ? fmt::format("; smallest |joint 5| {:.1f} deg", s.robot_wrist_margin_deg) : "");
+    rows[i / 3].push_back({caption, plot, 0.75});
+  }
+  return rows;
+}
+
 }  // namespace
 
 PolishReportContent ComposePolishReport(const PolishReportInputs& inputs) {
@@ -239,6 +270,20 @@ PolishReportContent ComposePolishReport(const PolishReportInputs& inputs) {
   content.figure_rows = MapRows(inputs.residual);
   content.figure_rows.push_back(PathMaps(inputs));
   content.figure_rows.push_back({SpeedPlot(inputs)});
+  if (s.has_robot && inputs.robot_joints.size() > 0) {
+    for (std::vector<ReportFigure>& row : JointRows(inputs)) content.figure_rows.push_back(std::move(row));
+    content.path.push_back(
+        {"Robot", fmt::format("{}, arm configuration cfx {}", s.robot_model, s.robot_cfx)});
+    double margin = s.robot_min_limit_margin_deg[0], ratio = 0.0;
+    for (std::size_t i = 0; i < 6; ++i) {
+      margin = std::min(margin, s.robot_min_limit_margin_deg[i]);
+      ratio = std::max(ratio, s.robot_max_speed_ratio[i]);
+    }
+    content.path.push_back(
+        {"Robot margins", fmt::format("joint limits >= {:.1f} deg, |joint 5| >= {:.1f} deg, "
+                                      "joint speeds <= {:.3f} of their maxima",
+                                      margin, s.robot_wrist_margin_deg, ratio)});
+  }
   content.job = FlattenJson(s.job);
   return content;
 }

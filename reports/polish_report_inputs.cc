@@ -335,6 +335,22 @@ PolishingPathTable ParsePolishingPathCsv(std::string_view text, const std::strin
   return path;
 }
 
+RobotJointsTable ParseRobotJointsCsv(std::string_view text, const std::string& source_name) {
+  RobotJointsTable table;
+  ReadCsv(
+      text, source_name, schema::polish::robot_joints::kColumns,
+      [&](const std::vector<double>& v, std::size_t line) {
+        for (double value : v) {
+          if (!std::isfinite(value)) BadLine(source_name, line, "every value must be finite");
+        }
+        table.target.push_back(v[0]);
+        for (std::size_t i = 0; i < 6; ++i) table.joint_deg[i].push_back(v[i + 1]);
+      },
+      [](std::string_view) {});
+  if (table.size() == 0) Bad(fmt::format("'{}' has no target", source_name));
+  return table;
+}
+
 PolishSummary ParsePolishSummary(const std::string& text, const std::string& source_name) {
   const json root = ParseJsonText(text, source_name, kStage);
   if (!root.is_object()) Bad(fmt::format("'{}' is not a JSON object", source_name));
@@ -371,6 +387,39 @@ PolishSummary ParsePolishSummary(const std::string& text, const std::string& sou
   s.limit_min_speed_mm_s = r.OptionalNumber(Dotted(machine, key::job::machine::kMinSpeedMmS), 0.0);
   s.limit_max_acceleration_mm_s2 =
       r.OptionalNumber(Dotted(machine, key::job::machine::kMaxAccelerationMmS2), 0.0);
+  if (r.Find(std::string(key::kRobot)) != nullptr) {
+    const std::string robot(key::kRobot);
+    s.has_robot = true;
+    s.robot_model = r.String(Dotted(robot, key::robot::kModel));
+    s.robot_cfx = r.Count(Dotted(robot, key::robot::kCfx));
+    s.robot_wrist_margin_deg = r.Number(Dotted(robot, key::robot::kWristMarginDeg));
+    const auto numbers = [&](std::string_view name, std::size_t count) {
+      const std::string k = Dotted(robot, name);
+      const json& v = r.Require(k);
+      if (!v.is_array() || v.size() != count) r.Fail(k, fmt::format("is not an array of {} values", count));
+      std::vector<double> out;
+      for (const json& e : v) {
+        if (e.is_array()) {
+          for (const json& f : e) out.push_back(f.is_number() ? f.get<double>() : kNaN);
+        } else {
+          out.push_back(e.is_number() ? e.get<double>() : kNaN);
+        }
+      }
+      for (double x : out) {
+        if (!std::isfinite(x)) r.Fail(k, "holds a value that is not a finite number");
+      }
+      return out;
+    };
+    const std::vector<double> limits = numbers(key::robot::kLimitsDeg, 6);
+    const std::vector<double> margins = numbers(key::robot::kMinLimitMarginDeg, 6);
+    const std::vector<double> ratios = numbers(key::robot::kMaxJointSpeedRatio, 6);
+    if (limits.size() != 12) r.Fail(Dotted(robot, key::robot::kLimitsDeg), "is not 6 pairs [lower, upper]");
+    for (std::size_t i = 0; i < 6; ++i) {
+      s.robot_limits_deg[i] = {limits[2 * i], limits[2 * i + 1]};
+      s.robot_min_limit_margin_deg[i] = margins[i];
+      s.robot_max_speed_ratio[i] = ratios[i];
+    }
+  }
   s.total_time_text = r.NumberText(total_time);
   s.before_pv_text = r.NumberText(before_pv);
   s.before_rms_text = r.NumberText(before_rms);
@@ -398,6 +447,15 @@ PolishReportInputs ReadPolishReportInputs(const std::filesystem::path& outdir) {
   }
   for (const auto& file : {summary_path, residual_path, path_path})
     inputs.sources.push_back({file, Sha256OfFile(file)});
+  if (inputs.summary.has_robot) {
+    const std::filesystem::path joints_path = outdir / schema::polish::kRobotJointsFileName;
+    inputs.robot_joints = ParseRobotJointsCsv(ReadWhole(joints_path), joints_path.string());
+    if (inputs.robot_joints.size() != inputs.path.size()) {
+      Bad(fmt::format("'{}' has {} targets but '{}' has {} points", joints_path.string(),
+                      inputs.robot_joints.size(), path_path.string(), inputs.path.size()));
+    }
+    inputs.sources.push_back({joints_path, Sha256OfFile(joints_path)});
+  }
   return inputs;
 }
 

@@ -7,6 +7,7 @@
 // (invalid JSON, a missing key, a wrong type, a bad CSV line, files that disagree) throws
 // Error{kBadInput, "reports.polish"} naming the file and the key or line.
 
+#include <array>
 #include <cstdint>
 #include <filesystem>
 #include <nlohmann/json.hpp>
@@ -72,6 +73,23 @@ struct PolishSummary {
   std::string after_pv_text;
   std::string after_rms_text;
   nlohmann::json job = nlohmann::json::object();  // the job as used
+  // The robot's solution (summary key "robot"), when the job named a robot: model, the arm
+  // configuration (cfx), per joint the limits [lower, upper] (deg), the smallest margin to them
+  // (deg) and the largest speed ratio; the smallest |joint 5| (deg).
+  bool has_robot = false;
+  std::string robot_model;
+  std::int64_t robot_cfx = 0;
+  std::array<std::array<double, 2>, 6> robot_limits_deg{};
+  std::array<double, 6> robot_min_limit_margin_deg{};
+  std::array<double, 6> robot_max_speed_ratio{};
+  double robot_wrist_margin_deg = 0.0;
+};
+
+// robot_joints.csv: joints 1 - 6 (deg) at each target, in path order.
+struct RobotJointsTable {
+  std::vector<double> target;                    // 1-based target number
+  std::array<std::vector<double>, 6> joint_deg;  // joint i + 1 at each target
+  [[nodiscard]] std::size_t size() const { return target.size(); }
 };
 
 // Parsers from text; `source_name` stands for the file in messages. These are the in-memory
@@ -79,6 +97,7 @@ struct PolishSummary {
 [[nodiscard]] ResidualMap ParseResidualMapCsv(std::string_view text, const std::string& source_name);
 [[nodiscard]] PolishingPathTable ParsePolishingPathCsv(std::string_view text, const std::string& source_name);
 [[nodiscard]] PolishSummary ParsePolishSummary(const std::string& text, const std::string& source_name);
+[[nodiscard]] RobotJointsTable ParseRobotJointsCsv(std::string_view text, const std::string& source_name);
 
 struct SourceFile {
   std::filesystem::path path;
@@ -91,7 +110,8 @@ struct PolishReportInputs {
   PolishSummary summary;
   ResidualMap residual;
   PolishingPathTable path;
-  std::vector<SourceFile> sources;  // summary, residual map, path, in that order
+  std::vector<SourceFile> sources;  // summary, residual map, path (and robot joints), in that order
+  RobotJointsTable robot_joints;    // empty unless the summary has a robot
 };
 
 // Reads the three files of a polish output folder. Throws as described at the top.

@@ -58,7 +58,7 @@ TEST(PolishReport, PdfCarriesPvRmsBeforeAfterAndTotalTimeRoundedFromTheSummary) 
   Polish(dir / "out", "--report pdf,html");
   EXPECT_EQ(ListFolder(dir / "out"),
             "polish.mod\npolish_report.html\npolish_report.pdf\npolish_summary.json\npolishing_path."
-            "csv\nresidual_map.csv\nresidual_map.h5\n");
+            "csv\nresidual_map.csv\nresidual_map.h5\nrobot_joints.csv\n");
   const std::string summary_text = ReadText(dir / "out" / "polish_summary.json");
   const nlohmann::json summary = nlohmann::json::parse(summary_text);
   const std::string text = PdfText(dir / "out" / "polish_report.pdf");
@@ -137,6 +137,40 @@ TEST(PolishReport, MapsShareOneColourScaleSpanningTargetRemovalAndResidual) {
   EXPECT_FALSE(own.colour_min.has_value()) << "the residual's own scale";
 }
 
+TEST(PolishReport, PlotsTheSixJointsAlongThePathWithTheSpecifiedLimits) {
+  TempDir dir;
+  Polish(dir / "out");
+  const PolishReportContent content = ComposePolishReport(ReadPolishReportInputs(dir / "out"));
+  // The example's IRB 4600-40/2.55: axis ranges of ABB's product specification (deg).
+  const double limits[6][2] = {{-180, 180}, {-90, 150}, {-180, 75}, {-400, 400}, {-125, 120}, {-400, 400}};
+  std::string joints_csv = ReadText(dir / "out" / "robot_joints.csv");
+  const std::size_t targets =
+      static_cast<std::size_t>(std::count(joints_csv.begin(), joints_csv.end(), '\n')) - 1;
+  int found = 0;
+  for (const auto& row : content.figure_rows) {
+    for (const ReportFigure& figure : row) {
+      const auto* plot = std::get_if<plot::LinePlot>(&figure.figure);
+      if (plot == nullptr || plot->title.rfind("Joint ", 0) != 0) continue;
+      const int joint = std::stoi(plot->title.substr(6));
+      ASSERT_GE(joint, 1);
+      ASSERT_LE(joint, 6);
+      ASSERT_EQ(plot->series.size(), 3u) << plot->title;
+      EXPECT_EQ(plot->series[0].y.size(), targets) << plot->title;
+      for (int side = 0; side < 2; ++side) {
+        EXPECT_TRUE(plot->series[1 + side].dashed);
+        for (double y : plot->series[1 + side].y)
+          EXPECT_NEAR(y, limits[joint - 1][side], 1e-9) << plot->title;
+      }
+      for (double angle : plot->series[0].y) {
+        EXPECT_GT(angle, limits[joint - 1][0]) << plot->title;
+        EXPECT_LT(angle, limits[joint - 1][1]) << plot->title;
+      }
+      ++found;
+    }
+  }
+  EXPECT_EQ(found, 6);
+}
+
 TEST(PolishReport, HtmlLoadsCleanlyInChromiumOnADesktopAndAPhoneScreen) {
   TempDir dir;
   Polish(dir / "out", "--report html");
@@ -186,7 +220,7 @@ TEST(ReportCommand, MakesThePolishReportForAPolishFolder) {
   EXPECT_THAT(result.output, HasSubstr((dir / "out" / "polish_report.pdf").string()));
   EXPECT_EQ(ListFolder(dir / "out"),
             "polish.mod\npolish_report.html\npolish_report.pdf\npolish_summary.json\npolishing_path."
-            "csv\nresidual_map.csv\nresidual_map.h5\n");
+            "csv\nresidual_map.csv\nresidual_map.h5\nrobot_joints.csv\n");
 }
 
 TEST(ReportCommand, RefusesACorruptResidualLineNamingFileAndLineAndKeepsTheEarlierReport) {

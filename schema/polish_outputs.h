@@ -22,6 +22,8 @@ inline constexpr std::string_view kResidualMapFileName = "residual_map.csv";
 // The same residual (and target and removal) as a grid map, schema/grid_map.h.
 inline constexpr std::string_view kResidualGridFileName = "residual_map.h5";
 inline constexpr std::string_view kPathFileName = "polishing_path.csv";
+// The robot's joint angles at each target (only when the job names a robot).
+inline constexpr std::string_view kRobotJointsFileName = "robot_joints.csv";
 
 // polish_summary.json. A key of a nested object lives in the namespace named after the object.
 namespace summary {
@@ -65,6 +67,20 @@ inline constexpr std::string_view kConverged = "converged";
 inline constexpr std::string_view kNonzeros = "nonzeros";
 inline constexpr std::string_view kShapingRounds = "shaping_rounds";
 }  // namespace solver
+// The robot's solution of the path (only when the job names a robot): docs/polishing.md, "Robot".
+inline constexpr std::string_view kRobot = "robot";
+namespace robot {
+inline constexpr std::string_view kModel = "model";
+inline constexpr std::string_view kCfx = "cfx";  // the arm configuration held, RAPID confdata cfx
+// Per joint 1 - 6: the smallest margin to either limit along the path (deg), the largest joint
+// speed / the joint's maximum, and the limits [lower, upper] (deg).
+inline constexpr std::string_view kMinLimitMarginDeg = "min_limit_margin_deg";
+inline constexpr std::string_view kMaxJointSpeedRatio = "max_joint_speed_ratio";
+inline constexpr std::string_view kLimitsDeg = "limits_deg";
+inline constexpr std::string_view kWristMarginDeg = "wrist_margin_deg";  // smallest |joint 5|
+inline constexpr std::string_view kLargestJointSpeedRatio = "largest_joint_speed_ratio";
+inline constexpr std::string_view kLargestJointSpeedJoint = "largest_joint_speed_joint";  // 1 - 6
+}  // namespace robot
 }  // namespace summary
 
 // residual_map.csv: one row per aperture node, in this column order.
@@ -92,5 +108,13 @@ inline constexpr std::string_view kDwellS = "dwell_s";
 inline constexpr std::array<std::string_view, 9> kColumns = {kXMm, kYMm, kZMm,      kQ1,    kQ2,
                                                              kQ3,  kQ4,  kSpeedMmS, kDwellS};
 }  // namespace path
+
+// robot_joints.csv: one row per target of polishing_path.csv, in path order: the target's number
+// (1 = the first row) and joints 1 - 6 in degrees (joints 4 and 6 unwrapped along the path).
+namespace robot_joints {
+inline constexpr std::string_view kTarget = "target";
+inline constexpr std::array<std::string_view, 7> kColumns = {kTarget,  "j1_deg", "j2_deg", "j3_deg",
+                                                             "j4_deg", "j5_deg", "j6_deg"};
+}  // namespace robot_joints
 
 }  // namespace arcwheel::schema::polish

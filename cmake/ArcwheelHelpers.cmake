@@ -33,20 +33,9 @@ if(ARCWHEEL_SANITIZE)
   add_link_options(-fsanitize=${_arcwheel_sanitizers})
 endif()
 
-# A build from nothing (scripts/demo.sh on a fresh machine) spends a third of its time parsing the
-# same few third-party headers in every file; ARCWHEEL_PCH precompiles them once per library. Off
-# by default: GCC 12 reports false warnings through precompiled headers (see above), and ccache
-# makes them needless for developers and CI.
-option(ARCWHEEL_PCH "Precompile the common third-party headers of each library" OFF)
-set(ARCWHEEL_PCH_HEADERS <algorithm> <cmath> <filesystem> <string> <vector> <fmt/format.h> <nlohmann/json.hpp>
-    <Eigen/Core>)
-
 function(arcwheel_add_library)
   cmake_parse_arguments(ARG "" "NAME" "SRCS;DEPS" ${ARGN})
   add_library(arcwheel_${ARG_NAME} STATIC ${ARG_SRCS})
-  if(ARCWHEEL_PCH)
-    target_precompile_headers(arcwheel_${ARG_NAME} PRIVATE ${ARCWHEEL_PCH_HEADERS})
-  endif()
   add_library(arcwheel::${ARG_NAME} ALIAS arcwheel_${ARG_NAME})
   target_include_directories(arcwheel_${ARG_NAME} PUBLIC $<BUILD_INTERFACE:${PROJECT_SOURCE_DIR}>
                              $<BUILD_INTERFACE:${PROJECT_BINARY_DIR}/generated>

@@ -45,8 +45,10 @@ std::vector<std::string> Input::Problems() const {
     problems.push_back(Violation(prefix + ".spread", spread, "finite, >= 0"));
   if (distribution == Distribution::kNormal && (!std::isfinite(coverage_factor) || coverage_factor <= 0.0))
     problems.push_back(Violation(prefix + ".coverage_factor", coverage_factor, "finite, > 0"));
-  if (!std::isfinite(sensitivity)) problems.push_back(Violation(prefix + ".sensitivity", sensitivity, "finite"));
-  if (std::isnan(dof) || dof <= 0.0) problems.push_back(Violation(prefix + ".dof", dof, "> 0 (may be infinite)"));
+  if (!std::isfinite(sensitivity))
+    problems.push_back(Violation(prefix + ".sensitivity", sensitivity, "finite"));
+  if (std::isnan(dof) || dof <= 0.0)
+    problems.push_back(Violation(prefix + ".dof", dof, "> 0 (may be infinite)"));
   return problems;
 }
 

@@ -95,7 +95,7 @@ struct Combined {
   std::vector<Contribution> contributions{};
   // Sum of c_i x_i, the correction the inputs' estimates add to the result (output's unit).
   double correction = 0.0;
-  double standard_uncertainty = 0.0;  // u_c(y) = sqrt(sum u_i(y)^2)
+  double standard_uncertainty = 0.0;    // u_c(y) = sqrt(sum u_i(y)^2)
   double effective_dof = kInfiniteDof;  // nu_eff by Welch-Satterthwaite, not rounded
   double coverage_probability = 0.95;
   double coverage_factor = 0.0;  // k = t_p(nu_eff)

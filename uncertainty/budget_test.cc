@@ -16,13 +16,15 @@ namespace {
 
 TEST(StandardUncertainty, FollowsEachDistributionsClosedForm) {
   // GUM 4.3.7 (a / sqrt 3), 4.3.9 (a / sqrt 6), H.1.3.2 (a / sqrt 2), 4.3.3 (U / k).
-  EXPECT_DOUBLE_EQ(StandardUncertainty({.distribution = Distribution::kRectangular, .spread = std::sqrt(3.0)}),
-                   1.0);
+  EXPECT_DOUBLE_EQ(
+      StandardUncertainty({.distribution = Distribution::kRectangular, .spread = std::sqrt(3.0)}), 1.0);
   EXPECT_DOUBLE_EQ(StandardUncertainty({.distribution = Distribution::kTriangular, .spread = std::sqrt(6.0)}),
                    1.0);
-  EXPECT_DOUBLE_EQ(StandardUncertainty({.distribution = Distribution::kArcsine, .spread = std::sqrt(2.0)}), 1.0);
+  EXPECT_DOUBLE_EQ(StandardUncertainty({.distribution = Distribution::kArcsine, .spread = std::sqrt(2.0)}),
+                   1.0);
   EXPECT_DOUBLE_EQ(
-      StandardUncertainty({.distribution = Distribution::kNormal, .spread = 3.0, .coverage_factor = 2.0}), 1.5);
+      StandardUncertainty({.distribution = Distribution::kNormal, .spread = 3.0, .coverage_factor = 2.0}),
+      1.5);
 }
 
 TEST(TypeAFromReadings, IsTheMeanWithSOverRootNAndNMinusOneDof) {
@@ -60,7 +62,10 @@ TEST(CoverageFactor, MatchesGumTableG2) {
 TEST(Combine, AddsContributionsInQuadratureAndCorrectionsLinearly) {
   const std::vector<Input> inputs = {
       {.name = "a", .value = 1.0, .distribution = Distribution::kNormal, .spread = 3.0, .sensitivity = 2.0},
-      {.name = "b", .value = 5.0, .distribution = Distribution::kRectangular, .spread = 8.0 * std::sqrt(3.0),
+      {.name = "b",
+       .value = 5.0,
+       .distribution = Distribution::kRectangular,
+       .spread = 8.0 * std::sqrt(3.0),
        .sensitivity = -1.0}};
   const Combined combined = Combine(inputs);
   EXPECT_DOUBLE_EQ(combined.contributions[0].contribution, 6.0);
@@ -79,9 +84,12 @@ TEST(Combine, NoInputsGiveZeroUncertainty) {
 }
 
 TEST(Combine, RefusesBadInputsNamingEveryProblem) {
-  const std::vector<Input> inputs = {
-      {.name = "scale", .value = std::nan(""), .spread = -1.0},
-      {.name = "scale", .distribution = Distribution::kNormal, .spread = 1.0, .coverage_factor = 0.0, .dof = 0.0}};
+  const std::vector<Input> inputs = {{.name = "scale", .value = std::nan(""), .spread = -1.0},
+                                     {.name = "scale",
+                                      .distribution = Distribution::kNormal,
+                                      .spread = 1.0,
+                                      .coverage_factor = 0.0,
+                                      .dof = 0.0}};
   const std::string message = arcwheel::testing::ErrorMessageOf(
       [&] { (void)Combine(inputs, {.coverage_probability = 1.5}); }, ErrorCode::kInvalidOption);
   EXPECT_EQ(message,
@@ -100,13 +108,17 @@ TEST(Combine, ReproducesGumAnnexH1EndGaugeCalibration) {
   const double alpha_s = 11.5e-6;     // H.1.3.3
 
   // H.1.3.1 u(l_s): U = 0.075 um at k = 3, nu = 18.
-  const Input l_s{.name = "l_s", .unit = "nm", .value = l_s_nm, .spread = 75.0, .coverage_factor = 3.0,
-                  .dof = 18.0};
+  const Input l_s{
+      .name = "l_s", .unit = "nm", .value = l_s_nm, .spread = 75.0, .coverage_factor = 3.0, .dof = 18.0};
   // H.1.3.2 u(d): five readings with the pooled s = 13 nm of 25 readings (nu = 24), the
   // comparator's random effects (0.01 um at 95 % from 6 readings: k = 2.57, nu = 5) and its
   // systematic effects (0.02 um at "three sigma", nu = 8). d = 215 nm (H.1.3 d-bar).
   const std::vector<Input> d_parts = {
-      {.name = "d_mean", .unit = "nm", .value = 215.0, .spread = 13.0 / std::sqrt(5.0), .dof = 24.0,
+      {.name = "d_mean",
+       .unit = "nm",
+       .value = 215.0,
+       .spread = 13.0 / std::sqrt(5.0),
+       .dof = 24.0,
        .type = EvaluationType::kA},
       {.name = "d1", .unit = "nm", .spread = 10.0, .coverage_factor = 2.57, .dof = 5.0},
       {.name = "d2", .unit = "nm", .spread = 20.0, .coverage_factor = 3.0, .dof = 8.0}};
@@ -115,7 +127,7 @@ TEST(Combine, ReproducesGumAnnexH1EndGaugeCalibration) {
   EXPECT_EQ(ShowFixed(d.contributions[1].contribution, 1), "3.9");
   EXPECT_EQ(ShowFixed(d.contributions[2].contribution, 1), "6.7");
   EXPECT_EQ(ShowFixed(d.standard_uncertainty, 1), "9.7");  // table H.1: u(d) = 9.7 nm
-  EXPECT_EQ(ShowFixed(d.effective_dof, 1), "25.6");         // H.1.3.2: nu_eff(d) = 25.6
+  EXPECT_EQ(ShowFixed(d.effective_dof, 1), "25.6");        // H.1.3.2: nu_eff(d) = 25.6
 
   // H.1.3.2 u(theta): the mean 0.2 degC and a cyclic variation of amplitude 0.5 degC (arcsine).
   const std::vector<Input> theta_parts = {
@@ -129,16 +141,27 @@ TEST(Combine, ReproducesGumAnnexH1EndGaugeCalibration) {
       l_s,
       InputFromCombined("d", "nm", d),
       // H.1.3.3 alpha_s: +-2e-6 rectangular; sensitivity -l_s delta_theta = 0 (delta_theta = 0).
-      {.name = "alpha_s", .unit = "1/degC", .distribution = Distribution::kRectangular, .spread = 2e-6,
+      {.name = "alpha_s",
+       .unit = "1/degC",
+       .distribution = Distribution::kRectangular,
+       .spread = 2e-6,
        .sensitivity = 0.0},
       // theta: sensitivity -l_s delta_alpha = 0 (delta_alpha = 0); its second order in H.1.7.
       InputFromCombined("theta", "degC", theta, 0.0),
       // H.1.3.4 delta_alpha: +-1e-6 rectangular, reliable to 10 %: nu = 50; c = -l_s theta.
-      {.name = "delta_alpha", .unit = "1/degC", .distribution = Distribution::kRectangular, .spread = 1e-6,
-       .sensitivity = -l_s_nm * theta_c, .dof = 50.0},
+      {.name = "delta_alpha",
+       .unit = "1/degC",
+       .distribution = Distribution::kRectangular,
+       .spread = 1e-6,
+       .sensitivity = -l_s_nm * theta_c,
+       .dof = 50.0},
       // H.1.3.5 delta_theta: +-0.05 degC rectangular, reliable to 50 %: nu = 2; c = -l_s alpha_s.
-      {.name = "delta_theta", .unit = "degC", .distribution = Distribution::kRectangular, .spread = 0.05,
-       .sensitivity = -l_s_nm * alpha_s, .dof = 2.0}};
+      {.name = "delta_theta",
+       .unit = "degC",
+       .distribution = Distribution::kRectangular,
+       .spread = 0.05,
+       .sensitivity = -l_s_nm * alpha_s,
+       .dof = 2.0}};
   const Combined l = Combine(inputs, {.coverage_probability = 0.99});
 
   // Table H.1, column u(x_i) and u_i(l).

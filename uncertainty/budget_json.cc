@@ -89,8 +89,8 @@ std::optional<Distribution> DistributionFromName(std::string_view name) {
 const std::set<std::string>& InputKeys() {
   static const std::set<std::string> keys = {
       "name",     "source", "unit",       "value",       "distribution",     "sigma",
-      "expanded", "k",      "half_width", "sensitivity", "sensitivity_unit", "dof",
-      "type"};
+      "expanded", "k",      "half_width", "sensitivity", "sensitivity_unit", "relative_factor",
+      "dof",      "type"};
   return keys;
 }
 
@@ -113,7 +113,7 @@ std::optional<BudgetInput> ParseInput(const nlohmann::json& item, const std::str
     if (!InputKeys().contains(key)) {
       reader.Problem(where + "." + key, value,
                      "a known key (name, source, unit, value, distribution, sigma, "
-                     "expanded, k, half_width, sensitivity, sensitivity_unit, dof, type)");
+                     "expanded, k, half_width, sensitivity, sensitivity_unit, relative_factor, dof, type)");
       ok = false;
     }
   }
@@ -235,7 +235,13 @@ std::optional<BudgetInput> ParseInput(const nlohmann::json& item, const std::str
       return std::nullopt;
     }
     out.relative = true;
-    input.sensitivity = unit_info->kind == "percent" ? 0.01 : unit_info->scale;
+    double factor = 1.0;
+    if (item.contains("relative_factor")) {
+      const auto number = reader.Number(item, "relative_factor", where + ".relative_factor", "");
+      if (!number) return std::nullopt;
+      factor = *number;
+    }
+    input.sensitivity = factor * (unit_info->kind == "percent" ? 0.01 : unit_info->scale);
   } else if (item.contains("sensitivity_unit")) {
     const nlohmann::json& text = item["sensitivity_unit"];
     const std::string expected = quantity_unit + "/" + input.unit;
@@ -384,7 +390,9 @@ nlohmann::json BudgetToJson(const BudgetFile& budget) {
         item["half_width"] = input.spread;
       }
       if (entry.relative) {
+        const std::optional<UnitInfo> unit = Unit(input.unit);
         item["sensitivity"] = "relative";
+        item["relative_factor"] = input.sensitivity / (unit->kind == "percent" ? 0.01 : unit->scale);
       } else {
         item["sensitivity"] = input.sensitivity;
         item["sensitivity_unit"] = QuantityUnit(quantity) + "/" + input.unit;

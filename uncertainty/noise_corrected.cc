@@ -92,13 +92,15 @@ std::pair<int, int> Group(SmoothBasis basis, int order) {
   return basis == SmoothBasis::kFourier ? std::pair{2 * order - 1, 2} : std::pair{order, 1};
 }
 
-// The estimate on data `y` (rows x columns, complete rows) with per-row noise sigma `row_sigma`.
+// The estimate on data `y` (rows x columns, complete rows) with per-row noise sigma `row_sigma`;
+// the fitted rows themselves only `with_fitted` (the bootstrap needs them once).
 Estimate Fit(const Eigen::MatrixXd& y, const Eigen::VectorXd& row_sigma, const Eigen::MatrixXd& q,
-             const NoiseCorrectedPvOptions& options) {
+             const NoiseCorrectedPvOptions& options, bool with_fitted) {
   const Eigen::MatrixXd coefficients = y * q;  // rows x functions
   const int rows = static_cast<int>(y.rows());
   const double log_points = std::log(static_cast<double>(y.size()));
-  Eigen::MatrixXd kept = Eigen::MatrixXd::Zero(rows, q.cols());
+  std::vector<int> kept;   // every function kept
+  std::vector<int> shown;  // those the PV counts
   Estimate estimate;
   for (int order = 0; order <= options.max_order; ++order) {
     const auto [first, count] = Group(options.basis, order);
@@ -109,14 +111,27 @@ Estimate Fit(const Eigen::MatrixXd& y, const Eigen::VectorXd& row_sigma, const E
     // times ln(points); the mean and the orders the PV leaves out always stay.
     const bool always = order == 0 || order < options.pv_from_order;
     if (!always && chi2_drop <= rows * count * log_points) continue;
-    kept.middleCols(first, count) = coefficients.middleCols(first, count);
+    for (int j = first; j < first + count; ++j) {
+      kept.push_back(j);
+      if (order >= options.pv_from_order) shown.push_back(j);
+    }
     if (order >= options.pv_from_order) estimate.order = std::max(estimate.order, order);
   }
-  estimate.fitted = kept * q.transpose();
-  const int from = options.pv_from_order == 0 ? 0 : Group(options.basis, options.pv_from_order).first;
-  const Eigen::MatrixXd shown = kept.rightCols(q.cols() - from) * q.rightCols(q.cols() - from).transpose();
-  for (int r = 0; r < rows; ++r)
-    estimate.fitted_pv = std::max(estimate.fitted_pv, shown.row(r).maxCoeff() - shown.row(r).minCoeff());
+  const auto product = [&](const std::vector<int>& columns) {
+    Eigen::MatrixXd c(rows, columns.size());
+    Eigen::MatrixXd basis(q.rows(), columns.size());
+    for (std::size_t i = 0; i < columns.size(); ++i) {
+      c.col(i) = coefficients.col(columns[i]);
+      basis.col(i) = q.col(columns[i]);
+    }
+    return Eigen::MatrixXd(c * basis.transpose());
+  };
+  if (with_fitted) estimate.fitted = product(kept);
+  if (!shown.empty()) {
+    const Eigen::MatrixXd values = product(shown);
+    for (int r = 0; r < rows; ++r)
+      estimate.fitted_pv = std::max(estimate.fitted_pv, values.row(r).maxCoeff() - values.row(r).minCoeff());
+  }
   return estimate;
 }
 
@@ -186,7 +201,7 @@ NoiseCorrectedPv EstimateNoiseCorrectedPv(std::span<const double> values, std::s
     row_sigma[i] = std::sqrt(sigma.row(i).squaredNorm() / columns);
   }
   const Eigen::MatrixXd q = OrthonormalBasis(options.basis, options.max_order, columns);
-  const Estimate estimate = Fit(y, row_sigma, q, options);
+  const Estimate estimate = Fit(y, row_sigma, q, options, true);
   result.fitted_pv = estimate.fitted_pv;
   result.order = estimate.order;
   result.rows_used = n_rows;
@@ -200,7 +215,7 @@ NoiseCorrectedPv EstimateNoiseCorrectedPv(std::span<const double> values, std::s
   for (int b = 0; b < options.replicates; ++b) {
     for (int j = 0; j < columns; ++j)
       for (int i = 0; i < n_rows; ++i) replicate(i, j) = estimate.fitted(i, j) + sigma(i, j) * normal(rng);
-    const double pv = Fit(replicate, row_sigma, q, options).fitted_pv;
+    const double pv = Fit(replicate, row_sigma, q, options, false).fitted_pv;
     sum += pv;
     sum_squares += pv * pv;
   }

@@ -83,6 +83,8 @@ bool FillRow(Eigen::Ref<Eigen::VectorXd> row, bool periodic) {
 struct Estimate {
   double fitted_pv = 0.0;
   int order = 0;
+  double chi2 = 0.0;  // of the data against the fitted rows
+  double dof = 0.0;
   Eigen::MatrixXd fitted;  // rows x columns, the rows at the chosen order
 };
 
@@ -96,9 +98,22 @@ std::pair<int, int> Group(SmoothBasis basis, int order) {
 // the fitted rows themselves only `with_fitted` (the bootstrap needs them once).
 Estimate Fit(const Eigen::MatrixXd& y, const Eigen::VectorXd& row_sigma, const Eigen::MatrixXd& q,
              const NoiseCorrectedPvOptions& options, bool with_fitted) {
-  const Eigen::MatrixXd coefficients = y * q;  // rows x functions
+  Eigen::MatrixXd coefficients = y * q;  // rows x functions
   const int rows = static_cast<int>(y.rows());
-  const double log_points = std::log(static_cast<double>(y.size()));
+  // Rows that share a shape (the sections of one wheel) scatter about their mean by noise and by
+  // their real differences: each coefficient's spread about its mean keeps only its part beyond
+  // the noise (James-Stein / empirical Bayes shrinkage), so that a maximum over the rows is not
+  // taken over noise. A coefficient's noise variance is its row's sigma^2 (orthonormal basis).
+  if (options.shrink_rows && rows > 2) {
+    const double noise = row_sigma.squaredNorm() / rows;
+    for (Eigen::Index j = 0; j < coefficients.cols(); ++j) {
+      const double mean = coefficients.col(j).mean();
+      const double spread = (coefficients.col(j).array() - mean).square().sum() / (rows - 1);
+      const double real = std::max(0.0, spread - noise);
+      const double keep = spread > 0.0 ? real / (real + noise) : 0.0;
+      coefficients.col(j) = (mean + keep * (coefficients.col(j).array() - mean)).matrix();
+    }
+  }
   std::vector<int> kept;   // every function kept
   std::vector<int> shown;  // those the PV counts
   Estimate estimate;
@@ -107,10 +122,12 @@ Estimate Fit(const Eigen::MatrixXd& y, const Eigen::VectorXd& row_sigma, const E
     double chi2_drop = 0.0;
     for (int r = 0; r < rows; ++r)
       chi2_drop += coefficients.row(r).segment(first, count).squaredNorm() / (row_sigma[r] * row_sigma[r]);
-    // BIC: an order's functions stay when they lower chi-square by more than their parameters
-    // times ln(points); the mean and the orders the PV leaves out always stay.
+    // An order's functions stay when they lower chi-square by more than noise alone would in
+    // five standard deviations of its chi-square (rows x count degrees of freedom); the mean and
+    // the orders the PV leaves out always stay.
+    const double dof = static_cast<double>(rows) * count;
     const bool always = order == 0 || order < options.pv_from_order;
-    if (!always && chi2_drop <= rows * count * log_points) continue;
+    if (!always && chi2_drop <= dof + 5.0 * std::sqrt(2.0 * dof)) continue;
     for (int j = first; j < first + count; ++j) {
       kept.push_back(j);
       if (order >= options.pv_from_order) shown.push_back(j);
@@ -126,7 +143,12 @@ Estimate Fit(const Eigen::MatrixXd& y, const Eigen::VectorXd& row_sigma, const E
     }
     return Eigen::MatrixXd(c * basis.transpose());
   };
-  if (with_fitted) estimate.fitted = product(kept);
+  if (with_fitted) {
+    estimate.fitted = product(kept);
+    const Eigen::MatrixXd residual = y - estimate.fitted;
+    for (int r = 0; r < rows; ++r) estimate.chi2 += residual.row(r).squaredNorm() / (row_sigma[r] * row_sigma[r]);
+    estimate.dof = static_cast<double>(y.size()) - static_cast<double>(rows) * static_cast<double>(kept.size());
+  }
   if (!shown.empty()) {
     const Eigen::MatrixXd values = product(shown);
     for (int r = 0; r < rows; ++r)
@@ -201,7 +223,15 @@ NoiseCorrectedPv EstimateNoiseCorrectedPv(std::span<const double> values, std::s
     row_sigma[i] = std::sqrt(sigma.row(i).squaredNorm() / columns);
   }
   const Eigen::MatrixXd q = OrthonormalBasis(options.basis, options.max_order, columns);
-  const Estimate estimate = Fit(y, row_sigma, q, options, true);
+  Estimate estimate = Fit(y, row_sigma, q, options, true);
+  // The noise as the data show it: the sigmas scaled by the root of chi-square per degree of
+  // freedom of the fit (Birge ratio), then the fit repeated with them.
+  if (options.sigmas_from_residuals && estimate.dof > 0.0 && estimate.chi2 > 0.0) {
+    result.sigma_scale = std::sqrt(estimate.chi2 / estimate.dof);
+    sigma *= result.sigma_scale;
+    row_sigma *= result.sigma_scale;
+    estimate = Fit(y, row_sigma, q, options, true);
+  }
   result.fitted_pv = estimate.fitted_pv;
   result.order = estimate.order;
   result.rows_used = n_rows;

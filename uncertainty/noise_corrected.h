@@ -7,14 +7,17 @@
 // about d2(N) sigma. The estimator here fits each row of values (a series over phase or over the
 // band) with a smooth basis (Fourier harmonics 0..max_order over a full turn, or Legendre
 // polynomials 0..max_order over the band, orthonormalised over the columns), keeps each order
-// whose functions lower the chi-square of all rows together by more than the Bayesian information
-// criterion's price (parameters x ln(points)), and takes the PV of the fitted rows (the largest
-// over the rows). Orders are kept one by one, not as a nested 0..K, so that a harmonic of noise
+// whose functions lower the chi-square of all rows together by more than noise would in five
+// standard deviations (dof + 5 sqrt(2 dof), dof = rows x the order's functions), and takes the PV of the fitted rows (the largest
+// over the rows; with shrink_rows each coefficient is first shrunk towards its mean over the rows
+// by the share of its spread that noise explains). Orders are kept one by one, not as a nested 0..K, so that a harmonic of noise
 // alone between real ones does not ride on the fit: it would add to the PV in first order.
 // The bootstrap then draws `replicates` new data sets, the fitted rows plus normal noise of each
 // value's sigma, repeats the whole estimate (the choice of orders included) on each, and gives
 //   bias = mean(PV*) - PV(fit),   value = max(0, PV(fit) - bias),   u = standard deviation of PV*.
-// The noise is taken as independent from value to value.
+// The noise is taken as independent from value to value; with sigmas_from_residuals its level
+// is the data's own: the sigmas are scaled by sqrt(chi-square / dof) of the fit (the Birge
+// ratio) before the bootstrap.
 
 #include <cstdint>
 #include <span>
@@ -38,6 +41,11 @@ struct NoiseCorrectedPvOptions {
   int pv_from_order = 0;
   // Bootstrap data sets. >= 20.
   int replicates = 200;
+  // Shrink each coefficient towards its mean over the rows by the share of its spread that the
+  // noise explains: for rows that share one shape (the sections' profile error).
+  bool shrink_rows = false;
+  // Scale the sigmas to the scatter of the values about the fit (see above).
+  bool sigmas_from_residuals = true;
   // Seed of the bootstrap's random numbers: the same inputs give the same result.
   std::uint64_t seed = 20261203;
   // Empty when valid, else "NoiseCorrectedPvOptions::replicates = 3 violates >= 20".
@@ -51,6 +59,7 @@ struct NoiseCorrectedPv {
   double value = 0.0;                 // fitted_pv - bias: the noise-corrected estimate
   double standard_uncertainty = 0.0;  // standard deviation of PV*
   int order = 0;                      // the highest order kept that the PV counts
+  double sigma_scale = 1.0;           // the Birge ratio the sigmas were scaled by
   int rows_used = 0;                  // rows with enough values to fit
   int replicates = 0;
 };

@@ -133,6 +133,7 @@ WheelUncertainty EvaluateWheelUncertainty(const WheelObservations& o, const Budg
           .max_order = FitOrder(SmoothBasis::kLegendre, options.max_degree, columns),
           .pv_from_order = 0,
           .replicates = options.replicates,
+          .shrink_rows = true,
           .seed = options.seed + 4};
       arc_error = EstimateNoiseCorrectedPv(residuals, residual_sigmas, phases, columns, across);
     }

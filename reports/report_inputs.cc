@@ -372,9 +372,17 @@ Summary ParseSummary(const std::string& text, const std::string& name) {
     if (const auto q = u->find(uk::kQuantities); q != u->end() && q->is_object()) {
       for (const auto& [quantity, item] : q->items()) {
         if (!item.is_object()) continue;
-        summary.uncertainty[quantity] = {
-            number(item, uk::quantity::kValue), number(item, uk::quantity::kExpanded),
-            number(item, uk::quantity::kCoverageFactor), number(item, uk::quantity::kStandardUncertainty)};
+        double type_a = std::numeric_limits<double>::quiet_NaN();
+        if (const auto c = item.find(uk::quantity::kContributions); c != item.end() && c->is_array()) {
+          for (const json& line : *c) {
+            if (line.is_object() && line.value(std::string(uk::quantity::contribution::kType), "") == "A")
+              type_a = number(line, uk::quantity::contribution::kContribution);
+          }
+        }
+        summary.uncertainty[quantity] = {number(item, uk::quantity::kValue),
+                                         number(item, uk::quantity::kExpanded),
+                                         number(item, uk::quantity::kCoverageFactor),
+                                         number(item, uk::quantity::kStandardUncertainty), type_a};
       }
     }
   }

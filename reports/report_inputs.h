@@ -128,6 +128,9 @@ struct Summary {
   // u_c (NaN where null); empty when the file has none.
   struct QuantityUncertainty {
     double value = 0.0, expanded = 0.0, coverage_factor = 0.0, standard_uncertainty = 0.0;
+    // The type A part alone (from the data): what a comparison of two scans of one sensor uses,
+    // whose type B parts are the same in both.
+    double type_a_uncertainty = 0.0;
   };
   std::map<std::string, QuantityUncertainty> uncertainty;
   double coverage_probability = 0.95;

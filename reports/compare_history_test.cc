@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <cmath>
 #include <nlohmann/json.hpp>
+#include <random>
 #include <sstream>
 
 #include "core/error.h"
@@ -190,6 +191,30 @@ TEST(FitWearRate, RecoversAnExactLineAndTheTwoPointSigma) {
 
 // Eight scans two hours apart, the arc radius shrinking 0.5 um per hour, and a dressing after the
 // fourth that takes 20 um off: each segment's wear rate is -0.5 um/h within 3 sigma.
+TEST(FitWearRate, AddsARepeatabilityTermForAKnownExtraScatterAndBringsChiSquareToOne) {
+  // 40 scans an hour apart, wearing 0.5 um/h, each with a stated sigma of 0.1 um but an extra
+  // scatter of 0.5 um between scans (a repeatability the per-scan sigma cannot see).
+  std::mt19937 rng(20261203);
+  std::normal_distribution<double> extra(0.0, 0.0005);
+  std::vector<double> t, r, s;
+  for (int i = 0; i < 40; ++i) {
+    t.push_back(3600.0 * i);
+    r.push_back(55.0 - 0.0005 * i + extra(rng));
+    s.push_back(0.0001);
+  }
+  const WearRate w = FitWearRate(t, r, s);
+  EXPECT_GT(w.chi2_per_dof_scans_alone, 10.0);  // (0.5^2 + 0.1^2) / 0.1^2 = 26 expected
+  // s_R^2 + 0.1^2 ~ 0.5^2 + 0.1^2: s_R within about 3 standard errors (0.5 / sqrt(2 x 38)).
+  EXPECT_NEAR(w.repeatability_um, 0.5, 0.17);
+  EXPECT_NEAR(w.chi2_per_dof, 1.0, 1e-6);
+  // The rate with its sigma from the widened weights covers the truth.
+  EXPECT_NEAR(w.rate_um_per_h, -0.5, 3.0 * w.sigma_um_per_h);
+  // Scans whose scatter their sigmas explain get no term.
+  std::normal_distribution<double> own(0.0, 0.0001);
+  for (int i = 0; i < 40; ++i) r[i] = 55.0 - 0.0005 * i + own(rng);
+  EXPECT_EQ(FitWearRate(t, r, s).repeatability_um, 0.0);
+}
+
 TEST(HistoryCommand, ReportsTheKnownWearRateBetweenDressingsWithinThreeSigma) {
   TempDir dir;
   constexpr double kWear_um_per_h = -0.5;

@@ -128,7 +128,6 @@ TEST(ReportCommand, ReportsASimulatedAndProcessedScanWithTheSummaryNumbers) {
   EXPECT_THAT(html, HasSubstr(fmt::format("{:.2f} µm", summary["max_runout_um"].get<double>())));
 }
 
-
 // ISO 14253-1 through the CLI: limits placed by hand around the summary's noise-corrected runout
 // and its U.
 TEST(ReportCommand, DecidesByIso14253AgainstValueAndExpandedUncertainty) {

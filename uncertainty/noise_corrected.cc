@@ -146,8 +146,10 @@ Estimate Fit(const Eigen::MatrixXd& y, const Eigen::VectorXd& row_sigma, const E
   if (with_fitted) {
     estimate.fitted = product(kept);
     const Eigen::MatrixXd residual = y - estimate.fitted;
-    for (int r = 0; r < rows; ++r) estimate.chi2 += residual.row(r).squaredNorm() / (row_sigma[r] * row_sigma[r]);
-    estimate.dof = static_cast<double>(y.size()) - static_cast<double>(rows) * static_cast<double>(kept.size());
+    for (int r = 0; r < rows; ++r)
+      estimate.chi2 += residual.row(r).squaredNorm() / (row_sigma[r] * row_sigma[r]);
+    estimate.dof =
+        static_cast<double>(y.size()) - static_cast<double>(rows) * static_cast<double>(kept.size());
   }
   if (!shown.empty()) {
     const Eigen::MatrixXd values = product(shown);

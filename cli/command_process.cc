@@ -160,6 +160,11 @@ void AddProcessCommand(CLI::App& app) {
                   "knot spacing of the model's common profile error p(u)")
       ->capture_default_str();
   cmd->add_flag("--no-model", args->pipeline.no_model, "skip the wheel model (docs/wheel_model.md)");
+  cmd->add_option("--uncertainty", args->pipeline.uncertainty_budget_path,
+                  "type B uncertainty budget (docs/uncertainty.md); default: the simulated sensor's")
+      ->check(CLI::ExistingFile);
+  cmd->add_flag("--no-uncertainty", args->pipeline.no_uncertainty,
+                "leave the uncertainty budget and the noise-corrected figures out of summary.json");
   cmd->add_flag("-q,--quiet", args->quiet, "no progress and no headline");
   cmd->add_flag("--timings", args->timings,
                 "print each stage's wall time, CPU time and peak memory so far on stderr");

@@ -3,6 +3,7 @@
 // files are staged under temporary names and renamed together only when both are complete.
 
 #include <filesystem>
+#include <nlohmann/json.hpp>
 #include <string>
 #include <utility>
 #include <vector>
@@ -25,14 +26,16 @@ struct RunRecord {
   std::vector<std::pair<std::string, std::string>> text_parameters;
 };
 
-// Writes OUTDIR/summary.json and OUTDIR/wheel_map.h5; creates OUTDIR if needed.
+// Writes OUTDIR/summary.json and OUTDIR/wheel_map.h5; creates OUTDIR if needed. `uncertainty`,
+// when given, is summary.json's "uncertainty" object (uncertainty/wheel_uncertainty.h makes it).
 // Throws Error{kIo}; on any failure neither file is replaced.
 void WriteProcessOutputs(const std::filesystem::path& outdir, const RunRecord& record,
                          const processing::ProcessedScan& processed, const WheelFit& fit,
-                         const WheelModel* model = nullptr);
+                         const WheelModel* model = nullptr, const nlohmann::json* uncertainty = nullptr);
 
 // The summary document alone (what WriteProcessOutputs writes to summary.json).
 [[nodiscard]] std::string SummaryJson(const RunRecord& record, const processing::ProcessedScan& processed,
-                                      const WheelFit& fit, const WheelModel* model = nullptr);
+                                      const WheelFit& fit, const WheelModel* model = nullptr,
+                                      const nlohmann::json* uncertainty = nullptr);
 
 }  // namespace arcwheel::fitting

@@ -39,6 +39,8 @@ HeadlineChange Change(std::string name, std::string label, Unit unit, double bef
   return c;
 }
 
+constexpr double kCoverageFactor95 = 1.959964;  // normal: the sigmas have many degrees of freedom
+
 std::vector<HeadlineChange> Changes(const Summary& b, const Summary& a) {
   std::vector<HeadlineChange> changes = {
       Change(std::string(key::kMeanArcRadiusMm), "Mean arc radius", units::kRadius_mm, b.mean_arc_radius_mm,
@@ -59,6 +61,16 @@ std::vector<HeadlineChange> Changes(const Summary& b, const Summary& a) {
       Change(std::string(key::kMaxRoundnessUm), "Max roundness in the band", units::kLength_um,
              b.max_roundness_um, kNaN, a.max_roundness_um, kNaN),
   };
+  // With uncertainties in both summaries, a peak-to-valley change is that of the noise-corrected
+  // estimates, with the type A sigma of each (the same sensor's type B parts cancel).
+  for (HeadlineChange& c : changes) {
+    const auto before = b.uncertainty.find(c.key);
+    const auto after = a.uncertainty.find(c.key);
+    if (c.key == key::kMeanArcRadiusMm || before == b.uncertainty.end() || after == a.uncertainty.end())
+      continue;
+    c = Change(c.key, c.label + " (noise-corrected)", c.unit, before->second.value,
+               before->second.type_a_uncertainty, after->second.value, after->second.type_a_uncertainty);
+  }
   if (b.model && a.model) {
     changes.push_back(Change("model.mean_arc_radius_mm", "Wheel model: mean arc radius", units::kRadius_mm,
                              b.model->mean_arc_radius_mm, b.model->mean_arc_radius_sigma_mm,
@@ -276,13 +288,17 @@ nlohmann::json ComparisonJson(const Comparison& c) {
          {"after_sigma", Number(h.after_sigma)},
          {"change", Number(h.change)},
          {"sigma", Number(h.sigma)},
-         {"significant", std::isfinite(h.sigma) ? nlohmann::json(h.significant) : nlohmann::json(nullptr)}});
+         {"significant", std::isfinite(h.sigma) ? nlohmann::json(h.significant) : nlohmann::json(nullptr)},
+         {"U", Number(kCoverageFactor95 * h.sigma)}});
   }
   return {{"wheel_id", c.wheel_id},
           {"before", {{"folder", c.before_dir.string()}, {"timestamp", c.before_timestamp}}},
           {"after", {{"folder", c.after_dir.string()}, {"timestamp", c.after_timestamp}}},
           {"sigma_rule", "sigma = sqrt(before_sigma^2 + after_sigma^2); null where a summary records none"},
           {"significance_rule", "significant when |change| > 3 sigma"},
+          {"expanded_rule",
+           "U = 1.96 sigma (95 %, normal); peak-to-valley changes are of the noise-corrected "
+           "estimates with their type A sigmas when both summaries record uncertainties"},
           {"changes", changes},
           {"map_difference",
            {{"quantity", "rho after minus rho before, um"},

@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <cmath>
 #include <nlohmann/json.hpp>
+#include <random>
 #include <sstream>
 
 #include "core/error.h"
@@ -28,12 +29,13 @@ constexpr double kArcRadius_mm = 55.4423;  // simulate's default
 // Simulates a small scan (66000 samples) of a wheel of arc radius `radius_mm` and processes it
 // into `out` (no wheel model, 180 phases: quick).
 void SimulateAndProcess(const fs::path& work, const std::string& name, double radius_mm, int seed,
-                        const std::string& timestamp = "2026-03-01T08:00:00Z") {
+                        const std::string& timestamp = "2026-03-01T08:00:00Z",
+                        const std::string& extra = "") {
   const fs::path scan = work / (name + ".h5");
   const auto simulated = RunArcwheel(fmt::format(
       "simulate '{}' --sample-period-s 0.0002 --noise-um 0.4 --arc-radius-mm {:.7f} --seed {} --timestamp {} "
-      "--wheel-id W9-arc55",
-      scan.string(), radius_mm, seed, timestamp));
+      "--wheel-id W9-arc55 {}",
+      scan.string(), radius_mm, seed, timestamp, extra));
   ASSERT_EQ(simulated.exit_status, 0) << simulated.output;
   const auto processed = RunArcwheel(
       fmt::format("process '{}' -o '{}' -q --no-model --phases 180", scan.string(), (work / name).string()));
@@ -55,6 +57,9 @@ class Compare : public ::testing::Test {
     SimulateAndProcess(work_->path(), "a", kArcRadius_mm, 1);
     SimulateAndProcess(work_->path(), "b", kArcRadius_mm + 0.005, 2);
     SimulateAndProcess(work_->path(), "c", kArcRadius_mm, 3);
+    // A 2.5 um eccentricity: the runout grows by its peak-to-valley, 5 um.
+    SimulateAndProcess(work_->path(), "d", kArcRadius_mm, 4, "2026-03-01T08:00:00Z",
+                       "--radial-harmonic 1:2.5");
   }
   static void TearDownTestSuite() { delete work_; }
   static nlohmann::json Run(const std::string& before, const std::string& after, const std::string& out) {
@@ -99,13 +104,26 @@ TEST_F(Compare, ReportsAKnownRadiusChangeOfFiveMicrometresWithinThreeSigma) {
   EXPECT_THAT(ReadText(*work_ / "ab" / "compare.html"), HasSubstr("yes (&gt; 3σ)"));
 }
 
+TEST_F(Compare, CallsAFiveMicrometreRunoutChangeSignificantWithItsU) {
+  const nlohmann::json comparison = Run("a", "d", "ad");
+  const nlohmann::json& runout = ChangeOf(comparison, "max_runout_um");
+  const double sigma = runout["sigma"].get<double>();
+  ASSERT_GT(sigma, 0.0);
+  EXPECT_NEAR(runout["change"].get<double>(), 5.0, 3.0 * sigma + 0.05);  // 0.05 um: the map's own error
+  EXPECT_TRUE(runout["significant"].get<bool>());
+  EXPECT_NEAR(runout["U"].get<double>(), 1.959964 * sigma, 1e-9);
+}
+
 TEST_F(Compare, ReportsNoChangeOfTheSameWheelAsNotSignificant) {
   const nlohmann::json comparison = Run("a", "c", "ac");
   const nlohmann::json& radius = ChangeOf(comparison, "mean_arc_radius_mm");
   EXPECT_FALSE(radius["significant"].get<bool>())
       << radius["change"].get<double>() * 1000.0 << " um against " << radius["sigma"].get<double>() * 1000.0;
-  EXPECT_TRUE(ChangeOf(comparison, "max_runout_um")["significant"].is_null())
-      << "no sigma recorded: no verdict";
+  // The noise-corrected runouts, both of a round wheel, with their type A sigmas: no change.
+  const nlohmann::json& runout = ChangeOf(comparison, "max_runout_um");
+  EXPECT_FALSE(runout["significant"].get<bool>())
+      << runout["change"].get<double>() << " um against " << runout["sigma"].get<double>();
+  EXPECT_NEAR(runout["change"].get<double>(), 0.0, 3.0 * runout["sigma"].get<double>() + 1e-9);
   EXPECT_NEAR(comparison["map_difference"]["median_um"].get<double>(), 0.0, 0.5);
 }
 
@@ -173,6 +191,30 @@ TEST(FitWearRate, RecoversAnExactLineAndTheTwoPointSigma) {
 
 // Eight scans two hours apart, the arc radius shrinking 0.5 um per hour, and a dressing after the
 // fourth that takes 20 um off: each segment's wear rate is -0.5 um/h within 3 sigma.
+TEST(FitWearRate, AddsARepeatabilityTermForAKnownExtraScatterAndBringsChiSquareToOne) {
+  // 40 scans an hour apart, wearing 0.5 um/h, each with a stated sigma of 0.1 um but an extra
+  // scatter of 0.5 um between scans (a repeatability the per-scan sigma cannot see).
+  std::mt19937 rng(20261203);
+  std::normal_distribution<double> extra(0.0, 0.0005);
+  std::vector<double> t, r, s;
+  for (int i = 0; i < 40; ++i) {
+    t.push_back(3600.0 * i);
+    r.push_back(55.0 - 0.0005 * i + extra(rng));
+    s.push_back(0.0001);
+  }
+  const WearRate w = FitWearRate(t, r, s);
+  EXPECT_GT(w.chi2_per_dof_scans_alone, 10.0);  // (0.5^2 + 0.1^2) / 0.1^2 = 26 expected
+  // s_R^2 + 0.1^2 ~ 0.5^2 + 0.1^2: s_R within about 3 standard errors (0.5 / sqrt(2 x 38)).
+  EXPECT_NEAR(w.repeatability_um, 0.5, 0.17);
+  EXPECT_NEAR(w.chi2_per_dof, 1.0, 1e-6);
+  // The rate with its sigma from the widened weights covers the truth.
+  EXPECT_NEAR(w.rate_um_per_h, -0.5, 3.0 * w.sigma_um_per_h);
+  // Scans whose scatter their sigmas explain get no term.
+  std::normal_distribution<double> own(0.0, 0.0001);
+  for (int i = 0; i < 40; ++i) r[i] = 55.0 - 0.0005 * i + own(rng);
+  EXPECT_EQ(FitWearRate(t, r, s).repeatability_um, 0.0);
+}
+
 TEST(HistoryCommand, ReportsTheKnownWearRateBetweenDressingsWithinThreeSigma) {
   TempDir dir;
   constexpr double kWear_um_per_h = -0.5;

@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <boost/math/distributions/chi_squared.hpp>
 #include <cmath>
 #include <ctime>
 #include <limits>
@@ -139,7 +140,13 @@ ReportFigure PeakToValleyFigure(const History& h) {
 
 std::string WearText(const WearRate& w) {
   std::string text = FormatWithSigma(w.rate_um_per_h, w.sigma_um_per_h, units::kWear_um_per_h);
-  if (std::isfinite(w.chi2_per_dof)) text += " (χ²/dof " + FormatFixed(w.chi2_per_dof, 2) + ")";
+  if (w.repeatability_um > 0.0) {
+    text += " (χ²/dof " + FormatFixed(w.chi2_per_dof_scans_alone, 2) +
+            " with the scans' σ alone; repeatability s_R " + FormatFixed(w.repeatability_um, 3) +
+            " µm added: χ²/dof " + FormatFixed(w.chi2_per_dof, 2) + ")";
+  } else if (std::isfinite(w.chi2_per_dof)) {
+    text += " (χ²/dof " + FormatFixed(w.chi2_per_dof, 2) + ")";
+  }
   return text;
 }
 
@@ -286,42 +293,81 @@ std::vector<double> ParseDressingsCsv(const std::string& text, const std::string
   return times;
 }
 
+namespace {
+
+// The weighted least-squares line of radius against time (hours from the first scan) with each
+// scan's sigma widened by `extra_mm` in quadrature; its chi-square.
+struct Line {
+  double slope_mm_per_h = 0.0, sigma_mm_per_h = 0.0, intercept_mm = 0.0, chi2 = 0.0;
+};
+
+Line FitLine(const std::vector<double>& time_s, const std::vector<double>& radius_mm,
+             const std::vector<double>& sigma_mm, double extra_mm) {
+  const double t0 = time_s.front();
+  double sw = 0.0, swt = 0.0, swr = 0.0;
+  for (std::size_t i = 0; i < time_s.size(); ++i) {
+    const double weight = 1.0 / (sigma_mm[i] * sigma_mm[i] + extra_mm * extra_mm);
+    const double t = (time_s[i] - t0) / kSecondsPerHour;
+    sw += weight, swt += weight * t, swr += weight * radius_mm[i];
+  }
+  const double t_mean = swt / sw, r_mean = swr / sw;
+  double stt = 0.0, str = 0.0;
+  for (std::size_t i = 0; i < time_s.size(); ++i) {
+    const double weight = 1.0 / (sigma_mm[i] * sigma_mm[i] + extra_mm * extra_mm);
+    const double t = (time_s[i] - t0) / kSecondsPerHour - t_mean;
+    stt += weight * t * t, str += weight * t * (radius_mm[i] - r_mean);
+  }
+  Line line;
+  line.slope_mm_per_h = str / stt;
+  line.sigma_mm_per_h = std::sqrt(1.0 / stt);
+  line.intercept_mm = r_mean - line.slope_mm_per_h * t_mean;
+  for (std::size_t i = 0; i < time_s.size(); ++i) {
+    const double t = (time_s[i] - t0) / kSecondsPerHour;
+    const double residual = (radius_mm[i] - line.intercept_mm - line.slope_mm_per_h * t);
+    line.chi2 += residual * residual / (sigma_mm[i] * sigma_mm[i] + extra_mm * extra_mm);
+  }
+  return line;
+}
+
+}  // namespace
+
 WearRate FitWearRate(const std::vector<double>& time_s, const std::vector<double>& radius_mm,
                      const std::vector<double>& sigma_mm) {
   WearRate w;
   w.scans = time_s.size();
   w.first_time_s = time_s.front();
   w.last_time_s = time_s.back();
-  // Hours from the first scan keep the sums well conditioned.
-  double sw = 0.0, swt = 0.0, swr = 0.0;
-  for (std::size_t i = 0; i < time_s.size(); ++i) {
-    const double weight = 1.0 / (sigma_mm[i] * sigma_mm[i]);
-    const double t = (time_s[i] - w.first_time_s) / kSecondsPerHour;
-    sw += weight, swt += weight * t, swr += weight * radius_mm[i];
-  }
-  const double t_mean = swt / sw, r_mean = swr / sw;
-  double stt = 0.0, str = 0.0;
-  for (std::size_t i = 0; i < time_s.size(); ++i) {
-    const double weight = 1.0 / (sigma_mm[i] * sigma_mm[i]);
-    const double t = (time_s[i] - w.first_time_s) / kSecondsPerHour - t_mean;
-    stt += weight * t * t, str += weight * t * (radius_mm[i] - r_mean);
-  }
-  const double slope_mm_per_h = str / stt;
-  double sigma_mm_per_h = std::sqrt(1.0 / stt);
-  w.intercept_mm = r_mean - slope_mm_per_h * t_mean;
+  Line line = FitLine(time_s, radius_mm, sigma_mm, 0.0);
   w.chi2_per_dof = kNaN;
+  w.chi2_per_dof_scans_alone = kNaN;
   if (time_s.size() > 2) {
-    double chi2 = 0.0;
-    for (std::size_t i = 0; i < time_s.size(); ++i) {
-      const double t = (time_s[i] - w.first_time_s) / kSecondsPerHour;
-      const double residual = (radius_mm[i] - w.intercept_mm - slope_mm_per_h * t) / sigma_mm[i];
-      chi2 += residual * residual;
+    const double dof = static_cast<double>(time_s.size() - 2);
+    w.chi2_per_dof_scans_alone = line.chi2 / dof;
+    w.chi2_per_dof = w.chi2_per_dof_scans_alone;
+    // Chi-square test of the scans' sigmas alone; rejected at 5 %: a repeatability term s_R found
+    // by bisection so that chi-square / dof = 1 (chi-square falls as s_R grows).
+    const double p_value =
+        boost::math::cdf(boost::math::complement(boost::math::chi_squared(dof), line.chi2));
+    if (p_value < 0.05) {
+      double low = 0.0, high = 0.0;
+      for (std::size_t i = 0; i < radius_mm.size(); ++i)
+        high = std::max(high, std::abs(radius_mm[i] - radius_mm[0]));
+      high = std::max(high, 1e-9) * 10.0;
+      for (int iteration = 0; iteration < 100; ++iteration) {
+        const double middle = 0.5 * (low + high);
+        (FitLine(time_s, radius_mm, sigma_mm, middle).chi2 > dof ? low : high) = middle;
+      }
+      w.repeatability_um = 0.5 * (low + high) * 1000.0;
+      line = FitLine(time_s, radius_mm, sigma_mm, w.repeatability_um / 1000.0);
+      w.chi2_per_dof = line.chi2 / dof;
+    } else {
+      // Not significant: the rate's sigma still takes the scatter the chi-square shows, if larger.
+      line.sigma_mm_per_h *= std::sqrt(std::max(1.0, w.chi2_per_dof));
     }
-    w.chi2_per_dof = chi2 / static_cast<double>(time_s.size() - 2);
-    sigma_mm_per_h *= std::sqrt(std::max(1.0, w.chi2_per_dof));
   }
-  w.rate_um_per_h = slope_mm_per_h * 1000.0;
-  w.sigma_um_per_h = sigma_mm_per_h * 1000.0;
+  w.intercept_mm = line.intercept_mm;
+  w.rate_um_per_h = line.slope_mm_per_h * 1000.0;
+  w.sigma_um_per_h = line.sigma_mm_per_h * 1000.0;
   return w;
 }
 
@@ -393,8 +439,8 @@ History BuildHistory(const std::vector<std::filesystem::path>& folders,
 std::string HistoryCsv(const History& h) {
   std::string csv = "# wheel_id: " + h.wheel_id + "\n";
   for (const WearRate& w : h.wear) {
-    csv += fmt::format("# wear segment {}: {} um/h, 1-sigma {} um/h, {} scans\n", w.segment, w.rate_um_per_h,
-                       w.sigma_um_per_h, w.scans);
+    csv += fmt::format("# wear segment {}: {} um/h, 1-sigma {} um/h, {} scans, repeatability {} um\n",
+                       w.segment, w.rate_um_per_h, w.sigma_um_per_h, w.scans, w.repeatability_um);
   }
   csv +=
       "timestamp,time_h,segment,mean_arc_radius_mm,mean_arc_radius_sigma_mm,arc_radius_range_mm,"

@@ -32,8 +32,13 @@ struct WearRate {
   std::size_t scans = 0;
   double rate_um_per_h = 0.0;
   double sigma_um_per_h = 0.0;
-  double chi2_per_dof = 0.0;  // NaN with two scans
-  double intercept_mm = 0.0;  // fitted radius at the segment's first scan time
+  double chi2_per_dof = 0.0;  // NaN with two scans; after the repeatability term, when one is added
+  // The scatter between scans that their sigmas do not explain: when the chi-square test rejects
+  // the sigmas alone (p < 0.05), s_R (um) such that chi-square / dof = 1 with sigma_i^2 + s_R^2,
+  // added to every scan's sigma for the fit; 0 when not needed or with two scans.
+  double repeatability_um = 0.0;
+  double chi2_per_dof_scans_alone = 0.0;  // chi-square / dof with the scans' sigmas only (NaN: two scans)
+  double intercept_mm = 0.0;              // fitted radius at the segment's first scan time
   double first_time_s = 0.0;
   double last_time_s = 0.0;
 };

@@ -102,7 +102,9 @@ TEST(ReportCommand, ReportsASimulatedAndProcessedScanWithTheSummaryNumbers) {
                                           summary["mean_arc_radius_sigma_mm"].get<double>())));
   EXPECT_THAT(
       text, HasSubstr(fmt::format("phase-to-phase σ {:.4f} mm", summary["arc_radius_std_mm"].get<double>())));
-  EXPECT_THAT(text, HasSubstr(summary["runout_note"].get<std::string>().substr(0, 40)));
+  // The caveat's cell wraps beside the uncertainty's, so pdftotext interleaves their lines: its
+  // first words are checked.
+  EXPECT_THAT(text, HasSubstr("Caveat: " + summary["runout_note"].get<std::string>().substr(0, 9)));
   EXPECT_THAT(text, HasSubstr(fmt::format("{:.4f} mm", summary["arc_radius_range_mm"].get<double>())));
   EXPECT_THAT(text, HasSubstr(fmt::format("{:.3f} %", summary["arc_radius_fluctuation_pct"].get<double>())));
   EXPECT_THAT(text, HasSubstr(fmt::format("{:.4f} mm", summary["center_axial_deviation_mm"].get<double>())));
@@ -124,6 +126,42 @@ TEST(ReportCommand, ReportsASimulatedAndProcessedScanWithTheSummaryNumbers) {
   EXPECT_THAT(text, HasSubstr(fmt::format("{:.2f} µm", model["profile_pv_um"].get<double>())));
   const std::string html = ReadText(dir / "out" / "report.html");
   EXPECT_THAT(html, HasSubstr(fmt::format("{:.2f} µm", summary["max_runout_um"].get<double>())));
+}
+
+// ISO 14253-1 through the CLI: limits placed by hand around the summary's noise-corrected runout
+// and its U.
+TEST(ReportCommand, DecidesByIso14253AgainstValueAndExpandedUncertainty) {
+  TempDir dir;
+  ASSERT_EQ(RunArcwheel("simulate '" + (dir / "scan.h5").string() + "' --noise-um 0.4 --radial-harmonic 1:3")
+                .exit_status,
+            0);
+  const auto processed =
+      RunArcwheel("process '" + (dir / "scan.h5").string() + "' -o '" + (dir / "out").string() + "' -q");
+  ASSERT_EQ(processed.exit_status, 0) << processed.output;
+  const nlohmann::json summary = nlohmann::json::parse(ReadText(dir / "out" / "summary.json"));
+  const nlohmann::json& runout = summary["uncertainty"]["quantities"]["max_runout_um"];
+  const double value = runout["value"].get<double>();
+  const double u = runout["U"].get<double>();
+  ASSERT_GT(u, 0.0);
+  const auto overall = [&](double limit, const std::string& extra = "") {
+    const auto reported = RunArcwheel("report '" + (dir / "out").string() +
+                                      "' --tolerance max_runout_um=" + fmt::format("{:.9f}", limit) + extra);
+    EXPECT_EQ(reported.exit_status, 0) << reported.output;
+    const std::size_t at = reported.output.find("overall: ");
+    return at == std::string::npos ? reported.output
+                                   : reported.output.substr(at, reported.output.find('\n', at) - at);
+  };
+  EXPECT_EQ(overall(value + u / 2), "overall: NOT PROVEN");
+  EXPECT_EQ(overall(value - u / 2), "overall: NOT PROVEN");
+  EXPECT_EQ(overall(value + 2 * u), "overall: PASS");
+  EXPECT_EQ(overall(value - 2 * u), "overall: FAIL");
+  const std::string text = PdfText(dir / "out" / "report.pdf");
+  EXPECT_THAT(text, HasSubstr("ISO 14253-1:2017 default rule"));
+  // Shared risk, named in the tolerance file: the value alone decides.
+  WriteText(dir / "shared.json", R"({"decision_rule": "simple-acceptance"})");
+  EXPECT_EQ(overall(value + u / 2, " --tolerances '" + (dir / "shared.json").string() + "'"),
+            "overall: PASS");
+  EXPECT_THAT(PdfText(dir / "out" / "report.pdf"), HasSubstr("simple acceptance"));
 }
 
 }  // namespace

@@ -122,6 +122,15 @@ void Explain(const ReportInputs& inputs, HeadlineRow& row) {
   }
 }
 
+using uncertainty::DecisionRule;
+
+// The rule a tolerance file names; else ISO 14253-1 when the summary records uncertainties,
+// simple acceptance when it does not (nothing else can be decided on).
+DecisionRule RuleOf(const Summary& summary, const Tolerances& tolerances) {
+  if (tolerances.rule) return *tolerances.rule;
+  return summary.uncertainty.empty() ? DecisionRule::kSimpleAcceptance : DecisionRule::kIso14253;
+}
+
 std::vector<HeadlineRow> HeadlineRows(const ReportInputs& inputs, const Tolerances& tolerances) {
   std::vector<HeadlineRow> rows;
   for (const HeadlineSpec& spec : kHeadline) {
@@ -134,7 +143,29 @@ std::vector<HeadlineRow> HeadlineRows(const ReportInputs& inputs, const Toleranc
     std::optional<Limit> limit;
     if (const auto it = tolerances.limits.find(row.key); it != tolerances.limits.end()) limit = it->second;
     row.tolerance = limit ? LimitText(*limit, spec) : "–";
-    row.verdict = Judge(value, limit);
+    const auto u = inputs.summary.uncertainty.find(row.key);
+    const DecisionRule rule = RuleOf(inputs.summary, tolerances);
+    if (u != inputs.summary.uncertainty.end()) {
+      // Value, U and k as the decision uses them (docs/uncertainty.md).
+      const std::string expanded =
+          "U = " + FormatValue(u->second.expanded, spec.unit) +
+          " (k = " + FormatFixed(u->second.coverage_factor, 2) + ", " +
+          FormatFixed(100.0 * inputs.summary.coverage_probability, 0) + " %) on " +
+          FormatValue(u->second.value, spec.unit) +
+          (row.key == key::kMeanArcRadiusMm ? std::string() : std::string(" noise-corrected"));
+      row.uncertainty = expanded + (row.uncertainty.empty() ? "" : "; " + row.uncertainty);
+    }
+    if (!limit) {
+      row.verdict = Verdict::kNoTolerance;
+    } else if (u == inputs.summary.uncertainty.end()) {
+      row.verdict = Judge(value, limit);
+    } else {
+      const uncertainty::Decision decision = uncertainty::Decide(
+          u->second.value, u->second.expanded, {.min = limit->min, .max = limit->max}, {.rule = rule});
+      row.verdict = decision == uncertainty::Decision::kConforms         ? Verdict::kPass
+                    : decision == uncertainty::Decision::kDoesNotConform ? Verdict::kFail
+                                                                         : Verdict::kNotProven;
+    }
     rows.push_back(row);
   }
   return rows;
@@ -144,16 +175,31 @@ Verdict Overall(const std::vector<HeadlineRow>& rows) {
   Verdict overall = Verdict::kNoTolerance;
   for (const HeadlineRow& row : rows) {
     if (row.verdict == Verdict::kFail) return Verdict::kFail;
-    if (row.verdict == Verdict::kPass) overall = Verdict::kPass;
+    if (row.verdict == Verdict::kNotProven) overall = Verdict::kNotProven;
+    if (row.verdict == Verdict::kPass && overall == Verdict::kNoTolerance) overall = Verdict::kPass;
   }
   return overall;
+}
+
+std::vector<std::string> NotProvenRows(const std::vector<HeadlineRow>& rows) {
+  std::vector<std::string> out;
+  for (const HeadlineRow& row : rows) {
+    if (row.verdict == Verdict::kNotProven)
+      out.push_back(row.label + ": " + row.uncertainty.substr(0, row.uncertainty.find(';')) + " (limit " +
+                    row.tolerance + ")");
+  }
+  return out;
 }
 
 std::vector<std::string> FailingRows(const std::vector<HeadlineRow>& rows) {
   std::vector<std::string> failing;
   for (const HeadlineRow& row : rows) {
     if (row.verdict == Verdict::kFail)
-      failing.push_back(row.label + ": " + row.value + " (limit " + row.tolerance + ")");
+      failing.push_back(row.label + ": " + row.value +
+                        (row.uncertainty.rfind("U = ", 0) == 0
+                             ? "; " + row.uncertainty.substr(0, row.uncertainty.find(';'))
+                             : std::string()) +
+                        " (limit " + row.tolerance + ")");
   }
   return failing;
 }
@@ -620,6 +666,8 @@ std::string VerdictText(Verdict verdict) {
       return "PASS";
     case Verdict::kFail:
       return "FAIL";
+    case Verdict::kNotProven:
+      return "NOT PROVEN";
     default:
       return "NO TOLERANCE";
   }
@@ -656,6 +704,12 @@ ReportContent ComposeReport(const ReportInputs& inputs, const Tolerances& tolera
   content.headline = HeadlineRows(inputs, tolerances);
   content.overall = Overall(content.headline);
   content.failing = FailingRows(content.headline);
+  content.not_proven = NotProvenRows(content.headline);
+  const DecisionRule rule = RuleOf(s, tolerances);
+  content.rule = std::string("Decision rule: ") + std::string(uncertainty::DecisionRuleTitle(rule)) +
+                 (tolerances.rule         ? ", as the tolerance file names it."
+                  : s.uncertainty.empty() ? ": the summary records no uncertainty."
+                                          : ", the default.");
   content.model = ModelPart(s);
   // ReadReportInputs guarantees the map's /model when the summary has one.
   const ModelCurves* model = content.model.shown && inputs.map.model ? &*inputs.map.model : nullptr;

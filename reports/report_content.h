@@ -54,12 +54,17 @@ struct ModelReport {
 };
 
 struct ReportContent {
-  std::string title;                        // "Wheel inspection report: WHEEL-ID"
-  std::vector<KeyValue> provenance;         // wheel, scan settings, input file and SHA-256, versions
-  std::vector<HeadlineRow> headline;        // in kHeadlineKeys order
-  Verdict overall = Verdict::kNoTolerance;  // kFail if any row fails, kPass if some pass and none fail
+  std::string title;                  // "Wheel inspection report: WHEEL-ID"
+  std::vector<KeyValue> provenance;   // wheel, scan settings, input file and SHA-256, versions
+  std::vector<HeadlineRow> headline;  // in kHeadlineKeys order
+  // kFail if any row fails, else kNotProven if any is not proven, else kPass if some pass.
+  Verdict overall = Verdict::kNoTolerance;
   // The failing rows, each "label: value (limit ...)", in headline order.
   std::vector<std::string> failing;
+  // The rows neither proven to conform nor not to, each "label: U = ... (limit ...)".
+  std::vector<std::string> not_proven;
+  // Which rule decided, e.g. "Decision rule: ISO 14253-1:2017 default rule (...), the default."
+  std::string rule;
   ModelReport model;
   std::vector<ReportFigure> figures;
   std::vector<KeyValue> processing;  // summary.json "processing", flattened to dotted keys

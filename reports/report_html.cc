@@ -26,9 +26,15 @@ std::string DecisionLine(const ReportContent& content) {
   if (content.overall == Verdict::kFail) {
     std::string html = "<p class=\"failing\"><strong>Failing:</strong></p>\n<ul class=\"failing\">\n";
     for (const std::string& row : content.failing) html += "<li>" + Escape(row) + "</li>\n";
-    return html + "</ul>\n";
+    return html + "</ul>\n<p>" + Escape(content.rule) + "</p>\n";
   }
-  if (content.overall == Verdict::kPass) return "<p>Every limit given holds.</p>\n";
+  if (content.overall == Verdict::kNotProven) {
+    std::string html = "<p class=\"failing\"><strong>Not proven:</strong></p>\n<ul class=\"failing\">\n";
+    for (const std::string& row : content.not_proven) html += "<li>" + Escape(row) + "</li>\n";
+    return html + "</ul>\n<p>" + Escape(content.rule) + "</p>\n";
+  }
+  if (content.overall == Verdict::kPass)
+    return "<p>Every limit given holds.</p>\n<p>" + Escape(content.rule) + "</p>\n";
   return "<p>No limits given: nothing was judged (<code>arcwheel report --tolerance KEY=MAX</code>).</p>\n";
 }
 

@@ -360,6 +360,32 @@ Summary ParseSummary(const std::string& text, const std::string& name) {
   }
   summary.warnings = ParseWarnings(root, top);
   summary.model = ParseModel(root, top);
+  // "uncertainty" is optional (schema < 1.2, --no-uncertainty); a number that is null reads NaN.
+  if (const auto u = root.find(key::kUncertainty); u != root.end() && u->is_object()) {
+    namespace uk = key::uncertainty;
+    const auto number = [](const json& object, std::string_view field) {
+      const auto it = object.find(field);
+      return it != object.end() && it->is_number() ? it->get<double>()
+                                                   : std::numeric_limits<double>::quiet_NaN();
+    };
+    summary.coverage_probability = number(*u, uk::kCoverageProbability);
+    if (const auto q = u->find(uk::kQuantities); q != u->end() && q->is_object()) {
+      for (const auto& [quantity, item] : q->items()) {
+        if (!item.is_object()) continue;
+        double type_a = std::numeric_limits<double>::quiet_NaN();
+        if (const auto c = item.find(uk::quantity::kContributions); c != item.end() && c->is_array()) {
+          for (const json& line : *c) {
+            if (line.is_object() && line.value(std::string(uk::quantity::contribution::kType), "") == "A")
+              type_a = number(line, uk::quantity::contribution::kContribution);
+          }
+        }
+        summary.uncertainty[quantity] = {number(item, uk::quantity::kValue),
+                                         number(item, uk::quantity::kExpanded),
+                                         number(item, uk::quantity::kCoverageFactor),
+                                         number(item, uk::quantity::kStandardUncertainty), type_a};
+      }
+    }
+  }
   return summary;
 }
 

@@ -10,6 +10,7 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <map>
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
@@ -123,6 +124,16 @@ struct Summary {
   std::string runout_note;
   // "model" when the file has one.
   std::optional<ModelSummary> model;
+  // "uncertainty" (schema 1.2): per headline key, the estimate a decision uses and its U, k and
+  // u_c (NaN where null); empty when the file has none.
+  struct QuantityUncertainty {
+    double value = 0.0, expanded = 0.0, coverage_factor = 0.0, standard_uncertainty = 0.0;
+    // The type A part alone (from the data): what a comparison of two scans of one sensor uses,
+    // whose type B parts are the same in both.
+    double type_a_uncertainty = 0.0;
+  };
+  std::map<std::string, QuantityUncertainty> uncertainty;
+  double coverage_probability = 0.95;
 };
 
 // wheel_map.h5 "/model": the wheel model's functions. Ra(c), a(c), b(c) and their 1-sigma on the

@@ -77,7 +77,7 @@ TEST(ReadReportInputs, ReadsBackTheFixtureModel) {
   ASSERT_EQ(m.radius_harmonics.size(), 2u);
   EXPECT_EQ(m.radius_harmonics[1].order, 2);
   EXPECT_DOUBLE_EQ(m.radius_harmonics[1].phase_deg, -90.0);
-  EXPECT_EQ(inputs.summary.schema_version, "1.1");
+  EXPECT_EQ(inputs.summary.schema_version, "1.2");
 
   ASSERT_TRUE(inputs.map.model.has_value());
   const ModelCurves& curves = *inputs.map.model;
@@ -117,11 +117,11 @@ TEST(ReadSummary, ReadsNullAsNaN) {
 }
 
 // 1.1 since both files gained the wheel model (docs/outputs.md).
-TEST(WriteFixture, RecordsSchemaVersion1_1InBothFiles) {
+TEST(WriteFixture, RecordsTheSchemaVersionOfEachFile) {
   TempDir dir;
   WriteFixture(dir.path(), {.n_phase = 12, .n_y = 21});
   std::ifstream summary_file(dir / "summary.json");
-  EXPECT_EQ(nlohmann::json::parse(summary_file).at("schema_version"), "1.1");
+  EXPECT_EQ(nlohmann::json::parse(summary_file).at("schema_version"), "1.2");
   EXPECT_EQ(hdf5::File::OpenReadOnly(dir / "wheel_map.h5").ReadAttributeString("/", "schema_version"), "1.1");
 }
 

@@ -30,9 +30,15 @@ std::string DecisionLine(const ReportContent& content) {
     std::string text = "Failing: ";
     for (std::size_t i = 0; i < content.failing.size(); ++i)
       text += (i == 0 ? "" : "; ") + content.failing[i];
-    return text + ".";
+    return text + ". " + content.rule;
   }
-  if (content.overall == Verdict::kPass) return "Every limit given holds.";
+  if (content.overall == Verdict::kNotProven) {
+    std::string text = "Not proven: ";
+    for (std::size_t i = 0; i < content.not_proven.size(); ++i)
+      text += (i == 0 ? "" : "; ") + content.not_proven[i];
+    return text + ". " + content.rule;
+  }
+  if (content.overall == Verdict::kPass) return "Every limit given holds. " + content.rule;
   return "No limits given: nothing was judged (arcwheel report --tolerance KEY=MAX).";
 }
 

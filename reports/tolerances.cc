@@ -96,6 +96,15 @@ Tolerances ParseTolerances(const std::string& text, const std::string& name) {
   Tolerances tolerances;
   for (const auto& [key, value] : root.items()) {
     const std::string where = "'" + name + "' key '" + key + "'";
+    if (key == "decision_rule") {
+      const auto rule =
+          value.is_string() ? uncertainty::DecisionRuleFromName(value.get<std::string>()) : std::nullopt;
+      if (!rule)
+        BadTolerance(ErrorCode::kBadInput, where,
+                     "is not 'iso14253-1' or 'simple-acceptance' (found " + value.dump() + ")");
+      tolerances.rule = rule;
+      continue;
+    }
     if (!IsHeadlineKey(key))
       BadTolerance(ErrorCode::kBadInput, where, "is not a headline quantity (" + KnownKeys() + ")");
     tolerances.limits[key] = ParseLimit(value, where);

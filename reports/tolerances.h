@@ -8,8 +8,13 @@
 // Keys: mean_arc_radius_mm, arc_radius_range_mm, arc_radius_fluctuation_pct,
 // center_axial_deviation_mm, max_arc_error_um, max_runout_um, max_roundness_um.
 // Command-line form of one limit: "KEY=MAX" or "KEY=MIN:MAX" (either side of ':' may be empty).
-// A value passes when min <= value <= max (limits inclusive, value as recorded in summary.json,
-// its uncertainty not added); a value that could not be computed (null) fails any limit.
+// The optional key "decision_rule" names the rule (uncertainty/decision.h): "iso14253-1" (the
+// default when the summary records uncertainties: conformance proven when value +- U lies inside
+// the limits, nonconformance when it lies outside, else not proven) or "simple-acceptance" (shared
+// risk: the estimate, noise-corrected for a PV, against the limits, its U not added). For a summary
+// without uncertainties a value passes when
+// min <= value <= max (limits inclusive, value as recorded in summary.json, its uncertainty not
+// added); a value that could not be computed (null) fails any limit.
 
 #include <array>
 #include <filesystem>
@@ -19,6 +24,7 @@
 #include <string_view>
 
 #include "schema/summary.h"
+#include "uncertainty/decision.h"
 
 namespace arcwheel::reports {
 
@@ -36,9 +42,12 @@ inline constexpr std::array<std::string_view, 7> kHeadlineKeys = {
 
 struct Tolerances {
   std::map<std::string, Limit> limits;  // by headline key; absent = no tolerance
+  // "decision_rule" as the file names it; absent = ISO 14253-1 where uncertainties are recorded.
+  std::optional<uncertainty::DecisionRule> rule = std::nullopt;
 };
 
-enum class Verdict { kPass, kFail, kNoTolerance };
+// kNotProven: by ISO 14253-1, neither conformance nor nonconformance is proven.
+enum class Verdict { kPass, kFail, kNoTolerance, kNotProven };
 
 // Verdict of one value against an optional limit (see the file comment for the rule).
 [[nodiscard]] Verdict Judge(double value, const std::optional<Limit>& limit);

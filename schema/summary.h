@@ -12,7 +12,7 @@
 namespace arcwheel::schema::summary {
 
 inline constexpr int kMajorVersion = 1;
-inline constexpr int kMinorVersion = 1;  // 1.1: the wheel model ("model")
+inline constexpr int kMinorVersion = 2;  // 1.1: the wheel model ("model"); 1.2: "uncertainty"
 inline constexpr Version kVersion{kMajorVersion, kMinorVersion};
 inline constexpr std::string_view kFileName = "summary.json";
 
@@ -185,5 +185,43 @@ inline constexpr std::string_view kStuckRunSamplesUsed = "stuck_run_samples_used
 }  // namespace processing
 
 inline constexpr std::string_view kWarnings = "warnings";  // array of strings
+
+// Measurement uncertainty per GUM and conformity decisions per ISO 14253-1
+// (uncertainty/wheel_uncertainty.h, docs/uncertainty.md); absent with --no-uncertainty.
+inline constexpr std::string_view kUncertainty = "uncertainty";
+namespace uncertainty {
+inline constexpr std::string_view kCoverageProbability = "coverage_probability";
+inline constexpr std::string_view kBudgetSource = "budget_source";  // "default" or the budget file's path
+inline constexpr std::string_view kBudget = "budget";               // the type B inputs, as a budget file
+inline constexpr std::string_view kQuantities = "quantities";       // by headline key:
+namespace quantity {
+inline constexpr std::string_view kUnit = "unit";             // "mm", "um" or "%"
+inline constexpr std::string_view kMeasured = "measured";     // the headline value as above
+inline constexpr std::string_view kValue = "value";           // the estimate: noise-corrected for a PV
+inline constexpr std::string_view kNoiseBias = "noise_bias";  // measured - value's PV part; PV only
+inline constexpr std::string_view kTypeAMethod = "type_a_method";
+inline constexpr std::string_view kContributions = "contributions";  // list of objects:
+namespace contribution {
+inline constexpr std::string_view kName = "name";
+inline constexpr std::string_view kSource = "source";
+inline constexpr std::string_view kType = "type";  // "A" or "B"
+inline constexpr std::string_view kUnit = "unit";
+inline constexpr std::string_view kDistribution = "distribution";
+inline constexpr std::string_view kStandardUncertainty = "standard_uncertainty";  // input's unit
+inline constexpr std::string_view kSensitivity = "sensitivity";
+inline constexpr std::string_view kContribution = "contribution";  // quantity's unit
+inline constexpr std::string_view kDof = "dof";                    // null = infinite
+}  // namespace contribution
+inline constexpr std::string_view kCorrection = "correction";
+inline constexpr std::string_view kStandardUncertainty = "u_c";
+inline constexpr std::string_view kEffectiveDof = "nu_eff";  // null = infinite
+inline constexpr std::string_view kCoverageFactor = "k";
+inline constexpr std::string_view kExpanded = "U";
+}  // namespace quantity
+// With `process --tolerances`: the rule and the decision for each toleranced quantity.
+inline constexpr std::string_view kDecisionRule = "decision_rule";  // "iso14253-1" or "simple-acceptance"
+inline constexpr std::string_view kDecisions = "decisions";  // by headline key: {"min", "max", "decision"}
+inline constexpr std::string_view kOverall = "overall";      // "conforms", "does not conform", "not proven"
+}  // namespace uncertainty
 
 }  // namespace arcwheel::schema::summary

@@ -79,11 +79,20 @@ TEST(Cli, ProcessTimingsListEveryStageAndSumThem) {
       cpu_s += cpu;
     }
   }
-  const std::vector<std::string> expected = {
-      "reading",        "valid span",   "stuck readings",        "noise and despike",
-      "spindle speed",  "helix spline", "sections and map",      "coverage counts",
-      "per-phase fits", "wheel model",  "releasing the samples", "waiting for the SHA-256",
-      "writing"};
+  const std::vector<std::string> expected = {"reading",
+                                             "valid span",
+                                             "stuck readings",
+                                             "noise and despike",
+                                             "spindle speed",
+                                             "helix spline",
+                                             "sections and map",
+                                             "coverage counts",
+                                             "per-phase fits",
+                                             "uncertainty",
+                                             "wheel model",
+                                             "releasing the samples",
+                                             "waiting for the SHA-256",
+                                             "writing"};
   EXPECT_EQ(stages, expected) << run.output;
 }
 

@@ -14,6 +14,7 @@
 #include "core/text_encoding.h"
 #include "processing/helix_geometry.h"
 #include "schema/summary.h"
+#include "uncertainty/default_budget.h"
 
 namespace arcwheel::workflows {
 namespace {
@@ -101,6 +102,65 @@ void ParseChoice(const char* flag, const std::string& text, const char* choices,
   }
 }
 
+// The headline figures' uncertainty from the per-phase fits and the map (before the spline goes:
+// nothing here reads it, but the map must still hold every node).
+uncertainty::WheelUncertainty EvaluateUncertainty(const ProcessPipelineOptions& options,
+                                                  const acquisition::Scan& scan,
+                                                  const processing::ProcessedScan& processed,
+                                                  const fitting::WheelFit& fit) {
+  const processing::WheelMap& map = processed.map;
+  std::vector<double> radius, radius_sigma, axial, axial_sigma, radial;
+  std::vector<char> usable;
+  for (const fitting::PhaseFit& phase : fit.phases) {
+    radius.push_back(phase.arc_radius_mm);
+    radius_sigma.push_back(phase.arc_radius_sigma_mm);
+    axial.push_back(phase.center_axial_mm);
+    axial_sigma.push_back(phase.center_axial_sigma_mm);
+    radial.push_back(phase.center_radial_mm);
+    usable.push_back(phase.usable ? 1 : 0);
+  }
+  // The typical 1-sigma of a map value: the median over the sections' points (summary.json's
+  // map_sigma_um).
+  std::vector<double> point_sigmas;
+  for (const auto& section : map.sections)
+    point_sigmas.insert(point_sigmas.end(), section.sigma_mm.begin(), section.sigma_mm.end());
+  std::sort(point_sigmas.begin(), point_sigmas.end());
+  const uncertainty::WheelObservations observations{
+      .mean_arc_radius_mm = fit.mean_arc_radius_mm,
+      .mean_arc_radius_sigma_mm = fit.mean_arc_radius_sigma_mm,
+      .arc_radius_range_mm = fit.arc_radius_range_mm,
+      .arc_radius_fluctuation_pct = fit.arc_radius_fluctuation_pct,
+      .center_axial_deviation_mm = fit.center_axial_deviation_mm,
+      .max_arc_error_um = fit.max_arc_error_um,
+      .max_runout_um = fit.max_runout_um,
+      .max_roundness_um = fit.max_roundness_um,
+      .arc_radius_mm = radius,
+      .arc_radius_sigma_mm = radius_sigma,
+      .center_axial_mm = axial,
+      .center_axial_sigma_mm = axial_sigma,
+      .center_radial_mm = radial,
+      .usable = usable,
+      .rho_mm = map.rho_mm,
+      .y_mm = map.y_mm,
+      .map_sigma_mm = point_sigmas.empty() ? 0.0 : point_sigmas[point_sigmas.size() / 2],
+      .band_low_mm = fit.band_low_mm,
+      .band_high_mm = fit.band_high_mm};
+  uncertainty::WheelUncertainty result;
+  if (options.uncertainty_budget) {
+    result =
+        uncertainty::EvaluateWheelUncertainty(observations, *options.uncertainty_budget, options.uncertainty);
+    result.budget_source = options.uncertainty_budget_path;
+  } else {
+    const double diameter = scan.metadata.wheel_diameter_mm.value_or(400.0);
+    const uncertainty::BudgetFile budget = uncertainty::DefaultBudget(
+        {.arc_radius_mm = fit.mean_arc_radius_mm,
+         .band_half_width_mm = std::min(options.fit.band_half_width_mm, 0.9 * fit.mean_arc_radius_mm),
+         .wheel_radius_mm = diameter / 2.0});
+    result = uncertainty::EvaluateWheelUncertainty(observations, budget, options.uncertainty);
+  }
+  return result;
+}
+
 // Everything after the scan is in memory. `sha256` delivers the input's hash (computed meanwhile
 // on another thread when the scan came from a file).
 ProcessPipelineResult RunOnScan(acquisition::Scan scan, const std::string& scan_path,
@@ -115,6 +175,10 @@ ProcessPipelineResult RunOnScan(acquisition::Scan scan, const std::string& scan_
   progress.Update("fitting", 0.7);
   clock.Start("per-phase fits");
   result.fit = fitting::FitWheel(result.processed.map, options.fit);
+  if (!options.no_uncertainty) {
+    clock.Start("uncertainty");
+    result.uncertainty = EvaluateUncertainty(options, scan, result.processed, result.fit);
+  }
   // Only the fits' sigmas read the helix spline (23 MB at 1e8 samples): gone before the model.
   result.processed.map.spline.reset();
   clock.Start("wheel model");
@@ -127,8 +191,11 @@ ProcessPipelineResult RunOnScan(acquisition::Scan scan, const std::string& scan_
   ThrowIfInterrupted();
   if (!outdir.empty()) {
     clock.Start("writing");
+    const nlohmann::json uncertainty =
+        result.uncertainty ? uncertainty::WheelUncertaintyToJson(*result.uncertainty) : nlohmann::json();
     fitting::WriteProcessOutputs(outdir, result.record, result.processed, result.fit,
-                                 result.model ? &*result.model : nullptr);
+                                 result.model ? &*result.model : nullptr,
+                                 result.uncertainty ? &uncertainty : nullptr);
   }
   clock.Stop();
   result.clock = std::move(clock);
@@ -152,7 +219,13 @@ void ResolveProcessPipelineOptions(ProcessPipelineOptions& options) {
   if (!options.no_model) {
     for (std::string& problem : options.model.Problems()) problems.push_back(std::move(problem));
   }
+  if (!options.no_uncertainty) {
+    for (std::string& problem : options.uncertainty.Problems()) problems.push_back(std::move(problem));
+  }
   ThrowIfProblems(ErrorCode::kInvalidOption, "process", problems);
+  // A bad budget is refused before the scan is read, with every problem it has (exit 2).
+  if (!options.no_uncertainty && !options.uncertainty_budget_path.empty())
+    options.uncertainty_budget = uncertainty::ReadBudget(options.uncertainty_budget_path);
 }
 
 ProcessPipelineResult RunProcessPipeline(const std::string& scan_path, const std::filesystem::path& outdir,

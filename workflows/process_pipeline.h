@@ -15,6 +15,8 @@
 #include "fitting/wheel_fit.h"
 #include "fitting/wheel_model.h"
 #include "processing/process_scan.h"
+#include "uncertainty/budget_json.h"
+#include "uncertainty/wheel_uncertainty.h"
 
 namespace arcwheel::workflows {
 
@@ -30,6 +32,14 @@ struct ProcessPipelineOptions {
   std::string despike_method = "median";
   std::string rpm_source = "auto";
   std::string fit_span = "band";
+  // The uncertainty of every headline figure (docs/uncertainty.md): the type B budget file
+  // (`--uncertainty FILE`; empty = the default budget of the simulated sensor), read and checked
+  // with the other options, before the scan; `no_uncertainty` leaves summary.json without it.
+  std::string uncertainty_budget_path;
+  bool no_uncertainty = false;
+  uncertainty::WheelUncertaintyOptions uncertainty;
+  // Filled by ResolveProcessPipelineOptions from uncertainty_budget_path.
+  std::optional<uncertainty::BudgetFile> uncertainty_budget;
 };
 
 // Parses the choice options into the structs and checks every option of both stages (and of the
@@ -41,7 +51,8 @@ struct ProcessPipelineResult {
   processing::ProcessedScan processed;
   fitting::WheelFit fit;
   std::optional<fitting::WheelModel> model;  // empty with no_model, or when the model could not be fitted
-  StageClock clock;                          // wall time of each step (`arcwheel process --timings`)
+  std::optional<uncertainty::WheelUncertainty> uncertainty;  // empty with no_uncertainty
+  StageClock clock;  // wall time of each step (`arcwheel process --timings`)
 };
 
 // Reads the scan at `scan_path` (acquisition::ReadScan, float32 readings kept as float32),

@@ -1,0 +1,236 @@
+#include "uncertainty/wheel_uncertainty.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "core/error.h"
+#include "core/number_format.h"
+#include "schema/summary.h"
+
+namespace arcwheel::uncertainty {
+namespace {
+
+constexpr const char* kStage = "uncertainty.wheel";
+namespace s = schema::summary;
+namespace su = schema::summary::uncertainty;
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+Input TypeA(std::string source, std::string unit, double sigma, double dof) {
+  return Input{.name = "data",
+               .source = std::move(source),
+               .unit = std::move(unit),
+               .distribution = Distribution::kNormal,
+               .spread = sigma,
+               .coverage_factor = 1.0,
+               .sensitivity = 1.0,
+               .dof = dof,
+               .type = EvaluationType::kA};
+}
+
+std::string BootstrapSource(const NoiseCorrectedPv& pv, std::string_view basis) {
+  return "noise-corrected PV by a parametric bootstrap of " + std::to_string(pv.replicates) + " data sets (" +
+         std::string(basis) + " up to order " + std::to_string(pv.order) + ", " +
+         std::to_string(pv.rows_used) + (pv.rows_used == 1 ? " row)" : " rows)");
+}
+
+// The largest order the basis can take on `columns` values.
+int FitOrder(SmoothBasis basis, int wanted, int columns) {
+  const int most = basis == SmoothBasis::kFourier ? (columns - 2) / 2 : columns - 2;
+  return std::max(0, std::min(wanted, most));
+}
+
+nlohmann::json Finite(double value) {
+  return std::isfinite(value) ? nlohmann::json(value) : nlohmann::json(nullptr);
+}
+
+}  // namespace
+
+std::vector<std::string> WheelUncertaintyOptions::Problems() const {
+  std::vector<std::string> problems;
+  if (max_harmonic < 1)
+    problems.push_back("WheelUncertaintyOptions::max_harmonic = " + std::to_string(max_harmonic) +
+                       " violates >= 1");
+  if (max_degree < 1)
+    problems.push_back("WheelUncertaintyOptions::max_degree = " + std::to_string(max_degree) +
+                       " violates >= 1");
+  if (replicates < 20)
+    problems.push_back("WheelUncertaintyOptions::replicates = " + std::to_string(replicates) +
+                       " violates >= 20");
+  return problems;
+}
+
+const QuantityUncertainty* WheelUncertainty::Find(std::string_view key) const {
+  for (const QuantityUncertainty& q : quantities)
+    if (q.key == key) return &q;
+  return nullptr;
+}
+
+WheelUncertainty EvaluateWheelUncertainty(const WheelObservations& o, const BudgetFile& budget,
+                                          const WheelUncertaintyOptions& options) {
+  ThrowIfProblems(ErrorCode::kInvalidOption, kStage, options.Problems());
+  const std::size_t n_phase = o.arc_radius_mm.size();
+  const std::size_t n_y = o.y_mm.size();
+  if (o.arc_radius_sigma_mm.size() != n_phase || o.center_axial_mm.size() != n_phase ||
+      o.center_axial_sigma_mm.size() != n_phase || o.center_radial_mm.size() != n_phase ||
+      o.usable.size() != n_phase || o.rho_mm.size() != n_phase * n_y || n_phase < 8) {
+    throw Error(ErrorCode::kBadInput, kStage,
+                "per-phase arrays and the map do not match (" + std::to_string(n_phase) + " phases, " +
+                    std::to_string(n_y) + " axial nodes, " + std::to_string(o.rho_mm.size()) +
+                    " map values)");
+  }
+  const int phases = static_cast<int>(n_phase);
+  const auto usable = [&](std::size_t p) { return o.usable[p] != 0; };
+
+  // Per-phase series, unusable phases missing.
+  std::vector<double> radius(n_phase), radius_sigma(n_phase), axial(n_phase), axial_sigma(n_phase);
+  for (std::size_t p = 0; p < n_phase; ++p) {
+    radius[p] = usable(p) ? o.arc_radius_mm[p] : kNaN;
+    radius_sigma[p] = o.arc_radius_sigma_mm[p];
+    axial[p] = usable(p) ? o.center_axial_mm[p] : kNaN;
+    axial_sigma[p] = o.center_axial_sigma_mm[p];
+  }
+  NoiseCorrectedPvOptions series{.basis = SmoothBasis::kFourier,
+                                 .max_order = FitOrder(SmoothBasis::kFourier, options.max_harmonic, phases),
+                                 .pv_from_order = 0,
+                                 .replicates = options.replicates,
+                                 .seed = options.seed};
+  const NoiseCorrectedPv range = EstimateNoiseCorrectedPv(radius, radius_sigma, 1, phases, series);
+  series.seed = options.seed + 1;
+  const NoiseCorrectedPv centre = EstimateNoiseCorrectedPv(axial, axial_sigma, 1, phases, series);
+
+  // The map over the band: rows = axial nodes, columns = phases (runout, roundness).
+  std::vector<std::size_t> band;
+  for (std::size_t j = 0; j < n_y; ++j)
+    if (o.y_mm[j] >= o.band_low_mm && o.y_mm[j] <= o.band_high_mm) band.push_back(j);
+  const double map_sigma_um = o.map_sigma_mm * 1000.0;
+  std::optional<NoiseCorrectedPv> runout, roundness, arc_error;
+  if (!band.empty() && map_sigma_um > 0.0) {
+    std::vector<double> rows(band.size() * n_phase), sigmas(rows.size(), map_sigma_um);
+    for (std::size_t i = 0; i < band.size(); ++i)
+      for (std::size_t p = 0; p < n_phase; ++p) rows[i * n_phase + p] = o.rho_mm[p * n_y + band[i]] * 1000.0;
+    NoiseCorrectedPvOptions turn = series;
+    turn.seed = options.seed + 2;
+    runout = EstimateNoiseCorrectedPv(rows, sigmas, static_cast<int>(band.size()), phases, turn);
+    turn.pv_from_order = std::min(2, turn.max_order);
+    turn.seed = options.seed + 3;
+    roundness = EstimateNoiseCorrectedPv(rows, sigmas, static_cast<int>(band.size()), phases, turn);
+    // The sections' geometric residuals against each phase's circle: rows = phases.
+    std::vector<double> residuals(n_phase * band.size(), kNaN),
+        residual_sigmas(residuals.size(), map_sigma_um);
+    for (std::size_t p = 0; p < n_phase; ++p) {
+      if (!usable(p)) continue;
+      for (std::size_t i = 0; i < band.size(); ++i) {
+        const double dy = o.y_mm[band[i]] - o.center_axial_mm[p];
+        const double drho = o.rho_mm[p * n_y + band[i]] - o.center_radial_mm[p];
+        residuals[p * band.size() + i] = (std::hypot(dy, drho) - o.arc_radius_mm[p]) * 1000.0;
+      }
+    }
+    const int columns = static_cast<int>(band.size());
+    if (columns >= 4) {
+      const NoiseCorrectedPvOptions across{
+          .basis = SmoothBasis::kLegendre,
+          .max_order = FitOrder(SmoothBasis::kLegendre, options.max_degree, columns),
+          .pv_from_order = 0,
+          .replicates = options.replicates,
+          .shrink_rows = true,
+          .seed = options.seed + 4};
+      arc_error = EstimateNoiseCorrectedPv(residuals, residual_sigmas, phases, columns, across);
+    }
+  }
+
+  WheelUncertainty out;
+  out.budget = budget;
+  const double bootstrap_dof = options.replicates - 1.0;
+  for (const std::string& key : BudgetQuantityKeys()) {
+    QuantityUncertainty q;
+    q.key = key;
+    q.unit = QuantityUnit(key);
+    double estimate = kNaN;
+    if (key == s::kMeanArcRadiusMm) {
+      q.measured = o.mean_arc_radius_mm;
+      estimate = q.measured;
+      q.type_a_method = "per-phase fits: sigma of the mean from the noise";
+      q.inputs.push_back(TypeA(q.type_a_method, "mm", o.mean_arc_radius_sigma_mm, kInfiniteDof));
+    } else {
+      const NoiseCorrectedPv* pv = nullptr;
+      double scale = 1.0;
+      std::string_view basis = "harmonics";
+      if (key == s::kArcRadiusRangeMm) {
+        q.measured = o.arc_radius_range_mm, pv = &range;
+      } else if (key == s::kArcRadiusFluctuationPct) {
+        q.measured = o.arc_radius_fluctuation_pct, pv = &range, scale = 100.0 / o.mean_arc_radius_mm;
+      } else if (key == s::kCenterAxialDeviationMm) {
+        q.measured = o.center_axial_deviation_mm, pv = &centre;
+      } else if (key == s::kMaxRunoutUm) {
+        q.measured = o.max_runout_um, pv = runout ? &*runout : nullptr;
+      } else if (key == s::kMaxRoundnessUm) {
+        q.measured = o.max_roundness_um, pv = roundness ? &*roundness : nullptr;
+      } else if (key == s::kMaxArcErrorUm) {
+        q.measured = o.max_arc_error_um, pv = arc_error ? &*arc_error : nullptr, basis = "Legendre degrees";
+      }
+      if (pv) {
+        estimate = pv->value * scale;
+        q.noise_bias = q.measured - estimate;
+        q.type_a_method = BootstrapSource(*pv, basis);
+        q.inputs.push_back(TypeA(q.type_a_method, q.unit, pv->standard_uncertainty * scale, bootstrap_dof));
+      } else {
+        q.type_a_method = "not available: no map values in the band";
+        q.inputs.push_back(TypeA(q.type_a_method, q.unit, kNaN, kInfiniteDof));
+      }
+    }
+    const auto found = budget.quantities.find(key);
+    if (found != budget.quantities.end()) {
+      for (Input& input : ResolveInputs(found->second, estimate)) q.inputs.push_back(std::move(input));
+    }
+    if (std::isfinite(q.inputs.front().spread)) {
+      q.combined = Combine(q.inputs, budget.combine);
+      q.value = estimate + q.combined.correction;
+    } else {
+      q.combined.standard_uncertainty = q.combined.expanded = q.combined.coverage_factor = kNaN;
+      q.value = kNaN;
+    }
+    out.quantities.push_back(std::move(q));
+  }
+  return out;
+}
+
+nlohmann::json WheelUncertaintyToJson(const WheelUncertainty& uncertainty) {
+  namespace qk = su::quantity;
+  namespace ck = su::quantity::contribution;
+  nlohmann::json quantities = nlohmann::json::object();
+  for (const QuantityUncertainty& q : uncertainty.quantities) {
+    nlohmann::json contributions = nlohmann::json::array();
+    for (std::size_t i = 0; i < q.inputs.size() && i < q.combined.contributions.size(); ++i) {
+      const Input& input = q.inputs[i];
+      const Contribution& line = q.combined.contributions[i];
+      contributions.push_back({{ck::kName, input.name},
+                               {ck::kSource, input.source},
+                               {ck::kType, input.type == EvaluationType::kA ? "A" : "B"},
+                               {ck::kUnit, input.unit},
+                               {ck::kDistribution, DistributionName(input.distribution)},
+                               {ck::kStandardUncertainty, line.standard_uncertainty},
+                               {ck::kSensitivity, line.sensitivity},
+                               {ck::kContribution, line.contribution},
+                               {ck::kDof, Finite(line.dof)}});
+    }
+    nlohmann::json item = {{qk::kUnit, q.unit},
+                           {qk::kMeasured, Finite(q.measured)},
+                           {qk::kValue, Finite(q.value)},
+                           {qk::kTypeAMethod, q.type_a_method},
+                           {qk::kContributions, std::move(contributions)},
+                           {qk::kCorrection, q.combined.correction},
+                           {qk::kStandardUncertainty, Finite(q.combined.standard_uncertainty)},
+                           {qk::kEffectiveDof, Finite(q.combined.effective_dof)},
+                           {qk::kCoverageFactor, Finite(q.combined.coverage_factor)},
+                           {qk::kExpanded, Finite(q.combined.expanded)}};
+    if (q.key != s::kMeanArcRadiusMm) item[qk::kNoiseBias] = Finite(q.noise_bias);
+    quantities[q.key] = std::move(item);
+  }
+  return {{su::kCoverageProbability, uncertainty.budget.combine.coverage_probability},
+          {su::kBudgetSource, uncertainty.budget_source},
+          {su::kBudget, BudgetToJson(uncertainty.budget)},
+          {su::kQuantities, std::move(quantities)}};
+}
+
+}  // namespace arcwheel::uncertainty

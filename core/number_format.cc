@@ -92,7 +92,8 @@ std::string ShowNumbersIn(std::string_view text) {
   std::string shown;
   const std::string input(text);
   auto last = input.cbegin();
-  for (auto it = std::sregex_iterator(input.begin(), input.end(), kNumber); it != std::sregex_iterator(); ++it) {
+  for (auto it = std::sregex_iterator(input.begin(), input.end(), kNumber); it != std::sregex_iterator();
+       ++it) {
     const std::string token = it->str();
     shown.append(last, input.cbegin() + it->position());
     shown += SignificantDigitsShown(token) > kMaxShownDigits ? ShowSignificant(std::stod(token)) : token;

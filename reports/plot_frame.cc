@@ -31,8 +31,7 @@ double TextWidth(cairo_t* cr, const std::string& text) {
   return extents.x_advance;
 }
 
-void DrawText(cairo_t* cr, const std::string& text, double x, double y, double align_x,
-              double angle_rad) {
+void DrawText(cairo_t* cr, const std::string& text, double x, double y, double align_x, double angle_rad) {
   cairo_font_extents_t font;
   cairo_font_extents(cr, &font);
   cairo_save(cr);

@@ -1,5 +1,3 @@
-#include "reports/plot_frame.h"
-
 #include <fmt/format.h>
 
 #include <algorithm>
@@ -12,7 +10,7 @@
 
 #include "core/check.h"
 #include "core/error.h"
-
+#include "reports/plot_frame.h"
 
 namespace arcwheel::reports::plot::internal {
 

@@ -1,5 +1,3 @@
-#include "reports/plot_frame.h"
-
 #include <fmt/format.h>
 
 #include <algorithm>
@@ -12,7 +10,7 @@
 
 #include "core/check.h"
 #include "core/error.h"
-
+#include "reports/plot_frame.h"
 
 namespace arcwheel::reports::plot::internal {
 namespace {
@@ -30,7 +28,6 @@ std::uint32_t PackArgb(const Rgb& c) {
   };
   return 0xFF000000u | (byte(c.r) << 16) | (byte(c.g) << 8) | byte(c.b);
 }
-
 
 // Builds the display image of an n_x x n_y grid: columns follow x, rows follow y from the top
 // (largest y) down. `colour_of_block(i0, i1, j0, j1)` gives the colour of a block of cells.
@@ -212,7 +209,6 @@ void DrawHeatMap(cairo_t* cr, const HeatMap& map, double width, double height) {
   DrawColourBar(cr, frame.area, colours, map.colour_bar_label);
 }
 
-
 void DrawPathMap(cairo_t* cr, const PathMap& map, double width, double height) {
   ARCWHEEL_CHECK(map.y_points.size() == map.x_points.size() && map.values.size() == map.x_points.size())
       << "path '" << map.title << "' sizes do not match";
@@ -253,7 +249,6 @@ void DrawPathMap(cairo_t* cr, const PathMap& map, double width, double height) {
   cairo_restore(cr);
   DrawColourBar(cr, frame.area, colours, map.colour_bar_label);
 }
-
 
 void DrawCategoryMap(cairo_t* cr, const CategoryMap& map, double width, double height) {
   CheckGrid(map.n_x, map.n_y, map.codes.size(), map.x_nodes, map.y_nodes, map.title);

@@ -14,11 +14,11 @@ inline constexpr std::string_view kNominalPathFileName = "nominal_path_predictio
 namespace record {
 inline constexpr std::string_view kFinishedUtc = "finished_utc";
 inline constexpr std::string_view kArcwheelVersion = "arcwheel_version";
-inline constexpr std::string_view kWheel = "wheel";                // summary.json's headline numbers
-inline constexpr std::string_view kPrediction = "prediction";      // toolpath_summary.json's
-inline constexpr std::string_view kNominalPath = "nominal_path";   // pv_um, rms_um of the nominal path
-inline constexpr std::string_view kPolishAfter = "polish_after";   // polish_summary.json's "after"
-inline constexpr std::string_view kPrevious = "previous";          // the regeneration compared with
+inline constexpr std::string_view kWheel = "wheel";               // summary.json's headline numbers
+inline constexpr std::string_view kPrediction = "prediction";     // toolpath_summary.json's
+inline constexpr std::string_view kNominalPath = "nominal_path";  // pv_um, rms_um of the nominal path
+inline constexpr std::string_view kPolishAfter = "polish_after";  // polish_summary.json's "after"
+inline constexpr std::string_view kPrevious = "previous";         // the regeneration compared with
 inline constexpr std::string_view kPvUm = "pv_um";
 inline constexpr std::string_view kRmsUm = "rms_um";
 }  // namespace record

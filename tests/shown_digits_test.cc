@@ -44,15 +44,16 @@ int SignificantDigits(const std::string& token) {
 std::vector<std::string> OverlongNumbers(std::string text) {
   static const std::vector<std::regex> kNotMeasurements = {
       std::regex(R"(\d{4}-\d{2}-\d{2}([T ]\d{2}:\d{2}(:\d{2}(\.\d+)?)?Z?)?)"),  // dates and times
-      std::regex(R"(\b\d{1,2}:\d{2}(:\d{2})?\b)"),                             // clock times
-      std::regex(R"(\b\d+\.\d+\.\d+\b)"),                                      // versions
-      std::regex(R"(\S*/\S*)"),                                                // paths, units per unit
-      std::regex(R"(\b[0-9a-f]{12,}\b)"),                                      // hashes
+      std::regex(R"(\b\d{1,2}:\d{2}(:\d{2})?\b)"),                              // clock times
+      std::regex(R"(\b\d+\.\d+\.\d+\b)"),                                       // versions
+      std::regex(R"(\S*/\S*)"),                                                 // paths, units per unit
+      std::regex(R"(\b[0-9a-f]{12,}\b)"),                                       // hashes
   };
   for (const std::regex& pattern : kNotMeasurements) text = std::regex_replace(text, pattern, " ");
   static const std::regex kNumber(R"((^|[^\w.])(\d+(\.\d+)?([eE][-+]?\d+)?)(?![\w]))");
   std::vector<std::string> overlong;
-  for (auto it = std::sregex_iterator(text.begin(), text.end(), kNumber); it != std::sregex_iterator(); ++it) {
+  for (auto it = std::sregex_iterator(text.begin(), text.end(), kNumber); it != std::sregex_iterator();
+       ++it) {
     const std::string token = (*it)[2];
     if (SignificantDigits(token) > kMaxDigits) overlong.push_back(token);
   }
@@ -71,11 +72,14 @@ std::string VisibleText(const std::string& html) {
 }
 
 TEST(ShownDigits, TheCheckFlagsAFullPrecisionDoubleAndPassesRoundedOnes) {
-  EXPECT_THAT(OverlongNumbers("measured 55.401577631285676 mm"), ::testing::ElementsAre("55.401577631285676"));
+  EXPECT_THAT(OverlongNumbers("measured 55.401577631285676 mm"),
+              ::testing::ElementsAre("55.401577631285676"));
   EXPECT_THAT(OverlongNumbers("Ra = 55.40158 mm, Rb = 144.5984 mm, range 0.0452 mm (−0.00012)"),
               ::testing::IsEmpty());
-  EXPECT_THAT(OverlongNumbers("[\"toolpath.csv\",144.59842236871432]"), ::testing::ElementsAre("144.59842236871432"));
-  EXPECT_THAT(OverlongNumbers("1.2345678e-05 and 132000000 samples"), ::testing::ElementsAre("1.2345678e-05"));
+  EXPECT_THAT(OverlongNumbers("[\"toolpath.csv\",144.59842236871432]"),
+              ::testing::ElementsAre("144.59842236871432"));
+  EXPECT_THAT(OverlongNumbers("1.2345678e-05 and 132000000 samples"),
+              ::testing::ElementsAre("1.2345678e-05"));
   EXPECT_THAT(OverlongNumbers("written 2026-12-03T07:26:23Z by arcwheel 0.1.0 to /tmp/a1234567890/b, "
                               "sha256 9f86d081884c7d659a2feaa0c55ad015"),
               ::testing::IsEmpty());
@@ -121,7 +125,8 @@ class ShownDigitsOfCommands : public ::testing::Test {
 };
 
 TEST_F(ShownDigitsOfCommands, ProcessAndItsReport) {
-  const auto run = RunArcwheel("process " + scan_.string() + " -o " + (dir_ / "p").string() + " --report html,pdf");
+  const auto run =
+      RunArcwheel("process " + scan_.string() + " -o " + (dir_ / "p").string() + " --report html,pdf");
   ASSERT_EQ(run.exit_status, 0) << run.output;
   ExpectShortNumbers("process output", run.output);
   ExpectShortNumbersInReport(dir_ / "p/report.html", dir_ / "p/report.pdf");
@@ -131,20 +136,22 @@ TEST_F(ShownDigitsOfCommands, ToolpathPolishAndRegenerateAndTheirReports) {
   const json part = SmallTrialPart();
   WriteText(dir_ / "part.json", part.dump(2));
   WriteText(dir_ / "polish.json", TrialPolishJob(part).dump(2));
-  const auto regenerate = RunArcwheel("regenerate --scan " + scan_.string() + " --job " +
-                                      (dir_ / "part.json").string() + " --polish " + (dir_ / "polish.json").string() +
-                                      " -o " + (dir_ / "r").string());
+  const auto regenerate =
+      RunArcwheel("regenerate --scan " + scan_.string() + " --job " + (dir_ / "part.json").string() +
+                  " --polish " + (dir_ / "polish.json").string() + " -o " + (dir_ / "r").string());
   ASSERT_EQ(regenerate.exit_status, 0) << regenerate.output;
   ExpectShortNumbers("regenerate output", regenerate.output);
   ExpectShortNumbersInReport(dir_ / "r/regenerate_report.html", dir_ / "r/regenerate_report.pdf");
 
-  const auto toolpath = RunArcwheel("toolpath " + (dir_ / "part.json").string() + " --wheel " +
-                                    (dir_ / "r/wheel/summary.json").string() + " -o " + (dir_ / "t").string());
+  const auto toolpath =
+      RunArcwheel("toolpath " + (dir_ / "part.json").string() + " --wheel " +
+                  (dir_ / "r/wheel/summary.json").string() + " -o " + (dir_ / "t").string());
   ASSERT_EQ(toolpath.exit_status, 0) << toolpath.output;
   ExpectShortNumbers("toolpath output", toolpath.output);
 
-  const auto polish = RunArcwheel("polish " + (testing::SourceDir() / "polishing/examples/disc_job.json").string() +
-                                  " -o " + (dir_ / "q").string() + " --report html,pdf");
+  const auto polish =
+      RunArcwheel("polish " + (testing::SourceDir() / "polishing/examples/disc_job.json").string() + " -o " +
+                  (dir_ / "q").string() + " --report html,pdf");
   ASSERT_EQ(polish.exit_status, 0) << polish.output;
   ExpectShortNumbers("polish output", polish.output);
   ExpectShortNumbersInReport(dir_ / "q/polish_report.html", dir_ / "q/polish_report.pdf");

@@ -57,7 +57,8 @@ pid_t SpawnProcess(const BatchOptions& args, const Scan& scan) {
 
 // What the child's wait status says; a result folder that did not finish is removed, so that
 // only complete results stay (the child's OutputSet removes its own; this covers a crash).
-Outcome Finish(const BatchOptions& args, const Scan& scan, int wait_status, double seconds, const json& inputs) {
+Outcome Finish(const BatchOptions& args, const Scan& scan, int wait_status, double seconds,
+               const json& inputs) {
   Outcome outcome{.status = Status::kFailed, .exit_code = std::nullopt, .message = {}, .seconds = seconds};
   const fs::path folder = ResultFolder(args, scan);
   if (WIFEXITED(wait_status)) {

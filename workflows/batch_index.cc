@@ -94,7 +94,8 @@ std::string CsvCell(const json& value) {
 
 }  // namespace
 
-void WriteIndex(const BatchOptions& args, const std::vector<Scan>& scans, const std::vector<Outcome>& outcomes) {
+void WriteIndex(const BatchOptions& args, const std::vector<Scan>& scans,
+                const std::vector<Outcome>& outcomes) {
   json rows = json::array();
   std::map<std::string, int> counts;
   for (size_t i = 0; i < scans.size(); ++i) {

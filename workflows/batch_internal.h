@@ -64,7 +64,8 @@ fs::path ArcwheelBinary(const BatchOptions& args);
 // `arcwheel process SCAN -o OUTDIR/NAME OPTIONS`, its output to the log.
 ::pid_t SpawnProcess(const BatchOptions& args, const Scan& scan);
 // What the child's wait status says; a result folder that did not finish is removed.
-Outcome Finish(const BatchOptions& args, const Scan& scan, int wait_status, double seconds, const json& inputs);
+Outcome Finish(const BatchOptions& args, const Scan& scan, int wait_status, double seconds,
+               const json& inputs);
 
 // Progress on stderr (batch_progress.cc).
 class BatchProgress {
@@ -87,7 +88,8 @@ class BatchProgress {
 };
 
 // OUTDIR/index.csv and index.json (batch_index.cc).
-void WriteIndex(const BatchOptions& args, const std::vector<Scan>& scans, const std::vector<Outcome>& outcomes);
+void WriteIndex(const BatchOptions& args, const std::vector<Scan>& scans,
+                const std::vector<Outcome>& outcomes);
 
 // An array job of one task per scan (batch_slurm.cc).
 std::string SlurmScript(const BatchOptions& args, const std::vector<Scan>& scans);

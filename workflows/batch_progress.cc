@@ -76,5 +76,4 @@ void BatchProgress::ClearLine() {
   line_open_ = false;
 }
 
-
 }  // namespace arcwheel::workflows::batch

@@ -35,7 +35,9 @@ std::optional<Status> ParseStatus(const std::string& name) {
   return std::nullopt;
 }
 
-fs::path ResultFolder(const BatchOptions& args, const Scan& scan) { return fs::path(args.outdir) / scan.name; }
+fs::path ResultFolder(const BatchOptions& args, const Scan& scan) {
+  return fs::path(args.outdir) / scan.name;
+}
 fs::path LogPath(const BatchOptions& args, const Scan& scan) {
   return fs::path(args.outdir) / kLogsFolder / (scan.name + ".log");
 }

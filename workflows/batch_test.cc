@@ -19,8 +19,8 @@ namespace {
 
 namespace fs = std::filesystem;
 using nlohmann::json;
-using ::testing::HasSubstr;
 using testing::ErrorMessageOf;
+using ::testing::HasSubstr;
 using testing::ReadText;
 using testing::TempDir;
 using testing::WriteText;
@@ -59,7 +59,9 @@ TEST(BatchPlan, RefusesTwoScansOfOneNameNamingBoth) {
   WriteText(dir / "x/w.h5", "1");
   WriteText(dir / "y/w.csv", "2");
   const std::string message = ErrorMessageOf(
-      [&] { (void)batch::PlanScans({(dir / "x/w.h5").string(), (dir / "y/w.csv").string()}); },
+      [&] {
+        (void)batch::PlanScans({(dir / "x/w.h5").string(), (dir / "y/w.csv").string()});
+      },
       ErrorCode::kInvalidOption);
   EXPECT_THAT(message, HasSubstr("x/w.h5"));
   EXPECT_THAT(message, HasSubstr("y/w.csv"));

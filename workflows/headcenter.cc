@@ -96,7 +96,6 @@ std::vector<RecordRow> ReadRecordList(const std::string& list, const char* x_nam
   return rows;
 }
 
-
 }  // namespace
 
 HeadcenterSolve SolveHeadcenterRecord(const std::string& record, const std::string& calibration_path,

@@ -56,7 +56,8 @@ struct HeadcenterMoves {
 
 // Repeatability and move-accuracy tables from the records a CSV list names
 // (record,commanded_x_mm,commanded_y_mm), in machine coordinates with `calibration`. Throws Error.
-[[nodiscard]] HeadcenterMoves TabulateHeadcenterMoves(const std::string& records, const std::string& calibration,
+[[nodiscard]] HeadcenterMoves TabulateHeadcenterMoves(const std::string& records,
+                                                      const std::string& calibration,
                                                       const RecordSolveOptions& options);
 
 }  // namespace arcwheel::workflows

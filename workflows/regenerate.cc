@@ -27,7 +27,6 @@ namespace {
 
 using nlohmann::json;
 
-
 // Runs a step unless its inputs are unchanged. A failing step leaves no folder of its own; the
 // message names the step, and the error keeps its code (so the exit status).
 bool RunOrReuse(const fs::path& outdir, const ChainStepSpec& step, const json& inputs,

@@ -11,11 +11,11 @@
 namespace arcwheel::workflows {
 
 struct RegenerateOptions {
-  std::string scan;     // raw wheel scan (.h5/.hdf5 or .csv)
-  std::string job;      // toolpath job of the part (docs/grinding.md)
-  std::string polish;   // polishing job; empty: no polishing step
-  std::string output;   // OUTDIR
-  std::string previous; // an earlier regeneration to compare with; empty: the latest beside OUTDIR
+  std::string scan;      // raw wheel scan (.h5/.hdf5 or .csv)
+  std::string job;       // toolpath job of the part (docs/grinding.md)
+  std::string polish;    // polishing job; empty: no polishing step
+  std::string output;    // OUTDIR
+  std::string previous;  // an earlier regeneration to compare with; empty: the latest beside OUTDIR
   // The map polished: "prediction" (what the regenerated toolpath leaves) or "nominal-path".
   std::string polish_map = "prediction";
   // The measured wheel for the toolpath: "mean" (per-phase fits) or "model".

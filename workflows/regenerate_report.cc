@@ -1,3 +1,5 @@
+#include "reports/regenerate_report.h"
+
 #include <fmt/chrono.h>
 #include <fmt/core.h>
 
@@ -12,7 +14,6 @@
 #include "core/number_format.h"
 #include "core/version.h"
 #include "reports/format.h"
-#include "reports/regenerate_report.h"
 #include "schema/grid_map.h"
 #include "schema/polish_outputs.h"
 #include "schema/regenerate_outputs.h"
@@ -78,14 +79,15 @@ ChainFiles ReadChainFiles(const fs::path& outdir) {
 // The headline numbers kept in OUTDIR/regenerate.json and compared with the previous one.
 json Record(const ChainFiles& f) {
   namespace key = schema::summary;
-  json record = {{record_key::kFinishedUtc, fmt::format("{:%Y-%m-%dT%H:%M:%SZ}", fmt::gmtime(std::time(nullptr)))},
-                 {record_key::kArcwheelVersion, kVersion},
-                 {record_key::kWheel,
-                  {{key::kMeanArcRadiusMm, At(f.wheel, key::kMeanArcRadiusMm)},
-                   {key::kMeanArcRadiusSigmaMm, At(f.wheel, key::kMeanArcRadiusSigmaMm)},
-                   {key::kArcRadiusRangeMm, At(f.wheel, key::kArcRadiusRangeMm)},
-                   {key::kMaxRunoutUm, At(f.wheel, key::kMaxRunoutUm)}}},
-                 {record_key::kPrediction, At(f.toolpath, toolpath_key::kPrediction)}};
+  json record = {
+      {record_key::kFinishedUtc, fmt::format("{:%Y-%m-%dT%H:%M:%SZ}", fmt::gmtime(std::time(nullptr)))},
+      {record_key::kArcwheelVersion, kVersion},
+      {record_key::kWheel,
+       {{key::kMeanArcRadiusMm, At(f.wheel, key::kMeanArcRadiusMm)},
+        {key::kMeanArcRadiusSigmaMm, At(f.wheel, key::kMeanArcRadiusSigmaMm)},
+        {key::kArcRadiusRangeMm, At(f.wheel, key::kArcRadiusRangeMm)},
+        {key::kMaxRunoutUm, At(f.wheel, key::kMaxRunoutUm)}}},
+      {record_key::kPrediction, At(f.toolpath, toolpath_key::kPrediction)}};
   if (f.nominal_path) record[record_key::kNominalPath] = *f.nominal_path;
   if (!f.polish.is_null()) record[record_key::kPolishAfter] = At(f.polish, schema::polish::summary::kAfter);
   return record;
@@ -102,7 +104,8 @@ std::optional<fs::path> FindPreviousBeside(const fs::path& outdir) {
     const fs::path record = entry.path() / kRecordFileName;
     if (!fs::exists(record)) continue;
     try {
-      const std::string time = At(ReadJsonFile(record, kRegenerateStage), record_key::kFinishedUtc).get<std::string>();
+      const std::string time =
+          At(ReadJsonFile(record, kRegenerateStage), record_key::kFinishedUtc).get<std::string>();
       if (!best || time > best_time) best = entry.path(), best_time = time;
     } catch (const std::exception&) {
       continue;  // not a record this command wrote
@@ -116,10 +119,9 @@ std::vector<std::string> ChangeRow(const std::string& label, const json& before,
   const auto text = [&](const json& v) {
     return v.is_number() ? ShowFixed(v.get<double>(), decimals) + " " + unit : std::string("n/a");
   };
-  const std::string change =
-      before.is_number() && now.is_number()
-          ? ShowSigned(now.get<double>() - before.get<double>(), decimals) + " " + unit
-          : "n/a";
+  const std::string change = before.is_number() && now.is_number()
+                                 ? ShowSigned(now.get<double>() - before.get<double>(), decimals) + " " + unit
+                                 : "n/a";
   return {label, text(before), text(now), change};
 }
 
@@ -133,8 +135,10 @@ std::vector<std::vector<std::string>> Changes(const json& previous, const json& 
                 5),
       ChangeRow("Arc radius range", At(pw, key::kArcRadiusRangeMm), At(nw, key::kArcRadiusRangeMm), "mm", 4),
       ChangeRow("Max runout", At(pw, key::kMaxRunoutUm), At(nw, key::kMaxRunoutUm), "µm", 2),
-      ChangeRow("Predicted form error PV", At(pp, toolpath_key::prediction::kPvUm), At(np, toolpath_key::prediction::kPvUm), "µm", 3),
-      ChangeRow("Predicted form error RMS", At(pp, toolpath_key::prediction::kRmsUm), At(np, toolpath_key::prediction::kRmsUm), "µm", 3)};
+      ChangeRow("Predicted form error PV", At(pp, toolpath_key::prediction::kPvUm),
+                At(np, toolpath_key::prediction::kPvUm), "µm", 3),
+      ChangeRow("Predicted form error RMS", At(pp, toolpath_key::prediction::kRmsUm),
+                At(np, toolpath_key::prediction::kRmsUm), "µm", 3)};
 }
 
 std::vector<reports::KeyValue> WheelRows(const ChainFiles& f) {
@@ -185,18 +189,21 @@ std::vector<reports::KeyValue> ToolpathRows(const ChainFiles& f) {
 std::vector<reports::KeyValue> PredictionRows(const ChainFiles& f) {
   const json& p = At(f.toolpath, toolpath_key::kPrediction);
   std::vector<reports::KeyValue> rows = {
-      {"PV, RMS", Um(At(p, toolpath_key::prediction::kPvUm)) + ", " + Um(At(p, toolpath_key::prediction::kRmsUm))},
-      {"After piston and tilt: PV, RMS",
-       Um(At(p, toolpath_key::prediction::kPvAfterTiltUm)) + ", " + Um(At(p, toolpath_key::prediction::kRmsAfterTiltUm))},
+      {"PV, RMS",
+       Um(At(p, toolpath_key::prediction::kPvUm)) + ", " + Um(At(p, toolpath_key::prediction::kRmsUm))},
+      {"After piston and tilt: PV, RMS", Um(At(p, toolpath_key::prediction::kPvAfterTiltUm)) + ", " +
+                                             Um(At(p, toolpath_key::prediction::kRmsAfterTiltUm))},
       {"Runout ripple PV", Um(At(p, toolpath_key::prediction::kRipplePvUm))},
       {"Arc radius error assumed",
        Mm(At(p, toolpath_key::prediction::kArcRadiusErrorMm), 6) + " (" +
-           (At(p, toolpath_key::prediction::kArcRadiusErrorSource).is_string() ? At(p, toolpath_key::prediction::kArcRadiusErrorSource).get<std::string>()
-                                                         : "") +
+           (At(p, toolpath_key::prediction::kArcRadiusErrorSource).is_string()
+                ? At(p, toolpath_key::prediction::kArcRadiusErrorSource).get<std::string>()
+                : "") +
            ")"}};
   if (f.nominal_path) {
     rows.push_back({"The nominal wheel's path would print (radius difference alone)",
-                    "PV " + Um(At(*f.nominal_path, record_key::kPvUm)) + ", RMS " + Um(At(*f.nominal_path, record_key::kRmsUm)) +
+                    "PV " + Um(At(*f.nominal_path, record_key::kPvUm)) + ", RMS " +
+                        Um(At(*f.nominal_path, record_key::kRmsUm)) +
                         ": avoided by the regenerated toolpath"});
   }
   return rows;
@@ -266,9 +273,10 @@ void WriteChainReport(const RegenerateOptions& args, const StepStatus& status, c
                               kRecordFileName));
     }
     const json before = ReadJsonFile(record_path, kRegenerateStage);
-    content.previous = fmt::format(
-        "{} (finished {})", previous->string(),
-        At(before, record_key::kFinishedUtc).is_string() ? At(before, record_key::kFinishedUtc).get<std::string>() : "?");
+    content.previous = fmt::format("{} (finished {})", previous->string(),
+                                   At(before, record_key::kFinishedUtc).is_string()
+                                       ? At(before, record_key::kFinishedUtc).get<std::string>()
+                                       : "?");
     content.changes = Changes(before, record);
     record[record_key::kPrevious] = previous->string();
   }

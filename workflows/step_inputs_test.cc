@@ -32,7 +32,9 @@ TEST(StepInputs, RecordsTheVersionTheOptionsAndEachFilesSha256) {
 
 TEST(StepInputs, AnUnreadableFileIsAnIoError) {
   TempDir dir;
-  const Error error = testing::ErrorOf([&] { (void)StepInputs({{"scan", dir / "missing.h5"}}, json::object()); });
+  const Error error = testing::ErrorOf([&] {
+    (void)StepInputs({{"scan", dir / "missing.h5"}}, json::object());
+  });
   EXPECT_EQ(error.code(), ErrorCode::kIo);
 }
 

@@ -9,6 +9,8 @@
 
 #include "cli/commands.h"
 #include "reports/polish_report.h"
+#include "store/records.h"
+#include "workflows/record.h"
 #include "workflows/steps.h"
 
 namespace arcwheel::cli {
@@ -18,6 +20,7 @@ void AddPolishCommand(CLI::App& app) {
     std::string job;
     std::string output;
     std::vector<std::string> report_formats;
+    std::string db;
   };
   auto arguments = std::make_shared<Arguments>();
   CLI::App* command = app.add_subcommand(
@@ -29,13 +32,22 @@ void AddPolishCommand(CLI::App& app) {
                    "also render the polishing report: html,pdf (both are written, docs/reports.md)")
       ->delimiter(',')
       ->check(CLI::IsMember({"html", "pdf"}));
+  AddDbOption(command, arguments->db);
   command->callback([arguments] {
-    (void)workflows::RunPolishStep(arguments->job, std::nullopt, arguments->output);
-    if (!arguments->report_formats.empty()) {
-      // Drawn from the files just written, exactly as `arcwheel report OUTDIR` would.
-      const reports::WrittenPolishReports written = reports::WritePolishReports(arguments->output);
-      fmt::print("report: {}\n        {}\n", written.html.string(), written.pdf.string());
-    }
+    workflows::RunRecorded(
+        arguments->db,
+        [&] {
+          (void)workflows::RunPolishStep(arguments->job, std::nullopt, arguments->output);
+          if (!arguments->report_formats.empty()) {
+            // Drawn from the files just written, exactly as `arcwheel report OUTDIR` would.
+            const reports::WrittenPolishReports written = reports::WritePolishReports(arguments->output);
+            fmt::print("report: {}\n        {}\n", written.html.string(), written.pdf.string());
+          }
+        },
+        [&] {
+          return std::vector<store::StoredRun>{
+              store::PolishRun(arguments->output, arguments->job, std::nullopt, "polish")};
+        });
   });
 }
 

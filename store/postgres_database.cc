@@ -34,10 +34,12 @@ class PostgresDatabase final : public Database {
     if (PQstatus(connection_) != CONNECTION_OK) {
       const std::string reason = Trimmed(PQerrorMessage(connection_));
       PQfinish(connection_);
-      throw Error(ErrorCode::kIo, kStage, fmt::format("cannot reach the results store '{}': {}", name_, reason));
+      throw Error(ErrorCode::kIo, kStage,
+                  fmt::format("cannot reach the results store '{}': {}", name_, reason));
     }
     // Notices (a table that exists already) are not the user's business.
-    PQsetNoticeProcessor(connection_, [](void*, const char*) {}, nullptr);
+    PQsetNoticeProcessor(
+        connection_, [](void*, const char*) {}, nullptr);
     Execute("SET client_min_messages TO warning", {});
   }
   ~PostgresDatabase() override { PQfinish(connection_); }
@@ -77,7 +79,8 @@ class PostgresDatabase final : public Database {
         if (PQgetisnull(result, r, c)) {
           row.emplace_back(std::monostate{});
         } else {
-          row.emplace_back(std::string(PQgetvalue(result, r, c), static_cast<size_t>(PQgetlength(result, r, c))));
+          row.emplace_back(
+              std::string(PQgetvalue(result, r, c), static_cast<size_t>(PQgetlength(result, r, c))));
         }
       }
       rows.push_back(std::move(row));
@@ -100,9 +103,10 @@ class PostgresDatabase final : public Database {
   }
 
   bool HasTable(const std::string& table) override {
-    return !Query("SELECT 1 FROM information_schema.tables WHERE table_schema = current_schema() AND "
-                  "table_name = $1",
-                  {table})
+    return !Query(
+                "SELECT 1 FROM information_schema.tables WHERE table_schema = current_schema() AND "
+                "table_name = $1",
+                {table})
                 .empty();
   }
 
@@ -113,6 +117,8 @@ class PostgresDatabase final : public Database {
 
 }  // namespace
 
-std::unique_ptr<Database> OpenPostgres(const std::string& url) { return std::make_unique<PostgresDatabase>(url); }
+std::unique_ptr<Database> OpenPostgres(const std::string& url) {
+  return std::make_unique<PostgresDatabase>(url);
+}
 
 }  // namespace arcwheel::store::internal

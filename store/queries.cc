@@ -22,7 +22,8 @@ double Value(const StoredRun& run, std::string_view characteristic) {
   return number != nullptr ? number->value : kNaN;
 }
 
-std::vector<StoredRun> Scans(Store& store, const std::string& wheel_id, const std::optional<double>& since_s) {
+std::vector<StoredRun> Scans(Store& store, const std::string& wheel_id,
+                             const std::optional<double>& since_s) {
   if (wheel_id.empty()) throw Error(ErrorCode::kInvalidOption, kStage, "--wheel needs a wheel id");
   std::vector<StoredRun> runs = store.Runs({.wheel_id = wheel_id, .command = "process", .since_s = since_s});
   if (runs.empty()) {
@@ -35,12 +36,21 @@ std::vector<StoredRun> Scans(Store& store, const std::string& wheel_id, const st
 
 // The columns of an export row, in order.
 const std::vector<std::string_view>& ExportColumns() {
-  static const std::vector<std::string_view> columns = {
-      s::kExportRunId,       s::runs::kCommand,         s::runs::kVia,
-      s::runs::kWheelId,     s::runs::kScanTimestamp,   s::runs::kRecordedAt,
-      s::numbers::kCharacteristic, s::numbers::kValue,  s::numbers::kSigma,
-      s::numbers::kUnit,     s::numbers::kExpandedUncertainty, s::numbers::kDecision,
-      s::runs::kOutputFolder, s::runs::kArcwheelVersion, s::runs::kHost};
+  static const std::vector<std::string_view> columns = {s::kExportRunId,
+                                                        s::runs::kCommand,
+                                                        s::runs::kVia,
+                                                        s::runs::kWheelId,
+                                                        s::runs::kScanTimestamp,
+                                                        s::runs::kRecordedAt,
+                                                        s::numbers::kCharacteristic,
+                                                        s::numbers::kValue,
+                                                        s::numbers::kSigma,
+                                                        s::numbers::kUnit,
+                                                        s::numbers::kExpandedUncertainty,
+                                                        s::numbers::kDecision,
+                                                        s::runs::kOutputFolder,
+                                                        s::runs::kArcwheelVersion,
+                                                        s::runs::kHost};
   return columns;
 }
 
@@ -83,7 +93,8 @@ std::string CsvCell(const json& value) {
 
 }  // namespace
 
-reports::History HistoryFromStore(Store& store, const std::string& wheel_id, const std::optional<double>& since_s,
+reports::History HistoryFromStore(Store& store, const std::string& wheel_id,
+                                  const std::optional<double>& since_s,
                                   const std::vector<double>& dressing_times_s,
                                   const std::vector<std::string>& dressing_timestamps) {
   std::vector<reports::HistoryScan> scans;
@@ -113,13 +124,13 @@ reports::History HistoryFromStore(Store& store, const std::string& wheel_id, con
   return reports::AssembleHistory(wheel_id, std::move(scans), dressing_times_s, dressing_timestamps);
 }
 
-std::pair<std::filesystem::path, std::filesystem::path> ComparisonFolders(Store& store, const std::string& wheel_id,
-                                                                          const std::optional<double>& since_s) {
+std::pair<std::filesystem::path, std::filesystem::path> ComparisonFolders(
+    Store& store, const std::string& wheel_id, const std::optional<double>& since_s) {
   const std::vector<StoredRun> runs = Scans(store, wheel_id, since_s);
   if (runs.size() < 2) {
     throw Error(ErrorCode::kBadInput, kStage,
-                fmt::format("'{}' holds {} scan of wheel '{}'{}: a comparison needs two", store.Name(), runs.size(),
-                            wheel_id, since_s ? " since the given date" : ""));
+                fmt::format("'{}' holds {} scan of wheel '{}'{}: a comparison needs two", store.Name(),
+                            runs.size(), wheel_id, since_s ? " since the given date" : ""));
   }
   const StoredRun& before = since_s ? runs.front() : runs[runs.size() - 2];
   return {before.output_folder, runs.back().output_folder};

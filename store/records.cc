@@ -55,8 +55,12 @@ std::vector<StoredNumber> Numbers(const json& document, const std::vector<Charac
   for (const Characteristic& c : characteristics) {
     const json* value = Find(document, c.path);
     if (value == nullptr || !value->is_number()) continue;
-    StoredNumber number{.characteristic = Name(c.path), .value = value->get<double>(), .sigma = std::nullopt,
-                        .unit = std::string(c.unit), .expanded_uncertainty = std::nullopt, .decision = {}};
+    StoredNumber number{.characteristic = Name(c.path),
+                        .value = value->get<double>(),
+                        .sigma = std::nullopt,
+                        .unit = std::string(c.unit),
+                        .expanded_uncertainty = std::nullopt,
+                        .decision = {}};
     if (!c.sigma_path.empty()) {
       const json* sigma = Find(document, c.sigma_path);
       if (sigma != nullptr && sigma->is_number()) number.sigma = sigma->get<double>();
@@ -149,7 +153,8 @@ StoredRun ProcessRun(const fs::path& outdir, const std::string& via) {
   run.scan_timestamp = String(summary, {k::kScan, k::scan::kTimestamp});
   if (!run.scan_timestamp.empty()) {
     try {
-      run.scan_time_s = reports::ParseTimestamp_s(run.scan_timestamp, "'" + path.string() + "' scan.timestamp");
+      run.scan_time_s =
+          reports::ParseTimestamp_s(run.scan_timestamp, "'" + path.string() + "' scan.timestamp");
     } catch (const Error&) {
       run.scan_time_s.reset();  // kept as text; `history` names it when asked
     }
@@ -159,13 +164,14 @@ StoredRun ProcessRun(const fs::path& outdir, const std::string& via) {
   const json* processing = Find(summary, {k::kProcessing});
   run.options = processing != nullptr ? processing->dump() : "{}";
   const std::string scan_path = String(summary, {k::kInput, k::input::kPath});
-  run.inputs.push_back({"scan", scan_path.empty() ? "" : Absolute(scan_path), String(summary, {k::kInput, k::input::kSha256})});
+  run.inputs.push_back({"scan", scan_path.empty() ? "" : Absolute(scan_path),
+                        String(summary, {k::kInput, k::input::kSha256})});
   run.numbers = Numbers(summary, ProcessCharacteristics());
   return run;
 }
 
-StoredRun ToolpathRun(const fs::path& outdir, const fs::path& job, const std::optional<fs::path>& wheel_summary,
-                      const std::string& via) {
+StoredRun ToolpathRun(const fs::path& outdir, const fs::path& job,
+                      const std::optional<fs::path>& wheel_summary, const std::string& via) {
   namespace k = schema::toolpath::summary;
   const json summary = ReadJsonFile(outdir / schema::toolpath::kSummaryFileName, "store");
   StoredRun run;

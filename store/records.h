@@ -26,6 +26,7 @@ namespace arcwheel::store {
 // `polish JOB` into `outdir`: the job and its error map (`error_map` when it replaced the job's,
 // else the job's error_map.file, relative to the job's folder), the job as used.
 [[nodiscard]] StoredRun PolishRun(const std::filesystem::path& outdir, const std::filesystem::path& job,
-                                  const std::optional<std::filesystem::path>& error_map, const std::string& via);
+                                  const std::optional<std::filesystem::path>& error_map,
+                                  const std::string& via);
 
 }  // namespace arcwheel::store

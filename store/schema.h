@@ -23,10 +23,13 @@ inline constexpr std::string_view kRunsTable = "runs";
 namespace runs {
 inline constexpr std::string_view kId = "id";
 inline constexpr std::string_view kCommand = "command";  // "process", "toolpath", "polish"
-inline constexpr std::string_view kVia = "via";  // the command that ran it: "process", "batch", "regenerate", ...
+inline constexpr std::string_view kVia =
+    "via";  // the command that ran it: "process", "batch", "regenerate", ...
 inline constexpr std::string_view kWheelId = "wheel_id";  // summary.json scan.wheel_id; "" when not recorded
-inline constexpr std::string_view kScanTimestamp = "scan_timestamp";  // summary.json scan.timestamp, as recorded
-inline constexpr std::string_view kScanTimeS = "scan_time_s";  // the same, seconds since 1970 UTC; NULL if none
+inline constexpr std::string_view kScanTimestamp =
+    "scan_timestamp";  // summary.json scan.timestamp, as recorded
+inline constexpr std::string_view kScanTimeS =
+    "scan_time_s";  // the same, seconds since 1970 UTC; NULL if none
 inline constexpr std::string_view kRecordedAt = "recorded_at";  // ISO 8601 UTC, when the run was recorded
 inline constexpr std::string_view kArcwheelVersion = "arcwheel_version";
 inline constexpr std::string_view kOutputFolder = "output_folder";  // absolute

@@ -85,12 +85,13 @@ class Statement {
 class SqliteDatabase final : public Database {
  public:
   explicit SqliteDatabase(const std::string& path) : name_(path) {
-    const int status = sqlite3_open_v2(path.c_str(), &db_,
-                                       SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE | SQLITE_OPEN_FULLMUTEX, nullptr);
+    const int status = sqlite3_open_v2(
+        path.c_str(), &db_, SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE | SQLITE_OPEN_FULLMUTEX, nullptr);
     if (status != SQLITE_OK) {
       const std::string reason = db_ != nullptr ? sqlite3_errmsg(db_) : sqlite3_errstr(status);
       sqlite3_close(db_);
-      throw Error(ErrorCode::kIo, kStage, fmt::format("cannot open the results store '{}': {}", path, reason));
+      throw Error(ErrorCode::kIo, kStage,
+                  fmt::format("cannot open the results store '{}': {}", path, reason));
     }
     sqlite3_busy_timeout(db_, kBusyTimeoutMs);
     try {
@@ -99,7 +100,8 @@ class SqliteDatabase final : public Database {
       Execute("PRAGMA foreign_keys=ON", {});
     } catch (const Error& e) {
       sqlite3_close(db_);
-      throw Error(ErrorCode::kIo, kStage, fmt::format("cannot use the results store '{}': {}", path, e.what()));
+      throw Error(ErrorCode::kIo, kStage,
+                  fmt::format("cannot use the results store '{}': {}", path, e.what()));
     }
   }
   ~SqliteDatabase() override { sqlite3_close(db_); }
@@ -155,7 +157,8 @@ class SqliteDatabase final : public Database {
   }
 
   bool HasTable(const std::string& table) override {
-    return !Query("SELECT name FROM sqlite_master WHERE type = 'table' AND name = $1", {Value(table)}).empty();
+    return !Query("SELECT name FROM sqlite_master WHERE type = 'table' AND name = $1", {Value(table)})
+                .empty();
   }
 
  private:
@@ -165,6 +168,8 @@ class SqliteDatabase final : public Database {
 
 }  // namespace
 
-std::unique_ptr<Database> OpenSqlite(const std::string& path) { return std::make_unique<SqliteDatabase>(path); }
+std::unique_ptr<Database> OpenSqlite(const std::string& path) {
+  return std::make_unique<SqliteDatabase>(path);
+}
 
 }  // namespace arcwheel::store::internal

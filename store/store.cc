@@ -43,7 +43,8 @@ std::string HostName() {
 
 // Version 1: the first layout.
 void CreateVersion1(Database& db) {
-  db.Execute(fmt::format("CREATE TABLE {} ({} INTEGER NOT NULL)", s::kSchemaVersionTable, s::schema_version::kVersion));
+  db.Execute(fmt::format("CREATE TABLE {} ({} INTEGER NOT NULL)", s::kSchemaVersionTable,
+                         s::schema_version::kVersion));
   db.Execute(fmt::format(
       "CREATE TABLE {} ({} {}, {} TEXT NOT NULL, {} TEXT NOT NULL, {} TEXT NOT NULL, {} TEXT NOT NULL, "
       "{} DOUBLE PRECISION, {} TEXT NOT NULL, {} TEXT NOT NULL, {} TEXT NOT NULL, {} TEXT NOT NULL)",
@@ -60,13 +61,15 @@ void CreateVersion1(Database& db) {
       "{} DOUBLE PRECISION, {} TEXT NOT NULL)",
       s::kNumbersTable, s::numbers::kRunId, s::kRunsTable, s::runs::kId, s::numbers::kCharacteristic,
       s::numbers::kValue, s::numbers::kSigma, s::numbers::kUnit));
-  db.Execute(fmt::format("INSERT INTO {} ({}) VALUES (1)", s::kSchemaVersionTable, s::schema_version::kVersion));
+  db.Execute(
+      fmt::format("INSERT INTO {} ({}) VALUES (1)", s::kSchemaVersionTable, s::schema_version::kVersion));
 }
 
 // 1 -> 2: the machine of each run (existing runs: ""), each number's expanded uncertainty and
 // decision (existing numbers: NULL), and an index for the queries by wheel and time.
 void MigrateTo2(Database& db) {
-  db.Execute(fmt::format("ALTER TABLE {} ADD COLUMN {} TEXT NOT NULL DEFAULT ''", s::kRunsTable, s::runs::kHost));
+  db.Execute(
+      fmt::format("ALTER TABLE {} ADD COLUMN {} TEXT NOT NULL DEFAULT ''", s::kRunsTable, s::runs::kHost));
   db.Execute(fmt::format("ALTER TABLE {} ADD COLUMN {} DOUBLE PRECISION", s::kNumbersTable,
                          s::numbers::kExpandedUncertainty));
   db.Execute(fmt::format("ALTER TABLE {} ADD COLUMN {} TEXT", s::kNumbersTable, s::numbers::kDecision));
@@ -83,7 +86,8 @@ static_assert(s::kLatestVersion == 2, "a new schema version needs its migration 
 
 int VersionOf(Database& db) {
   if (!db.HasTable(std::string(s::kSchemaVersionTable))) return 0;
-  const auto rows = db.Query(fmt::format("SELECT {} FROM {}", s::schema_version::kVersion, s::kSchemaVersionTable));
+  const auto rows =
+      db.Query(fmt::format("SELECT {} FROM {}", s::schema_version::kVersion, s::kSchemaVersionTable));
   if (rows.size() != 1 || !internal::AsInteger(rows[0][0])) {
     throw Error(ErrorCode::kBadInput, kStage,
                 fmt::format("'{}': table '{}' does not hold one version", db.Name(), s::kSchemaVersionTable));
@@ -96,9 +100,7 @@ void SetVersion(Database& db, int version) {
              {static_cast<std::int64_t>(version)});
 }
 
-Value Optional(const std::optional<double>& value) {
-  return value ? Value(*value) : Value(std::monostate{});
-}
+Value Optional(const std::optional<double>& value) { return value ? Value(*value) : Value(std::monostate{}); }
 
 std::string Text(const Value& value) { return internal::AsText(value).value_or(""); }
 
@@ -133,7 +135,8 @@ Store& Store::operator=(Store&&) noexcept = default;
 Store::~Store() = default;
 
 Store Store::Open(const std::string& location) {
-  if (location.empty()) throw Error(ErrorCode::kInvalidOption, kStage, "no store given (--db or ARCWHEEL_DB)");
+  if (location.empty())
+    throw Error(ErrorCode::kInvalidOption, kStage, "no store given (--db or ARCWHEEL_DB)");
   return Store(IsPostgresUrl(location) ? internal::OpenPostgres(location) : internal::OpenSqlite(location));
 }
 
@@ -173,7 +176,8 @@ void Store::Init(int version) {
     if (found == version) return;
     if (found != 0) {
       throw Error(ErrorCode::kBadInput, kStage,
-                  fmt::format("'{}' holds schema version {} already (`arcwheel db migrate` updates it)", Name(), found));
+                  fmt::format("'{}' holds schema version {} already (`arcwheel db migrate` updates it)",
+                              Name(), found));
     }
     CreateVersion1(*database_);
     for (int v = 1; v < version; ++v) kMigrations[static_cast<size_t>(v - 1)](*database_);
@@ -185,7 +189,9 @@ std::pair<int, int> Store::Migrate() {
   std::pair<int, int> versions;
   database_->WriteTransaction([&] {
     const int found = VersionOf(*database_);
-    if (found == 0) throw Error(ErrorCode::kBadInput, kStage, fmt::format("'{}' holds no store: run `arcwheel db init`", Name()));
+    if (found == 0)
+      throw Error(ErrorCode::kBadInput, kStage,
+                  fmt::format("'{}' holds no store: run `arcwheel db init`", Name()));
     if (found > s::kLatestVersion) RequireVersion(s::kLatestVersion);
     for (int v = found; v < s::kLatestVersion; ++v) kMigrations[static_cast<size_t>(v - 1)](*database_);
     SetVersion(*database_, s::kLatestVersion);
@@ -202,11 +208,12 @@ void Store::Record(std::vector<StoredRun>& runs) {
       if (run.arcwheel_version.empty()) run.arcwheel_version = kVersion;
       if (run.host.empty()) run.host = HostName();
       const auto id = database_->Query(
-          fmt::format("INSERT INTO {} ({}, {}, {}, {}, {}, {}, {}, {}, {}, {}) VALUES ($1, $2, $3, $4, $5, $6, $7, "
-                      "$8, $9, $10) RETURNING {}",
-                      s::kRunsTable, s::runs::kCommand, s::runs::kVia, s::runs::kWheelId, s::runs::kScanTimestamp,
-                      s::runs::kScanTimeS, s::runs::kRecordedAt, s::runs::kArcwheelVersion, s::runs::kOutputFolder,
-                      s::runs::kOptions, s::runs::kHost, s::runs::kId),
+          fmt::format(
+              "INSERT INTO {} ({}, {}, {}, {}, {}, {}, {}, {}, {}, {}) VALUES ($1, $2, $3, $4, $5, $6, $7, "
+              "$8, $9, $10) RETURNING {}",
+              s::kRunsTable, s::runs::kCommand, s::runs::kVia, s::runs::kWheelId, s::runs::kScanTimestamp,
+              s::runs::kScanTimeS, s::runs::kRecordedAt, s::runs::kArcwheelVersion, s::runs::kOutputFolder,
+              s::runs::kOptions, s::runs::kHost, s::runs::kId),
           {run.command, run.via, run.wheel_id, run.scan_timestamp, Optional(run.scan_time_s), run.recorded_at,
            run.arcwheel_version, run.output_folder, run.options, run.host});
       if (id.size() != 1 || !internal::AsInteger(id[0][0])) {
@@ -214,9 +221,10 @@ void Store::Record(std::vector<StoredRun>& runs) {
       }
       run.id = *internal::AsInteger(id[0][0]);
       for (const StoredInput& input : run.inputs) {
-        database_->Execute(fmt::format("INSERT INTO {} ({}, {}, {}, {}) VALUES ($1, $2, $3, $4)", s::kInputsTable,
-                                       s::inputs::kRunId, s::inputs::kRole, s::inputs::kPath, s::inputs::kSha256),
-                           {run.id, input.role, input.path, input.sha256});
+        database_->Execute(
+            fmt::format("INSERT INTO {} ({}, {}, {}, {}) VALUES ($1, $2, $3, $4)", s::kInputsTable,
+                        s::inputs::kRunId, s::inputs::kRole, s::inputs::kPath, s::inputs::kSha256),
+            {run.id, input.role, input.path, input.sha256});
       }
       for (const StoredNumber& number : run.numbers) {
         database_->Execute(
@@ -252,11 +260,12 @@ std::vector<StoredRun> Store::Runs(const RunFilter& filter) {
   std::map<std::int64_t, size_t> by_id;
   // NULL scan times (toolpath, polish) sort by recording order after the scans.
   for (const auto& row : database_->Query(
-           fmt::format("SELECT {}, {}, {}, {}, {}, {}, {}, {}, {}, {}, {} FROM {} WHERE {} ORDER BY {} IS NULL, {}, {}",
-                       s::runs::kId, s::runs::kCommand, s::runs::kVia, s::runs::kWheelId, s::runs::kScanTimestamp,
-                       s::runs::kScanTimeS, s::runs::kRecordedAt, s::runs::kArcwheelVersion, s::runs::kOutputFolder,
-                       s::runs::kOptions, s::runs::kHost, s::kRunsTable, where, s::runs::kScanTimeS,
-                       s::runs::kScanTimeS, s::runs::kId),
+           fmt::format("SELECT {}, {}, {}, {}, {}, {}, {}, {}, {}, {}, {} FROM {} WHERE {} ORDER BY {} IS "
+                       "NULL, {}, {}",
+                       s::runs::kId, s::runs::kCommand, s::runs::kVia, s::runs::kWheelId,
+                       s::runs::kScanTimestamp, s::runs::kScanTimeS, s::runs::kRecordedAt,
+                       s::runs::kArcwheelVersion, s::runs::kOutputFolder, s::runs::kOptions, s::runs::kHost,
+                       s::kRunsTable, where, s::runs::kScanTimeS, s::runs::kScanTimeS, s::runs::kId),
            parameters)) {
     StoredRun run;
     run.id = internal::AsInteger(row[0]).value_or(0);
@@ -274,23 +283,22 @@ std::vector<StoredRun> Store::Runs(const RunFilter& filter) {
     runs.push_back(std::move(run));
   }
   if (runs.empty()) return runs;
-  const std::string selected =
-      fmt::format("SELECT {} FROM {} WHERE {}", s::runs::kId, s::kRunsTable, where);
-  for (const auto& row : database_->Query(
-           fmt::format("SELECT {}, {}, {}, {} FROM {} WHERE {} IN ({}) ORDER BY {}", s::inputs::kRunId,
-                       s::inputs::kRole, s::inputs::kPath, s::inputs::kSha256, s::kInputsTable,
-                       s::inputs::kRunId, selected, s::inputs::kRunId),
-           parameters)) {
+  const std::string selected = fmt::format("SELECT {} FROM {} WHERE {}", s::runs::kId, s::kRunsTable, where);
+  for (const auto& row :
+       database_->Query(fmt::format("SELECT {}, {}, {}, {} FROM {} WHERE {} IN ({}) ORDER BY {}",
+                                    s::inputs::kRunId, s::inputs::kRole, s::inputs::kPath, s::inputs::kSha256,
+                                    s::kInputsTable, s::inputs::kRunId, selected, s::inputs::kRunId),
+                        parameters)) {
     const auto run = by_id.find(internal::AsInteger(row[0]).value_or(0));
     if (run == by_id.end()) continue;
     runs[run->second].inputs.push_back({Text(row[1]), Text(row[2]), Text(row[3])});
   }
-  for (const auto& row : database_->Query(
-           fmt::format("SELECT {}, {}, {}, {}, {}, {}, {} FROM {} WHERE {} IN ({})", s::numbers::kRunId,
-                       s::numbers::kCharacteristic, s::numbers::kValue, s::numbers::kSigma, s::numbers::kUnit,
-                       s::numbers::kExpandedUncertainty, s::numbers::kDecision, s::kNumbersTable,
-                       s::numbers::kRunId, selected),
-           parameters)) {
+  for (const auto& row :
+       database_->Query(fmt::format("SELECT {}, {}, {}, {}, {}, {}, {} FROM {} WHERE {} IN ({})",
+                                    s::numbers::kRunId, s::numbers::kCharacteristic, s::numbers::kValue,
+                                    s::numbers::kSigma, s::numbers::kUnit, s::numbers::kExpandedUncertainty,
+                                    s::numbers::kDecision, s::kNumbersTable, s::numbers::kRunId, selected),
+                        parameters)) {
     const auto run = by_id.find(internal::AsInteger(row[0]).value_or(0));
     if (run == by_id.end()) continue;
     StoredNumber number;

@@ -32,7 +32,8 @@ struct StoredInput {
 };
 
 struct StoredNumber {
-  std::string characteristic;  // the output file's key, e.g. "mean_arc_radius_mm", "model.arc_radius_range_mm"
+  std::string
+      characteristic;  // the output file's key, e.g. "mean_arc_radius_mm", "model.arc_radius_range_mm"
   double value = 0.0;
   std::optional<double> sigma;  // 1 sigma, in `unit`; none for peak-to-valley figures
   std::string unit;
@@ -58,9 +59,9 @@ struct StoredRun {
 };
 
 struct RunFilter {
-  std::string wheel_id;            // empty: every wheel
-  std::string command;             // empty: every command
-  std::optional<double> since_s;   // scans at or after this time (seconds since 1970 UTC)
+  std::string wheel_id;           // empty: every wheel
+  std::string command;            // empty: every command
+  std::optional<double> since_s;  // scans at or after this time (seconds since 1970 UTC)
 };
 
 // The store a command records into: `option` (`--db`) when not empty, else the environment

@@ -78,8 +78,9 @@ TEST(Store, AFailedTransactionLeavesNothing) {
   { Store store = Store::OpenForRecording(path); }
   auto db = internal::OpenSqlite(path);
   EXPECT_THROW(db->WriteTransaction([&] {
-    db->Execute("INSERT INTO runs (command, via, wheel_id, scan_timestamp, recorded_at, arcwheel_version, "
-                "output_folder, options) VALUES ('process', 'test', 'D1', '', '', '', '/x', '{}')");
+    db->Execute(
+        "INSERT INTO runs (command, via, wheel_id, scan_timestamp, recorded_at, arcwheel_version, "
+        "output_folder, options) VALUES ('process', 'test', 'D1', '', '', '', '/x', '{}')");
     throw Error(ErrorCode::kIo, "test", "the run failed");
   }),
                Error);
@@ -114,14 +115,16 @@ TEST(Store, MigrationFromVersionOneKeepsEveryRow) {
   // Rows as a version-1 arcwheel wrote them: the version-1 columns only.
   auto db = internal::OpenSqlite(path);
   for (int i = 0; i < 5; ++i) {
-    db->Execute("INSERT INTO runs (command, via, wheel_id, scan_timestamp, scan_time_s, recorded_at, "
-                "arcwheel_version, output_folder, options) VALUES ('process', 'process', 'D15', $1, $2, "
-                "'2026-03-10T00:00:00Z', '0.1.0', $3, '{}')",
-                {"2026-03-01T0" + std::to_string(i) + ":00:00Z", 1772323200.0 + 3600.0 * i,
-                 "/results/" + std::to_string(i)});
-    db->Execute("INSERT INTO numbers (run_id, characteristic, value, sigma, unit) VALUES ($1, "
-                "'mean_arc_radius_mm', $2, 0.001, 'mm')",
-                {static_cast<std::int64_t>(i + 1), 50.0 + i / 7.0});
+    db->Execute(
+        "INSERT INTO runs (command, via, wheel_id, scan_timestamp, scan_time_s, recorded_at, "
+        "arcwheel_version, output_folder, options) VALUES ('process', 'process', 'D15', $1, $2, "
+        "'2026-03-10T00:00:00Z', '0.1.0', $3, '{}')",
+        {"2026-03-01T0" + std::to_string(i) + ":00:00Z", 1772323200.0 + 3600.0 * i,
+         "/results/" + std::to_string(i)});
+    db->Execute(
+        "INSERT INTO numbers (run_id, characteristic, value, sigma, unit) VALUES ($1, "
+        "'mean_arc_radius_mm', $2, 0.001, 'mm')",
+        {static_cast<std::int64_t>(i + 1), 50.0 + i / 7.0});
     db->Execute("INSERT INTO inputs (run_id, role, path, sha256) VALUES ($1, 'scan', '/s.h5', 'ff')",
                 {static_cast<std::int64_t>(i + 1)});
   }
@@ -151,7 +154,8 @@ TEST(Store, AStoreThatCannotBeOpenedIsNamed) {
   EXPECT_EQ(error.code(), ErrorCode::kIo);
   EXPECT_NE(std::string(error.what()).find(missing), std::string::npos) << error.what();
   testing::WriteText(dir / "not_a_database", "this is text, not SQLite\n");
-  const Error garbage = testing::ErrorOf([&] { (void)Store::OpenForRecording((dir / "not_a_database").string()); });
+  const Error garbage =
+      testing::ErrorOf([&] { (void)Store::OpenForRecording((dir / "not_a_database").string()); });
   EXPECT_NE(std::string(garbage.what()).find("not_a_database"), std::string::npos) << garbage.what();
   const Error server = testing::ErrorOf(
       [&] { (void)Store::Open("postgresql://arcwheel:secret@127.0.0.1:1/results?connect_timeout=2"); });
@@ -163,7 +167,8 @@ TEST(Store, AStoreThatCannotBeOpenedIsNamed) {
 TEST(Store, SinceTakesADateOrADateTime) {
   EXPECT_EQ(ParseSince_s("2026-03-01", "--since"), 1772323200.0);
   EXPECT_EQ(ParseSince_s("2026-03-01T01:00:00Z", "--since"), 1772323200.0 + 3600.0);
-  EXPECT_EQ(testing::ErrorOf([] { (void)ParseSince_s("March", "--since"); }).code(), ErrorCode::kInvalidOption);
+  EXPECT_EQ(testing::ErrorOf([] { (void)ParseSince_s("March", "--since"); }).code(),
+            ErrorCode::kInvalidOption);
 }
 
 }  // namespace

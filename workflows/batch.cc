@@ -12,6 +12,7 @@
 #include "core/error.h"
 #include "core/interrupt.h"
 #include "workflows/batch_internal.h"
+#include "workflows/record.h"
 #include "workflows/step_inputs.h"
 
 namespace arcwheel::workflows {
@@ -174,19 +175,29 @@ void CheckOutputNotSet(const std::vector<std::string>& options) {
           ErrorCode::kInvalidOption, kStage,
           "the process options after -- must not set the output folder: batch writes OUTDIR/<scan name>");
     }
+    if (option.rfind("--db", 0) == 0) {
+      throw Error(ErrorCode::kInvalidOption, kStage,
+                  "the process options after -- must not name a store: give --db to batch, which hands it "
+                  "to every scan");
+    }
   }
 }
 
 }  // namespace
 }  // namespace batch
 
-BatchReport RunBatch(const BatchOptions& args) {
+BatchReport RunBatch(const BatchOptions& options) {
   using namespace batch;
+  // Every child records into the store this batch names, which is checked (and an empty one given
+  // its schema, once, before two children could race to create it) before anything is written.
+  BatchOptions args = options;
+  args.db = store::StoreLocation(options.db);
   if (args.jobs < 1)
     throw Error(ErrorCode::kInvalidOption, kStage, fmt::format("-j {} violates >= 1", args.jobs));
   const std::vector<Scan> scans = PlanScans(args.inputs);
   CheckOutputNotSet(args.process_options);
   if (args.check_process_options) args.check_process_options(args.process_options, scans.front().path);
+  if (!args.db.empty() && !args.index_only) (void)OpenRunStore(args.db);
   EnsureDirectory(fs::path(args.outdir) / kLogsFolder);
   BatchReport report;
   report.scans = scans.size();

@@ -36,7 +36,8 @@ struct DbArguments {
 
 store::Store OpenNamed(const DbArguments& arguments) {
   const std::string location = store::StoreLocation(arguments.db);
-  if (location.empty()) throw Error(ErrorCode::kInvalidOption, "store", "no store given: --db STORE or ARCWHEEL_DB");
+  if (location.empty())
+    throw Error(ErrorCode::kInvalidOption, "store", "no store given: --db STORE or ARCWHEEL_DB");
   return store::Store::Open(location);
 }
 
@@ -87,7 +88,8 @@ void AddDbCommand(CLI::App& app) {
                    "create this older version instead of the latest (to test a migration)")
       ->capture_default_str();
   init->callback([arguments] { db::Init(*arguments); });
-  CLI::App* migrate = command->add_subcommand("migrate", "bring the store to the latest schema, keeping every row");
+  CLI::App* migrate =
+      command->add_subcommand("migrate", "bring the store to the latest schema, keeping every row");
   AddDbOption(migrate, arguments->db);
   migrate->callback([arguments] { db::Migrate(*arguments); });
   CLI::App* exported = command->add_subcommand(

@@ -4,6 +4,8 @@
 #include <fmt/core.h>
 #include <libpq-fe.h>
 
+#include <cmath>
+
 #include "core/error.h"
 #include "store/database.h"
 
@@ -23,8 +25,13 @@ std::string Trimmed(const char* message) {
 std::string ParameterText(const Value& value) {
   if (const auto* text = std::get_if<std::string>(&value)) return *text;
   if (const auto* integer = std::get_if<std::int64_t>(&value)) return std::to_string(*integer);
-  // The shortest text that reads back as the same double.
-  return fmt::format("{}", std::get<double>(value));
+  // The shortest text that reads back as the same double; NaN and infinities as PostgreSQL spells them.
+  if (const auto* number = std::get_if<double>(&value)) {
+    if (std::isnan(*number)) return "NaN";
+    if (std::isinf(*number)) return *number > 0 ? "Infinity" : "-Infinity";
+    return fmt::format("{}", *number);
+  }
+  return "";  // NULL: passed as a null pointer
 }
 
 class PostgresDatabase final : public Database {

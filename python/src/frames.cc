@@ -17,10 +17,12 @@ namespace arcwheel::python {
 namespace {
 
 // An (N, 3) array of points, mm; (N, 2) gets z = 0.
-std::vector<Eigen::Vector3d> Points(const py::array_t<double, py::array::c_style | py::array::forcecast>& array,
-                                    const char* stage, const char* name) {
+std::vector<Eigen::Vector3d> Points(
+    const py::array_t<double, py::array::c_style | py::array::forcecast>& array, const char* stage,
+    const char* name) {
   if (array.ndim() != 2 || (array.shape(1) != 2 && array.shape(1) != 3)) {
-    throw Error(ErrorCode::kInvalidOption, stage, std::string(name) + " must be an (N, 2) or (N, 3) array of points");
+    throw Error(ErrorCode::kInvalidOption, stage,
+                std::string(name) + " must be an (N, 2) or (N, 3) array of points");
   }
   std::vector<Eigen::Vector3d> points;
   const auto view = array.unchecked<2>();
@@ -31,7 +33,8 @@ std::vector<Eigen::Vector3d> Points(const py::array_t<double, py::array::c_style
 }
 
 Eigen::Vector3d Point(const std::vector<double>& p, const char* name) {
-  if (p.size() != 3) throw Error(ErrorCode::kInvalidOption, "frames.three_point", std::string(name) + " needs x, y, z");
+  if (p.size() != 3)
+    throw Error(ErrorCode::kInvalidOption, "frames.three_point", std::string(name) + " needs x, y, z");
   return {p[0], p[1], p[2]};
 }
 
@@ -46,11 +49,14 @@ py::array_t<double> Matrix(const frames::Transform& t) {
   return ToNumpy(std::move(m), {4, 4});
 }
 
-py::array_t<double> Vector(const Eigen::VectorXd& v) { return ToNumpy(std::vector<double>(v.data(), v.data() + v.size())); }
+py::array_t<double> Vector(const Eigen::VectorXd& v) {
+  return ToNumpy(std::vector<double>(v.data(), v.data() + v.size()));
+}
 
 py::dict Frame(const std::vector<double>& p1, const std::vector<double>& p2, const std::vector<double>& p3,
                double min_separation_mm, double min_angle_deg) {
-  const frames::ThreePointFrameOptions options{.min_separation_mm = min_separation_mm, .min_angle_deg = min_angle_deg};
+  const frames::ThreePointFrameOptions options{.min_separation_mm = min_separation_mm,
+                                               .min_angle_deg = min_angle_deg};
   ThrowIfProblems(ErrorCode::kInvalidOption, "frame", options.Problems());
   const frames::WorkpieceFrame frame =
       frames::ThreePointFrame(Point(p1, "p1"), Point(p2, "p2"), Point(p3, "p3"), options);
@@ -73,7 +79,8 @@ py::dict FitTransform(const py::array_t<double, py::array::c_style | py::array::
   const std::vector<Eigen::Vector3d> from = Points(source, "frames.transform_fit", "source");
   const std::vector<Eigen::Vector3d> to = Points(target, "frames.transform_fit", "target");
   if (from.size() != to.size()) {
-    throw Error(ErrorCode::kInvalidOption, "frames.transform_fit", "source and target differ in their number of points");
+    throw Error(ErrorCode::kInvalidOption, "frames.transform_fit",
+                "source and target differ in their number of points");
   }
   std::vector<frames::PointPair> pairs;
   for (size_t i = 0; i < from.size(); ++i) pairs.push_back({from[i], to[i]});
@@ -81,7 +88,8 @@ py::dict FitTransform(const py::array_t<double, py::array::c_style | py::array::
   options.outlier_threshold = outlier_threshold;
   options.drop_outliers = drop_outliers;
   ThrowIfProblems(ErrorCode::kInvalidOption, "frames.transform_fit", options.Problems());
-  const frames::TransformFit fit = RunReleased([&] { return frames::FitTransform(pairs, frames::ParseModel(model), options); });
+  const frames::TransformFit fit =
+      RunReleased([&] { return frames::FitTransform(pairs, frames::ParseModel(model), options); });
   py::dict d;
   d["fit"] = ParseJson(frames::TransformFitToJson(fit).dump());
   d["matrix"] = Matrix(fit.transform);
@@ -94,8 +102,9 @@ py::dict FitTransform(const py::array_t<double, py::array::c_style | py::array::
 }
 
 py::dict Headcenter(const std::string& record, const std::string& calibration,
-                    const std::optional<std::vector<double>>& commanded_mm, const std::optional<double>& z0_mm,
-                    const std::string& tare, double min_force_fraction, double min_force_N) {
+                    const std::optional<std::vector<double>>& commanded_mm,
+                    const std::optional<double>& z0_mm, const std::string& tare, double min_force_fraction,
+                    double min_force_N) {
   workflows::RecordSolveOptions options;
   options.z0_mm = z0_mm;
   options.tare = tare;
@@ -103,7 +112,8 @@ py::dict Headcenter(const std::string& record, const std::string& calibration,
   options.min_force_N = min_force_N;
   std::optional<Eigen::Vector2d> commanded;
   if (commanded_mm) {
-    if (commanded_mm->size() != 2) throw Error(ErrorCode::kInvalidOption, "headcenter", "commanded_mm needs x, y");
+    if (commanded_mm->size() != 2)
+      throw Error(ErrorCode::kInvalidOption, "headcenter", "commanded_mm needs x, y");
     commanded = Eigen::Vector2d((*commanded_mm)[0], (*commanded_mm)[1]);
   }
   const workflows::HeadcenterSolve solve =
@@ -112,7 +122,8 @@ py::dict Headcenter(const std::string& record, const std::string& calibration,
   d["result"] = ParseJson(solve.json.dump());
   d["centre_mm"] = Vector(solve.centre.centre_mm);
   d["centre_sigma_mm"] = Vector(solve.centre.SigmaMm());
-  d["centre_machine_mm"] = solve.centre_machine_mm ? py::object(Vector(*solve.centre_machine_mm)) : py::none();
+  d["centre_machine_mm"] =
+      solve.centre_machine_mm ? py::object(Vector(*solve.centre_machine_mm)) : py::none();
   d["offset_mm"] = solve.offset_mm ? py::object(Vector(*solve.offset_mm)) : py::none();
   return d;
 }
@@ -125,8 +136,8 @@ void BindFrames(py::module_& module) {
              py::arg("min_separation_mm") = frame_defaults.min_separation_mm,
              py::arg("min_angle_deg") = frame_defaults.min_angle_deg);
   const frames::TransformFitOptions fit_defaults;
-  module.def("_fit_transform", &FitTransform, py::arg("source"), py::arg("target"), py::arg("model") = "rigid3d",
-             py::arg("outlier_threshold") = fit_defaults.outlier_threshold,
+  module.def("_fit_transform", &FitTransform, py::arg("source"), py::arg("target"),
+             py::arg("model") = "rigid3d", py::arg("outlier_threshold") = fit_defaults.outlier_threshold,
              py::arg("drop_outliers") = fit_defaults.drop_outliers);
   const workflows::RecordSolveOptions solve_defaults;
   module.def("_headcenter", &Headcenter, py::arg("record"), py::arg("calibration") = "",

@@ -28,7 +28,9 @@ namespace {
 
 namespace fs = std::filesystem;
 
-py::object JsonFile(const fs::path& path, const char* stage) { return ParseJson(ReadJsonFile(path, stage).dump()); }
+py::object JsonFile(const fs::path& path, const char* stage) {
+  return ParseJson(ReadJsonFile(path, stage).dump());
+}
 
 // `arcwheel toolpath JOB [--wheel SUMMARY] -o OUTDIR`: its files, and toolpath_summary.json.
 py::dict Toolpath(const fs::path& job_path, const std::optional<fs::path>& wheel, const fs::path& output_dir,
@@ -38,9 +40,10 @@ py::dict Toolpath(const fs::path& job_path, const std::optional<fs::path>& wheel
                 "wheel_profile '" + wheel_profile + "' is not one of: mean, model");
   }
   RunReleased([&] {
-    const grinding::Job job = grinding::ReadJob(
-        job_path, wheel, max_wheel_change_mm,
-        wheel_profile == "model" ? grinding::WheelProfileSource::kModel : grinding::WheelProfileSource::kMeanProfile);
+    const grinding::Job job =
+        grinding::ReadJob(job_path, wheel, max_wheel_change_mm,
+                          wheel_profile == "model" ? grinding::WheelProfileSource::kModel
+                                                   : grinding::WheelProfileSource::kMeanProfile);
     return grinding::RunToolpathJob(job, output_dir);
   });
   py::dict d;
@@ -50,7 +53,8 @@ py::dict Toolpath(const fs::path& job_path, const std::optional<fs::path>& wheel
 
 // `arcwheel polish JOB -o OUTDIR`, `error_map` replacing the job's: its files, and
 // polish_summary.json.
-py::dict Polish(const fs::path& job_path, const std::optional<fs::path>& error_map, const fs::path& output_dir) {
+py::dict Polish(const fs::path& job_path, const std::optional<fs::path>& error_map,
+                const fs::path& output_dir) {
   RunReleased([&] {
     const polishing::PolishJob job = polishing::ReadPolishJob(job_path, error_map);
     return polishing::RunPolishJob(job, output_dir);

@@ -25,7 +25,8 @@ double Value(const StoredRun& run, std::string_view characteristic) {
 std::vector<StoredRun> Scans(Store& store, const std::string& wheel_id,
                              const std::optional<double>& since_s) {
   if (wheel_id.empty()) throw Error(ErrorCode::kInvalidOption, kStage, "--wheel needs a wheel id");
-  std::vector<StoredRun> runs = store.Runs({.wheel_id = wheel_id, .command = "process", .since_s = since_s});
+  std::vector<StoredRun> runs =
+      store.Runs({.wheel_id = wheel_id, .command = std::string(s::runs::kProcess), .since_s = since_s});
   if (runs.empty()) {
     throw Error(ErrorCode::kBadInput, kStage,
                 fmt::format("'{}' holds no scan of wheel '{}'{}", store.Name(), wheel_id,

@@ -18,6 +18,7 @@ namespace arcwheel::store {
 namespace {
 
 namespace fs = std::filesystem;
+namespace s = schema::store;
 using nlohmann::json;
 
 // A headline number: where it sits in the file (a path of keys), its sigma's key path (empty:
@@ -75,8 +76,8 @@ std::string String(const json& document, const std::vector<std::string_view>& pa
   return value != nullptr && value->is_string() ? value->get<std::string>() : "";
 }
 
-StoredInput Input(const std::string& role, const fs::path& path) {
-  return {role, fs::absolute(path).lexically_normal().string(), Sha256OfFile(path)};
+StoredInput Input(std::string_view role, const fs::path& path) {
+  return {std::string(role), fs::absolute(path).lexically_normal().string(), Sha256OfFile(path)};
 }
 
 std::string Absolute(const fs::path& path) { return fs::absolute(path).lexically_normal().string(); }
@@ -147,7 +148,7 @@ StoredRun ProcessRun(const fs::path& outdir, const std::string& via) {
   const fs::path path = outdir / k::kFileName;
   const json summary = ReadJsonFile(path, "store");
   StoredRun run;
-  run.command = "process";
+  run.command = s::runs::kProcess;
   run.via = via;
   run.wheel_id = String(summary, {k::kScan, k::scan::kWheelId});
   run.scan_timestamp = String(summary, {k::kScan, k::scan::kTimestamp});
@@ -164,7 +165,7 @@ StoredRun ProcessRun(const fs::path& outdir, const std::string& via) {
   const json* processing = Find(summary, {k::kProcessing});
   run.options = processing != nullptr ? processing->dump() : "{}";
   const std::string scan_path = String(summary, {k::kInput, k::input::kPath});
-  run.inputs.push_back({"scan", scan_path.empty() ? "" : Absolute(scan_path),
+  run.inputs.push_back({std::string(s::inputs::kScan), scan_path.empty() ? "" : Absolute(scan_path),
                         String(summary, {k::kInput, k::input::kSha256})});
   run.numbers = Numbers(summary, ProcessCharacteristics());
   return run;
@@ -175,15 +176,15 @@ StoredRun ToolpathRun(const fs::path& outdir, const fs::path& job,
   namespace k = schema::toolpath::summary;
   const json summary = ReadJsonFile(outdir / schema::toolpath::kSummaryFileName, "store");
   StoredRun run;
-  run.command = "toolpath";
+  run.command = s::runs::kToolpath;
   run.via = via;
   run.arcwheel_version = String(summary, {k::kArcwheelVersion});
   run.output_folder = Absolute(outdir);
   const json* used = Find(summary, {k::kJob});
   run.options = used != nullptr ? used->dump() : "{}";
-  run.inputs.push_back(Input("job", job));
+  run.inputs.push_back(Input(s::inputs::kJob, job));
   if (wheel_summary) {
-    run.inputs.push_back(Input("wheel", *wheel_summary));
+    run.inputs.push_back(Input(s::inputs::kWheel, *wheel_summary));
     const json wheel = ReadJsonFile(*wheel_summary, "store");
     run.wheel_id = String(wheel, {schema::summary::kScan, schema::summary::scan::kWheelId});
   }
@@ -196,16 +197,16 @@ StoredRun PolishRun(const fs::path& outdir, const fs::path& job, const std::opti
   namespace k = schema::polish::summary;
   const json summary = ReadJsonFile(outdir / schema::polish::kSummaryFileName, "store");
   StoredRun run;
-  run.command = "polish";
+  run.command = s::runs::kPolish;
   run.via = via;
   run.arcwheel_version = String(summary, {k::kArcwheelVersion});
   run.output_folder = Absolute(outdir);
   const json* used = Find(summary, {k::kJob});
   run.options = used != nullptr ? used->dump() : "{}";
-  run.inputs.push_back(Input("job", job));
+  run.inputs.push_back(Input(s::inputs::kJob, job));
   fs::path map = error_map.value_or(String(summary, {k::kJob, k::job::kErrorMap, k::job::error_map::kFile}));
   if (!map.empty() && map.is_relative() && !fs::exists(map)) map = job.parent_path() / map;
-  if (!map.empty() && fs::exists(map)) run.inputs.push_back(Input("error_map", map));
+  if (!map.empty() && fs::exists(map)) run.inputs.push_back(Input(s::inputs::kErrorMap, map));
   run.numbers = Numbers(summary, PolishCharacteristics());
   return run;
 }

@@ -36,6 +36,10 @@ inline constexpr std::string_view kOutputFolder = "output_folder";  // absolute
 inline constexpr std::string_view kOptions = "options";             // JSON text: the options as used
 // Version 2.
 inline constexpr std::string_view kHost = "host";  // the machine that ran it
+// The values of kCommand.
+inline constexpr std::string_view kProcess = "process";
+inline constexpr std::string_view kToolpath = "toolpath";
+inline constexpr std::string_view kPolish = "polish";
 }  // namespace runs
 
 // The files a run read: one row per input.
@@ -45,6 +49,11 @@ inline constexpr std::string_view kRunId = "run_id";
 inline constexpr std::string_view kRole = "role";  // "scan", "job", "wheel", "error_map"
 inline constexpr std::string_view kPath = "path";  // absolute
 inline constexpr std::string_view kSha256 = "sha256";
+// The values of kRole.
+inline constexpr std::string_view kScan = "scan";
+inline constexpr std::string_view kJob = "job";
+inline constexpr std::string_view kWheel = "wheel";
+inline constexpr std::string_view kErrorMap = "error_map";
 }  // namespace inputs
 
 // Every headline number of a run, one row per characteristic (the shape SPC tools import).

@@ -50,7 +50,11 @@ void Init(const DbArguments& arguments) {
 void Migrate(const DbArguments& arguments) {
   store::Store results = OpenNamed(arguments);
   const auto [from, to] = results.Migrate();
-  fmt::print("store: {} migrated from schema version {} to {}\n", results.Name(), from, to);
+  if (from == to) {
+    fmt::print("store: {} is at the latest schema version {} already\n", results.Name(), to);
+  } else {
+    fmt::print("store: {} migrated from schema version {} to {}, every row kept\n", results.Name(), from, to);
+  }
 }
 
 void Export(const DbArguments& arguments) {

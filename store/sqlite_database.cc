@@ -98,10 +98,10 @@ class SqliteDatabase final : public Database {
       // Also the first read: a file that is not a database fails here, before any output.
       (void)Query("PRAGMA journal_mode=WAL", {});
       Execute("PRAGMA foreign_keys=ON", {});
-    } catch (const Error& e) {
+    } catch (const Error&) {
+      const std::string reason = sqlite3_errmsg(db_);
       sqlite3_close(db_);
-      throw Error(ErrorCode::kIo, kStage,
-                  fmt::format("cannot use the results store '{}': {}", path, e.what()));
+      throw Error(ErrorCode::kIo, kStage, fmt::format("cannot use the results store '{}': {}", path, reason));
     }
   }
   ~SqliteDatabase() override { sqlite3_close(db_); }

@@ -240,6 +240,19 @@ void Store::Record(std::vector<StoredRun>& runs) {
   });
 }
 
+bool Store::HasRun(const std::string& command, const std::string& output_folder, const std::string& role,
+                   const std::string& sha256) {
+  RequireVersion(s::kLatestVersion);
+  return !database_
+              ->Query(fmt::format(
+                          "SELECT r.{} FROM {} r JOIN {} i ON i.{} = r.{} WHERE r.{} = $1 AND r.{} = $2 AND "
+                          "i.{} = $3 AND i.{} = $4",
+                          s::runs::kId, s::kRunsTable, s::kInputsTable, s::inputs::kRunId, s::runs::kId,
+                          s::runs::kCommand, s::runs::kOutputFolder, s::inputs::kRole, s::inputs::kSha256),
+                      {command, output_folder, role, sha256})
+              .empty();
+}
+
 std::vector<StoredRun> Store::Runs(const RunFilter& filter) {
   RequireVersion(s::kLatestVersion);
   std::string where = "1 = 1";

@@ -98,6 +98,10 @@ class Store {
   std::pair<int, int> Migrate();
   // Records the runs in one transaction and sets their ids; all or none.
   void Record(std::vector<StoredRun>& runs);
+  // Whether a `command` run into `output_folder` (absolute) whose input of role `role` has
+  // `sha256` is recorded.
+  [[nodiscard]] bool HasRun(const std::string& command, const std::string& output_folder,
+                            const std::string& role, const std::string& sha256);
   // The recorded runs that pass the filter, in the order of their scan time, then of recording.
   [[nodiscard]] std::vector<StoredRun> Runs(const RunFilter& filter = {});
 

@@ -11,6 +11,7 @@
 #include "core/atomic_file.h"
 #include "core/error.h"
 #include "core/interrupt.h"
+#include "store/records.h"
 #include "workflows/batch_internal.h"
 #include "workflows/record.h"
 #include "workflows/step_inputs.h"
@@ -140,6 +141,19 @@ std::vector<Outcome> RunScans(const BatchOptions& args, const std::vector<Scan>&
   return outcomes;
 }
 
+// A scan reused from an earlier batch that recorded into no store or another one: recorded now,
+// once (a result the store holds already, by folder and scan SHA-256, is not recorded again).
+void RecordReused(const BatchOptions& args, const std::vector<Scan>& scans,
+                  const std::vector<Outcome>& outcomes, store::Store& results) {
+  for (size_t i = 0; i < scans.size(); ++i) {
+    if (outcomes[i].status != Status::kReused) continue;
+    std::vector<store::StoredRun> runs = {store::ProcessRun(ResultFolder(args, scans[i]), kStage)};
+    const store::StoredInput& scan = runs.front().inputs.front();
+    if (results.HasRun(runs.front().command, runs.front().output_folder, scan.role, scan.sha256)) continue;
+    results.Record(runs);
+  }
+}
+
 // The outcome of each scan as OUTDIR holds it, running nothing.
 std::vector<Outcome> ReadOutcomes(const BatchOptions& args, const std::vector<Scan>& scans) {
   std::vector<Outcome> outcomes(scans.size());
@@ -197,7 +211,8 @@ BatchReport RunBatch(const BatchOptions& options) {
   const std::vector<Scan> scans = PlanScans(args.inputs);
   CheckOutputNotSet(args.process_options);
   if (args.check_process_options) args.check_process_options(args.process_options, scans.front().path);
-  if (!args.db.empty() && !args.index_only) (void)OpenRunStore(args.db);
+  std::optional<store::Store> results;
+  if (!args.db.empty() && !args.index_only) results = OpenRunStore(args.db);
   EnsureDirectory(fs::path(args.outdir) / kLogsFolder);
   BatchReport report;
   report.scans = scans.size();
@@ -208,6 +223,7 @@ BatchReport RunBatch(const BatchOptions& options) {
     return report;
   }
   const std::vector<Outcome> outcomes = args.index_only ? ReadOutcomes(args, scans) : RunScans(args, scans);
+  if (results) RecordReused(args, scans, outcomes, *results);
   std::map<Status, size_t> counts;
   for (const Outcome& outcome : outcomes) ++counts[outcome.status];
   if (!args.no_index) {

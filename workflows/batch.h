@@ -47,7 +47,7 @@ struct BatchReport {
 // writes OUTDIR/index.csv and index.json; with emit_slurm writes the script and runs nothing.
 // A scan's failure is recorded in its row, not thrown. Throws Error{kInvalidOption} for bad
 // inputs or options (before any scan runs), Error{kIo} when OUTDIR cannot be written or the store
-// cannot be reached (before any scan runs). A reused scan is not recorded again. Progress
+// cannot be reached (before any scan runs). A reused scan is recorded unless the store holds it. Progress
 // goes to stderr: a refreshed bar on a terminal, a line per scan otherwise.
 [[nodiscard]] BatchReport RunBatch(const BatchOptions& options);
 

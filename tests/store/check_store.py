@@ -11,7 +11,8 @@ summary.json files `arcwheel process` wrote:
 
   - 20 scans of two wheels recorded by `batch -j 2` (children recording at once): every scan's
     row present once, with every headline number and sigma of its summary.json and the SHA-256 of
-    its scan file;
+    its scan file; a rerun records nothing twice, and records the scans it reuses into a store
+    that lacks them;
   - `history --wheel` from the store writes the history.csv that `history` writes from the folders;
   - a run killed while it works, and a run that fails, leave no row;
   - a store that cannot be reached fails the run before any output, naming the store;
@@ -116,6 +117,19 @@ def check_batch(work):
         inputs = query(STORE, f"SELECT role, path, sha256 FROM inputs WHERE run_id = {run_id}")
         assert len(inputs) == 1 and inputs[0][0] == "scan", inputs
         assert inputs[0][2] == sha256(scans / f"{name}.h5"), (name, inputs)
+
+    # Run again: every scan is reused, and none recorded twice.
+    batch = ["batch", str(scans), "-o", str(work / "out"), "-j", "2", "--db", STORE, "--", "--phases", "90",
+             "--no-model"]
+    run(*batch)
+    assert int(query(STORE, "SELECT count(*) FROM runs")[0][0]) == 20
+    # A store that lacks them (the first batch recorded elsewhere): the rerun records the reused scans.
+    execute(STORE, "DELETE FROM numbers; DELETE FROM inputs; DELETE FROM runs;")
+    run(*batch)
+    rerecorded = query(STORE, "SELECT via, output_folder FROM runs")
+    assert len(rerecorded) == 20 and {via for via, _ in rerecorded} == {"batch"}, rerecorded
+    assert sorted(folder for _, folder in rerecorded) == sorted(folders)
+    assert int(query(STORE, "SELECT count(*) FROM numbers")[0][0]) >= 20 * len(CHARACTERISTICS)
     return scans
 
 

@@ -103,6 +103,7 @@ void AddBatchCommand(CLI::App& app) {
   cmd->add_flag("--index-only", args->index_only,
                 "run nothing: write the index of what OUTDIR holds (after a Slurm or HTCondor run)");
   cmd->add_flag("--no-index", args->no_index, "write no index (each Slurm array task)");
+  AddDbOption(cmd, args->db);
   cmd->callback([args] { batch::Run(*args); });
 }
 

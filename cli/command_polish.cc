@@ -10,6 +10,8 @@
 #include "cli/commands.h"
 #include "polishing/job.h"
 #include "reports/polish_report.h"
+#include "store/records.h"
+#include "workflows/record.h"
 #include "workflows/steps.h"
 
 namespace arcwheel::cli {
@@ -20,6 +22,7 @@ void AddPolishCommand(CLI::App& app) {
     std::string output;
     std::vector<std::string> report_formats;
     bool place_workobject = false;
+    std::string db;
   };
   auto arguments = std::make_shared<Arguments>();
   CLI::App* command = app.add_subcommand(
@@ -34,18 +37,27 @@ void AddPolishCommand(CLI::App& app) {
                    "also render the polishing report: html,pdf (both are written, docs/reports.md)")
       ->delimiter(',')
       ->check(CLI::IsMember({"html", "pdf"}));
+  AddDbOption(command, arguments->db);
   command->callback([arguments] {
     if (arguments->place_workobject) {
       const polishing::PolishJob job = polishing::ReadPolishJob(arguments->job);
       fmt::print("{}", polishing::DescribeProposal(polishing::ProposeWorkObject(job), job));
       return;
     }
-    (void)workflows::RunPolishStep(arguments->job, std::nullopt, arguments->output);
-    if (!arguments->report_formats.empty()) {
-      // Drawn from the files just written, exactly as `arcwheel report OUTDIR` would.
-      const reports::WrittenPolishReports written = reports::WritePolishReports(arguments->output);
-      fmt::print("report: {}\n        {}\n", written.html.string(), written.pdf.string());
-    }
+    workflows::RunRecorded(
+        arguments->db,
+        [&] {
+          (void)workflows::RunPolishStep(arguments->job, std::nullopt, arguments->output);
+          if (!arguments->report_formats.empty()) {
+            // Drawn from the files just written, exactly as `arcwheel report OUTDIR` would.
+            const reports::WrittenPolishReports written = reports::WritePolishReports(arguments->output);
+            fmt::print("report: {}\n        {}\n", written.html.string(), written.pdf.string());
+          }
+        },
+        [&] {
+          return std::vector<store::StoredRun>{
+              store::PolishRun(arguments->output, arguments->job, std::nullopt, "polish")};
+        });
   });
 }
 

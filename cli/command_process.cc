@@ -16,7 +16,9 @@
 #include "reports/tolerances.h"
 #include "schema/summary.h"
 #include "schema/wheel_map.h"
+#include "store/records.h"
 #include "workflows/process_pipeline.h"
+#include "workflows/record.h"
 
 namespace arcwheel::cli {
 namespace {
@@ -29,6 +31,7 @@ struct ProcessArgs {
   std::string tolerance_file;
   bool quiet = false;
   bool timings = false;
+  std::string db;
 };
 
 void PrintHeadline(const ProcessArgs& args, const processing::ProcessedScan& p, const fitting::WheelFit& f) {
@@ -76,7 +79,7 @@ void PrintTimings(const StageClock& clock) {
              Shown(total_cpu_s));
 }
 
-void Run(ProcessArgs& args) {
+void RunAndPrint(ProcessArgs& args) {
   Progress progress(!args.quiet);
   const workflows::ProcessPipelineResult result =
       workflows::RunProcessPipeline(args.scan_path, args.outdir, args.pipeline, progress);
@@ -91,6 +94,12 @@ void Run(ProcessArgs& args) {
     const reports::WrittenReports written = reports::WriteReports(args.outdir, tolerances);
     if (!args.quiet) fmt::print("report:  {}\n         {}\n", written.html.string(), written.pdf.string());
   }
+}
+
+void Run(ProcessArgs& args) {
+  workflows::RunRecorded(
+      args.db, [&] { RunAndPrint(args); },
+      [&] { return std::vector<store::StoredRun>{store::ProcessRun(args.outdir, "process")}; });
 }
 
 }  // namespace
@@ -165,6 +174,7 @@ void AddProcessCommand(CLI::App& app) {
       ->check(CLI::ExistingFile);
   cmd->add_flag("--no-uncertainty", args->pipeline.no_uncertainty,
                 "leave the uncertainty budget and the noise-corrected figures out of summary.json");
+  AddDbOption(cmd, args->db);
   cmd->add_flag("-q,--quiet", args->quiet, "no progress and no headline");
   cmd->add_flag("--timings", args->timings,
                 "print each stage's wall time, CPU time and peak memory so far on stderr");

@@ -51,6 +51,7 @@ void AddRegenerateCommand(CLI::App& app) {
                   "an earlier regeneration's OUTDIR to compare with (default: the latest one beside OUTDIR)")
       ->check(CLI::ExistingDirectory);
   cmd->add_option("-o,--output", args->output, "output folder")->required();
+  AddDbOption(cmd, args->db);
   cmd->callback([args] { workflows::RunRegenerate(*args); });
 }
 

@@ -6,6 +6,8 @@
 
 #include "cli/commands.h"
 #include "grinding/job.h"
+#include "store/records.h"
+#include "workflows/record.h"
 #include "workflows/steps.h"
 
 namespace arcwheel::cli {
@@ -17,6 +19,7 @@ void AddToolpathCommand(CLI::App& app) {
     std::string output;
     double max_wheel_change_mm = grinding::kDefaultMaxWheelChangeMm;
     std::string wheel_profile = "mean";
+    std::string db;
   };
   auto arguments = std::make_shared<Arguments>();
   CLI::App* command = app.add_subcommand(
@@ -38,13 +41,22 @@ void AddToolpathCommand(CLI::App& app) {
       ->check(CLI::IsMember({"mean", "model"}))
       ->capture_default_str();
   command->add_option("-o,--output", arguments->output, "output folder")->required();
+  AddDbOption(command, arguments->db);
   command->callback([arguments] {
     std::optional<std::filesystem::path> wheel;
     if (!arguments->wheel.empty()) wheel = arguments->wheel;
-    (void)workflows::RunToolpathStep(arguments->job, wheel, arguments->max_wheel_change_mm, arguments->output,
-                                     arguments->wheel_profile == "model"
-                                         ? grinding::WheelProfileSource::kModel
-                                         : grinding::WheelProfileSource::kMeanProfile);
+    workflows::RunRecorded(
+        arguments->db,
+        [&] {
+          (void)workflows::RunToolpathStep(
+              arguments->job, wheel, arguments->max_wheel_change_mm, arguments->output,
+              arguments->wheel_profile == "model" ? grinding::WheelProfileSource::kModel
+                                                  : grinding::WheelProfileSource::kMeanProfile);
+        },
+        [&] {
+          return std::vector<store::StoredRun>{
+              store::ToolpathRun(arguments->output, arguments->job, wheel, "toolpath")};
+        });
   });
 }
 

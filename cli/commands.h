@@ -22,6 +22,11 @@ void AddCompareCommand(CLI::App& app);
 void AddHistoryCommand(CLI::App& app);
 void AddRegenerateCommand(CLI::App& app);
 void AddBatchCommand(CLI::App& app);
+void AddDbCommand(CLI::App& app);
+
+// `--db STORE` on a command that records its run (or reads the store): a SQLite file or a
+// postgresql:// URL; without it, the environment variable ARCWHEEL_DB (docs/store.md).
+void AddDbOption(CLI::App* command, std::string& db);
 
 // `arcwheel batch ... -- OPTIONS`: the arguments after `--`, which main() takes off the command
 // line before parsing (CLI11 would not hand them to the subcommand as they are).

@@ -41,6 +41,7 @@ const std::vector<Command> kCommands = {
     {"polish", arcwheel::cli::AddPolishCommand},
     {"regenerate", arcwheel::cli::AddRegenerateCommand},
     {"batch", arcwheel::cli::AddBatchCommand},
+    {"db", arcwheel::cli::AddDbCommand},
 };
 
 constexpr const char* kExitCodes =

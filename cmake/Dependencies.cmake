@@ -38,6 +38,9 @@ endif()
 # cairo draws the report plots to SVG, PNG and PDF from one drawing code (reports/).
 find_package(PkgConfig REQUIRED)
 pkg_check_modules(CAIRO REQUIRED IMPORTED_TARGET cairo)
+# The results store (store/): SQLite by default, PostgreSQL's client library for a server.
+pkg_check_modules(SQLITE3 REQUIRED IMPORTED_TARGET sqlite3)
+pkg_check_modules(LIBPQ REQUIRED IMPORTED_TARGET libpq)
 # FFTW: the dwell solve's removal products as FFT convolutions (polishing/removal_fft.h).
 pkg_check_modules(FFTW3 REQUIRED IMPORTED_TARGET fftw3)
 # FFTW's threads library (the same Debian package, no pkg-config file of its own): the large

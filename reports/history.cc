@@ -374,7 +374,8 @@ WearRate FitWearRate(const std::vector<double>& time_s, const std::vector<double
 History BuildHistory(const std::vector<std::filesystem::path>& folders,
                      const std::vector<double>& dressing_times_s,
                      const std::vector<std::string>& dressing_timestamps) {
-  History h;
+  std::string wheel_id;
+  std::vector<HistoryScan> scans;
   for (const std::filesystem::path& folder : folders) {
     HistoryScan scan;
     scan.folder = folder;
@@ -386,15 +387,23 @@ History BuildHistory(const std::vector<std::filesystem::path>& folders,
                   "'" + path.string() + "' key 'scan.timestamp' is missing or empty");
     scan.time_s = ParseTimestamp_s(scan.timestamp, "'" + path.string() + "' key 'scan.timestamp'");
     const std::string id = ScanString(scan.summary, key::scan::kWheelId);
-    if (!h.scans.empty() && id != h.wheel_id) {
-      throw Error(
-          ErrorCode::kBadInput, kStage,
-          fmt::format("'{}' is of wheel '{}' but '{}' of wheel '{}': a history holds one wheel",
-                      (h.scans.front().folder / key::kFileName).string(), h.wheel_id, path.string(), id));
+    if (!scans.empty() && id != wheel_id) {
+      throw Error(ErrorCode::kBadInput, kStage,
+                  fmt::format("'{}' is of wheel '{}' but '{}' of wheel '{}': a history holds one wheel",
+                              (scans.front().folder / key::kFileName).string(), wheel_id, path.string(), id));
     }
-    h.wheel_id = id;
-    h.scans.push_back(std::move(scan));
+    wheel_id = id;
+    scans.push_back(std::move(scan));
   }
+  return AssembleHistory(wheel_id, std::move(scans), dressing_times_s, dressing_timestamps);
+}
+
+History AssembleHistory(const std::string& wheel_id, std::vector<HistoryScan> scans,
+                        const std::vector<double>& dressing_times_s,
+                        const std::vector<std::string>& dressing_timestamps) {
+  History h;
+  h.wheel_id = wheel_id;
+  h.scans = std::move(scans);
   std::stable_sort(h.scans.begin(), h.scans.end(),
                    [](const HistoryScan& a, const HistoryScan& b) { return a.time_s < b.time_s; });
   for (std::size_t i = 1; i < h.scans.size(); ++i) {

@@ -73,6 +73,13 @@ struct History {
                                    const std::vector<double>& dressing_times_s,
                                    const std::vector<std::string>& dressing_timestamps);
 
+// What BuildHistory does once it has read the folders, for scans read elsewhere (the results
+// store, store/history.h): orders the scans by time (refusing two of one time, naming their
+// folders), assigns each its segment and fits the wear rate of each segment.
+[[nodiscard]] History AssembleHistory(const std::string& wheel_id, std::vector<HistoryScan> scans,
+                                      const std::vector<double>& dressing_times_s,
+                                      const std::vector<std::string>& dressing_timestamps);
+
 [[nodiscard]] std::string HistoryCsv(const History& history);
 
 struct WrittenHistory {

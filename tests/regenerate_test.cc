@@ -217,7 +217,8 @@ TEST_F(Regenerate, RedoesNothingWhoseInputsAreUnchangedAndComparesWithThePreviou
   // `first` lies beside it: found as the previous regeneration, nothing changed since.
   const std::string html = ReadText(second / "regenerate_report.html");
   EXPECT_THAT(html, HasSubstr(first.string()));
-  EXPECT_THAT(html, HasSubstr("+0.00000 mm"));
+  // No change: a change that rounds to zero is "+0.00000" (core/number_format.h, ShowSigned).
+  EXPECT_THAT(html, HasSubstr("<td class=\"number\">+0.00000 mm</td>"));
   EXPECT_EQ(ReadJson(second / "regenerate.json")["previous"], first.string());
   // A --previous that is no regeneration is refused before any step runs.
   const auto refused = RunArcwheel(

@@ -11,8 +11,7 @@ namespace arcwheel::testing {
 // The trial part with coarser rows, points and map; the surface, the aperture and the wheel
 // (nominal radius included) are the shipped ones.
 inline nlohmann::json SmallTrialPart() {
-  nlohmann::json job =
-      nlohmann::json::parse(ReadText(SourceDir() / "grinding/examples/trial_part.json"));
+  nlohmann::json job = nlohmann::json::parse(ReadText(SourceDir() / "grinding/examples/trial_part.json"));
   job["path"]["step_over_mm"] = 10.0;
   job["path"]["point_spacing_mm"] = 10.0;
   job["gouge_check"] = {{"spacing_mm", 50.0}, {"samples", 9}};

@@ -11,7 +11,9 @@
 #include "core/atomic_file.h"
 #include "core/error.h"
 #include "core/interrupt.h"
+#include "store/records.h"
 #include "workflows/batch_internal.h"
+#include "workflows/record.h"
 #include "workflows/step_inputs.h"
 
 namespace arcwheel::workflows {
@@ -139,6 +141,19 @@ std::vector<Outcome> RunScans(const BatchOptions& args, const std::vector<Scan>&
   return outcomes;
 }
 
+// A scan reused from an earlier batch that recorded into no store or another one: recorded now,
+// once (a result the store holds already, by folder and scan SHA-256, is not recorded again).
+void RecordReused(const BatchOptions& args, const std::vector<Scan>& scans,
+                  const std::vector<Outcome>& outcomes, store::Store& results) {
+  for (size_t i = 0; i < scans.size(); ++i) {
+    if (outcomes[i].status != Status::kReused) continue;
+    std::vector<store::StoredRun> runs = {store::ProcessRun(ResultFolder(args, scans[i]), kStage)};
+    const store::StoredInput& scan = runs.front().inputs.front();
+    if (results.HasRun(runs.front().command, runs.front().output_folder, scan.role, scan.sha256)) continue;
+    results.Record(runs);
+  }
+}
+
 // The outcome of each scan as OUTDIR holds it, running nothing.
 std::vector<Outcome> ReadOutcomes(const BatchOptions& args, const std::vector<Scan>& scans) {
   std::vector<Outcome> outcomes(scans.size());
@@ -174,19 +189,30 @@ void CheckOutputNotSet(const std::vector<std::string>& options) {
           ErrorCode::kInvalidOption, kStage,
           "the process options after -- must not set the output folder: batch writes OUTDIR/<scan name>");
     }
+    if (option.rfind("--db", 0) == 0) {
+      throw Error(ErrorCode::kInvalidOption, kStage,
+                  "the process options after -- must not name a store: give --db to batch, which hands it "
+                  "to every scan");
+    }
   }
 }
 
 }  // namespace
 }  // namespace batch
 
-BatchReport RunBatch(const BatchOptions& args) {
+BatchReport RunBatch(const BatchOptions& options) {
   using namespace batch;
+  // Every child records into the store this batch names, which is checked (and an empty one given
+  // its schema, once, before two children could race to create it) before anything is written.
+  BatchOptions args = options;
+  args.db = store::StoreLocation(options.db);
   if (args.jobs < 1)
     throw Error(ErrorCode::kInvalidOption, kStage, fmt::format("-j {} violates >= 1", args.jobs));
   const std::vector<Scan> scans = PlanScans(args.inputs);
   CheckOutputNotSet(args.process_options);
   if (args.check_process_options) args.check_process_options(args.process_options, scans.front().path);
+  std::optional<store::Store> results;
+  if (!args.db.empty() && !args.index_only) results = OpenRunStore(args.db);
   EnsureDirectory(fs::path(args.outdir) / kLogsFolder);
   BatchReport report;
   report.scans = scans.size();
@@ -197,6 +223,7 @@ BatchReport RunBatch(const BatchOptions& args) {
     return report;
   }
   const std::vector<Outcome> outcomes = args.index_only ? ReadOutcomes(args, scans) : RunScans(args, scans);
+  if (results) RecordReused(args, scans, outcomes, *results);
   std::map<Status, size_t> counts;
   for (const Outcome& outcome : outcomes) ++counts[outcome.status];
   if (!args.no_index) {

@@ -21,6 +21,9 @@ struct BatchOptions {
   std::vector<std::string> sbatch_lines;  // extra #SBATCH lines of that script
   bool index_only = false;                // run nothing: index what OUTDIR holds
   bool no_index = false;                  // write no index (each Slurm array task)
+  // The results store each scan's `arcwheel process` records into (`--db`); empty: ARCWHEEL_DB,
+  // else none. Opened before any scan runs, so that an unreachable store fails the batch at once.
+  std::string db;
   // Passed unchanged to every `arcwheel process`; must not set the output folder.
   std::vector<std::string> process_options;
   // The `arcwheel` binary each scan runs as `arcwheel process`; empty: this process's own.
@@ -43,7 +46,8 @@ struct BatchReport {
 // Plans the scans, checks the options, then runs (or, with index_only, reads) every scan and
 // writes OUTDIR/index.csv and index.json; with emit_slurm writes the script and runs nothing.
 // A scan's failure is recorded in its row, not thrown. Throws Error{kInvalidOption} for bad
-// inputs or options (before any scan runs), Error{kIo} when OUTDIR cannot be written. Progress
+// inputs or options (before any scan runs), Error{kIo} when OUTDIR cannot be written or the store
+// cannot be reached (before any scan runs). A reused scan is recorded unless the store holds it. Progress
 // goes to stderr: a refreshed bar on a terminal, a line per scan otherwise.
 [[nodiscard]] BatchReport RunBatch(const BatchOptions& options);
 

@@ -26,6 +26,7 @@ pid_t SpawnProcess(const BatchOptions& args, const Scan& scan) {
   std::vector<std::string> arguments = {binary, "process", scan.path.string(), "-o",
                                         ResultFolder(args, scan).string()};
   arguments.insert(arguments.end(), args.process_options.begin(), args.process_options.end());
+  if (!args.db.empty()) arguments.insert(arguments.end(), {"--db", args.db});
   std::vector<char*> argv;
   for (std::string& argument : arguments) argv.push_back(argument.data());
   argv.push_back(nullptr);

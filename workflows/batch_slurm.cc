@@ -75,8 +75,9 @@ std::string SlurmScript(const BatchOptions& args, const std::vector<Scan>& scans
   script += "set -euo pipefail\nscans=(\n";
   for (const Scan& scan : scans) script += "  " + ShellQuote(fs::absolute(scan.path).string()) + "\n";
   script += ")\n";
-  script += fmt::format("exec {} batch \"${{scans[$SLURM_ARRAY_TASK_ID]}}\" -o {} --no-index{}\n",
-                        ShellQuote(binary), ShellQuote(outdir), options);
+  const std::string db = args.db.empty() ? "" : " --db " + ShellQuote(args.db);
+  script += fmt::format("exec {} batch \"${{scans[$SLURM_ARRAY_TASK_ID]}}\" -o {} --no-index{}{}\n",
+                        ShellQuote(binary), ShellQuote(outdir), db, options);
   return script;
 }
 

@@ -17,6 +17,8 @@
 #include "grinding/prediction.h"
 #include "schema/summary.h"
 #include "schema/wheel_map.h"
+#include "store/records.h"
+#include "workflows/record.h"
 #include "workflows/regenerate_internal.h"
 #include "workflows/step_inputs.h"
 #include "workflows/steps.h"
@@ -108,6 +110,7 @@ void RunRegenerate(const RegenerateOptions& args) {
                 fmt::format("--previous '{}' holds no {}: not a finished regeneration", args.previous,
                             kRecordFileName));
   }
+  std::optional<store::Store> results = OpenRunStore(args.db);
   const fs::path outdir(args.output);
   EnsureDirectory(outdir);
   // The report and the record describe the steps below: gone until they are rewritten.
@@ -173,6 +176,16 @@ void RunRegenerate(const RegenerateOptions& args) {
                 fmt::format("step 4/4 'report' failed (the steps' outputs in '{}' are complete): {}",
                             outdir.string(), e.what()));
   }
+  if (!results) return;
+  std::vector<store::StoredRun> runs;
+  if (status.wheel_ran) runs.push_back(store::ProcessRun(outdir / kWheelStep.id, "regenerate"));
+  if (status.toolpath_ran) {
+    runs.push_back(store::ToolpathRun(outdir / kToolpathStep.id, args.job, summary, "regenerate"));
+  }
+  if (status.polish_ran.value_or(false)) {
+    runs.push_back(store::PolishRun(outdir / kPolishStep.id, args.polish, polished_map, "regenerate"));
+  }
+  results->Record(runs);
 }
 
 }  // namespace arcwheel::workflows

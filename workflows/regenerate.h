@@ -21,11 +21,14 @@ struct RegenerateOptions {
   // The measured wheel for the toolpath: "mean" (per-phase fits) or "model".
   std::string wheel_profile = "mean";
   double max_wheel_change_mm = grinding::kDefaultMaxWheelChangeMm;
+  // The results store the steps that ran are recorded into (`--db`); empty: ARCWHEEL_DB, else none.
+  std::string db;
 };
 
 // Runs (or reuses) every step and writes the report and OUTDIR/regenerate.json, printing a line
 // per step on stdout. A failing step leaves the earlier steps' outputs complete and the later ones
-// absent; its Error keeps its code and names the step.
+// absent; its Error keeps its code and names the step. With a store, the store is opened before
+// any step runs and the steps that ran (not those reused) are recorded once the report is written.
 void RunRegenerate(const RegenerateOptions& options);
 
 }  // namespace arcwheel::workflows

@@ -25,6 +25,8 @@ from ._arcwheel import (
     SIMULATE_OPTIONS,
     Scan,
     __version__,
+    DEFAULT_MAX_WHEEL_CHANGE_MM,
+    read_grid_map,
     read_scan,
     read_summary,
     read_wheel_map,
@@ -34,6 +36,7 @@ __all__ = [
     "Error", "InvalidOptionError", "BadInputError", "IoError", "FitFailedError", "InternalError",
     "Scan", "Result", "CircleFit", "read_scan", "process", "simulate", "fit_circle", "read_summary",
     "read_wheel_map", "PROCESS_OPTIONS", "SIMULATE_OPTIONS", "__version__",
+    "toolpath", "polish", "compare", "history", "frame", "fit_transform", "headcenter", "read_grid_map",
 ]
 
 
@@ -173,6 +176,122 @@ def fit_circle(points, weights=None, *, max_iterations: int = 100,
     of known noise, else it is scaled by the residual variance. A fit that does not converge is
     returned with its status (not raised)."""
     return CircleFit(**_arcwheel._fit_circle(points, weights, max_iterations, weights_are_inverse_sigmas))
+
+
+def _read_table(path) -> dict:
+    """A CSV table arcwheel wrote ('#' header lines, then a line of column names): {column: array}."""
+    with open(path, encoding="utf-8") as table:
+        lines = [line for line in table if line.strip() and not line.startswith("#")]
+    names = [name.strip() for name in lines[0].split(",")]
+    values = numpy.loadtxt(lines[1:], delimiter=",", dtype=float, ndmin=2).reshape(-1, len(names))
+    return {name: values[:, i].copy() for i, name in enumerate(names)}
+
+
+def _in_folder(output_dir, run):
+    """Runs run(folder) in output_dir, or in a temporary folder removed afterwards."""
+    if output_dir is not None:
+        return run(os.fspath(output_dir))
+    import tempfile
+    with tempfile.TemporaryDirectory(prefix="arcwheel-") as folder:
+        return run(folder)
+
+
+def toolpath(job: Union[str, os.PathLike], wheel: Union[str, os.PathLike, None] = None,
+             output_dir: Union[str, os.PathLike, None] = None, *,
+             max_wheel_change_mm: float = DEFAULT_MAX_WHEEL_CHANGE_MM, wheel_profile: str = "mean") -> dict:
+    """Runs `arcwheel toolpath JOB [--wheel SUMMARY]` (docs/grinding.md): the same library calls.
+
+    wheel: a measured wheel's summary.json (arcwheel.process's output), which replaces the job's
+    wheel; wheel_profile "mean" or "model" as --wheel-profile. The command's files go to output_dir
+    (a temporary folder when None). Returns {"summary": toolpath_summary.json as a dict,
+    "toolpath": {column: array} of toolpath.csv (xw_mm, yw_mm, zw_mm, x_mm, ..., row, pass),
+    "prediction": prediction.h5 as read_grid_map gives it, or None without a prediction}.
+    Raises InvalidOptionError, BadInputError (stage "grinding.job", ...) or IoError.
+    """
+    def run(folder):
+        parts = _arcwheel._toolpath(os.fspath(job), _path_or_none(wheel), folder, max_wheel_change_mm,
+                                    wheel_profile)
+        parts["toolpath"] = _read_table(os.path.join(folder, "toolpath.csv"))
+        prediction = os.path.join(folder, "prediction.h5")
+        parts["prediction"] = read_grid_map(prediction) if os.path.exists(prediction) else None
+        return parts
+    return _in_folder(output_dir, run)
+
+
+def polish(job: Union[str, os.PathLike], error_map: Union[str, os.PathLike, None] = None,
+           output_dir: Union[str, os.PathLike, None] = None) -> dict:
+    """Runs `arcwheel polish JOB` (docs/polishing.md), error_map replacing the job's error_map.file.
+
+    The command's files go to output_dir (a temporary folder when None). Returns {"summary":
+    polish_summary.json as a dict, "path": {column: array} of polishing_path.csv (the dwell points),
+    "residual": {column: array} of residual_map.csv (x_mm, y_mm, target_um, removal_um,
+    residual_um per aperture node), "residual_map": residual_map.h5 as read_grid_map gives it}.
+    Raises InvalidOptionError, BadInputError (stage "polishing.job", ...) or IoError.
+    """
+    def run(folder):
+        parts = _arcwheel._polish(os.fspath(job), _path_or_none(error_map), folder)
+        parts["path"] = _read_table(os.path.join(folder, "polishing_path.csv"))
+        parts["residual"] = _read_table(os.path.join(folder, "residual_map.csv"))
+        grid = os.path.join(folder, "residual_map.h5")
+        parts["residual_map"] = read_grid_map(grid) if os.path.exists(grid) else None
+        return parts
+    return _in_folder(output_dir, run)
+
+
+def compare(before_dir: Union[str, os.PathLike], after_dir: Union[str, os.PathLike]) -> dict:
+    """`arcwheel compare BEFORE_DIR AFTER_DIR` (docs/reports.md) without writing: {"comparison":
+    what compare.json holds (headline changes with their combined sigma and significance),
+    "map": {phase_deg [n_phase], y_mm [n_y], difference_um [n_phase, n_y]}}.
+    Raises BadInputError (stage "reports.compare", ...) or IoError."""
+    return _arcwheel._compare(os.fspath(before_dir), os.fspath(after_dir))
+
+
+def history(folders=None, *, wheel: Optional[str] = None, since: Optional[str] = None,
+            db: Optional[str] = None, dressings=()) -> dict:
+    """`arcwheel history` (docs/reports.md) without writing: the scans of one wheel in time order,
+    from `folders` (arcwheel process outputs) or, with wheel=ID, from the results store (db, else
+    $ARCWHEEL_DB; since="YYYY-MM-DD" keeps the later scans). dressings: ISO 8601 date-times.
+
+    Returns {"wheel_id", "timestamp": [str], "folder": [str], "time_s", "segment",
+    "mean_arc_radius_mm", "mean_arc_radius_sigma_mm", "max_runout_um", "max_arc_error_um" (arrays,
+    one entry per scan), "wear": [{segment, scans, rate_um_per_h, sigma_um_per_h, chi2_per_dof,
+    intercept_mm, first_time_s, last_time_s}], "csv": history.csv's text}.
+    Raises InvalidOptionError, BadInputError (stage "reports.history" or "store") or IoError."""
+    paths = [os.fspath(f) for f in (folders or [])]
+    return _arcwheel._history(paths, wheel or "", since or "", db or "", list(dressings))
+
+
+def frame(p1, p2, p3, *, min_separation_mm: float = 1e-3, min_angle_deg: float = 0.1) -> dict:
+    """`arcwheel frame` (docs/frames.md): the three-point workpiece frame from probed P1 (origin),
+    P2 (on +X) and P3 (in the XY plane, +Y side), machine coordinates in mm. Returns {"origin_mm"
+    (3,), "axes" (3, 3) (columns i, j, k), "angle_p2_p3_deg", "workpiece_to_machine" and
+    "machine_to_workpiece" (4, 4), "transform": the transform JSON the command writes}.
+    Raises BadInputError (stage "frames.three_point") for coincident or collinear points."""
+    return _arcwheel._frame(list(map(float, p1)), list(map(float, p2)), list(map(float, p3)),
+                            min_separation_mm, min_angle_deg)
+
+
+def fit_transform(source, target, model: str = "rigid3d", *, outlier_threshold: float = 3.0,
+                  drop_outliers: bool = False) -> dict:
+    """`arcwheel transform fit` (docs/frames.md): the best-fit transform target = T(source) of
+    (N, 3) (or (N, 2)) point arrays in mm; model as --model (rigid3d, similarity3d, rigid2d, ...).
+    Returns {"fit": the JSON the command writes, "matrix" (4, 4), "parameters", "residuals_mm"
+    (N, 3), "rms_residual_mm"}. Raises InvalidOptionError or BadInputError."""
+    return _arcwheel._fit_transform(numpy.asarray(source, dtype=float), numpy.asarray(target, dtype=float),
+                                    model, outlier_threshold, drop_outliers)
+
+
+def headcenter(record: Union[str, os.PathLike], *, calibration: Union[str, os.PathLike, None] = None,
+               commanded_mm=None, z0_mm: Optional[float] = None, tare: Union[str, os.PathLike, None] = None,
+               min_force_fraction: float = 0.1, min_force_N: float = 0.0) -> dict:
+    """`arcwheel headcenter solve RECORD` (docs/frames.md): the contact (removal) centre of one
+    force/torque record. Returns {"result": the JSON the command writes, "centre_mm" (2,) and
+    "centre_sigma_mm" (2,) in the sensor frame, "centre_machine_mm" and "offset_mm" ((2,) with a
+    calibration, and commanded_mm for the offset; else None)}.
+    Raises InvalidOptionError, BadInputError (stage "frames.force_record", ...) or IoError."""
+    return _arcwheel._headcenter(os.fspath(record), _path_or_none(calibration) or "",
+                                 None if commanded_mm is None else list(map(float, commanded_mm)),
+                                 z0_mm, _path_or_none(tare) or "", min_force_fraction, min_force_N)
 
 
 def _path_or_none(path):

@@ -140,6 +140,8 @@ void BindProcess(py::module_& module);
 void BindSimulate(py::module_& module);
 void BindOutputs(py::module_& module);
 void BindFitCircle(py::module_& module);
+void BindStages(py::module_& module);
+void BindFrames(py::module_& module);
 
 // Python's json.loads of `text`.
 py::object ParseJson(const std::string& text);

@@ -13,4 +13,6 @@ PYBIND11_MODULE(_arcwheel, module) {
   python::BindSimulate(module);
   python::BindOutputs(module);
   python::BindFitCircle(module);
+  python::BindStages(module);
+  python::BindFrames(module);
 }

@@ -46,7 +46,8 @@ double BandCircleRadius(const std::vector<double>& y, const std::vector<double>&
   return p(2);
 }
 
-// Mean over the 360 phases of the band circle of the rim averaged over each phase's bin.
+// Mean over the 360 phases of the band circle of the rim averaged over each phase's bin
+// (0.005-degree steps, three to a grit cell).
 double TruthMeanRadius(const acquisition::WheelModel& wheel, double zero_mm) {
   std::vector<double> y;
   // The band as an interval: the midpoint rule, 0.01 mm steps (6e-4 um from the limit).
@@ -56,10 +57,11 @@ double TruthMeanRadius(const acquisition::WheelModel& wheel, double zero_mm) {
   for (int j = 0; j < 360; ++j) {
     for (std::size_t k = 0; k < y.size(); ++k) {
       double s = 0.0;
-      for (int m = 0; m < 50; ++m) s += wheel.RadiusMm(j - 0.49 + 0.02 * m, y[k]);
-      rho[k] = s / 50.0 - zero_mm;
+      for (int m = 0; m < 200; ++m) s += wheel.RadiusMm(j - 0.4975 + 0.005 * m, y[k]);
+      rho[k] = s / 200.0 - zero_mm;
     }
-    sum += BandCircleRadius(y, rho, {wheel.CenterAxialMm(j), wheel.CenterDistanceMm(j) - zero_mm, wheel.ArcRadiusMm(j)});
+    sum += BandCircleRadius(
+        y, rho, {wheel.CenterAxialMm(j), wheel.CenterDistanceMm(j) - zero_mm, wheel.ArcRadiusMm(j)});
   }
   return sum / 360.0;
 }

@@ -6,9 +6,9 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 #include <numeric>
-#include <cstdint>
 #include <vector>
 
 #include "core/check.h"
@@ -186,8 +186,8 @@ void CollectRuns(std::span<const T> rho, const processing::HelixGeometry& geomet
 // Every run of the scan on two workers, halves meeting where the node changes; then the turns
 // each run stands for (the whole number of pitches back to the node's last run, 1 to 3).
 template <typename T>
-std::vector<Run> Runs(std::span<const T> rho, const processing::HelixGeometry& geometry, const NodeLocator& locate,
-                      std::size_t n_phase, double pitch_mm) {
+std::vector<Run> Runs(std::span<const T> rho, const processing::HelixGeometry& geometry,
+                      const NodeLocator& locate, std::size_t n_phase, double pitch_mm) {
   ThrowIfInterrupted();
   const std::size_t n = rho.size();
   const auto boundary = [&](std::size_t b) {
@@ -198,12 +198,14 @@ std::vector<Run> Runs(std::span<const T> rho, const processing::HelixGeometry& g
     return b;
   };
   const double turns = n > 1 ? std::abs(geometry.PhaseAt(n - 1) - geometry.PhaseAt(0)) / 360.0 : 1.0;
-  const auto expected = static_cast<std::size_t>((turns + 2.0) * static_cast<double>(n_phase) * 1.02 / kWorkers);
+  const auto expected =
+      static_cast<std::size_t>((turns + 2.0) * static_cast<double>(n_phase) * 1.02 / kWorkers);
   std::array<std::vector<Run>, kWorkers> parts;
   RunOnWorkers(kWorkers, [&](int worker) {
     const auto w = static_cast<std::size_t>(worker);
     parts[w].reserve(std::min(expected, n));
-    CollectRuns(rho, geometry, boundary(n * w / kWorkers), boundary(n * (w + 1) / kWorkers), locate, parts[w]);
+    CollectRuns(rho, geometry, boundary(n * w / kWorkers), boundary(n * (w + 1) / kWorkers), locate,
+                parts[w]);
   });
   std::vector<Run> runs = std::move(parts[0]);
   for (int w = 1; w < kWorkers; ++w) runs.insert(runs.end(), parts[w].begin(), parts[w].end());
@@ -226,7 +228,8 @@ void AccumulateRuns(const std::vector<Run>& runs, const PassSetup& pass, const p
   const double map_inv_step = n_y > 1 ? 1.0 / (map.y_mm[1] - map.y_mm[0]) : 0.0;
   for (const Run& run : runs) {
     const double y = run.y_mm;
-    const double v = pass.slope != nullptr ? run.rho_mm - run.offset_deg * pass.slope->At(run.node, y) : run.rho_mm;
+    const double v =
+        pass.slope != nullptr ? run.rho_mm - run.offset_deg * pass.slope->At(run.node, y) : run.rho_mm;
     const bool in_band = pass.full || std::abs(y - pass.band_center_mm) <= pass.band_half_mm;
     const double w = run.turns * (pass.full ? 1.0 : BandWeight(y, pass));
     const double samples = run.samples;
@@ -319,8 +322,8 @@ Circle KasaCircle(const NodeSums& s, double band_center_mm, int min_points) {
   return c;
 }
 
-bool Usable(const NodeSums& s, const Circle& c, double band_width_mm, bool full, const WheelFitOptions& options,
-            std::string* flag) {
+bool Usable(const NodeSums& s, const Circle& c, double band_width_mm, bool full,
+            const WheelFitOptions& options, std::string* flag) {
   if (!c.valid) {
     if (flag != nullptr) *flag = "no circle: too few samples or a degenerate section";
     return false;
@@ -340,8 +343,8 @@ bool Usable(const NodeSums& s, const Circle& c, double band_width_mm, bool full,
 }
 
 // Mean arc-centre axial position of the usable circles; throws Error{kFitFailed} when there is none.
-double MeanCenterAxial(const std::vector<Circle>& circles, const std::vector<NodeSums>& sums, double band_width_mm,
-                       bool full, const WheelFitOptions& options) {
+double MeanCenterAxial(const std::vector<Circle>& circles, const std::vector<NodeSums>& sums,
+                       double band_width_mm, bool full, const WheelFitOptions& options) {
   double sum = 0.0;
   int usable = 0;
   std::string why;
@@ -361,7 +364,8 @@ double MeanCenterAxial(const std::vector<Circle>& circles, const std::vector<Nod
 SlopeTable Slopes(const std::vector<Circle>& circles, double y_low, double y_high, double node_step_deg) {
   SlopeTable table;
   table.y0 = y_low;
-  table.nodes = std::max<std::size_t>(2, static_cast<std::size_t>(std::ceil((y_high - y_low) / kSlopeStepMm)) + 1);
+  table.nodes =
+      std::max<std::size_t>(2, static_cast<std::size_t>(std::ceil((y_high - y_low) / kSlopeStepMm)) + 1);
   const std::size_t n = circles.size();
   table.values.assign(n * table.nodes, 0.0);
   for (std::size_t j = 0; j < n; ++j) {
@@ -484,10 +488,11 @@ void SetMap(const std::vector<Circle>& circles, const CellSums& cells, processin
 }
 
 template <typename T>
-WheelFit FitToSamples(std::span<const T> rho, const processing::HelixGeometry& geometry, processing::WheelMap& map,
-                      const WheelFitOptions& options) {
+WheelFit FitToSamples(std::span<const T> rho, const processing::HelixGeometry& geometry,
+                      processing::WheelMap& map, const WheelFitOptions& options) {
   ThrowIfProblems(ErrorCode::kInvalidOption, kStage, options.Problems());
-  ARCWHEEL_CHECK(geometry.size() == rho.size()) << geometry.size() << " positions for " << rho.size() << " samples";
+  ARCWHEEL_CHECK(geometry.size() == rho.size())
+      << geometry.size() << " positions for " << rho.size() << " samples";
   ARCWHEEL_CHECK(map.n_phase() >= 4 && map.n_y() >= 2) << map.n_phase() << " x " << map.n_y() << " map";
   const NodeLocator locate(map.n_phase());
   const bool full = options.fit_span == FitSpan::kFull;
@@ -506,7 +511,8 @@ WheelFit FitToSamples(std::span<const T> rho, const processing::HelixGeometry& g
   std::vector<NodeSums> sums(n_phase);
   AccumulateRuns(runs, pass, map, sums, nullptr);
   std::vector<Circle> circles(n_phase);
-  for (std::size_t j = 0; j < n_phase; ++j) circles[j] = KasaCircle(sums[j], pass.band_center_mm, options.min_points);
+  for (std::size_t j = 0; j < n_phase; ++j)
+    circles[j] = KasaCircle(sums[j], pass.band_center_mm, options.min_points);
   const double band_width = 2.0 * half;
   SlopeTable slope;
   CellSums cells;

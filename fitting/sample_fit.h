@@ -35,9 +35,11 @@ namespace arcwheel::fitting {
 // `rho_mm` per sample (NaN = invalid or despiked), in the order `geometry` addresses them.
 // Replaces the map's values (map.rho_mm) by the sample-based map described above and returns the
 // fits and every metric of WheelFit from it. Throws as FitWheel.
-[[nodiscard]] WheelFit FitWheelToSamples(std::span<const double> rho_mm, const processing::HelixGeometry& geometry,
-                                         processing::WheelMap& map, const WheelFitOptions& options);
-[[nodiscard]] WheelFit FitWheelToSamples(std::span<const float> rho_mm, const processing::HelixGeometry& geometry,
-                                         processing::WheelMap& map, const WheelFitOptions& options);
+[[nodiscard]] WheelFit FitWheelToSamples(std::span<const double> rho_mm,
+                                         const processing::HelixGeometry& geometry, processing::WheelMap& map,
+                                         const WheelFitOptions& options);
+[[nodiscard]] WheelFit FitWheelToSamples(std::span<const float> rho_mm,
+                                         const processing::HelixGeometry& geometry, processing::WheelMap& map,
+                                         const WheelFitOptions& options);
 
 }  // namespace arcwheel::fitting

@@ -125,6 +125,10 @@ std::string TruthJson(const WheelModel& wheel, const ScanSettings& s, const Simu
                     {"center_axial_harmonics_mm", HarmonicsJson(wheel.center_axial_harmonics_mm)},
                     {"radial_harmonics_um", HarmonicsJson(wheel.radial_harmonics_um)},
                     {"profile_legendre_um", wheel.profile_legendre_um},
+                    {"profile_wave_um", wheel.profile_wave_um},
+                    {"profile_wave_period_mm", wheel.profile_wave_period_mm},
+                    {"edge_drop_um", wheel.edge_drop_um},
+                    {"edge_length_mm", wheel.edge_length_mm},
                     {"grit_sigma_um", wheel.grit_sigma_um},
                     {"grit_cell_mm", wheel.grit_cell_mm}};
   truth["settings"] = {{"spindle_rpm_nominal", s.spindle_rpm_nominal},

@@ -66,6 +66,13 @@ double WheelModel::ProfileErrorMm(double u_mm) const {
   const double x = u_mm / (width_mm / 2.0);
   double sum = 0.0;
   for (std::size_t n = 0; n < profile_legendre_um.size(); ++n) sum += profile_legendre_um[n] * Legendre(n, x);
+  if (profile_wave_um != 0.0)
+    sum += profile_wave_um * std::cos(2.0 * std::numbers::pi * u_mm / profile_wave_period_mm);
+  const double edge_start_mm = width_mm / 2.0 - edge_length_mm;
+  if (edge_drop_um != 0.0 && std::abs(u_mm) > edge_start_mm) {
+    const double s = (std::abs(u_mm) - edge_start_mm) / edge_length_mm;
+    sum -= edge_drop_um * (s * s) * (s * s);
+  }
   return sum / 1000.0;
 }
 
@@ -101,6 +108,31 @@ WheelModel LobedTestWheel() {
   return w;
 }
 
+WheelModel PaperTestWheel() {
+  WheelModel w;
+  w.arc_radius_harmonics_mm = {{2, 0.020, 0.0}, {3, 0.010, 40.0}, {5, 0.005, 110.0}};
+  w.profile_wave_um = 1.0;
+  w.profile_wave_period_mm = 3.0;
+  w.edge_drop_um = 20.0;
+  w.edge_length_mm = 5.0;
+  w.grit_sigma_um = 0.2;
+  return w;
+}
+
+ScanSettings PaperTestScan(std::uint64_t seed) {
+  ScanSettings s;
+  s.noise_um = 0.2;
+  // 0.2 % of the samples spiked: 0.15 % isolated, 0.05 % in bursts of 2-5 (3.5 on average).
+  s.spike_rate = 1.5e-3;
+  s.burst_rate = 0.5e-3 / 3.5;
+  s.spike_amplitude_um = 50.0;
+  // 0.1 % of the samples in dropouts of 1-40 (20.5 on average).
+  s.dropout_rate = 1e-3 / 20.5;
+  s.seed = seed;
+  s.wheel_id = "paper-test-wheel";
+  return s;
+}
+
 SimulatedScan SimulateScan(const WheelModel& wheel, const ScanSettings& s) {
   Require(s.spindle_rpm_true > 0 && s.spindle_rpm_nominal > 0, "spindle speeds must be positive");
   Require(s.feed_mm_per_min > 0, "feed_mm_per_min must be positive");
@@ -108,6 +140,9 @@ SimulatedScan SimulateScan(const WheelModel& wheel, const ScanSettings& s) {
   Require(s.end_y_mm > s.start_y_mm, "end_y_mm must exceed start_y_mm");
   Require(s.radius_sign == 1.0 || s.radius_sign == -1.0, "radius_sign must be +1 or -1");
   Require(wheel.arc_radius_mm > wheel.width_mm / 2.0, "arc_radius_mm must exceed half the width");
+  Require(wheel.profile_wave_period_mm > 0, "profile_wave_period_mm must be positive");
+  Require(wheel.edge_length_mm > 0 && wheel.edge_length_mm <= wheel.width_mm / 2.0,
+          "edge_length_mm must lie in (0, width_mm / 2]");
   Require(s.burst_length_max >= 2 && s.dropout_length_max >= 1,
           "burst and dropout lengths must be >= 2 and >= 1");
   const double duration_s = (s.end_y_mm - s.start_y_mm) / s.feed_mm_per_min * 60.0;

@@ -10,7 +10,10 @@
 //   Rb(c) = wheel_diameter_mm / 2 - arc_radius_mm + sum of radial_harmonics_um / 1000
 //           (order 1 is eccentricity, orders >= 2 are lobing),
 //   profile(u) = sum_n profile_legendre_um[n] * P_n(u / (width_mm / 2)) / 1000 (non-circular profile
-//           error, the same at every phase),
+//           error, the same at every phase)
+//           + profile_wave_um * cos(2 pi u / profile_wave_period_mm) / 1000 (a profile wave)
+//           - edge_drop_um * ((|u| - (width_mm / 2 - edge_length_mm)) / edge_length_mm)^4 / 1000
+//             over the last edge_length_mm of each side (a rim edge falling off as the 4th power),
 //   grit(c, y) = a repeatable random texture, constant over cells of grit_cell_mm.
 // The sensor's beam is parallel to the radial direction at lateral offset beam_offset_mm from the
 // axis (method.md A.7), so it reads h = sqrt(R^2 - beam_offset^2); its reading is
@@ -42,6 +45,10 @@ struct WheelModel {
   std::vector<Harmonic> center_axial_harmonics_mm;
   std::vector<Harmonic> radial_harmonics_um;
   std::vector<double> profile_legendre_um;  // coefficient of P_n, n = 0, 1, 2, ...
+  double profile_wave_um = 0.0;             // amplitude of the profile wave (0: none)
+  double profile_wave_period_mm = 3.0;      // its period along the axis, > 0
+  double edge_drop_um = 0.0;                // how far the rim falls at each edge (0: a sharp edge)
+  double edge_length_mm = 5.0;              // over this much of each side, in (0, width_mm / 2]
   double grit_sigma_um = 0.0;
   double grit_cell_mm = 0.05;
   std::uint64_t grit_seed = 7;
@@ -62,6 +69,12 @@ struct WheelModel {
 // eccentricity, lobes of orders 3 and 5, a 4 um axial wobble of the arc centre and a 10 um
 // second-order variation of the arc radius; no profile error.
 [[nodiscard]] WheelModel LobedTestWheel();
+
+// The wheel of issue 29 (method.md A, the paper's geometry): 400 x 20 mm, Ra 55.4423 mm whose
+// arc radius varies by lobes of 20, 10 and 5 um of orders 2, 3 and 5; a profile wave of 1 um
+// amplitude and 3 mm period; a rim edge that falls 20 um as the 4th power over the last 5 mm of
+// each side; a fixed 0.2 um rms grit texture (the same for every scan of it).
+[[nodiscard]] WheelModel PaperTestWheel();
 
 struct ScanSettings {
   double spindle_rpm_nominal = 500.0;
@@ -90,6 +103,11 @@ struct ScanSettings {
   std::string wheel_id = "simulated";
   std::string timestamp = "2017-09-13T10:00:00Z";  // ISO 8601, written as the scan's timestamp
 };
+
+// The scan of PaperTestWheel that issue 29 measures: 500 rpm, 100 mm/min, 100 us (132,001
+// samples over 22 mm), 0.2 um white noise, 0.2 % of the samples spiked (a quarter of them in
+// bursts), 0.1 % of them in dropouts, with noise and defects from `seed`.
+[[nodiscard]] ScanSettings PaperTestScan(std::uint64_t seed);
 
 // What the simulator injected, for the truth file.
 struct SimulationCounts {

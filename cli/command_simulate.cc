@@ -95,6 +95,11 @@ void AddSimulateCommand(CLI::App& app) {
   cmd->add_option("--profile-legendre-um", w.profile_legendre_um,
                   "profile error: coefficients of P0, P1, ... in um")
       ->delimiter(',');
+  cmd->add_option("--profile-wave-um", w.profile_wave_um, "profile wave amplitude")->capture_default_str();
+  cmd->add_option("--profile-wave-period-mm", w.profile_wave_period_mm, "profile wave period")
+      ->capture_default_str();
+  cmd->add_option("--edge-drop-um", w.edge_drop_um, "rim edge fall-off (4th power)")->capture_default_str();
+  cmd->add_option("--edge-length-mm", w.edge_length_mm, "length of the falling edge")->capture_default_str();
   cmd->add_option("--grit-um", w.grit_sigma_um, "repeatable grit texture, 1 sigma")->capture_default_str();
   cmd->add_option("--grit-cell-mm", w.grit_cell_mm, "grit texture cell size")->capture_default_str();
   cmd->add_option("--rpm", s.spindle_rpm_nominal, "nominal spindle speed written to the file")

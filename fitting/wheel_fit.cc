@@ -393,10 +393,14 @@ WheelFit FitWheel(const processing::WheelMap& map, const WheelFitOptions& option
     SummarisePhases(fits.solutions, map, out);
   }  // the fits' sensitivities go before the map-wide arrays below are made
   ReturnFreedMemory();
-  SetRunoutAndRoundness(map, options, out);
-  SetProfileError(map, out);
-  SetFormError(map, out);
+  SetMapMetrics(map, options, out);
   return out;
+}
+
+void SetMapMetrics(const processing::WheelMap& map, const WheelFitOptions& options, WheelFit& fit) {
+  SetRunoutAndRoundness(map, options, fit);
+  SetProfileError(map, fit);
+  SetFormError(map, fit);
 }
 
 }  // namespace arcwheel::fitting

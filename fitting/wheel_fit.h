@@ -61,4 +61,9 @@ struct WheelFit {
 // outside the scanned span.
 [[nodiscard]] WheelFit FitWheel(const processing::WheelMap& map, const WheelFitOptions& options);
 
+// Runout and roundness at the map's axial nodes in the band, the mean profile error and the form
+// error, for a fit whose phases, means and band are already set (FitWheel's last steps; the
+// all-sample fit, fitting/sample_fit.h, uses them on its own map).
+void SetMapMetrics(const processing::WheelMap& map, const WheelFitOptions& options, WheelFit& fit);
+
 }  // namespace arcwheel::fitting

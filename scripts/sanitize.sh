@@ -28,5 +28,7 @@ export UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
 # tests/same_results_test processes (SameResults.ShippedScan still runs). And the interrupted
 # batch of tests/batch_test (four 3e5-sample scans: 11 of the file's 31 s here under ASan, load 7;
 # the child's own unwinding on a signal runs in tests/fault_test, the batch's other cases run).
-export GTEST_FILTER="${GTEST_FILTER:--*N1e7*:SolveDwell.CutsTheResidualRmsTenfold*:SolveDwell.AMeasuredGaussian*:SpiralPath.CarriesADwell*:WheelModelStatistics.*:HistoryCommand.ReportsTheKnownWear*:WheelProfileModel.*:SameResults.SimulatedN1e6*:Batch.AnInterruptedBatch*}"
+# And the 120 paper-wheel scans of tests/all_sample_accuracy_test (the statistics over seeds;
+# every process run, tests/same_results_test's shipped scan among them, runs the same fits).
+export GTEST_FILTER="${GTEST_FILTER:--*N1e7*:*AllSampleAccuracy.*:SolveDwell.CutsTheResidualRmsTenfold*:SolveDwell.AMeasuredGaussian*:SpiralPath.CarriesADwell*:WheelModelStatistics.*:HistoryCommand.ReportsTheKnownWear*:WheelProfileModel.*:SameResults.SimulatedN1e6*:Batch.AnInterruptedBatch*}"
 ctest --preset asan --parallel "$(nproc)" "$@"

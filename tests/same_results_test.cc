@@ -6,7 +6,9 @@
 //   in the key's own unit. The relative part allows a different order of floating-point sums
 //   (another compiler, the sanitizer build); the absolute part allows values that are zero up to
 //   round-off.
-// - testdata/regression/d837b52/: the version before the changes made for speed. Since then the
+// - testdata/regression/d837b52/: the version before the changes made for speed, for the numbers
+//   upstream of the per-phase fits only (UpstreamOfTheFits; the fits are of every sample since
+//   issue 29). Since then the
 //   per-phase circle fits converge to the least-squares minimum, where they used to stop up to
 //   3.4e-5 sigma short of it, depending on rounding; the numbers they make moved by that much. So
 //   a number with a sigma beside it (`x_mm` and `x_sigma_mm`) is held to 1e-4 of that sigma, and
@@ -24,6 +26,7 @@
 #include <cmath>
 #include <fstream>
 #include <nlohmann/json.hpp>
+#include <set>
 #include <string>
 
 #include "core/testing/testing.h"
@@ -71,6 +74,16 @@ nlohmann::json SigmaOf(const nlohmann::json& object, const std::string& key) {
 
 // Every leaf of `reference` must be in `actual`, numbers within the tolerance, the rest equal.
 // `key` is the name of the innermost object key above the leaf.
+// The top-level keys that the all-sample per-phase fits (issue 29) left as they were: what the
+// scan, the noise, the despiking and the speed give. The d837b52 references predate those fits.
+bool UpstreamOfTheFits(const std::string& name) {
+  static const std::set<std::string> kKeys = {
+      "map_sigma_um",          "noise_sigma_um",     "processing",          "scan",
+      "spindle_rpm_estimated", "spindle_rpm_fitted", "spindle_rpm_nominal", "spindle_rpm_sigma",
+      "spindle_rpm_source"};
+  return kKeys.contains(name);
+}
+
 void ExpectSameNumbers(const nlohmann::json& reference, const nlohmann::json& actual,
                        const nlohmann::json& sigma, const std::string& where, const std::string& key,
                        const Tolerance& tolerance, int& compared) {
@@ -78,6 +91,7 @@ void ExpectSameNumbers(const nlohmann::json& reference, const nlohmann::json& ac
     for (const auto& [name, value] : reference.items()) {
       // The schema's minor version grows with added keys (1.2: "uncertainty"); the numbers are compared.
       if (where.empty() && (name == "model" || name == "schema_version")) continue;
+      if (where.empty() && tolerance.before_the_fits_converged && !UpstreamOfTheFits(name)) continue;
       ASSERT_TRUE(actual.contains(name)) << where << "/" << name << " is missing";
       ExpectSameNumbers(value, actual[name], SigmaOf(reference, name), where + "/" + name, name, tolerance,
                         compared);
@@ -116,7 +130,9 @@ void ExpectSameSummary(const std::string& scan, const std::string& reference_nam
     int compared = 0;
     ExpectSameNumbers(reference, summary, nullptr, "", "", Tolerance{.before_the_fits_converged = before},
                       compared);
-    EXPECT_GT(compared, 3000) << "the reference holds every per-phase number";
+    if (!before) {
+      EXPECT_GT(compared, 3000) << "the reference holds every per-phase number";
+    }
   }
 }
 

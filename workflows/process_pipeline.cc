@@ -12,6 +12,7 @@
 #include "core/interrupt.h"
 #include "core/sha256.h"
 #include "core/text_encoding.h"
+#include "fitting/sample_fit.h"
 #include "processing/helix_geometry.h"
 #include "schema/summary.h"
 #include "uncertainty/default_budget.h"
@@ -174,13 +175,17 @@ ProcessPipelineResult RunOnScan(acquisition::Scan scan, const std::string& scan_
   clock.Append(result.processed.timings);
   progress.Update("fitting", 0.7);
   clock.Start("per-phase fits");
-  result.fit = fitting::FitWheel(result.processed.map, options.fit);
+  // The fits are of the samples (fitting/sample_fit.h): the helix spline (23 MB at 1e8 samples)
+  // is not read again.
+  result.processed.map.spline.reset();
+  result.fit = acquisition::VisitReadings(scan, [&](const auto& rho) {
+    return fitting::FitWheelToSamples(std::span(rho), processing::HelixGeometry(scan, result.processed.rpm_used),
+                                      result.processed.map, options.fit);
+  });
   if (!options.no_uncertainty) {
     clock.Start("uncertainty");
     result.uncertainty = EvaluateUncertainty(options, scan, result.processed, result.fit);
   }
-  // Only the fits' sigmas read the helix spline (23 MB at 1e8 samples): gone before the model.
-  result.processed.map.spline.reset();
   clock.Start("wheel model");
   result.model = FitModelUnlessOff(options, scan, result.processed, result.fit);
   clock.Start("releasing the samples");

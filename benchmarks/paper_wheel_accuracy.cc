@@ -19,7 +19,7 @@
 
 #include "acquisition/simulate.h"
 #include "core/progress.h"
-#include "fitting/process_pipeline.h"
+#include "workflows/process_pipeline.h"
 
 namespace {
 
@@ -79,12 +79,12 @@ int main(int argc, char** argv) {
   const double truth = TruthMeanRadius(wheel, settings.sensor_zero_radius_mm);
   acquisition::SimulatedScan simulated = acquisition::SimulateScan(wheel, settings);
   const std::size_t n = simulated.scan.size();
-  fitting::ProcessPipelineOptions options;
+  workflows::ProcessPipelineOptions options;
   options.no_model = true;
   Progress progress(false);
   const auto start = std::chrono::steady_clock::now();
-  const fitting::ProcessPipelineResult result =
-      fitting::RunProcessPipeline(std::move(simulated.scan), "", "", options, progress);
+  const workflows::ProcessPipelineResult result =
+      workflows::RunProcessPipeline(std::move(simulated.scan), "", "", options, progress);
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   const double error = result.fit.mean_arc_radius_mm - truth;
   std::printf(

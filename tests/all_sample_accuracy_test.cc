@@ -23,8 +23,8 @@
 
 #include "acquisition/simulate.h"
 #include "core/progress.h"
-#include "fitting/process_pipeline.h"
 #include "fitting/wheel_model.h"
+#include "workflows/process_pipeline.h"
 
 namespace arcwheel {
 namespace {
@@ -233,11 +233,11 @@ TEST_P(AllSampleAccuracy, PerPhaseFitsMatchTheReferenceAndTheMeanIsUnbiasedWithH
     settings.start_y_mm = -11.0 - 0.2 * unit(starts);
     acquisition::SimulatedScan simulated = acquisition::SimulateScan(*wheel_, settings);
     const ReferenceResult ref = Reference(simulated.scan, settings);
-    fitting::ProcessPipelineOptions options;
+    workflows::ProcessPipelineOptions options;
     options.no_model = true;
     Progress progress(false);
-    const fitting::ProcessPipelineResult result =
-        fitting::RunProcessPipeline(std::move(simulated.scan), "", "", options, progress);
+    const workflows::ProcessPipelineResult result =
+        workflows::RunProcessPipeline(std::move(simulated.scan), "", "", options, progress);
     const fitting::WheelFit& fit = result.fit;
     ASSERT_EQ(fit.usable_phases, kPhases) << "seed " << seed;
     std::vector<double> radii;
@@ -291,8 +291,8 @@ TEST_F(AllSampleAccuracy, WheelModelArcRadiusErrorIsWithinItsOwnSigma) {
     settings.start_y_mm = -11.0 - 0.2 * unit(starts);
     acquisition::SimulatedScan simulated = acquisition::SimulateScan(*wheel_, settings);
     Progress progress(false);
-    const fitting::ProcessPipelineResult result = fitting::RunProcessPipeline(
-        std::move(simulated.scan), "", "", fitting::ProcessPipelineOptions{}, progress);
+    const workflows::ProcessPipelineResult result = workflows::RunProcessPipeline(
+        std::move(simulated.scan), "", "", workflows::ProcessPipelineOptions{}, progress);
     ASSERT_TRUE(result.model.has_value()) << "seed " << seed;
     const fitting::WheelModel& model = *result.model;
     ASSERT_EQ(model.arc_radius_mm.size(), static_cast<std::size_t>(kPhases));

@@ -179,7 +179,8 @@ ProcessPipelineResult RunOnScan(acquisition::Scan scan, const std::string& scan_
   // is not read again.
   result.processed.map.spline.reset();
   result.fit = acquisition::VisitReadings(scan, [&](const auto& rho) {
-    return fitting::FitWheelToSamples(std::span(rho), processing::HelixGeometry(scan, result.processed.rpm_used),
+    return fitting::FitWheelToSamples(std::span(rho),
+                                      processing::HelixGeometry(scan, result.processed.rpm_used),
                                       result.processed.map, options.fit);
   });
   if (!options.no_uncertainty) {

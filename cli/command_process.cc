@@ -80,6 +80,8 @@ void PrintTimings(const StageClock& clock) {
 }
 
 void RunAndPrint(ProcessArgs& args) {
+  // A bad tolerance file is refused before the scan is read (exit 2, nothing written).
+  if (!args.tolerance_file.empty()) args.pipeline.tolerances = reports::ReadTolerances(args.tolerance_file);
   Progress progress(!args.quiet);
   const workflows::ProcessPipelineResult result =
       workflows::RunProcessPipeline(args.scan_path, args.outdir, args.pipeline, progress);
@@ -89,9 +91,8 @@ void RunAndPrint(ProcessArgs& args) {
   if (!args.quiet && result.model) PrintModelHeadline(*result.model);
   if (!args.report_formats.empty()) {
     // The report is drawn from the files just written, exactly as `arcwheel report` would.
-    reports::Tolerances tolerances;
-    if (!args.tolerance_file.empty()) tolerances = reports::ReadTolerances(args.tolerance_file);
-    const reports::WrittenReports written = reports::WriteReports(args.outdir, tolerances);
+    const reports::WrittenReports written =
+        reports::WriteReports(args.outdir, args.pipeline.tolerances.value_or(reports::Tolerances{}));
     if (!args.quiet) fmt::print("report:  {}\n         {}\n", written.html.string(), written.pdf.string());
   }
 }

@@ -164,5 +164,53 @@ TEST(ReportCommand, DecidesByIso14253AgainstValueAndExpandedUncertainty) {
   EXPECT_THAT(PdfText(dir / "out" / "report.pdf"), HasSubstr("simple acceptance"));
 }
 
+// `process --tolerances`: summary.json records the rule and, for each toleranced quantity, the
+// value, U, k and decision the report's page 1 shows. The limits are placed against the value and
+// U of a run without tolerances (the same scan gives the same figures: the bootstrap is seeded).
+TEST(ProcessCommand, RecordsTheDecisionsInTheSummary) {
+  TempDir dir;
+  const std::string scan = (dir / "scan.h5").string();
+  ASSERT_EQ(RunArcwheel("simulate '" + scan + "' --noise-um 0.4 --radial-harmonic 1:3").exit_status, 0);
+  ASSERT_EQ(RunArcwheel("process '" + scan + "' -o '" + (dir / "plain").string() + "' -q").exit_status, 0);
+  const nlohmann::json plain = nlohmann::json::parse(ReadText(dir / "plain" / "summary.json"));
+  ASSERT_FALSE(plain["uncertainty"].contains("decisions"));
+  const nlohmann::json& q = plain["uncertainty"]["quantities"];
+  const auto value = [&](const char* key) { return q[key]["value"].get<double>(); };
+  const auto u = [&](const char* key) { return q[key]["U"].get<double>(); };
+  ASSERT_GT(u("max_runout_um"), 0.0);
+  const nlohmann::json tolerances = {
+      {"max_runout_um", {{"max", value("max_runout_um") + u("max_runout_um") / 2}}},
+      {"mean_arc_radius_mm",
+       {{"min", value("mean_arc_radius_mm") - 2 * u("mean_arc_radius_mm")},
+        {"max", value("mean_arc_radius_mm") + 2 * u("mean_arc_radius_mm")}}},
+      {"max_roundness_um", value("max_roundness_um") - 2 * u("max_roundness_um")}};
+  WriteText(dir / "tolerances.json", tolerances.dump());
+  const auto run = RunArcwheel("process '" + scan + "' -o '" + (dir / "decided").string() +
+                               "' -q --tolerances '" + (dir / "tolerances.json").string() + "'");
+  ASSERT_EQ(run.exit_status, 0) << run.output;
+  const nlohmann::json decided =
+      nlohmann::json::parse(ReadText(dir / "decided" / "summary.json"))["uncertainty"];
+  EXPECT_EQ(decided["decision_rule"], "iso14253-1");
+  const nlohmann::json& d = decided["decisions"];
+  ASSERT_EQ(d.size(), 3u) << d.dump();
+  EXPECT_EQ(d["max_runout_um"]["decision"], "not proven");
+  EXPECT_EQ(d["mean_arc_radius_mm"]["decision"], "conforms");
+  EXPECT_EQ(d["max_roundness_um"]["decision"], "does not conform");
+  EXPECT_TRUE(d["max_roundness_um"]["min"].is_null());
+  EXPECT_EQ(d["max_runout_um"]["U"].get<double>(), u("max_runout_um"));
+  EXPECT_EQ(d["max_runout_um"]["value"].get<double>(), value("max_runout_um"));
+  EXPECT_EQ(d["max_runout_um"]["k"].get<double>(), q["max_runout_um"]["k"].get<double>());
+  EXPECT_EQ(decided["overall"], "does not conform");
+
+  // A tolerance file that does not parse is refused before the scan is read: exit 3 (bad input,
+  // docs/reports.md), nothing written.
+  WriteText(dir / "bad.json", R"({"max_runout_um": {"max": "ten"}})");
+  const auto refused = RunArcwheel("process '" + scan + "' -o '" + (dir / "refused").string() +
+                                   "' -q --tolerances '" + (dir / "bad.json").string() + "'");
+  EXPECT_EQ(refused.exit_status, 3) << refused.output;
+  EXPECT_THAT(refused.output, HasSubstr("bad.json"));
+  EXPECT_FALSE(std::filesystem::exists(dir / "refused"));
+}
+
 }  // namespace
 }  // namespace arcwheel::reports

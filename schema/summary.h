@@ -220,8 +220,18 @@ inline constexpr std::string_view kExpanded = "U";
 }  // namespace quantity
 // With `process --tolerances`: the rule and the decision for each toleranced quantity.
 inline constexpr std::string_view kDecisionRule = "decision_rule";  // "iso14253-1" or "simple-acceptance"
-inline constexpr std::string_view kDecisions = "decisions";  // by headline key: {"min", "max", "decision"}
-inline constexpr std::string_view kOverall = "overall";      // "conforms", "does not conform", "not proven"
+inline constexpr std::string_view kDecisions = "decisions";         // by headline key, objects:
+namespace decision {
+inline constexpr std::string_view kMin = "min";  // the specification's limits; null = one-sided
+inline constexpr std::string_view kMax = "max";
+inline constexpr std::string_view kValue = "value";  // the estimate decided on (as quantities)
+inline constexpr std::string_view kExpanded = "U";   // its expanded uncertainty
+inline constexpr std::string_view kCoverageFactor = "k";
+inline constexpr std::string_view kDecision = "decision";  // "conforms", "does not conform", "not proven"
+}  // namespace decision
+// Over the toleranced quantities: "does not conform" if any does not, else "not proven" if any is
+// not proven, else "conforms"; null when the tolerance file limits none of them.
+inline constexpr std::string_view kOverall = "overall";
 }  // namespace uncertainty
 
 }  // namespace arcwheel::schema::summary

@@ -19,6 +19,7 @@ namespace {
 
 namespace fs = std::filesystem;
 namespace s = schema::store;
+namespace su = schema::summary;
 using nlohmann::json;
 
 // A headline number: where it sits in the file (a path of keys), its sigma's key path (empty:
@@ -66,6 +67,13 @@ std::vector<StoredNumber> Numbers(const json& document, const std::vector<Charac
       const json* sigma = Find(document, c.sigma_path);
       if (sigma != nullptr && sigma->is_number()) number.sigma = sigma->get<double>();
     }
+    // A headline figure of summary.json: its U and, with tolerances, its decision.
+    const json* expanded = Find(document, {su::kUncertainty, su::uncertainty::kQuantities,
+                                           number.characteristic, su::uncertainty::quantity::kExpanded});
+    if (expanded != nullptr && expanded->is_number()) number.expanded_uncertainty = expanded->get<double>();
+    const json* decision = Find(document, {su::kUncertainty, su::uncertainty::kDecisions,
+                                           number.characteristic, su::uncertainty::decision::kDecision});
+    if (decision != nullptr && decision->is_string()) number.decision = decision->get<std::string>();
     numbers.push_back(std::move(number));
   }
   return numbers;

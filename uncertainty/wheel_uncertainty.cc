@@ -195,6 +195,26 @@ WheelUncertainty EvaluateWheelUncertainty(const WheelObservations& o, const Budg
   return out;
 }
 
+void DecideConformity(WheelUncertainty& uncertainty,
+                      const std::map<std::string, Specification>& specifications, DecisionRule rule) {
+  uncertainty.rule = rule;
+  uncertainty.decisions.clear();
+  for (const auto& [key, specification] : specifications) {
+    const QuantityUncertainty* q = uncertainty.Find(key);
+    if (q == nullptr)
+      throw Error(ErrorCode::kBadInput, kStage, "no uncertainty is evaluated for '" + key + "'");
+  }
+  // In the budget's order (the report's), not the map's.
+  for (const QuantityUncertainty& q : uncertainty.quantities) {
+    const auto found = specifications.find(q.key);
+    if (found == specifications.end()) continue;
+    uncertainty.decisions.push_back(
+        {.key = q.key,
+         .specification = found->second,
+         .decision = Decide(q.value, q.combined.expanded, found->second, {.rule = rule})});
+  }
+}
+
 nlohmann::json WheelUncertaintyToJson(const WheelUncertainty& uncertainty) {
   namespace qk = su::quantity;
   namespace ck = su::quantity::contribution;
@@ -227,10 +247,30 @@ nlohmann::json WheelUncertaintyToJson(const WheelUncertainty& uncertainty) {
     if (q.key != s::kMeanArcRadiusMm) item[qk::kNoiseBias] = Finite(q.noise_bias);
     quantities[q.key] = std::move(item);
   }
-  return {{su::kCoverageProbability, uncertainty.budget.combine.coverage_probability},
-          {su::kBudgetSource, uncertainty.budget_source},
-          {su::kBudget, BudgetToJson(uncertainty.budget)},
-          {su::kQuantities, std::move(quantities)}};
+  nlohmann::json out = {{su::kCoverageProbability, uncertainty.budget.combine.coverage_probability},
+                        {su::kBudgetSource, uncertainty.budget_source},
+                        {su::kBudget, BudgetToJson(uncertainty.budget)},
+                        {su::kQuantities, std::move(quantities)}};
+  if (uncertainty.rule) {
+    namespace dk = su::decision;
+    nlohmann::json decisions = nlohmann::json::object();
+    std::vector<Decision> all;
+    for (const ConformityDecision& d : uncertainty.decisions) {
+      const QuantityUncertainty& q = *uncertainty.Find(d.key);
+      decisions[d.key] = {{dk::kMin, d.specification.min ? nlohmann::json(*d.specification.min) : nullptr},
+                          {dk::kMax, d.specification.max ? nlohmann::json(*d.specification.max) : nullptr},
+                          {dk::kValue, Finite(q.value)},
+                          {dk::kExpanded, Finite(q.combined.expanded)},
+                          {dk::kCoverageFactor, Finite(q.combined.coverage_factor)},
+                          {dk::kDecision, DecisionName(d.decision)}};
+      all.push_back(d.decision);
+    }
+    out[su::kDecisionRule] = DecisionRuleName(*uncertainty.rule);
+    out[su::kDecisions] = std::move(decisions);
+    const std::optional<Decision> overall = Overall(all);
+    out[su::kOverall] = overall ? nlohmann::json(DecisionName(*overall)) : nlohmann::json(nullptr);
+  }
+  return out;
 }
 
 }  // namespace arcwheel::uncertainty

@@ -5,13 +5,16 @@
 // (budget_json.h, default_budget.h), combined per GUM (budget.h). Stage id "uncertainty.wheel".
 // The inputs are plain arrays, filled by the process pipeline from its per-phase fits and map.
 
+#include <map>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <span>
 #include <string>
 #include <vector>
 
 #include "uncertainty/budget.h"
 #include "uncertainty/budget_json.h"
+#include "uncertainty/decision.h"
 #include "uncertainty/noise_corrected.h"
 
 namespace arcwheel::uncertainty {
@@ -63,10 +66,20 @@ struct QuantityUncertainty {
   Combined combined;
 };
 
+// One toleranced quantity's decision: its specification and what the rule made of value +- U.
+struct ConformityDecision {
+  std::string key;  // summary.json key
+  Specification specification;
+  Decision decision = Decision::kNotProven;
+};
+
 struct WheelUncertainty {
   std::string budget_source = "default";
   BudgetFile budget;
   std::vector<QuantityUncertainty> quantities;  // in BudgetQuantityKeys() order
+  // With tolerances (DecideConformity): the rule and a decision per toleranced quantity.
+  std::optional<DecisionRule> rule = std::nullopt;
+  std::vector<ConformityDecision> decisions;
   // The quantity by key; nullptr if absent.
   [[nodiscard]] const QuantityUncertainty* Find(std::string_view key) const;
 };
@@ -76,6 +89,13 @@ struct WheelUncertainty {
 [[nodiscard]] WheelUncertainty EvaluateWheelUncertainty(const WheelObservations& observations,
                                                         const BudgetFile& budget,
                                                         const WheelUncertaintyOptions& options = {});
+
+// Decides every quantity that `specifications` (by summary.json key) tolerances by `rule`, with
+// the value and U the evaluation gave (Decide), into uncertainty.rule and uncertainty.decisions;
+// the report's page 1 decides the same way. Throws Error{kBadInput} for a key that is not a
+// quantity of the budget.
+void DecideConformity(WheelUncertainty& uncertainty,
+                      const std::map<std::string, Specification>& specifications, DecisionRule rule);
 
 // summary.json's "uncertainty" object (schema/summary.h, namespace uncertainty).
 [[nodiscard]] nlohmann::json WheelUncertaintyToJson(const WheelUncertainty& uncertainty);

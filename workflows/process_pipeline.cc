@@ -162,6 +162,15 @@ uncertainty::WheelUncertainty EvaluateUncertainty(const ProcessPipelineOptions& 
   return result;
 }
 
+// The decisions summary.json records, by the rule the report's page 1 uses (RuleOf there).
+void DecideTolerances(const reports::Tolerances& tolerances, uncertainty::WheelUncertainty& uncertainty) {
+  std::map<std::string, uncertainty::Specification> specifications;
+  for (const auto& [key, limit] : tolerances.limits)
+    specifications[key] = {.min = limit.min, .max = limit.max};
+  uncertainty::DecideConformity(uncertainty, specifications,
+                                tolerances.rule.value_or(uncertainty::DecisionRule::kIso14253));
+}
+
 // Everything after the scan is in memory. `sha256` delivers the input's hash (computed meanwhile
 // on another thread when the scan came from a file).
 ProcessPipelineResult RunOnScan(acquisition::Scan scan, const std::string& scan_path,
@@ -186,6 +195,7 @@ ProcessPipelineResult RunOnScan(acquisition::Scan scan, const std::string& scan_
   if (!options.no_uncertainty) {
     clock.Start("uncertainty");
     result.uncertainty = EvaluateUncertainty(options, scan, result.processed, result.fit);
+    if (options.tolerances) DecideTolerances(*options.tolerances, *result.uncertainty);
   }
   clock.Start("wheel model");
   result.model = FitModelUnlessOff(options, scan, result.processed, result.fit);

@@ -15,6 +15,7 @@
 #include "fitting/wheel_fit.h"
 #include "fitting/wheel_model.h"
 #include "processing/process_scan.h"
+#include "reports/tolerances.h"
 #include "uncertainty/budget_json.h"
 #include "uncertainty/wheel_uncertainty.h"
 
@@ -38,6 +39,10 @@ struct ProcessPipelineOptions {
   std::string uncertainty_budget_path;
   bool no_uncertainty = false;
   uncertainty::WheelUncertaintyOptions uncertainty;
+  // The tolerances (`--tolerances FILE`, reports/tolerances.h), read by the caller before the
+  // scan: with the uncertainty, every toleranced quantity is decided by the file's rule (ISO
+  // 14253-1 by default) and summary.json's "uncertainty" carries the rule and the decisions.
+  std::optional<reports::Tolerances> tolerances;
   // Filled by ResolveProcessPipelineOptions from uncertainty_budget_path.
   std::optional<uncertainty::BudgetFile> uncertainty_budget;
 };

@@ -163,14 +163,6 @@ py::dict ResultDict(workflows::ProcessPipelineResult& r) {
   return d;
 }
 
-// The inspection report of `arcwheel process --report`, drawn from the files just written.
-void WriteReport(const std::filesystem::path& outdir,
-                 const std::optional<std::filesystem::path>& tolerance_file) {
-  reports::Tolerances tolerances;
-  if (tolerance_file) tolerances = reports::ReadTolerances(*tolerance_file);
-  (void)reports::WriteReports(outdir, tolerances);
-}
-
 py::dict Process(const py::object& scan_or_path, const std::optional<std::filesystem::path>& output_dir,
                  bool report, const std::optional<std::filesystem::path>& tolerances,
                  const py::kwargs& kwargs) {
@@ -180,6 +172,8 @@ py::dict Process(const py::object& scan_or_path, const std::optional<std::filesy
     throw Error(ErrorCode::kInvalidOption, "process", "report and tolerances need output_dir");
   }
   const std::filesystem::path outdir = output_dir.value_or(std::filesystem::path());
+  // Read before the scan, as the command line does: summary.json then records the decisions.
+  if (tolerances) options.tolerances = reports::ReadTolerances(*tolerances);
   workflows::ProcessPipelineResult result;
   if (py::isinstance<acquisition::Scan>(scan_or_path)) {
     // The pipeline works on the readings in place: it gets a copy, and the caller keeps the scan.
@@ -197,7 +191,8 @@ py::dict Process(const py::object& scan_or_path, const std::optional<std::filesy
   }
   if (report)
     RunReleased([&] {
-      WriteReport(outdir, tolerances);
+      // The inspection report of `arcwheel process --report`, drawn from the files just written.
+      (void)reports::WriteReports(outdir, options.tolerances.value_or(reports::Tolerances{}));
       return 0;
     });
   return ResultDict(result);

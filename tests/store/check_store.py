@@ -105,10 +105,18 @@ def check_batch(work):
         assert wheel == truth[name] == summary["scan"]["wheel_id"], (name, wheel)
         assert timestamp == summary["scan"]["timestamp"], (name, timestamp)
         numbers = {row[0]: row[1:] for row in query(
-            STORE, f"SELECT characteristic, value, sigma FROM numbers WHERE run_id = {run_id}")}
+            STORE, "SELECT characteristic, value, sigma, expanded_uncertainty, decision FROM numbers "
+            f"WHERE run_id = {run_id}")}
+        quantities = summary["uncertainty"]["quantities"]
         for key, sigma_key in CHARACTERISTICS.items():
             assert key in numbers, (name, key, sorted(numbers))
-            value, sigma = numbers[key]
+            value, sigma, expanded, decision = numbers[key]
+            # The headline figures' U from summary.json; no decision without tolerances.
+            if key in quantities:
+                assert float(expanded) == quantities[key]["U"], (name, key, expanded)
+            else:
+                assert expanded is None, (name, key, expanded)
+            assert decision is None, (name, key, decision)
             assert float(value) == summary[key], (name, key, value, summary[key])
             if sigma_key:
                 assert float(sigma) == summary[sigma_key], (name, sigma_key, sigma, summary[sigma_key])
@@ -219,6 +227,23 @@ def check_migration(work, store):
     assert len(query(store, "SELECT id FROM runs")) == 6
 
 
+def check_decisions(work, scans):
+    """`process --tolerances --db`: each toleranced number's decision as summary.json has it."""
+    tolerances = work / "tolerances.json"
+    tolerances.write_text(json.dumps({"max_runout_um": 1000.0, "mean_arc_radius_mm": {"max": 54.9}}))
+    out = work / "decided"
+    run("process", str(scans / "scan_00.h5"), "-o", str(out), "-q", "--phases", "90", "--no-model",
+        "--tolerances", str(tolerances), "--db", STORE)
+    summary = json.loads((out / "summary.json").read_text())
+    decisions = summary["uncertainty"]["decisions"]
+    assert decisions["max_runout_um"]["decision"] == "conforms", decisions
+    assert decisions["mean_arc_radius_mm"]["decision"] == "does not conform", decisions  # a 55 mm arc
+    run_id = query(STORE, f"SELECT id FROM runs WHERE output_folder = '{out.resolve()}'")[0][0]
+    stored = dict(query(STORE, f"SELECT characteristic, decision FROM numbers WHERE run_id = {run_id}"))
+    assert stored["max_runout_um"] == "conforms" and stored["mean_arc_radius_mm"] == "does not conform", stored
+    assert stored["max_arc_error_um"] is None, stored
+
+
 def main():
     global STORE
     with tempfile.TemporaryDirectory(prefix="arcwheel-store-") as folder:
@@ -227,6 +252,7 @@ def main():
             STORE = str(work / "results.sqlite")
         scans = check_batch(work)
         check_history(work)
+        check_decisions(work, scans)
         check_no_row_from_failed_runs(work, scans)
         check_migration(work, sys.argv[3] if len(sys.argv) > 3 else str(work / "v1.sqlite"))
         exported = run("db", "export", "--csv", "--db", STORE).stdout.splitlines()

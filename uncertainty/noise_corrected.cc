@@ -9,6 +9,7 @@
 
 #include "core/error.h"
 #include "core/number_format.h"
+#include "core/parallel.h"
 
 namespace arcwheel::uncertainty {
 namespace {
@@ -94,33 +95,38 @@ std::pair<int, int> Group(SmoothBasis basis, int order) {
   return basis == SmoothBasis::kFourier ? std::pair{2 * order - 1, 2} : std::pair{order, 1};
 }
 
-// The estimate on data `y` (rows x columns, complete rows) with per-row noise sigma `row_sigma`;
-// the fitted rows themselves only `with_fitted` (the bootstrap needs them once).
-Estimate Fit(const Eigen::MatrixXd& y, const Eigen::VectorXd& row_sigma, const Eigen::MatrixXd& q,
-             const NoiseCorrectedPvOptions& options, bool with_fitted) {
-  Eigen::MatrixXd coefficients = y * q;  // rows x functions
-  const int rows = static_cast<int>(y.rows());
-  // Rows that share a shape (the sections of one wheel) scatter about their mean by noise and by
-  // their real differences: each coefficient's spread about its mean keeps only its part beyond
-  // the noise (James-Stein / empirical Bayes shrinkage), so that a maximum over the rows is not
-  // taken over noise. A coefficient's noise variance is its row's sigma^2 (orthonormal basis).
-  if (options.shrink_rows && rows > 2) {
-    const double noise = row_sigma.squaredNorm() / rows;
-    for (Eigen::Index j = 0; j < coefficients.cols(); ++j) {
-      const double mean = coefficients.col(j).mean();
-      const double spread = (coefficients.col(j).array() - mean).square().sum() / (rows - 1);
-      const double real = std::max(0.0, spread - noise);
-      const double keep = spread > 0.0 ? real / (real + noise) : 0.0;
-      coefficients.col(j) = (mean + keep * (coefficients.col(j).array() - mean)).matrix();
-    }
+// Rows that share a shape (the sections of one wheel) scatter about their mean by noise and by
+// their real differences: each coefficient's spread about its mean keeps only its part beyond the
+// noise (James-Stein / empirical Bayes shrinkage), so that a maximum over the rows is not taken
+// over noise. A coefficient's noise variance is its row's sigma^2 (orthonormal basis).
+void ShrinkRows(Eigen::MatrixXd& coefficients, const Eigen::VectorXd& row_sigma,
+                const NoiseCorrectedPvOptions& options) {
+  const auto rows = coefficients.rows();
+  if (!options.shrink_rows || rows <= 2) return;
+  const double noise = row_sigma.squaredNorm() / static_cast<double>(rows);
+  for (Eigen::Index j = 0; j < coefficients.cols(); ++j) {
+    const double mean = coefficients.col(j).mean();
+    const double spread = (coefficients.col(j).array() - mean).square().sum() / static_cast<double>(rows - 1);
+    const double real = std::max(0.0, spread - noise);
+    const double keep = spread > 0.0 ? real / (real + noise) : 0.0;
+    coefficients.col(j) = (mean + keep * (coefficients.col(j).array() - mean)).matrix();
   }
+}
+
+struct Selection {
   std::vector<int> kept;   // every function kept
   std::vector<int> shown;  // those the PV counts
-  Estimate estimate;
+  int order = 0;           // the highest order the PV counts
+};
+
+Selection SelectOrders(const Eigen::MatrixXd& coefficients, const Eigen::VectorXd& row_sigma,
+                       const NoiseCorrectedPvOptions& options) {
+  Selection selection;
+  const auto rows = coefficients.rows();
   for (int order = 0; order <= options.max_order; ++order) {
     const auto [first, count] = Group(options.basis, order);
     double chi2_drop = 0.0;
-    for (int r = 0; r < rows; ++r)
+    for (Eigen::Index r = 0; r < rows; ++r)
       chi2_drop += coefficients.row(r).segment(first, count).squaredNorm() / (row_sigma[r] * row_sigma[r]);
     // An order's functions stay when they lower chi-square by more than noise alone would in
     // five standard deviations of its chi-square (rows x count degrees of freedom); the mean and
@@ -129,34 +135,75 @@ Estimate Fit(const Eigen::MatrixXd& y, const Eigen::VectorXd& row_sigma, const E
     const bool always = order == 0 || order < options.pv_from_order;
     if (!always && chi2_drop <= dof + 5.0 * std::sqrt(2.0 * dof)) continue;
     for (int j = first; j < first + count; ++j) {
-      kept.push_back(j);
-      if (order >= options.pv_from_order) shown.push_back(j);
+      selection.kept.push_back(j);
+      if (order >= options.pv_from_order) selection.shown.push_back(j);
     }
-    if (order >= options.pv_from_order) estimate.order = std::max(estimate.order, order);
+    if (order >= options.pv_from_order) selection.order = std::max(selection.order, order);
   }
-  const auto product = [&](const std::vector<int>& columns) {
-    Eigen::MatrixXd c(rows, columns.size());
-    Eigen::MatrixXd basis(q.rows(), columns.size());
-    for (std::size_t i = 0; i < columns.size(); ++i) {
-      c.col(i) = coefficients.col(columns[i]);
-      basis.col(i) = q.col(columns[i]);
-    }
-    return Eigen::MatrixXd(c * basis.transpose());
-  };
-  if (with_fitted) {
-    estimate.fitted = product(kept);
-    const Eigen::MatrixXd residual = y - estimate.fitted;
-    for (int r = 0; r < rows; ++r)
-      estimate.chi2 += residual.row(r).squaredNorm() / (row_sigma[r] * row_sigma[r]);
-    estimate.dof =
-        static_cast<double>(y.size()) - static_cast<double>(rows) * static_cast<double>(kept.size());
+  return selection;
+}
+
+// The rows of `columns` of the basis with their coefficients.
+Eigen::MatrixXd RowsOf(const Eigen::MatrixXd& coefficients, const Eigen::MatrixXd& q,
+                       const std::vector<int>& columns) {
+  Eigen::MatrixXd c(coefficients.rows(), static_cast<Eigen::Index>(columns.size()));
+  Eigen::MatrixXd basis(q.rows(), static_cast<Eigen::Index>(columns.size()));
+  for (std::size_t i = 0; i < columns.size(); ++i) {
+    c.col(static_cast<Eigen::Index>(i)) = coefficients.col(columns[i]);
+    basis.col(static_cast<Eigen::Index>(i)) = q.col(columns[i]);
   }
-  if (!shown.empty()) {
-    const Eigen::MatrixXd values = product(shown);
-    for (int r = 0; r < rows; ++r)
-      estimate.fitted_pv = std::max(estimate.fitted_pv, values.row(r).maxCoeff() - values.row(r).minCoeff());
+  return c * basis.transpose();
+}
+
+double LargestRowPv(const Eigen::MatrixXd& coefficients, const Eigen::MatrixXd& q,
+                    const std::vector<int>& shown) {
+  if (shown.empty()) return 0.0;
+  const Eigen::MatrixXd values = RowsOf(coefficients, q, shown);
+  double pv = 0.0;
+  for (Eigen::Index r = 0; r < values.rows(); ++r)
+    pv = std::max(pv, values.row(r).maxCoeff() - values.row(r).minCoeff());
+  return pv;
+}
+
+// The estimate from the rows' raw coefficients on the basis (data times q): shrunk, orders
+// chosen, the PV of the shown orders.
+Estimate FromCoefficients(Eigen::MatrixXd coefficients, const Eigen::VectorXd& row_sigma,
+                          const Eigen::MatrixXd& q, const NoiseCorrectedPvOptions& options,
+                          Eigen::MatrixXd* kept_coefficients = nullptr) {
+  ShrinkRows(coefficients, row_sigma, options);
+  const Selection selection = SelectOrders(coefficients, row_sigma, options);
+  Estimate estimate;
+  estimate.order = selection.order;
+  estimate.fitted_pv = LargestRowPv(coefficients, q, selection.shown);
+  if (kept_coefficients != nullptr) {
+    *kept_coefficients = Eigen::MatrixXd::Zero(coefficients.rows(), coefficients.cols());
+    for (const int j : selection.kept) kept_coefficients->col(j) = coefficients.col(j);
   }
   return estimate;
+}
+
+// The estimate on data `y` (rows x columns, complete rows) with per-row noise sigma `row_sigma`,
+// with the fitted rows, their coefficients and the chi-square of the data against them.
+Estimate Fit(const Eigen::MatrixXd& y, const Eigen::VectorXd& row_sigma, const Eigen::MatrixXd& q,
+             const NoiseCorrectedPvOptions& options, Eigen::MatrixXd& kept_coefficients) {
+  Estimate estimate = FromCoefficients(y * q, row_sigma, q, options, &kept_coefficients);
+  estimate.fitted = kept_coefficients * q.transpose();
+  const Eigen::MatrixXd residual = y - estimate.fitted;
+  for (Eigen::Index r = 0; r < y.rows(); ++r)
+    estimate.chi2 += residual.row(r).squaredNorm() / (row_sigma[r] * row_sigma[r]);
+  const auto kept = static_cast<double>((kept_coefficients.colwise().squaredNorm().array() > 0.0).count());
+  estimate.dof = static_cast<double>(y.size()) - static_cast<double>(y.rows()) * kept;
+  return estimate;
+}
+
+// True when every row's sigmas are one value: the noise of the row's coefficients on the
+// orthonormal basis is then that sigma times independent standard normals.
+bool SigmaConstantAlongRows(const Eigen::MatrixXd& sigma) {
+  for (Eigen::Index r = 0; r < sigma.rows(); ++r) {
+    const double first = sigma(r, 0);
+    if ((sigma.row(r).array() - first).abs().maxCoeff() > 1e-12 * std::abs(first)) return false;
+  }
+  return true;
 }
 
 }  // namespace
@@ -225,31 +272,55 @@ NoiseCorrectedPv EstimateNoiseCorrectedPv(std::span<const double> values, std::s
     row_sigma[i] = std::sqrt(sigma.row(i).squaredNorm() / columns);
   }
   const Eigen::MatrixXd q = OrthonormalBasis(options.basis, options.max_order, columns);
-  Estimate estimate = Fit(y, row_sigma, q, options, true);
+  Eigen::MatrixXd kept_coefficients;
+  Estimate estimate = Fit(y, row_sigma, q, options, kept_coefficients);
   // The noise as the data show it: the sigmas scaled by the root of chi-square per degree of
   // freedom of the fit (Birge ratio), then the fit repeated with them.
   if (options.sigmas_from_residuals && estimate.dof > 0.0 && estimate.chi2 > 0.0) {
     result.sigma_scale = std::sqrt(estimate.chi2 / estimate.dof);
     sigma *= result.sigma_scale;
     row_sigma *= result.sigma_scale;
-    estimate = Fit(y, row_sigma, q, options, true);
+    estimate = Fit(y, row_sigma, q, options, kept_coefficients);
   }
   result.fitted_pv = estimate.fitted_pv;
   result.order = estimate.order;
   result.rows_used = n_rows;
   result.replicates = options.replicates;
 
-  std::mt19937_64 rng(options.seed);
-  std::normal_distribution<double> normal(0.0, 1.0);
+  // Each data set is the fitted rows plus normal noise of each value's sigma. Where the sigma is
+  // one value along each row (the map's rows), the noise of the row's coefficients is drawn
+  // instead: the same distribution (the basis is orthonormal), with a few dozen draws a row
+  // instead of one a value. Each replicate has its own random stream (the seed and its number),
+  // so the result does not depend on how the replicates are shared between the two workers.
+  const bool draw_coefficients = SigmaConstantAlongRows(sigma);
+  const Eigen::Index functions = q.cols();
+  std::vector<double> pv(static_cast<std::size_t>(options.replicates));
+  RunOnWorkers(2, [&](int worker) {
+    for (int b = worker; b < options.replicates; b += 2) {
+      std::seed_seq seeds{options.seed, static_cast<std::uint64_t>(b)};
+      std::mt19937_64 rng(seeds);
+      std::normal_distribution<double> normal(0.0, 1.0);
+      Eigen::MatrixXd coefficients;
+      if (draw_coefficients) {
+        coefficients = kept_coefficients;
+        for (Eigen::Index j = 0; j < functions; ++j)
+          for (Eigen::Index i = 0; i < n_rows; ++i) coefficients(i, j) += row_sigma[i] * normal(rng);
+      } else {
+        Eigen::MatrixXd replicate(n_rows, columns);
+        for (Eigen::Index j = 0; j < columns; ++j)
+          for (Eigen::Index i = 0; i < n_rows; ++i)
+            replicate(i, j) = estimate.fitted(i, j) + sigma(i, j) * normal(rng);
+        coefficients = replicate * q;
+      }
+      pv[static_cast<std::size_t>(b)] =
+          FromCoefficients(std::move(coefficients), row_sigma, q, options).fitted_pv;
+    }
+  });
   double sum = 0.0;
   double sum_squares = 0.0;
-  Eigen::MatrixXd replicate(n_rows, columns);
-  for (int b = 0; b < options.replicates; ++b) {
-    for (int j = 0; j < columns; ++j)
-      for (int i = 0; i < n_rows; ++i) replicate(i, j) = estimate.fitted(i, j) + sigma(i, j) * normal(rng);
-    const double pv = Fit(replicate, row_sigma, q, options, false).fitted_pv;
-    sum += pv;
-    sum_squares += pv * pv;
+  for (const double x : pv) {
+    sum += x;
+    sum_squares += x * x;
   }
   const double n = options.replicates;
   const double mean = sum / n;

@@ -209,12 +209,7 @@ std::string SummaryJson(const RunRecord& record, const processing::ProcessedScan
   s[key::kSpindleRpmSigma] = processed.speed.available ? json(processed.speed.sigma_rpm) : json(nullptr);
   s[key::kSpindleRpmFitted] = processed.speed.available ? json(processed.speed.fitted_rpm) : json(nullptr);
   s[key::kNoiseSigmaUm] = processed.noise_sigma_mm * 1000.0;
-  std::vector<double> point_sigmas;
-  for (const auto& section : map.sections)
-    point_sigmas.insert(point_sigmas.end(), section.sigma_mm.begin(), section.sigma_mm.end());
-  std::sort(point_sigmas.begin(), point_sigmas.end());
-  s[key::kMapSigmaUm] =
-      point_sigmas.empty() ? json(nullptr) : json(point_sigmas[point_sigmas.size() / 2] * 1000.0);
+  s[key::kMapSigmaUm] = map.map_sigma_mm > 0.0 ? json(map.map_sigma_mm * 1000.0) : json(nullptr);
   s[key::kMeanArcRadiusMm] = fit.mean_arc_radius_mm;
   s[key::kMeanArcRadiusSigmaMm] = fit.mean_arc_radius_sigma_mm;
   s[key::kArcRadiusRangeMm] = fit.arc_radius_range_mm;

@@ -9,6 +9,7 @@
 #include <cstdint>
 #include <limits>
 #include <numeric>
+#include <ranges>
 #include <vector>
 
 #include "core/check.h"
@@ -156,6 +157,10 @@ struct Run {
   std::uint8_t gap_before = 1, gap_after = 1;
 };
 
+// The runs of a scan in scan order, as the two workers collected them (not joined: at 1e8
+// samples a copy would add some 36 MB to the peak).
+using RunParts = std::array<std::vector<Run>, kWorkers>;
+
 // The runs of samples [begin, end), in scan order.
 template <typename T>
 void CollectRuns(std::span<const T> rho, const processing::HelixGeometry& geometry, std::size_t begin,
@@ -188,11 +193,58 @@ void CollectRuns(std::span<const T> rho, const processing::HelixGeometry& geomet
   flush();
 }
 
+// The same for a scan whose phase and axial position follow from its settings alone (linear in
+// the sample index), where a node's stretch of samples on a turn is found from the phase instead
+// of sample by sample: its end by the phase of the node's upper edge, checked against Locate on
+// either side, so that every sample falls in the run CollectRuns gives it. Each run's centroid is
+// then its samples' mean index; the readings are summed in the same order. A few times faster at
+// many samples per node and turn (133 at the 400 kHz of the 1e8 benchmark).
+template <typename T>
+void CollectRunsOfLinearScan(std::span<const T> rho, const processing::HelixGeometry& geometry,
+                             std::size_t begin, std::size_t end, const NodeLocator& locate,
+                             std::vector<Run>& runs) {
+  const double start_phase = geometry.PhaseAtIndex(0.0);
+  const double phase_step = geometry.PhaseAtIndex(1.0) - start_phase;
+  const auto node_at = [&](std::size_t i) {
+    return locate.Locate(geometry.PhaseAtIndex(static_cast<double>(i)));
+  };
+  std::size_t i = begin;
+  while (i < end) {
+    const double phase = geometry.PhaseAtIndex(static_cast<double>(i));
+    const NodeOf at = locate.Locate(phase);
+    const double centre = phase - at.offset_deg;  // the node's centre on this turn, unwrapped
+    // First sample past the node's upper edge, then moved to where Locate says the node ends.
+    const double past = std::ceil((centre + 0.5 * locate.step_deg() - start_phase) / phase_step);
+    std::size_t stop = i + 1;
+    if (past > static_cast<double>(stop))
+      stop = past >= static_cast<double>(end) ? end : static_cast<std::size_t>(past);
+    while (stop > i + 1 && node_at(stop - 1).node != at.node) --stop;
+    while (stop < end && node_at(stop).node == at.node) ++stop;
+    double sum_rho = 0.0, sum_index = 0.0;
+    std::uint32_t count = 0;
+    for (std::size_t k = i; k < stop; ++k) {
+      const auto value = static_cast<double>(rho[k]);
+      if (!std::isfinite(value)) continue;
+      sum_rho += value;
+      sum_index += static_cast<double>(k);
+      ++count;
+    }
+    if (count > 0) {
+      const double n = count;
+      const double mean_index = sum_index / n;
+      runs.push_back({sum_rho / n, geometry.AxialAtIndex(mean_index),
+                      geometry.PhaseAtIndex(mean_index) - centre, static_cast<std::uint32_t>(at.node), count,
+                      1, 1});
+    }
+    i = stop;
+  }
+}
+
 // Every run of the scan on two workers, halves meeting where the node changes; then the gaps in
 // each node's turns on either side of each run (in pitches).
 template <typename T>
-std::vector<Run> Runs(std::span<const T> rho, const processing::HelixGeometry& geometry,
-                      const NodeLocator& locate, std::size_t n_phase, double pitch_mm) {
+RunParts Runs(std::span<const T> rho, const processing::HelixGeometry& geometry, const NodeLocator& locate,
+              std::size_t n_phase, double pitch_mm) {
   ThrowIfInterrupted();
   const std::size_t n = rho.size();
   const auto boundary = [&](std::size_t b) {
@@ -205,15 +257,21 @@ std::vector<Run> Runs(std::span<const T> rho, const processing::HelixGeometry& g
   const double turns = n > 1 ? std::abs(geometry.PhaseAt(n - 1) - geometry.PhaseAt(0)) / 360.0 : 1.0;
   const auto expected =
       static_cast<std::size_t>((turns + 2.0) * static_cast<double>(n_phase) * 1.02 / kWorkers);
-  std::array<std::vector<Run>, kWorkers> parts;
+  // Fewer samples than nodes a turn: CollectRuns, whose runs then split by the phase's jumps.
+  const bool linear = geometry.from_settings() && n > 1 &&
+                      std::abs(geometry.PhaseAtIndex(1.0) - geometry.PhaseAtIndex(0.0)) < locate.step_deg() &&
+                      geometry.PhaseAtIndex(1.0) > geometry.PhaseAtIndex(0.0);
+  RunParts parts;
   RunOnWorkers(kWorkers, [&](int worker) {
     const auto w = static_cast<std::size_t>(worker);
     parts[w].reserve(std::min(expected, n));
-    CollectRuns(rho, geometry, boundary(n * w / kWorkers), boundary(n * (w + 1) / kWorkers), locate,
-                parts[w]);
+    const std::size_t from = boundary(n * w / kWorkers), to = boundary(n * (w + 1) / kWorkers);
+    if (linear) {
+      CollectRunsOfLinearScan(rho, geometry, from, to, locate, parts[w]);
+    } else {
+      CollectRuns(rho, geometry, from, to, locate, parts[w]);
+    }
   });
-  std::vector<Run> runs = std::move(parts[0]);
-  for (int w = 1; w < kWorkers; ++w) runs.insert(runs.end(), parts[w].begin(), parts[w].end());
   // The turns each node lost between its runs (a dropout, a burst of spikes), for RunWeight.
   const auto gap = [pitch_mm](double from, double to) -> std::uint8_t {
     if (!std::isfinite(from)) return 1;
@@ -221,16 +279,20 @@ std::vector<Run> Runs(std::span<const T> rho, const processing::HelixGeometry& g
     return pitches >= 1.0 && pitches <= kMaxGapPitches ? static_cast<std::uint8_t>(pitches) : 1;
   };
   std::vector<double> neighbour_y(n_phase, kNaN);
-  for (Run& r : runs) {
-    r.gap_before = gap(neighbour_y[r.node], r.y_mm);
-    neighbour_y[r.node] = r.y_mm;
+  for (std::vector<Run>& part : parts) {
+    for (Run& r : part) {
+      r.gap_before = gap(neighbour_y[r.node], r.y_mm);
+      neighbour_y[r.node] = r.y_mm;
+    }
   }
   neighbour_y.assign(n_phase, kNaN);
-  for (auto r = runs.rbegin(); r != runs.rend(); ++r) {
-    r->gap_after = gap(neighbour_y[r->node], r->y_mm);
-    neighbour_y[r->node] = r->y_mm;
+  for (auto part = parts.rbegin(); part != parts.rend(); ++part) {
+    for (auto r = part->rbegin(); r != part->rend(); ++r) {
+      r->gap_after = gap(neighbour_y[r->node], r->y_mm);
+      neighbour_y[r->node] = r->y_mm;
+    }
   }
-  return runs;
+  return parts;
 }
 
 // A run's weight: its band weight, plus the share of each turn its node lost next to it that
@@ -253,12 +315,12 @@ double RunWeight(const Run& run, const PassSetup& pass) {
 
 // One pass of the fit over the runs (Kasa or Gauss-Newton, as `pass` says). A run weighs
 // RunWeight; its centroid's variance is sigma^2 / samples.
-void AccumulateRuns(const std::vector<Run>& runs, const PassSetup& pass, const processing::WheelMap& map,
+void AccumulateRuns(const RunParts& parts, const PassSetup& pass, const processing::WheelMap& map,
                     std::vector<NodeSums>& sums, CellSums* cells) {
   const std::size_t n_y = map.n_y();
   const double map_y0 = map.y_mm.front();
   const double map_inv_step = n_y > 1 ? 1.0 / (map.y_mm[1] - map.y_mm[0]) : 0.0;
-  for (const Run& run : runs) {
+  for (const Run& run : parts | std::views::join) {
     const double y = run.y_mm;
     const double v =
         pass.slope != nullptr ? run.rho_mm - run.offset_deg * pass.slope->At(run.node, y) : run.rho_mm;
@@ -546,7 +608,7 @@ WheelFit FitToSamples(std::span<const T> rho, const processing::HelixGeometry& g
                                                                                           : pass.taper_mm;
   pass.band_center_mm = 0.5 * (y_low + y_high);
   const std::size_t n_phase = map.n_phase();
-  const std::vector<Run> runs = Runs(rho, geometry, locate, n_phase, pass.taper_mm);
+  const RunParts runs = Runs(rho, geometry, locate, n_phase, pass.taper_mm);
   ThrowIfInterrupted();
 
   std::vector<NodeSums> sums(n_phase);

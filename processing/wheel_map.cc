@@ -80,6 +80,17 @@ void SetSectionSigmas(const HelixSpline& spline, double noise_sigma_mm, std::vec
 // even a penalised spline swings by many sigmas: left in, they set the peak-to-valley metrics
 // (max arc error 2-4 um above truth on a scan with 1 % spikes). The median point rests on the
 // full sample density, so the cut follows the scan's own sampling.
+// The median of every section point's sigma (the element at half the count, as a sort would
+// place it); 0 when there is no point.
+double MedianPointSigma(const std::vector<Section>& sections) {
+  std::vector<double> sigmas;
+  for (const Section& s : sections) sigmas.insert(sigmas.end(), s.sigma_mm.begin(), s.sigma_mm.end());
+  if (sigmas.empty()) return 0.0;
+  const auto middle = sigmas.begin() + static_cast<long>(sigmas.size() / 2);
+  std::nth_element(sigmas.begin(), middle, sigmas.end());
+  return *middle;
+}
+
 void DropImpreciseSectionPoints(std::vector<Section>& sections, double ratio) {
   std::vector<double> sigmas;
   for (const Section& s : sections) sigmas.insert(sigmas.end(), s.sigma_mm.begin(), s.sigma_mm.end());
@@ -367,6 +378,7 @@ WheelMap Build(std::span<const T> rho, const HelixGeometry& geometry, double noi
   spline->ReleaseValues();  // the sections were their last use
   SetSectionSigmas(*spline, noise_sigma_mm, map.sections);
   DropImpreciseSectionPoints(map.sections, options.max_sigma_ratio);
+  map.map_sigma_mm = MedianPointSigma(map.sections);
   double y_low = -std::numeric_limits<double>::infinity();
   double y_high = std::numeric_limits<double>::infinity();
   for (const Section& s : map.sections) {

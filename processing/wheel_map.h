@@ -43,6 +43,9 @@ struct WheelMap {
   std::vector<int> despiked_count;  // despiked samples per cell
   std::vector<Section> sections;    // [n_phase]
   double noise_sigma_mm = 0.0;      // per-sample noise used for the sigmas
+  // The typical 1-sigma of a section point: the median over every section's points
+  // (summary.json's map_sigma_um); 0 when there is none. Kept when the sections are let go.
+  double map_sigma_mm = 0.0;
   double knot_step_deg = 0.0;
   double axial_step_mm = 0.0;
   double pitch_mm = 0.0;

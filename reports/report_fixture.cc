@@ -92,10 +92,8 @@ processing::ProcessedScan FixtureScan(const FixtureOptions& options) {
       if (IsDespiked(map.phase_deg[i], map.y_mm[j])) map.despiked_count[k] = 1;
     }
   }
-  // Every map value has a 1-sigma of 0.05 um, so the median the writer records is 0.05 um.
-  processing::Section section;
-  section.sigma_mm = {0.05e-3};
-  map.sections.assign(options.n_phase, section);
+  // Every map value has a 1-sigma of 0.05 um: the median the writer records.
+  map.map_sigma_mm = 0.05e-3;
   return scan;
 }
 

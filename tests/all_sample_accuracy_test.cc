@@ -305,6 +305,39 @@ TEST_F(AllSampleAccuracy, WheelModelArcRadiusErrorIsWithinItsOwnSigma) {
   EXPECT_LE(z_rms, 1.2);
 }
 
+// The runs of a scan whose phase and axial position follow from its settings are found from the
+// phase (CollectRunsOfLinearScan), those of any other scan sample by sample: the same scan with a
+// time column takes the second way, and every per-phase fit agrees with the first to rounding.
+TEST(SampleFitRuns, ALinearScanGivesTheFitsOfTheSampleBySamplePath) {
+  const WheelModel wheel = acquisition::PaperTestWheel();
+  std::vector<fitting::WheelFit> fits;
+  for (const bool time_column : {false, true}) {
+    ScanSettings settings = acquisition::PaperTestScan(3);
+    settings.spindle_rpm_true = 501.0;
+    settings.start_phase_deg = 123.4;
+    settings.write_time = time_column;
+    acquisition::SimulatedScan simulated = acquisition::SimulateScan(wheel, settings);
+    workflows::ProcessPipelineOptions options;
+    options.no_model = true;
+    options.no_uncertainty = true;
+    options.rpm_source = "nominal";  // the same phase whichever columns the scan has
+    Progress progress(false);
+    fits.push_back(workflows::RunProcessPipeline(std::move(simulated.scan), "", "", options, progress).fit);
+  }
+  ASSERT_EQ(fits[0].phases.size(), fits[1].phases.size());
+  for (std::size_t j = 0; j < fits[0].phases.size(); ++j) {
+    const fitting::PhaseFit& a = fits[0].phases[j];
+    const fitting::PhaseFit& b = fits[1].phases[j];
+    ASSERT_EQ(a.points, b.points) << "phase " << j;
+    EXPECT_NEAR(a.arc_radius_mm, b.arc_radius_mm, 1e-9 * a.arc_radius_sigma_mm) << "phase " << j;
+    EXPECT_NEAR(a.center_axial_mm, b.center_axial_mm, 1e-9 * a.center_axial_sigma_mm) << "phase " << j;
+    EXPECT_NEAR(a.arc_radius_sigma_mm, b.arc_radius_sigma_mm, 1e-9 * a.arc_radius_sigma_mm) << "phase " << j;
+  }
+  EXPECT_NEAR(fits[0].mean_arc_radius_mm, fits[1].mean_arc_radius_mm,
+              1e-9 * fits[0].mean_arc_radius_sigma_mm);
+  EXPECT_NEAR(fits[0].max_runout_um, fits[1].max_runout_um, 1e-9);
+}
+
 INSTANTIATE_TEST_SUITE_P(PaperWheel, AllSampleAccuracy,
                          ::testing::Values(Scenario{"Nominal500Rpm", 500.0, false},
                                            Scenario{"Fast501RpmSpeedEstimated", 501.0, false},

@@ -88,9 +88,9 @@ TEST(Cli, ProcessTimingsListEveryStageAndSumThem) {
                                              "sections and map",
                                              "coverage counts",
                                              "per-phase fits",
-                                             "uncertainty",
                                              "wheel model",
                                              "releasing the samples",
+                                             "uncertainty",
                                              "waiting for the SHA-256",
                                              "writing"};
   EXPECT_EQ(stages, expected) << run.output;

@@ -106,7 +106,7 @@ void ParseChoice(const char* flag, const std::string& text, const char* choices,
 // The headline figures' uncertainty from the per-phase fits and the map (before the spline goes:
 // nothing here reads it, but the map must still hold every node).
 uncertainty::WheelUncertainty EvaluateUncertainty(const ProcessPipelineOptions& options,
-                                                  const acquisition::Scan& scan,
+                                                  const acquisition::ScanMetadata& metadata,
                                                   const processing::ProcessedScan& processed,
                                                   const fitting::WheelFit& fit) {
   const processing::WheelMap& map = processed.map;
@@ -120,12 +120,6 @@ uncertainty::WheelUncertainty EvaluateUncertainty(const ProcessPipelineOptions& 
     radial.push_back(phase.center_radial_mm);
     usable.push_back(phase.usable ? 1 : 0);
   }
-  // The typical 1-sigma of a map value: the median over the sections' points (summary.json's
-  // map_sigma_um).
-  std::vector<double> point_sigmas;
-  for (const auto& section : map.sections)
-    point_sigmas.insert(point_sigmas.end(), section.sigma_mm.begin(), section.sigma_mm.end());
-  std::sort(point_sigmas.begin(), point_sigmas.end());
   const uncertainty::WheelObservations observations{
       .mean_arc_radius_mm = fit.mean_arc_radius_mm,
       .mean_arc_radius_sigma_mm = fit.mean_arc_radius_sigma_mm,
@@ -143,7 +137,7 @@ uncertainty::WheelUncertainty EvaluateUncertainty(const ProcessPipelineOptions& 
       .usable = usable,
       .rho_mm = map.rho_mm,
       .y_mm = map.y_mm,
-      .map_sigma_mm = point_sigmas.empty() ? 0.0 : point_sigmas[point_sigmas.size() / 2],
+      .map_sigma_mm = map.map_sigma_mm,  // summary.json's map_sigma_um
       .band_low_mm = fit.band_low_mm,
       .band_high_mm = fit.band_high_mm};
   uncertainty::WheelUncertainty result;
@@ -152,7 +146,7 @@ uncertainty::WheelUncertainty EvaluateUncertainty(const ProcessPipelineOptions& 
         uncertainty::EvaluateWheelUncertainty(observations, *options.uncertainty_budget, options.uncertainty);
     result.budget_source = options.uncertainty_budget_path;
   } else {
-    const double diameter = scan.metadata.wheel_diameter_mm.value_or(400.0);
+    const double diameter = metadata.wheel_diameter_mm.value_or(400.0);
     const uncertainty::BudgetFile budget = uncertainty::DefaultBudget(
         {.arc_radius_mm = fit.mean_arc_radius_mm,
          .band_half_width_mm = std::min(options.fit.band_half_width_mm, 0.9 * fit.mean_arc_radius_mm),
@@ -187,20 +181,23 @@ ProcessPipelineResult RunOnScan(acquisition::Scan scan, const std::string& scan_
   // The fits are of the samples (fitting/sample_fit.h): the helix spline (23 MB at 1e8 samples)
   // is not read again.
   result.processed.map.spline.reset();
+  // Nor are the sections (24 MB at 1e8 samples); their typical sigma stays (map.map_sigma_mm).
+  std::vector<processing::Section>().swap(result.processed.map.sections);
   result.fit = acquisition::VisitReadings(scan, [&](const auto& rho) {
     return fitting::FitWheelToSamples(std::span(rho),
                                       processing::HelixGeometry(scan, result.processed.rpm_used),
                                       result.processed.map, options.fit);
   });
-  if (!options.no_uncertainty) {
-    clock.Start("uncertainty");
-    result.uncertainty = EvaluateUncertainty(options, scan, result.processed, result.fit);
-    if (options.tolerances) DecideTolerances(*options.tolerances, *result.uncertainty);
-  }
   clock.Start("wheel model");
   result.model = FitModelUnlessOff(options, scan, result.processed, result.fit);
   clock.Start("releasing the samples");
-  scan = {};  // the samples are no longer needed
+  const acquisition::ScanMetadata metadata = scan.metadata;
+  scan = {};  // the samples are no longer needed: the uncertainty's bootstrap works on the map
+  if (!options.no_uncertainty) {
+    clock.Start("uncertainty");
+    result.uncertainty = EvaluateUncertainty(options, metadata, result.processed, result.fit);
+    if (options.tolerances) DecideTolerances(*options.tolerances, *result.uncertainty);
+  }
   progress.Update("writing", 0.9);
   clock.Start("waiting for the SHA-256");
   result.record.input_sha256 = sha256.get();

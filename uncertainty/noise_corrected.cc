@@ -165,13 +165,41 @@ double LargestRowPv(const Eigen::MatrixXd& coefficients, const Eigen::MatrixXd& 
   return pv;
 }
 
+// Rows that are neighbours along a smooth coordinate (the map's axial nodes, the sections'
+// phases): each kept order's coefficients are fitted along the rows with the across-rows basis
+// (Legendre polynomials of the row index, or harmonics over a turn of rows), each of its functions
+// kept when it lowers the chi-square of the order's functions by more than noise would in three
+// standard deviations (the rows' mean always), so that each row's coefficient carries the noise of
+// a few parameters instead of its own.
+void SmoothAcrossRows(Eigen::MatrixXd& coefficients, const Eigen::VectorXd& row_sigma,
+                      const Selection& selection, const NoiseCorrectedPvOptions& options) {
+  const int degree = options.across_rows_max_degree;
+  const auto rows = static_cast<int>(coefficients.rows());
+  if (degree < 0 || rows < Functions(options.across_rows_basis, degree) + 1) return;
+  const Eigen::MatrixXd along = OrthonormalBasis(options.across_rows_basis, degree, rows);
+  const double noise = row_sigma.squaredNorm() / rows;  // a coefficient's noise variance, on average
+  for (int order = 0; order <= options.max_order; ++order) {
+    const auto [first, count] = Group(options.basis, order);
+    if (std::find(selection.kept.begin(), selection.kept.end(), first) == selection.kept.end()) continue;
+    const Eigen::MatrixXd a = along.transpose() * coefficients.middleCols(first, count);  // degrees x count
+    Eigen::MatrixXd smooth = Eigen::MatrixXd::Zero(rows, count);
+    for (Eigen::Index d = 0; d < along.cols(); ++d) {
+      const double drop = a.row(d).squaredNorm() / noise;
+      if (d > 0 && drop <= count + 3.0 * std::sqrt(2.0 * count)) continue;
+      smooth += along.col(d) * a.row(d);
+    }
+    coefficients.middleCols(first, count) = smooth;
+  }
+}
+
 // The estimate from the rows' raw coefficients on the basis (data times q): shrunk, orders
-// chosen, the PV of the shown orders.
+// chosen, smoothed across the rows when asked, the PV of the shown orders.
 Estimate FromCoefficients(Eigen::MatrixXd coefficients, const Eigen::VectorXd& row_sigma,
                           const Eigen::MatrixXd& q, const NoiseCorrectedPvOptions& options,
                           Eigen::MatrixXd* kept_coefficients = nullptr) {
   ShrinkRows(coefficients, row_sigma, options);
   const Selection selection = SelectOrders(coefficients, row_sigma, options);
+  SmoothAcrossRows(coefficients, row_sigma, selection, options);
   Estimate estimate;
   estimate.order = selection.order;
   estimate.fitted_pv = LargestRowPv(coefficients, q, selection.shown);

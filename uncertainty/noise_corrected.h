@@ -44,6 +44,12 @@ struct NoiseCorrectedPvOptions {
   // Shrink each coefficient towards its mean over the rows by the share of its spread that the
   // noise explains: for rows that share one shape (the sections' profile error).
   bool shrink_rows = false;
+  // Fit each kept order's coefficients along the rows too (the rows are neighbours along a smooth
+  // coordinate, in order), with `across_rows_basis` up to this order or degree, each of its
+  // functions kept when it lowers the chi-square by more than noise would in three standard
+  // deviations; -1: off, each row fitted on its own.
+  int across_rows_max_degree = -1;
+  SmoothBasis across_rows_basis = SmoothBasis::kLegendre;
   // Scale the sigmas to the scatter of the values about the fit (see above).
   bool sigmas_from_residuals = true;
   // Seed of the bootstrap's random numbers: the same inputs give the same result.

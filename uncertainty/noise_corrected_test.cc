@@ -23,7 +23,7 @@ struct Trial {
 
 // `rows` rows over 360 phases: row r = amplitude * (1 + 0.1 r) * cos(order * c) + noise `sigma`;
 // the true PV is the largest row's 2 * amplitude * (1 + 0.1 (rows - 1)) (cos hits +-1 at the nodes).
-Trial FourierTrial(int rows, int order, double amplitude, double sigma, unsigned seed) {
+Trial FourierTrial(int rows, int order, double amplitude, double sigma, unsigned seed, int across_rows = -1) {
   std::mt19937 rng(seed);
   std::normal_distribution<double> noise(0.0, sigma);
   const int columns = 360;
@@ -33,9 +33,34 @@ Trial FourierTrial(int rows, int order, double amplitude, double sigma, unsigned
       values[r * columns + j] =
           amplitude * (1.0 + 0.1 * r) * std::cos(order * 2.0 * std::numbers::pi * j / columns) + noise(rng);
   const double truth = 2.0 * amplitude * (1.0 + 0.1 * (rows - 1));
-  const NoiseCorrectedPv pv = EstimateNoiseCorrectedPv(values, sigmas, rows, columns,
-                                                       {.max_order = 12, .replicates = 100, .seed = seed});
+  const NoiseCorrectedPv pv = EstimateNoiseCorrectedPv(
+      values, sigmas, rows, columns,
+      {.max_order = 12, .replicates = 100, .across_rows_max_degree = across_rows, .seed = seed});
   return {pv.raw_pv - truth, pv.value - truth, std::abs(pv.value - truth) <= 1.96 * pv.standard_uncertainty};
+}
+
+// Rows that are neighbours (a map's axial nodes): the third harmonic's amplitude grows linearly
+// from row to row, and the largest row's PV is the figure. Fitting the coefficients along the rows
+// (degree 1 is real, the rest noise) takes the maximum over rows of far less noise than each row on
+// its own: the estimate scatters less, keeps no bias, and its interval still covers the truth.
+TEST(EstimateNoiseCorrectedPv, AlongTheRowsAMaximumOverNeighbouringRowsScattersLessAndCovers) {
+  const int trials = 60;
+  double alone_ss = 0.0, along_ss = 0.0, along_bias = 0.0;
+  int covered = 0;
+  for (int t = 0; t < trials; ++t) {
+    const Trial alone = FourierTrial(40, 3, 0.5, 1.0, 500 + t);
+    const Trial along = FourierTrial(40, 3, 0.5, 1.0, 500 + t, 10);
+    alone_ss += alone.value_minus_truth * alone.value_minus_truth;
+    along_ss += along.value_minus_truth * along.value_minus_truth;
+    along_bias += along.value_minus_truth / trials;
+    covered += along.covered;
+  }
+  const double alone_rms = std::sqrt(alone_ss / trials), along_rms = std::sqrt(along_ss / trials);
+  EXPECT_LT(along_rms, 0.6 * alone_rms) << along_rms << " against " << alone_rms;
+  EXPECT_LT(std::abs(along_bias), 3.0 * along_rms / std::sqrt(trials));
+  // 95 % nominal; 60 trials: binomial sd 2.8 %, bounds at about 3 sd.
+  EXPECT_GE(covered, 0.86 * trials);
+  EXPECT_LE(covered, trials);
 }
 
 TEST(EstimateNoiseCorrectedPv, RemovesTheNoiseBiasOfARangeAndCoversTheTruth) {

@@ -110,6 +110,8 @@ WheelUncertainty EvaluateWheelUncertainty(const WheelObservations& o, const Budg
     for (std::size_t i = 0; i < band.size(); ++i)
       for (std::size_t p = 0; p < n_phase; ++p) rows[i * n_phase + p] = o.rho_mm[p * n_y + band[i]] * 1000.0;
     NoiseCorrectedPvOptions turn = series;
+    // The rows are the band's axial nodes in order: each harmonic varies smoothly along them.
+    turn.across_rows_max_degree = std::min(options.max_degree, static_cast<int>(band.size()) - 2);
     turn.seed = options.seed + 2;
     runout = EstimateNoiseCorrectedPv(rows, sigmas, static_cast<int>(band.size()), phases, turn);
     turn.pv_from_order = std::min(2, turn.max_order);
@@ -133,7 +135,10 @@ WheelUncertainty EvaluateWheelUncertainty(const WheelObservations& o, const Budg
           .max_order = FitOrder(SmoothBasis::kLegendre, options.max_degree, columns),
           .pv_from_order = 0,
           .replicates = options.replicates,
-          .shrink_rows = true,
+          // The rows are the phases, over a full turn: each degree's coefficient varies smoothly
+          // with the phase (the arc centre's and radius's harmonics move the residual's shape).
+          .across_rows_max_degree = FitOrder(SmoothBasis::kFourier, options.max_harmonic, phases),
+          .across_rows_basis = SmoothBasis::kFourier,
           .seed = options.seed + 4};
       arc_error = EstimateNoiseCorrectedPv(residuals, residual_sigmas, phases, columns, across);
     }

@@ -9,7 +9,6 @@
 #include <cstdint>
 #include <limits>
 #include <numeric>
-#include <ranges>
 #include <vector>
 
 #include "core/check.h"
@@ -320,83 +319,86 @@ void AccumulateRuns(const RunParts& parts, const PassSetup& pass, const processi
   const std::size_t n_y = map.n_y();
   const double map_y0 = map.y_mm.front();
   const double map_inv_step = n_y > 1 ? 1.0 / (map.y_mm[1] - map.y_mm[0]) : 0.0;
-  for (const Run& run : parts | std::views::join) {
-    const double y = run.y_mm;
-    const double v =
-        pass.slope != nullptr ? run.rho_mm - run.offset_deg * pass.slope->At(run.node, y) : run.rho_mm;
-    const bool in_band = pass.full || std::abs(y - pass.band_center_mm) <= pass.band_half_mm;
-    const double w = RunWeight(run, pass);
-    const double samples = run.samples;
-    NodeSums& s = sums[run.node];
-    // A run just outside the band weighs in when it bridges a turn lost inside it (RunWeight);
-    // the band's statistics (counts, extent, residual extremes) are of the runs inside it.
-    const bool weighted = w > 0.0;
-    if (pass.kind == PassSetup::Kind::kKasa) {
-      if (!weighted) continue;
-      const double x = y - pass.band_center_mm;
-      const double q = x * x + v * v;
-      // w [x, v, 1] outer [x, v, 1]: 0 xx, 1 xv, 2 x1, 3 vv, 4 v1, 5 11.
-      s.jtj[0] += w * x * x;
-      s.jtj[1] += w * x * v;
-      s.jtj[2] += w * x;
-      s.jtj[3] += w * v * v;
-      s.jtj[4] += w * v;
-      s.jtj[5] += w;
-      s.kasa_w[0] += w * x * q;
-      s.kasa_w[1] += w * v * q;
-      s.kasa_w[2] += w * q;
+  // The parts one after the other (not std::views::join: clang 14 with libstdc++ 12 refuses it).
+  for (const std::vector<Run>& part : parts) {
+    for (const Run& run : part) {
+      const double y = run.y_mm;
+      const double v =
+          pass.slope != nullptr ? run.rho_mm - run.offset_deg * pass.slope->At(run.node, y) : run.rho_mm;
+      const bool in_band = pass.full || std::abs(y - pass.band_center_mm) <= pass.band_half_mm;
+      const double w = RunWeight(run, pass);
+      const double samples = run.samples;
+      NodeSums& s = sums[run.node];
+      // A run just outside the band weighs in when it bridges a turn lost inside it (RunWeight);
+      // the band's statistics (counts, extent, residual extremes) are of the runs inside it.
+      const bool weighted = w > 0.0;
+      if (pass.kind == PassSetup::Kind::kKasa) {
+        if (!weighted) continue;
+        const double x = y - pass.band_center_mm;
+        const double q = x * x + v * v;
+        // w [x, v, 1] outer [x, v, 1]: 0 xx, 1 xv, 2 x1, 3 vv, 4 v1, 5 11.
+        s.jtj[0] += w * x * x;
+        s.jtj[1] += w * x * v;
+        s.jtj[2] += w * x;
+        s.jtj[3] += w * v * v;
+        s.jtj[4] += w * v;
+        s.jtj[5] += w;
+        s.kasa_w[0] += w * x * q;
+        s.kasa_w[1] += w * v * q;
+        s.kasa_w[2] += w * q;
+        if (in_band) {
+          s.count += samples;
+          s.runs += 1.0;
+          s.y_min = std::min(s.y_min, y);
+          s.y_max = std::max(s.y_max, y);
+        }
+        continue;
+      }
+      const Circle& c = (*pass.circles)[run.node];
+      if (!c.valid) continue;
+      const double dy = y - c.a;
+      const double dv = v - c.b;
+      const double d = std::sqrt(dy * dy + dv * dv);
+      const double e = d - c.r;
+      if (weighted) {
+        const double inv = 1.0 / d;
+        const double j0 = -dy * inv, j1 = -dv * inv;  // d e / d(a, b); d e / d r = -1
+        const double w0 = w * j0, w1 = w * j1;
+        s.jtj[0] += w0 * j0;
+        s.jtj[1] += w0 * j1;
+        s.jtj[2] -= w0;
+        s.jtj[3] += w1 * j1;
+        s.jtj[4] -= w1;
+        s.jtj[5] += w;
+        s.jte[0] += w0 * e;
+        s.jte[1] += w1 * e;
+        s.jte[2] -= w * e;
+        // The centroid's variance is sigma^2 / samples: J^T W (sigma^2 / n) W J.
+        const double ww = w * w / samples;
+        s.jtwwj[0] += ww * j0 * j0;
+        s.jtwwj[1] += ww * j0 * j1;
+        s.jtwwj[2] -= ww * j0;
+        s.jtwwj[3] += ww * j1 * j1;
+        s.jtwwj[4] -= ww * j1;
+        s.jtwwj[5] += ww;
+      }
       if (in_band) {
+        s.ee += samples * e * e;
         s.count += samples;
         s.runs += 1.0;
         s.y_min = std::min(s.y_min, y);
         s.y_max = std::max(s.y_max, y);
+        s.e_min = std::min(s.e_min, e);
+        s.e_max = std::max(s.e_max, e);
       }
-      continue;
-    }
-    const Circle& c = (*pass.circles)[run.node];
-    if (!c.valid) continue;
-    const double dy = y - c.a;
-    const double dv = v - c.b;
-    const double d = std::sqrt(dy * dy + dv * dv);
-    const double e = d - c.r;
-    if (weighted) {
-      const double inv = 1.0 / d;
-      const double j0 = -dy * inv, j1 = -dv * inv;  // d e / d(a, b); d e / d r = -1
-      const double w0 = w * j0, w1 = w * j1;
-      s.jtj[0] += w0 * j0;
-      s.jtj[1] += w0 * j1;
-      s.jtj[2] -= w0;
-      s.jtj[3] += w1 * j1;
-      s.jtj[4] -= w1;
-      s.jtj[5] += w;
-      s.jte[0] += w0 * e;
-      s.jte[1] += w1 * e;
-      s.jte[2] -= w * e;
-      // The centroid's variance is sigma^2 / samples: J^T W (sigma^2 / n) W J.
-      const double ww = w * w / samples;
-      s.jtwwj[0] += ww * j0 * j0;
-      s.jtwwj[1] += ww * j0 * j1;
-      s.jtwwj[2] -= ww * j0;
-      s.jtwwj[3] += ww * j1 * j1;
-      s.jtwwj[4] -= ww * j1;
-      s.jtwwj[5] += ww;
-    }
-    if (in_band) {
-      s.ee += samples * e * e;
-      s.count += samples;
-      s.runs += 1.0;
-      s.y_min = std::min(s.y_min, y);
-      s.y_max = std::max(s.y_max, y);
-      s.e_min = std::min(s.e_min, e);
-      s.e_max = std::max(s.e_max, e);
-    }
-    if (cells != nullptr) {
-      const double m = std::round((y - map_y0) * map_inv_step);
-      if (m >= 0.0 && m < static_cast<double>(n_y)) {
-        const std::size_t cell = run.node * n_y + static_cast<std::size_t>(m);
-        // The run's radial offset from the node's circle, measured along rho.
-        cells->residual[cell] += samples * (v - c.At(y));
-        cells->count[cell] += samples;
+      if (cells != nullptr) {
+        const double m = std::round((y - map_y0) * map_inv_step);
+        if (m >= 0.0 && m < static_cast<double>(n_y)) {
+          const std::size_t cell = run.node * n_y + static_cast<std::size_t>(m);
+          // The run's radial offset from the node's circle, measured along rho.
+          cells->residual[cell] += samples * (v - c.At(y));
+          cells->count[cell] += samples;
+        }
       }
     }
   }

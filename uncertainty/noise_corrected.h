@@ -10,10 +10,12 @@
 // whose functions lower the chi-square of all rows together by more than noise would in five
 // standard deviations (dof + 5 sqrt(2 dof), dof = rows x the order's functions), and takes the PV of the
 // fitted rows (the largest over the rows; with shrink_rows each coefficient is first shrunk towards its mean
-// over the rows by the share of its spread that noise explains). Orders are kept one by one, not as a nested
-// 0..K, so that a harmonic of noise alone between real ones does not ride on the fit: it would add to the PV
-// in first order. The bootstrap then draws `replicates` new data sets, the fitted rows plus normal noise of
-// each value's sigma, repeats the whole estimate (the choice of orders included) on each, and gives
+// over the rows by the share of its spread that noise explains; with across_rows_max_degree the kept orders'
+// coefficients are then fitted along the rows, for rows that are neighbours). Orders are kept one by one, not
+// as a nested 0..K, so that a harmonic of noise alone between real ones does not ride on the fit: it would
+// add to the PV in first order. The bootstrap then draws `replicates` new data sets, the fitted rows plus
+// normal noise of each value's sigma, repeats the whole estimate (the choice of orders included) on each, and
+// gives
 //   bias = mean(PV*) - PV(fit),   value = max(0, PV(fit) - bias),   u = standard deviation of PV*.
 // The noise is taken as independent from value to value; with sigmas_from_residuals its level
 // is the data's own: the sigmas are scaled by sqrt(chi-square / dof) of the fit (the Birge

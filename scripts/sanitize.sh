@@ -28,7 +28,9 @@ export UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
 # tests/same_results_test processes (SameResults.ShippedScan still runs). And the interrupted
 # batch of tests/batch_test (four 3e5-sample scans: 11 of the file's 31 s here under ASan, load 7;
 # the child's own unwinding on a signal runs in tests/fault_test, the batch's other cases run).
-# And the 120 paper-wheel scans of tests/all_sample_accuracy_test (the statistics over seeds;
-# every process run, tests/same_results_test's shipped scan among them, runs the same fits).
-export GTEST_FILTER="${GTEST_FILTER:--*N1e7*:*AllSampleAccuracy.*:SolveDwell.CutsTheResidualRmsTenfold*:SolveDwell.AMeasuredGaussian*:SpiralPath.CarriesADwell*:WheelModelStatistics.*:HistoryCommand.ReportsTheKnownWear*:WheelProfileModel.*:SameResults.SimulatedN1e6*:Batch.AnInterruptedBatch*}"
+# And the 300 paper-wheel scans of tests/all_sample_accuracy_test (the statistics over seeds;
+# every process run, tests/same_results_test's shipped scan among them, runs the same fits), and
+# the 24 scans of tests/uncertainty_coverage_test (42 s here, 2026-12-03; uncertainty/'s own tests
+# run the same estimators, and every process run the same budget).
+export GTEST_FILTER="${GTEST_FILTER:--*N1e7*:*AllSampleAccuracy.*:SolveDwell.CutsTheResidualRmsTenfold*:SolveDwell.AMeasuredGaussian*:SpiralPath.CarriesADwell*:WheelModelStatistics.*:HistoryCommand.ReportsTheKnownWear*:WheelProfileModel.*:SameResults.SimulatedN1e6*:Batch.AnInterruptedBatch*:UncertaintyCoverage.*}"
 ctest --preset asan --parallel "$(nproc)" "$@"

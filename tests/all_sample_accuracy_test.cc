@@ -237,6 +237,7 @@ TEST_P(AllSampleAccuracy, PerPhaseFitsMatchTheReferenceAndTheMeanIsUnbiasedWithH
     const ReferenceResult ref = Reference(simulated.scan, settings);
     workflows::ProcessPipelineOptions options;
     options.no_model = true;
+    options.no_uncertainty = true;  // the fits' own sigmas are what is tested here
     Progress progress(false);
     const workflows::ProcessPipelineResult result =
         workflows::RunProcessPipeline(std::move(simulated.scan), "", "", options, progress);
@@ -288,9 +289,11 @@ TEST_F(AllSampleAccuracy, WheelModelArcRadiusErrorIsWithinItsOwnSigma) {
     settings.start_phase_deg = 360.0 * unit(starts);
     settings.start_y_mm = -11.0 - 0.2 * unit(starts);
     acquisition::SimulatedScan simulated = acquisition::SimulateScan(*wheel_, settings);
+    workflows::ProcessPipelineOptions options;
+    options.no_uncertainty = true;  // the model's own sigmas are what is tested here
     Progress progress(false);
-    const workflows::ProcessPipelineResult result = workflows::RunProcessPipeline(
-        std::move(simulated.scan), "", "", workflows::ProcessPipelineOptions{}, progress);
+    const workflows::ProcessPipelineResult result =
+        workflows::RunProcessPipeline(std::move(simulated.scan), "", "", options, progress);
     ASSERT_TRUE(result.model.has_value()) << "seed " << seed;
     const fitting::WheelModel& model = *result.model;
     ASSERT_EQ(model.arc_radius_mm.size(), static_cast<std::size_t>(kPhases));

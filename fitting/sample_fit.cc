@@ -58,11 +58,20 @@ struct NodeSums {
   double e_max = -std::numeric_limits<double>::infinity();
 };
 
-// Residual sums of the map's cells: [node * n_y + axial node].
+// Residual sums of the map's cells: [node * n_y + axial node]; and of the sections' points: each
+// node's runs in the band, by axial bin [node * bins + bin].
 struct CellSums {
   std::vector<double> residual;
   std::vector<double> count;
+  std::size_t bins = 0;
+  double bin_low_mm = 0.0, bin_width_mm = 1.0;
+  std::vector<double> section_e, section_y, section_count;
 };
+
+// The most axial bins a section's points are gathered in (WheelFit::section_bins): one a pitch,
+// so that each holds one run a turn, unless the pitch is so fine that the arc error's bootstrap
+// would fit thousands of points a phase.
+constexpr std::size_t kMaxSectionBins = 100;
 
 // One node's slope along the phase (mm per degree) tabulated over the axial span.
 struct SlopeTable {
@@ -399,6 +408,14 @@ void AccumulateRuns(const RunParts& parts, const PassSetup& pass, const processi
           cells->residual[cell] += samples * (v - c.At(y));
           cells->count[cell] += samples;
         }
+        if (in_band && cells->bins > 0) {
+          const double x = std::max(0.0, (y - cells->bin_low_mm) / cells->bin_width_mm);
+          const std::size_t k =
+              run.node * cells->bins + std::min(cells->bins - 1, static_cast<std::size_t>(x));
+          cells->section_e[k] += samples * e;
+          cells->section_y[k] += samples * y;
+          cells->section_count[k] += samples;
+        }
       }
     }
   }
@@ -590,6 +607,22 @@ void SetMap(const std::vector<Circle>& circles, const CellSums& cells, processin
   }
 }
 
+// The sections' points from the last pass's bins: mean residual, position and its noise sigma.
+void SetSections(const CellSums& cells, double sigma_mm, WheelFit& out) {
+  out.section_bins = static_cast<int>(cells.bins);
+  const std::size_t n = cells.section_count.size();
+  out.section_residual_um.assign(n, kNaN);
+  out.section_y_mm.assign(n, kNaN);
+  out.section_sigma_um.assign(n, kNaN);
+  for (std::size_t k = 0; k < n; ++k) {
+    const double count = cells.section_count[k];
+    if (count <= 0.0) continue;
+    out.section_residual_um[k] = cells.section_e[k] / count * 1000.0;
+    out.section_y_mm[k] = cells.section_y[k] / count;
+    out.section_sigma_um[k] = sigma_mm * 1000.0 / std::sqrt(count);
+  }
+}
+
 template <typename T>
 WheelFit FitToSamples(std::span<const T> rho, const processing::HelixGeometry& geometry,
                       processing::WheelMap& map, const WheelFitOptions& options) {
@@ -632,6 +665,15 @@ WheelFit FitToSamples(std::span<const T> rho, const processing::HelixGeometry& g
     if (last) {
       cells.residual.assign(n_phase * map.n_y(), 0.0);
       cells.count.assign(n_phase * map.n_y(), 0.0);
+      const double low = full ? y_low : pass.band_center_mm - half;
+      const double width = full ? y_high - y_low : band_width;
+      cells.bins = std::clamp<std::size_t>(static_cast<std::size_t>(std::lround(width / pass.taper_mm)), 1,
+                                           kMaxSectionBins);
+      cells.bin_low_mm = low;
+      cells.bin_width_mm = width / static_cast<double>(cells.bins);
+      cells.section_e.assign(n_phase * cells.bins, 0.0);
+      cells.section_y.assign(n_phase * cells.bins, 0.0);
+      cells.section_count.assign(n_phase * cells.bins, 0.0);
     }
     AccumulateRuns(runs, pass, map, sums, last ? &cells : nullptr);
     // The map's cells and the residual extremes are those of the circles the last pass started
@@ -671,6 +713,7 @@ WheelFit FitToSamples(std::span<const T> rho, const processing::HelixGeometry& g
   }
   Summarise(circles, sums, band_width, full, map.noise_sigma_mm, options, out);
   SetMap(circles, cells, map);
+  SetSections(cells, map.noise_sigma_mm, out);
   SetMapMetrics(map, options, out);
   return out;
 }

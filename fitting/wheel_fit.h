@@ -54,6 +54,12 @@ struct WheelFit {
   std::vector<double> profile_u_mm, profile_error_um;
   // rho minus the mean wheel (circle of mean radius and centre), um, [n_phase * n_y].
   std::vector<double> form_error_um;
+  // The sections' points (the all-sample fit, fitting/sample_fit.h; empty from FitWheel): each
+  // phase's runs in the band, gathered in section_bins equal axial bins over it, [n_phase *
+  // section_bins]: their mean geometric residual against the phase's circle (um), mean axial
+  // position (mm) and the residual's 1-sigma from the noise (um); NaN where a bin holds no run.
+  int section_bins = 0;
+  std::vector<double> section_residual_um, section_y_mm, section_sigma_um;
   std::vector<std::string> warnings;
 };
 

@@ -5,14 +5,16 @@
 //
 // The truth of each figure is what the same pipeline finds on the same wheel scanned without
 // noise (for the mean arc radius too: with a profile error the least-squares circle over the band
-// is not the model's 55.4423 mm, by some 0.09 mm here). CI runs ARCWHEEL_COVERAGE_SCANS = 24 scans (default)
-// and checks coverage loosely; the full count, e.g.
+// is not the model's 55.4423 mm, by some 0.09 mm here), except the max arc error's: the wheel
+// model's own sections over the band (TrueMaxArcErrorUm), computed here without the pipeline. CI runs
+// ARCWHEEL_COVERAGE_SCANS = 24 scans (default) and checks coverage loosely; the full count, e.g.
 //   ARCWHEEL_COVERAGE_SCANS=200 build/tests/tests_uncertainty_coverage_test
 // prints the figures (docs/uncertainty.md quotes them) and checks 93-97 %.
 
 #include <fmt/core.h>
 #include <gtest/gtest.h>
 
+#include <Eigen/Dense>
 #include <cmath>
 #include <cstdlib>
 #include <map>
@@ -39,11 +41,42 @@ acquisition::WheelModel Wheel() {
   return wheel;
 }
 
-workflows::ProcessPipelineResult Scan(double noise_um, unsigned seed) {
+// The wheel's true max arc error over the band [-8, 8] mm (the mean arc centre is at 0): at each
+// whole degree, the section R(c, y) of the model on 1601 points, its geometric least-squares
+// circle by Gauss-Newton from the model's circle, and the PV of the residuals.
+double TrueMaxArcErrorUm(const acquisition::WheelModel& wheel) {
+  const int points = 1601;
+  double largest = 0.0;
+  for (int phase = 0; phase < 360; ++phase) {
+    Eigen::VectorXd y(points), rho(points);
+    for (int k = 0; k < points; ++k) {
+      y[k] = -8.0 + 16.0 * k / (points - 1);
+      rho[k] = wheel.SmoothRadiusMm(phase, y[k]);
+    }
+    Eigen::Vector3d circle(wheel.CenterAxialMm(phase), wheel.CenterDistanceMm(phase),
+                           wheel.ArcRadiusMm(phase));
+    Eigen::VectorXd e(points);
+    for (int iteration = 0; iteration < 20; ++iteration) {
+      Eigen::MatrixXd jacobian(points, 3);
+      for (int k = 0; k < points; ++k) {
+        const double dy = y[k] - circle[0], drho = rho[k] - circle[1];
+        const double d = std::hypot(dy, drho);
+        e[k] = d - circle[2];
+        jacobian.row(k) << -dy / d, -drho / d, -1.0;
+      }
+      circle -= jacobian.colPivHouseholderQr().solve(e);
+    }
+    largest = std::max(largest, (e.maxCoeff() - e.minCoeff()) * 1000.0);
+  }
+  return largest;
+}
+
+workflows::ProcessPipelineResult Scan(double noise_um, unsigned seed,
+                                      const acquisition::WheelModel& wheel = Wheel()) {
   acquisition::ScanSettings settings;
   settings.noise_um = noise_um;
   settings.seed = seed;
-  auto simulated = acquisition::SimulateScan(Wheel(), settings);
+  auto simulated = acquisition::SimulateScan(wheel, settings);
   workflows::ProcessPipelineOptions options;
   options.no_model = true;
   options.uncertainty_budget = uncertainty::BudgetFile{};  // type A only: nothing else is injected
@@ -56,6 +89,14 @@ int Scans() {
   return text ? std::max(1, std::atoi(text)) : 24;
 }
 
+// The first scan's seed (the scans take the next ones): 1000 unless ARCWHEEL_COVERAGE_FIRST_SEED
+// says otherwise, so that a check on other scans than those the estimators were tuned on is one
+// command (docs/uncertainty.md: 5000 for 300 scans).
+unsigned FirstSeed() {
+  const char* text = std::getenv("ARCWHEEL_COVERAGE_FIRST_SEED");
+  return text ? static_cast<unsigned>(std::max(0, std::atoi(text))) : 1000u;
+}
+
 TEST(UncertaintyCoverage, NinetyFivePercentIntervalsCoverTheTruth) {
   const std::vector<std::string> keys = {
       "mean_arc_radius_mm", "arc_radius_range_mm", "center_axial_deviation_mm",
@@ -63,12 +104,15 @@ TEST(UncertaintyCoverage, NinetyFivePercentIntervalsCoverTheTruth) {
   const workflows::ProcessPipelineResult exact = Scan(0.0, 1);
   std::map<std::string, double> truth;
   for (const std::string& key : keys) truth[key] = exact.uncertainty->Find(key)->measured;
+  fmt::print("max arc error: the model's {:.4f} um, the noise-free scan's {:.4f} um\n",
+             TrueMaxArcErrorUm(Wheel()), truth["max_arc_error_um"]);
+  truth["max_arc_error_um"] = TrueMaxArcErrorUm(Wheel());
 
   const int scans = Scans();
   std::map<std::string, int> covered;
   std::map<std::string, double> error_sum, u_sum, raw_bias_sum;
   for (int i = 0; i < scans; ++i) {
-    const workflows::ProcessPipelineResult result = Scan(0.4, 1000 + i);
+    const workflows::ProcessPipelineResult result = Scan(0.4, FirstSeed() + i);
     for (const std::string& key : keys) {
       const uncertainty::QuantityUncertainty& q = *result.uncertainty->Find(key);
       const double error = q.value - truth[key];
@@ -78,7 +122,8 @@ TEST(UncertaintyCoverage, NinetyFivePercentIntervalsCoverTheTruth) {
       raw_bias_sum[key] += q.measured - truth[key];
     }
   }
-  fmt::print("coverage over {} scans (noise 0.4 um), 95 % intervals:\n", scans);
+  fmt::print("coverage over {} scans (seeds {}-{}, noise 0.4 um), 95 % intervals:\n", scans, FirstSeed(),
+             FirstSeed() + scans - 1);
   fmt::print("{:<28} {:>12} {:>12} {:>12} {:>12} {:>9}\n", "quantity", "truth", "raw bias", "mean error",
              "mean u", "covered");
   for (const std::string& key : keys) {
@@ -91,13 +136,29 @@ TEST(UncertaintyCoverage, NinetyFivePercentIntervalsCoverTheTruth) {
     if (scans >= 200) {
       EXPECT_GE(fraction, 0.93) << key;
       EXPECT_LE(fraction, 0.97) << key;
-    } else if (key != "max_arc_error_um") {
-      // 24 scans at 95 %: 22.8 expected, binomial sd 1.1; at least 19 holds with p > 0.998. The
-      // arc error's coverage at 200 scans is short of 93 % (docs/uncertainty.md): printed here,
-      // checked only in the full run.
+    } else {
+      // 24 scans at 95 %: 22.8 expected, binomial sd 1.1; at least 19 holds with p > 0.998.
       EXPECT_GE(fraction, 19.0 / 24.0) << key;
     }
   }
+}
+
+// A pure P3 profile error of 0.5 um over the rim's +-10 mm: over the band's +-8 mm (h = 0.8 of
+// the rim) the least-squares circle takes the cubic's linear part, and the residual is 0.5 h^3
+// P3(y / 8 mm), whose PV over the band is 0.5 x 0.8^3 x 2 = 0.512 um to first order (the circle
+// is not a parabola: the model's sections give 0.508 um). The estimate's interval holds the
+// model's figure; the raw figure of the noisy scan lies far above.
+TEST(UncertaintyCoverage, TheArcErrorOfACubicProfileIsTheClosedForm) {
+  acquisition::WheelModel wheel;
+  wheel.profile_legendre_um = {0.0, 0.0, 0.0, 0.5};
+  const double closed_form_um = 0.5 * 0.8 * 0.8 * 0.8 * 2.0;
+  const double truth_um = TrueMaxArcErrorUm(wheel);
+  EXPECT_NEAR(truth_um, closed_form_um, 0.01 * closed_form_um);
+  const workflows::ProcessPipelineResult result = Scan(0.4, 77, wheel);
+  const uncertainty::QuantityUncertainty& q = *result.uncertainty->Find("max_arc_error_um");
+  EXPECT_NEAR(q.value, truth_um, q.combined.expanded);
+  EXPECT_LT(q.combined.expanded, 0.05);
+  EXPECT_GT(q.measured, closed_form_um + 0.5);
 }
 
 }  // namespace

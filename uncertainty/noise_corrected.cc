@@ -20,21 +20,21 @@ int Functions(SmoothBasis basis, int order) {
   return basis == SmoothBasis::kFourier ? 1 + 2 * order : order + 1;
 }
 
-// The basis sampled at the columns, orthonormalised in order (thin Q of a Householder QR), so
-// that the fit of each order is the first Functions(order) coefficients of one projection.
-Eigen::MatrixXd OrthonormalBasis(SmoothBasis basis, int max_order, int columns) {
+// The basis's functions at `positions` (column indices over a turn for kFourier, u in [-1, 1]
+// for kLegendre): positions x Functions(basis, max_order).
+Eigen::MatrixXd Design(SmoothBasis basis, int max_order, const Eigen::VectorXd& positions, int columns) {
   const int n = Functions(basis, max_order);
-  Eigen::MatrixXd design(columns, n);
-  for (int j = 0; j < columns; ++j) {
+  Eigen::MatrixXd design(positions.size(), n);
+  for (Eigen::Index j = 0; j < positions.size(); ++j) {
     if (basis == SmoothBasis::kFourier) {
-      const double c = 2.0 * std::numbers::pi * j / columns;
+      const double c = 2.0 * std::numbers::pi * positions[j] / columns;
       design(j, 0) = 1.0;
       for (int k = 1; k <= max_order; ++k) {
         design(j, 2 * k - 1) = std::cos(k * c);
         design(j, 2 * k) = std::sin(k * c);
       }
     } else {
-      const double u = columns == 1 ? 0.0 : -1.0 + 2.0 * j / (columns - 1);
+      const double u = positions[j];
       double p0 = 1.0;
       double p1 = u;
       design(j, 0) = p0;
@@ -47,11 +47,102 @@ Eigen::MatrixXd OrthonormalBasis(SmoothBasis basis, int max_order, int columns) 
       }
     }
   }
-  Eigen::HouseholderQR<Eigen::MatrixXd> qr(design);
-  Eigen::MatrixXd q = qr.householderQ() * Eigen::MatrixXd::Identity(columns, n);
-  // Keep the sign of each function as the design has it (QR may flip it): irrelevant for fits.
-  return q;
+  return design;
 }
+
+// Positions of `columns` equally spaced columns: indices over a turn, or u over [-1, 1].
+Eigen::VectorXd EvenPositions(SmoothBasis basis, int columns) {
+  Eigen::VectorXd positions(columns);
+  for (int j = 0; j < columns; ++j)
+    positions[j] = basis == SmoothBasis::kFourier ? j : (columns == 1 ? 0.0 : -1.0 + 2.0 * j / (columns - 1));
+  return positions;
+}
+
+// The basis at `columns` equally spaced columns, orthonormalised in order (thin Q of a Householder
+// QR), so that the fit of each order is the first Functions(order) coefficients of one projection.
+Eigen::MatrixXd OrthonormalBasis(SmoothBasis basis, int max_order, int columns) {
+  const Eigen::MatrixXd design = Design(basis, max_order, EvenPositions(basis, columns), columns);
+  const Eigen::HouseholderQR<Eigen::MatrixXd> qr(design);
+  return qr.householderQ() * Eigen::MatrixXd::Identity(columns, design.cols());
+}
+
+// Points over [-1, 1] at which a positioned row's PV is taken: the fitted function over the
+// whole interval, so that the PV does not depend on how near the edges a row's points happen to
+// fall.
+constexpr int kPvGridPoints = 401;
+
+// The basis each row is fitted on, and the fits and rows it gives.
+//  - Shared: every row's values sit at the same equally spaced columns; one orthonormal basis Q.
+//  - Positioned (Legendre): each value has a position of its own (a section's points lie where the
+//    helix crossed the phase). Every row is fitted (least squares) on the Legendre polynomials of
+//    the interval itself, each scaled to a unit sum of squares over as many evenly spread points
+//    as a row has columns: a coefficient is the same function of position in every row (the rows'
+//    fits can be smoothed along the rows), an order is the interval's (a P4 profile is order 4
+//    alone, wherever a row's points fall; a basis orthonormal over a row's points would spread it
+//    over the orders below, which the choice of orders then drops by chance), and the basis is
+//    orthonormal to within the points' unevenness. Missing values take no part (their rows of the
+//    design are zero). The PV is of the fitted function over [-1, 1].
+class RowBases {
+ public:
+  explicit RowBases(Eigen::MatrixXd q) : shared_(std::move(q)) {}
+  RowBases(int max_order, const Eigen::MatrixXd& positions, const Eigen::MatrixXd& present) {
+    const Eigen::Index rows = positions.rows(), columns = positions.cols();
+    const auto design = [&](const Eigen::VectorXd& u) {
+      return Design(SmoothBasis::kLegendre, max_order, u, static_cast<int>(columns));
+    };
+    // P_k scaled to a unit sum of squares over `columns` points spread evenly over [-1, 1] (the
+    // mean of P_k^2 over the interval is 1 / (2k + 1)).
+    Eigen::VectorXd scale(max_order + 1);
+    for (int k = 0; k <= max_order; ++k) scale[k] = std::sqrt((2.0 * k + 1.0) / static_cast<double>(columns));
+    for (Eigen::Index i = 0; i < rows; ++i) {
+      Eigen::MatrixXd e = design(positions.row(i).transpose()) * scale.asDiagonal();
+      for (Eigen::Index j = 0; j < columns; ++j)
+        if (present(i, j) == 0.0) e.row(j).setZero();
+      fit_.emplace_back((e.transpose() * e).ldlt().solve(e.transpose()));
+      eval_.push_back(std::move(e));
+    }
+    grid_ = design(EvenPositions(SmoothBasis::kLegendre, kPvGridPoints)) * scale.asDiagonal();
+  }
+
+  [[nodiscard]] bool shared() const { return eval_.empty(); }
+  [[nodiscard]] Eigen::Index functions() const { return shared() ? shared_.cols() : grid_.cols(); }
+
+  // rows x functions: each row's least-squares coefficients (missing values are 0 in `y`).
+  [[nodiscard]] Eigen::MatrixXd Coefficients(const Eigen::MatrixXd& y) const {
+    if (shared()) return y * shared_;
+    Eigen::MatrixXd c(y.rows(), functions());
+    for (Eigen::Index i = 0; i < y.rows(); ++i) c.row(i) = (fit_[i] * y.row(i).transpose()).transpose();
+    return c;
+  }
+
+  // rows x columns: the fitted rows at the values' columns or positions (0 where one is missing).
+  [[nodiscard]] Eigen::MatrixXd Rows(const Eigen::MatrixXd& coefficients) const {
+    if (shared()) return coefficients * shared_.transpose();
+    Eigen::MatrixXd values(coefficients.rows(), eval_.front().rows());
+    for (Eigen::Index i = 0; i < coefficients.rows(); ++i)
+      values.row(i) = (eval_[i] * coefficients.row(i).transpose()).transpose();
+    return values;
+  }
+
+  // The rows of the functions `which` alone, where the PV is taken: at the columns (shared) or
+  // over the grid (positioned).
+  [[nodiscard]] Eigen::MatrixXd PvRows(const Eigen::MatrixXd& coefficients,
+                                       const std::vector<int>& which) const {
+    const Eigen::MatrixXd& basis = shared() ? shared_ : grid_;
+    const auto n = static_cast<Eigen::Index>(which.size());
+    Eigen::MatrixXd c(coefficients.rows(), n), b(basis.rows(), n);
+    for (Eigen::Index k = 0; k < n; ++k) {
+      c.col(k) = coefficients.col(which[k]);
+      b.col(k) = basis.col(which[k]);
+    }
+    return c * b.transpose();
+  }
+
+ private:
+  Eigen::MatrixXd shared_;
+  std::vector<Eigen::MatrixXd> eval_, fit_;
+  Eigen::MatrixXd grid_;
+};
 
 // Fills missing values of a row by linear interpolation; false when fewer than half are present.
 bool FillRow(Eigen::Ref<Eigen::VectorXd> row, bool periodic) {
@@ -143,22 +234,10 @@ Selection SelectOrders(const Eigen::MatrixXd& coefficients, const Eigen::VectorX
   return selection;
 }
 
-// The rows of `columns` of the basis with their coefficients.
-Eigen::MatrixXd RowsOf(const Eigen::MatrixXd& coefficients, const Eigen::MatrixXd& q,
-                       const std::vector<int>& columns) {
-  Eigen::MatrixXd c(coefficients.rows(), static_cast<Eigen::Index>(columns.size()));
-  Eigen::MatrixXd basis(q.rows(), static_cast<Eigen::Index>(columns.size()));
-  for (std::size_t i = 0; i < columns.size(); ++i) {
-    c.col(static_cast<Eigen::Index>(i)) = coefficients.col(columns[i]);
-    basis.col(static_cast<Eigen::Index>(i)) = q.col(columns[i]);
-  }
-  return c * basis.transpose();
-}
-
-double LargestRowPv(const Eigen::MatrixXd& coefficients, const Eigen::MatrixXd& q,
+double LargestRowPv(const Eigen::MatrixXd& coefficients, const RowBases& bases,
                     const std::vector<int>& shown) {
   if (shown.empty()) return 0.0;
-  const Eigen::MatrixXd values = RowsOf(coefficients, q, shown);
+  const Eigen::MatrixXd values = bases.PvRows(coefficients, shown);
   double pv = 0.0;
   for (Eigen::Index r = 0; r < values.rows(); ++r)
     pv = std::max(pv, values.row(r).maxCoeff() - values.row(r).minCoeff());
@@ -185,24 +264,24 @@ void SmoothAcrossRows(Eigen::MatrixXd& coefficients, const Eigen::VectorXd& row_
     Eigen::MatrixXd smooth = Eigen::MatrixXd::Zero(rows, count);
     for (Eigen::Index d = 0; d < along.cols(); ++d) {
       const double drop = a.row(d).squaredNorm() / noise;
-      if (d > 0 && drop <= count + 3.0 * std::sqrt(2.0 * count)) continue;
+      if (d > 0 && drop <= count + options.across_rows_keep_sd * std::sqrt(2.0 * count)) continue;
       smooth += along.col(d) * a.row(d);
     }
     coefficients.middleCols(first, count) = smooth;
   }
 }
 
-// The estimate from the rows' raw coefficients on the basis (data times q): shrunk, orders
-// chosen, smoothed across the rows when asked, the PV of the shown orders.
+// The estimate from the rows' raw coefficients on the basis: shrunk, orders chosen, smoothed
+// across the rows when asked, the PV of the shown orders.
 Estimate FromCoefficients(Eigen::MatrixXd coefficients, const Eigen::VectorXd& row_sigma,
-                          const Eigen::MatrixXd& q, const NoiseCorrectedPvOptions& options,
+                          const RowBases& bases, const NoiseCorrectedPvOptions& options,
                           Eigen::MatrixXd* kept_coefficients = nullptr) {
   ShrinkRows(coefficients, row_sigma, options);
   const Selection selection = SelectOrders(coefficients, row_sigma, options);
   SmoothAcrossRows(coefficients, row_sigma, selection, options);
   Estimate estimate;
   estimate.order = selection.order;
-  estimate.fitted_pv = LargestRowPv(coefficients, q, selection.shown);
+  estimate.fitted_pv = LargestRowPv(coefficients, bases, selection.shown);
   if (kept_coefficients != nullptr) {
     *kept_coefficients = Eigen::MatrixXd::Zero(coefficients.rows(), coefficients.cols());
     for (const int j : selection.kept) kept_coefficients->col(j) = coefficients.col(j);
@@ -210,17 +289,18 @@ Estimate FromCoefficients(Eigen::MatrixXd coefficients, const Eigen::VectorXd& r
   return estimate;
 }
 
-// The estimate on data `y` (rows x columns, complete rows) with per-row noise sigma `row_sigma`,
-// with the fitted rows, their coefficients and the chi-square of the data against them.
-Estimate Fit(const Eigen::MatrixXd& y, const Eigen::VectorXd& row_sigma, const Eigen::MatrixXd& q,
-             const NoiseCorrectedPvOptions& options, Eigen::MatrixXd& kept_coefficients) {
-  Estimate estimate = FromCoefficients(y * q, row_sigma, q, options, &kept_coefficients);
-  estimate.fitted = kept_coefficients * q.transpose();
-  const Eigen::MatrixXd residual = y - estimate.fitted;
+// The estimate on data `y` (rows x columns; missing values 0, as `bases` marks them) with per-row
+// noise sigma `row_sigma`, with the fitted rows, their coefficients and the chi-square of the data
+// against them.
+Estimate Fit(const Eigen::MatrixXd& y, const Eigen::VectorXd& row_sigma, double present,
+             const RowBases& bases, const NoiseCorrectedPvOptions& options,
+             Eigen::MatrixXd& kept_coefficients) {
+  Estimate estimate = FromCoefficients(bases.Coefficients(y), row_sigma, bases, options, &kept_coefficients);
+  estimate.fitted = bases.Rows(kept_coefficients);
   for (Eigen::Index r = 0; r < y.rows(); ++r)
-    estimate.chi2 += residual.row(r).squaredNorm() / (row_sigma[r] * row_sigma[r]);
+    estimate.chi2 += (y.row(r) - estimate.fitted.row(r)).squaredNorm() / (row_sigma[r] * row_sigma[r]);
   const auto kept = static_cast<double>((kept_coefficients.colwise().squaredNorm().array() > 0.0).count());
-  estimate.dof = static_cast<double>(y.size()) - static_cast<double>(y.rows()) * kept;
+  estimate.dof = present - static_cast<double>(y.rows()) * kept;
   return estimate;
 }
 
@@ -246,11 +326,14 @@ std::vector<std::string> NoiseCorrectedPvOptions::Problems() const {
   rule(max_order >= 0, "max_order", max_order, ">= 0");
   rule(pv_from_order >= 0 && pv_from_order <= max_order, "pv_from_order", pv_from_order, "0..max_order");
   rule(replicates >= 20, "replicates", replicates, ">= 20");
+  rule(across_rows_keep_sd > 0.0, "across_rows_keep_sd", across_rows_keep_sd, "> 0");
   return problems;
 }
 
-NoiseCorrectedPv EstimateNoiseCorrectedPv(std::span<const double> values, std::span<const double> sigmas,
-                                          int rows, int columns, const NoiseCorrectedPvOptions& options) {
+namespace {
+
+void CheckShapes(std::span<const double> values, std::span<const double> sigmas, int rows, int columns,
+                 const NoiseCorrectedPvOptions& options) {
   ThrowIfProblems(ErrorCode::kInvalidOption, kStage, options.Problems());
   if (rows <= 0 || columns <= 0 || values.size() != static_cast<std::size_t>(rows) * columns ||
       sigmas.size() != values.size()) {
@@ -263,65 +346,130 @@ NoiseCorrectedPv EstimateNoiseCorrectedPv(std::span<const double> values, std::s
                 "NoiseCorrectedPvOptions::max_order = " + std::to_string(options.max_order) + " violates < " +
                     std::to_string(columns) + " functions for a row of " + std::to_string(columns));
   }
-  const bool periodic = options.basis == SmoothBasis::kFourier;
-  std::vector<int> kept;
-  Eigen::MatrixXd all(rows, columns);
-  Eigen::MatrixXd all_sigma(rows, columns);
-  NoiseCorrectedPv result;
+}
+
+// The rows that are used, their values (0 where missing), sigmas (0 where missing) and positions.
+struct Rows {
+  Eigen::MatrixXd y, sigma, positions, present;
+  Eigen::VectorXd row_sigma;  // root mean square of each row's present sigmas
+  double values = 0.0;        // present values
+  double raw_pv = 0.0;
+};
+
+bool Present(double v, double s) { return std::isfinite(v) && std::isfinite(s) && s > 0.0; }
+
+void SetRowSigmas(Rows& rows) {
+  rows.row_sigma.resize(rows.y.rows());
+  for (Eigen::Index i = 0; i < rows.y.rows(); ++i) {
+    const double n = rows.present.size() > 0 ? rows.present.row(i).sum() : static_cast<double>(rows.y.cols());
+    rows.row_sigma[i] = std::sqrt(rows.sigma.row(i).squaredNorm() / n);
+    rows.values += n;
+  }
+}
+
+// Values at the columns: a missing value is filled along its row; a row with fewer than half its
+// values present is left out.
+Rows FilledRows(std::span<const double> values, std::span<const double> sigmas, int rows, int columns,
+                bool periodic) {
+  std::vector<Eigen::VectorXd> y_rows, sigma_rows;
+  Rows out;
   for (int r = 0; r < rows; ++r) {
-    double low = std::numeric_limits<double>::infinity();
-    double high = -low;
+    Eigen::VectorXd row(columns), sigma_row(columns);
+    double low = std::numeric_limits<double>::infinity(), high = -low;
     for (int j = 0; j < columns; ++j) {
       const double v = values[static_cast<std::size_t>(r) * columns + j];
       const double s = sigmas[static_cast<std::size_t>(r) * columns + j];
-      const bool present = std::isfinite(v) && std::isfinite(s) && s > 0.0;
-      all(r, j) = present ? v : std::numeric_limits<double>::quiet_NaN();
-      all_sigma(r, j) = present ? s : std::numeric_limits<double>::quiet_NaN();
+      const bool present = Present(v, s);
+      row[j] = present ? v : std::numeric_limits<double>::quiet_NaN();
+      sigma_row[j] = present ? s : std::numeric_limits<double>::quiet_NaN();
       if (present) low = std::min(low, v), high = std::max(high, v);
     }
-    Eigen::VectorXd row = all.row(r).transpose();
-    if (FillRow(row, periodic)) {
-      all.row(r) = row.transpose();
-      Eigen::VectorXd sigma_row = all_sigma.row(r).transpose();
-      FillRow(sigma_row, periodic);
-      all_sigma.row(r) = sigma_row.transpose();
-      kept.push_back(r);
-      result.raw_pv = std::max(result.raw_pv, high - low);
+    if (!FillRow(row, periodic)) continue;
+    FillRow(sigma_row, periodic);
+    y_rows.push_back(std::move(row));
+    sigma_rows.push_back(std::move(sigma_row));
+    out.raw_pv = std::max(out.raw_pv, high - low);
+  }
+  if (y_rows.empty()) throw Error(ErrorCode::kBadInput, kStage, "no row has half its values present");
+  const auto n = static_cast<Eigen::Index>(y_rows.size());
+  out.y.resize(n, columns);
+  out.sigma.resize(n, columns);
+  for (Eigen::Index i = 0; i < n; ++i) {
+    out.y.row(i) = y_rows[i].transpose();
+    out.sigma.row(i) = sigma_rows[i].transpose();
+  }
+  SetRowSigmas(out);
+  return out;
+}
+
+// Values at positions of their own: a missing one is left out; a row with fewer than half its
+// values present, or no more than the basis has functions, is left out.
+Rows PositionedRows(std::span<const double> values, std::span<const double> sigmas,
+                    std::span<const double> positions, int rows, int columns, int functions) {
+  std::vector<int> used;
+  Rows out;
+  for (int r = 0; r < rows; ++r) {
+    int present = 0;
+    double low = std::numeric_limits<double>::infinity(), high = -low;
+    for (int j = 0; j < columns; ++j) {
+      const std::size_t k = static_cast<std::size_t>(r) * columns + j;
+      if (!Present(values[k], sigmas[k]) || !std::isfinite(positions[k])) continue;
+      ++present;
+      low = std::min(low, values[k]), high = std::max(high, values[k]);
+    }
+    if (2 * present < columns || present <= functions) continue;
+    used.push_back(r);
+    out.raw_pv = std::max(out.raw_pv, high - low);
+  }
+  if (used.empty()) throw Error(ErrorCode::kBadInput, kStage, "no row has half its values present");
+  const auto n = static_cast<Eigen::Index>(used.size());
+  out.y = out.sigma = out.present = Eigen::MatrixXd::Zero(n, columns);
+  out.positions = Eigen::MatrixXd::Zero(n, columns);
+  for (Eigen::Index i = 0; i < n; ++i) {
+    for (int j = 0; j < columns; ++j) {
+      const std::size_t k = static_cast<std::size_t>(used[i]) * columns + j;
+      if (!Present(values[k], sigmas[k]) || !std::isfinite(positions[k])) continue;
+      out.y(i, j) = values[k];
+      out.sigma(i, j) = sigmas[k];
+      out.positions(i, j) = positions[k];
+      out.present(i, j) = 1.0;
     }
   }
-  if (kept.empty()) throw Error(ErrorCode::kBadInput, kStage, "no row has half its values present");
-  const int n_rows = static_cast<int>(kept.size());
-  Eigen::MatrixXd y(n_rows, columns);
-  Eigen::MatrixXd sigma(n_rows, columns);
-  Eigen::VectorXd row_sigma(n_rows);
-  for (int i = 0; i < n_rows; ++i) {
-    y.row(i) = all.row(kept[i]);
-    sigma.row(i) = all_sigma.row(kept[i]);
-    row_sigma[i] = std::sqrt(sigma.row(i).squaredNorm() / columns);
-  }
-  const Eigen::MatrixXd q = OrthonormalBasis(options.basis, options.max_order, columns);
+  SetRowSigmas(out);
+  return out;
+}
+
+// The estimate and its bootstrap on rows gathered by FilledRows or PositionedRows.
+NoiseCorrectedPv Solve(Rows data, const RowBases& bases, const NoiseCorrectedPvOptions& options) {
+  NoiseCorrectedPv result;
+  result.raw_pv = data.raw_pv;
+  Eigen::MatrixXd& sigma = data.sigma;
+  Eigen::VectorXd& row_sigma = data.row_sigma;
+  const auto n_rows = data.y.rows();
+  const auto columns = data.y.cols();
   Eigen::MatrixXd kept_coefficients;
-  Estimate estimate = Fit(y, row_sigma, q, options, kept_coefficients);
+  Estimate estimate = Fit(data.y, row_sigma, data.values, bases, options, kept_coefficients);
   // The noise as the data show it: the sigmas scaled by the root of chi-square per degree of
   // freedom of the fit (Birge ratio), then the fit repeated with them.
   if (options.sigmas_from_residuals && estimate.dof > 0.0 && estimate.chi2 > 0.0) {
     result.sigma_scale = std::sqrt(estimate.chi2 / estimate.dof);
     sigma *= result.sigma_scale;
     row_sigma *= result.sigma_scale;
-    estimate = Fit(y, row_sigma, q, options, kept_coefficients);
+    estimate = Fit(data.y, row_sigma, data.values, bases, options, kept_coefficients);
   }
   result.fitted_pv = estimate.fitted_pv;
   result.order = estimate.order;
-  result.rows_used = n_rows;
+  result.rows_used = static_cast<int>(n_rows);
   result.replicates = options.replicates;
 
   // Each data set is the fitted rows plus normal noise of each value's sigma. Where the sigma is
-  // one value along each row (the map's rows), the noise of the row's coefficients is drawn
-  // instead: the same distribution (the basis is orthonormal), with a few dozen draws a row
-  // instead of one a value. Each replicate has its own random stream (the seed and its number),
-  // so the result does not depend on how the replicates are shared between the two workers.
-  const bool draw_coefficients = SigmaConstantAlongRows(sigma);
-  const Eigen::Index functions = q.cols();
+  // one value along each row on a shared basis (the map's rows), the noise of the row's
+  // coefficients is drawn instead: the same distribution (the basis is orthonormal), with a few
+  // dozen draws a row instead of one a value. Each replicate has its own random stream (the seed
+  // and its number), so the result does not depend on how the replicates are shared between the
+  // two workers.
+  const bool draw_coefficients = bases.shared() && SigmaConstantAlongRows(sigma);
+  const Eigen::Index functions = bases.functions();
   std::vector<double> pv(static_cast<std::size_t>(options.replicates));
   RunOnWorkers(2, [&](int worker) {
     for (int b = worker; b < options.replicates; b += 2) {
@@ -338,10 +486,10 @@ NoiseCorrectedPv EstimateNoiseCorrectedPv(std::span<const double> values, std::s
         for (Eigen::Index j = 0; j < columns; ++j)
           for (Eigen::Index i = 0; i < n_rows; ++i)
             replicate(i, j) = estimate.fitted(i, j) + sigma(i, j) * normal(rng);
-        coefficients = replicate * q;
+        coefficients = bases.Coefficients(replicate);
       }
       pv[static_cast<std::size_t>(b)] =
-          FromCoefficients(std::move(coefficients), row_sigma, q, options).fitted_pv;
+          FromCoefficients(std::move(coefficients), row_sigma, bases, options).fitted_pv;
     }
   });
   double sum = 0.0;
@@ -356,6 +504,31 @@ NoiseCorrectedPv EstimateNoiseCorrectedPv(std::span<const double> values, std::s
   result.value = std::max(0.0, result.fitted_pv - result.bias);  // a PV is never negative
   result.standard_uncertainty = std::sqrt(std::max(0.0, (sum_squares - n * mean * mean) / (n - 1.0)));
   return result;
+}
+
+}  // namespace
+
+NoiseCorrectedPv EstimateNoiseCorrectedPv(std::span<const double> values, std::span<const double> sigmas,
+                                          int rows, int columns, const NoiseCorrectedPvOptions& options) {
+  CheckShapes(values, sigmas, rows, columns, options);
+  Rows data = FilledRows(values, sigmas, rows, columns, options.basis == SmoothBasis::kFourier);
+  const RowBases bases(OrthonormalBasis(options.basis, options.max_order, columns));
+  return Solve(std::move(data), bases, options);
+}
+
+NoiseCorrectedPv EstimateNoiseCorrectedPv(std::span<const double> values, std::span<const double> sigmas,
+                                          std::span<const double> positions, int rows, int columns,
+                                          const NoiseCorrectedPvOptions& options) {
+  CheckShapes(values, sigmas, rows, columns, options);
+  if (options.basis != SmoothBasis::kLegendre || positions.size() != values.size()) {
+    throw Error(ErrorCode::kBadInput, kStage,
+                std::to_string(positions.size()) + " positions for " + std::to_string(values.size()) +
+                    " values (a Legendre basis needs one a value)");
+  }
+  Rows data =
+      PositionedRows(values, sigmas, positions, rows, columns, Functions(options.basis, options.max_order));
+  const RowBases bases(options.max_order, data.positions, data.present);
+  return Solve(std::move(data), bases, options);
 }
 
 }  // namespace arcwheel::uncertainty

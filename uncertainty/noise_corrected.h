@@ -52,6 +52,9 @@ struct NoiseCorrectedPvOptions {
   // deviations; -1: off, each row fitted on its own.
   int across_rows_max_degree = -1;
   SmoothBasis across_rows_basis = SmoothBasis::kLegendre;
+  // How many standard deviations of noise's chi-square an across-rows function must lower the
+  // chi-square by to be kept. > 0.
+  double across_rows_keep_sd = 3.0;
   // Scale the sigmas to the scatter of the values about the fit (see above).
   bool sigmas_from_residuals = true;
   // Seed of the bootstrap's random numbers: the same inputs give the same result.
@@ -79,6 +82,20 @@ struct NoiseCorrectedPv {
 // do not match or no usable row.
 [[nodiscard]] NoiseCorrectedPv EstimateNoiseCorrectedPv(std::span<const double> values,
                                                         std::span<const double> sigmas, int rows, int columns,
+                                                        const NoiseCorrectedPvOptions& options = {});
+
+// The same for values at positions of their own (a Legendre basis only): `positions` holds each
+// value's u in [-1, 1] beside it, row-major as `values`. Each row is fitted at its values'
+// positions and its PV taken over them (a section's points lie where the helix crossed the phase,
+// a fraction of a pitch off the map's nodes, and the contract's arc error is their PV); a value
+// whose value, sigma or position is missing is left out, not filled. The coefficients are those of
+// the interval's Legendre polynomials in every row (scaled to a unit sum of squares over `columns`
+// evenly spread points), so an order and its fit along the rows mean the same function in every
+// row, and the PV is that of the fitted row over the whole of [-1, 1] (401 points).
+[[nodiscard]] NoiseCorrectedPv EstimateNoiseCorrectedPv(std::span<const double> values,
+                                                        std::span<const double> sigmas,
+                                                        std::span<const double> positions, int rows,
+                                                        int columns,
                                                         const NoiseCorrectedPvOptions& options = {});
 
 }  // namespace arcwheel::uncertainty

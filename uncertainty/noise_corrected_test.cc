@@ -116,6 +116,57 @@ TEST(EstimateNoiseCorrectedPv, FitsLegendrePolynomialsAndLeavesOutTheLowOrders) 
   EXPECT_NEAR(pv.value, high - low, 1e-6);
 }
 
+// Sections whose points lie where a helix crossed them: row r's 80 points sit at u_j = -1 +
+// (2 j + 1 + f_r) / 81 with f_r = r / rows (a fraction of a spacing, growing with the row), and
+// every tenth point is missing. The rows are a P4 of amplitude A (1 + 0.2 cos(2 pi r / rows)) plus
+// noise; the truth is the largest row's PV of P4 over the whole interval, 1.2 A (1 + 3/7) (P4 is 1
+// at the ends and -3/7 at u^2 = 3/7), which no row's points reach.
+Trial PositionedTrial(double sigma, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::normal_distribution<double> noise(0.0, sigma);
+  const int rows = 90, columns = 80;
+  const double amplitude = 0.2;
+  std::vector<double> values(rows * columns), sigmas(values.size(), sigma), u(values.size());
+  for (int r = 0; r < rows; ++r) {
+    const double scale = amplitude * (1.0 + 0.2 * std::cos(2.0 * std::numbers::pi * r / rows));
+    for (int j = 0; j < columns; ++j) {
+      const std::size_t k = static_cast<std::size_t>(r) * columns + j;
+      u[k] = -1.0 + (2.0 * j + 1.0 + static_cast<double>(r) / rows) / 81.0;
+      const double x2 = u[k] * u[k];
+      values[k] = (j + r) % 10 == 0 ? NAN : scale * (35.0 * x2 * x2 - 30.0 * x2 + 3.0) / 8.0 + noise(rng);
+    }
+  }
+  const double truth = 1.2 * amplitude * (1.0 + 3.0 / 7.0);
+  const NoiseCorrectedPv pv = EstimateNoiseCorrectedPv(values, sigmas, u, rows, columns,
+                                                       {.basis = SmoothBasis::kLegendre,
+                                                        .max_order = 6,
+                                                        .replicates = 100,
+                                                        .across_rows_max_degree = 6,
+                                                        .across_rows_basis = SmoothBasis::kFourier,
+                                                        .across_rows_keep_sd = 5.0,
+                                                        .seed = seed});
+  return {pv.raw_pv - truth, pv.value - truth, std::abs(pv.value - truth) <= 1.96 * pv.standard_uncertainty};
+}
+
+TEST(EstimateNoiseCorrectedPv, FitsSectionsAtTheirOwnPointsAndTakesThePvOverTheInterval) {
+  // Without noise the fit is exact; the PV over a grid of 401 points misses P4's minimum by at
+  // most A P4''/2 (h/2)^2 = 0.24 x 15 / 2 x 0.0025^2, about 1e-5 relative.
+  EXPECT_NEAR(PositionedTrial(1e-9, 1).value_minus_truth, 0.0, 1e-6);
+  const int trials = 60;
+  int covered = 0;
+  double bias = 0.0, raw_bias = 0.0;
+  for (int t = 0; t < trials; ++t) {
+    const Trial trial = PositionedTrial(0.05, 700 + t);
+    covered += trial.covered;
+    bias += trial.value_minus_truth / trials;
+    raw_bias += trial.raw_minus_truth / trials;
+  }
+  EXPECT_GT(raw_bias, 0.05);  // the raw PV of 90 rows of noisy points
+  EXPECT_LT(std::abs(bias), 0.004);
+  // 95 % nominal; 60 trials: binomial sd 2.8 %, bounds at about 3 sd.
+  EXPECT_GE(covered, 0.86 * trials);
+}
+
 TEST(EstimateNoiseCorrectedPv, FillsMissingValuesAndRefusesBadShapes) {
   std::vector<double> values(360), sigmas(360, 0.01);
   for (int j = 0; j < 360; ++j) values[j] = std::cos(2.0 * std::numbers::pi * j / 360);

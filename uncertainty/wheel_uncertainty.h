@@ -41,6 +41,11 @@ struct WheelObservations {
   std::span<const double> y_mm{};
   double map_sigma_mm = 0.0;
   double band_low_mm = 0.0, band_high_mm = 0.0;
+  // The sections' points (fitting::WheelFit::section_*), [n_phase * section_bins], NaN where none:
+  // residual against the phase's circle (um), axial position (mm), 1-sigma (um). Without them
+  // (section_bins = 0) the map's nodes in the band stand for them, with the map's sigma.
+  int section_bins = 0;
+  std::span<const double> section_residual_um{}, section_y_mm{}, section_sigma_um{};
 };
 
 struct WheelUncertaintyOptions {

@@ -139,7 +139,11 @@ uncertainty::WheelUncertainty EvaluateUncertainty(const ProcessPipelineOptions& 
       .y_mm = map.y_mm,
       .map_sigma_mm = map.map_sigma_mm,  // summary.json's map_sigma_um
       .band_low_mm = fit.band_low_mm,
-      .band_high_mm = fit.band_high_mm};
+      .band_high_mm = fit.band_high_mm,
+      .section_bins = fit.section_bins,
+      .section_residual_um = fit.section_residual_um,
+      .section_y_mm = fit.section_y_mm,
+      .section_sigma_um = fit.section_sigma_um};
   uncertainty::WheelUncertainty result;
   if (options.uncertainty_budget) {
     result =

@@ -86,8 +86,8 @@ struct NoiseCorrectedPv {
 
 // The same for values at positions of their own (a Legendre basis only): `positions` holds each
 // value's u in [-1, 1] beside it, row-major as `values`. Each row is fitted at its values'
-// positions and its PV taken over them (a section's points lie where the helix crossed the phase,
-// a fraction of a pitch off the map's nodes, and the contract's arc error is their PV); a value
+// positions (a section's points lie where the helix crossed the phase, a fraction of a pitch off
+// the map's nodes, and the contract's arc error is their PV); a value
 // whose value, sigma or position is missing is left out, not filled. The coefficients are those of
 // the interval's Legendre polynomials in every row (scaled to a unit sum of squares over `columns`
 // evenly spread points), so an order and its fit along the rows mean the same function in every

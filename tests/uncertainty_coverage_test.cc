@@ -110,7 +110,7 @@ TEST(UncertaintyCoverage, NinetyFivePercentIntervalsCoverTheTruth) {
 
   const int scans = Scans();
   std::map<std::string, int> covered;
-  std::map<std::string, double> error_sum, u_sum, raw_bias_sum;
+  std::map<std::string, double> error_sum, error_squares, u_sum, raw_bias_sum;
   for (int i = 0; i < scans; ++i) {
     const workflows::ProcessPipelineResult result = Scan(0.4, FirstSeed() + i);
     for (const std::string& key : keys) {
@@ -118,18 +118,22 @@ TEST(UncertaintyCoverage, NinetyFivePercentIntervalsCoverTheTruth) {
       const double error = q.value - truth[key];
       covered[key] += std::abs(error) <= q.combined.expanded;
       error_sum[key] += error;
+      error_squares[key] += error * error;
       u_sum[key] += q.combined.standard_uncertainty;
       raw_bias_sum[key] += q.measured - truth[key];
     }
   }
   fmt::print("coverage over {} scans (seeds {}-{}, noise 0.4 um), 95 % intervals:\n", scans, FirstSeed(),
              FirstSeed() + scans - 1);
-  fmt::print("{:<28} {:>12} {:>12} {:>12} {:>12} {:>9}\n", "quantity", "truth", "raw bias", "mean error",
-             "mean u", "covered");
+  fmt::print("{:<28} {:>12} {:>12} {:>12} {:>12} {:>12} {:>9}\n", "quantity", "truth", "raw bias",
+             "mean error", "sd of error", "mean u", "covered");
   for (const std::string& key : keys) {
-    fmt::print("{:<28} {:>12.6g} {:>12.3g} {:>12.3g} {:>12.3g} {:>8.1f}%\n", key, Shown(truth[key]),
-               Shown(raw_bias_sum[key] / scans), Shown(error_sum[key] / scans), Shown(u_sum[key] / scans),
-               Shown(100.0 * covered[key] / scans));
+    const double mean_error = error_sum[key] / scans;
+    const double sd_error = std::sqrt(std::max(0.0, error_squares[key] - scans * mean_error * mean_error) /
+                                      std::max(1, scans - 1));
+    fmt::print("{:<28} {:>12.6g} {:>12.3g} {:>12.3g} {:>12.3g} {:>12.3g} {:>8.1f}%\n", key, Shown(truth[key]),
+               Shown(raw_bias_sum[key] / scans), Shown(mean_error), Shown(sd_error),
+               Shown(u_sum[key] / scans), Shown(100.0 * covered[key] / scans));
   }
   for (const std::string& key : keys) {
     const double fraction = static_cast<double>(covered[key]) / scans;

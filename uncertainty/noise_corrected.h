@@ -8,15 +8,18 @@
 // band) with a smooth basis (Fourier harmonics 0..max_order over a full turn, or Legendre
 // polynomials 0..max_order over the band, orthonormalised over the columns), keeps each order
 // whose functions lower the chi-square of all rows together by more than noise would in five
-// standard deviations (dof + 5 sqrt(2 dof), dof = rows x the order's functions), and takes the PV of the
+// standard deviations (dof + 5 sqrt(2 dof), dof = rows x the order's functions; in part, its
+// coefficients weighted linearly from 0 at five to 1 at seven), and takes the PV of the
 // fitted rows (the largest over the rows; with shrink_rows each coefficient is first shrunk towards its mean
 // over the rows by the share of its spread that noise explains; with across_rows_max_degree the kept orders'
 // coefficients are then fitted along the rows, for rows that are neighbours). Orders are kept one by one, not
 // as a nested 0..K, so that a harmonic of noise alone between real ones does not ride on the fit: it would
 // add to the PV in first order. The bootstrap then draws `replicates` new data sets, the fitted rows plus
 // normal noise of each value's sigma, repeats the whole estimate (the choice of orders included) on each, and
-// gives
-//   bias = mean(PV*) - PV(fit),   value = max(0, PV(fit) - bias),   u = standard deviation of PV*.
+// gives (the data sets drawn from the fit with its orders kept in part at full size)
+//   bias = mean(PV*) - PV(fit at full size),   value = max(0, PV(fit) - bias),
+//   u = standard deviation of the PV* whose fits keep in full every order the data's fit keeps in
+//       full (of all PV* when fewer than half do).
 // The noise is taken as independent from value to value; with sigmas_from_residuals its level
 // is the data's own: the sigmas are scaled by sqrt(chi-square / dof) of the fit (the Birge
 // ratio) before the bootstrap.
@@ -64,11 +67,11 @@ struct NoiseCorrectedPvOptions {
 };
 
 struct NoiseCorrectedPv {
-  double raw_pv = 0.0;                // largest over the rows of max - min of the values themselves
-  double fitted_pv = 0.0;             // largest over the rows of the PV of the fitted rows
-  double bias = 0.0;                  // mean(PV*) - fitted_pv
-  double value = 0.0;                 // fitted_pv - bias: the noise-corrected estimate
-  double standard_uncertainty = 0.0;  // standard deviation of PV*
+  double raw_pv = 0.0;     // largest over the rows of max - min of the values themselves
+  double fitted_pv = 0.0;  // largest over the rows of the PV of the fitted rows
+  double bias = 0.0;       // mean(PV*) - the PV of the fit with its orders kept in part at full size
+  double value = 0.0;      // fitted_pv - bias: the noise-corrected estimate
+  double standard_uncertainty = 0.0;  // standard deviation of PV* (see above)
   int order = 0;                      // the highest order kept that the PV counts
   double sigma_scale = 1.0;           // the Birge ratio the sigmas were scaled by
   int rows_used = 0;                  // rows with enough values to fit

@@ -336,17 +336,10 @@ Estimate Fit(const Eigen::MatrixXd& y, const Eigen::VectorXd& row_sigma, double 
   return estimate;
 }
 
-double Mean(const std::vector<double>& x) {
-  double sum = 0.0;
-  for (const double v : x) sum += v;
-  return sum / static_cast<double>(x.size());
-}
-
 double StandardDeviation(const std::vector<double>& x) {
-  const double mean = Mean(x);
-  double squares = 0.0;
-  for (const double v : x) squares += (v - mean) * (v - mean);
-  return x.size() > 1 ? std::sqrt(squares / static_cast<double>(x.size() - 1)) : 0.0;
+  if (x.size() < 2) return 0.0;
+  const Eigen::Map<const Eigen::ArrayXd> a(x.data(), static_cast<Eigen::Index>(x.size()));
+  return std::sqrt((a - a.mean()).square().sum() / static_cast<double>(x.size() - 1));
 }
 
 // The standard deviation of the replicates' PVs that keep in full every order the data keep in
@@ -361,7 +354,7 @@ double StandardUncertainty(const std::vector<double>& pv, const std::vector<char
   std::vector<double> kept;
   for (std::size_t b = 0; b < pv.size(); ++b)
     if (keeps_the_data_orders[b] != 0) kept.push_back(pv[b]);
-  return 2 * kept.size() >= pv.size() && kept.size() > 1 ? StandardDeviation(kept) : StandardDeviation(pv);
+  return 2 * kept.size() >= pv.size() ? StandardDeviation(kept) : StandardDeviation(pv);
 }
 
 // True when every row's sigmas are one value: the noise of the row's coefficients on the
@@ -556,7 +549,8 @@ NoiseCorrectedPv Solve(Rows data, const RowBases& bases, const NoiseCorrectedPvO
                         estimate.kept_in_full.begin(), estimate.kept_in_full.end());
     }
   });
-  const double mean = Mean(pv);
+  const double mean =
+      Eigen::Map<const Eigen::ArrayXd>(pv.data(), static_cast<Eigen::Index>(pv.size())).mean();
   result.bias = mean - estimate.world_pv;
   result.value = std::max(0.0, result.fitted_pv - result.bias);  // a PV is never negative
   result.standard_uncertainty = StandardUncertainty(pv, keeps_the_data_orders);

@@ -176,8 +176,9 @@ struct Estimate {
   double fitted_pv = 0.0;
   int order = 0;
   std::vector<int> kept_in_full;  // the functions of the orders kept at full weight, ascending
-  double world_pv = 0.0;          // the PV with the orders kept in part at full weight
-  double chi2 = 0.0;              // of the data against the fitted rows
+  bool shows_an_order_in_full = false;
+  double world_pv = 0.0;  // the PV with the orders kept in part at full weight
+  double chi2 = 0.0;      // of the data against the fitted rows
   double dof = 0.0;
   Eigen::MatrixXd fitted;  // rows x columns, the rows at the chosen order
 };
@@ -212,6 +213,7 @@ struct Selection {
   std::vector<int> kept_in_full;                // those kept at full weight
   std::vector<std::pair<int, double>> partial;  // (order, weight < 1) of the orders kept in part
   int order = 0;                                // the highest order the PV counts
+  bool shows_an_order_in_full = false;          // an order the PV counts, not the mean, at full weight
 };
 
 // An order whose functions lower the chi-square by z standard deviations of noise's chi-square
@@ -246,6 +248,7 @@ Selection SelectOrders(const Eigen::MatrixXd& coefficients, const Eigen::VectorX
     const double weight = always ? 1.0 : KeepWeight(chi2_drop, dof);
     if (weight <= 0.0) continue;
     if (weight < 1.0) selection.partial.emplace_back(order, weight);
+    if (weight == 1.0 && !always) selection.shows_an_order_in_full = true;
     for (int j = first; j < first + count; ++j) {
       selection.kept.push_back(j);
       if (weight == 1.0) selection.kept_in_full.push_back(j);
@@ -304,6 +307,7 @@ Estimate FromCoefficients(Eigen::MatrixXd coefficients, const Eigen::VectorXd& r
   Estimate estimate;
   estimate.order = selection.order;
   estimate.kept_in_full = selection.kept_in_full;
+  estimate.shows_an_order_in_full = selection.shows_an_order_in_full;
   // The bootstrap's world holds the orders kept in part at their full fitted size: the weight is
   // the estimator's, and the bias the replicates find then includes what it takes off a real order
   // on the edge (drawn from the weighted fit, the replicates would lose that order more often still,
@@ -342,13 +346,17 @@ double StandardDeviation(const std::vector<double>& x) {
   return std::sqrt((a - a.mean()).square().sum() / static_cast<double>(x.size() - 1));
 }
 
-// The standard deviation of the replicates' PVs that keep in full every order the data keep in
+// The standard deviation of the replicates' PVs that keep in full just the orders the data keep in
 // full: the uncertainty of the PV of the orders the data show, given that they show them. A
 // replicate that loses a real order has a PV far below the rest, and the replicates of data whose
 // real orders happen to come out low lose them far more often than measurements of the wheel do
 // (the bootstrap of a choice at a threshold is not consistent there), so the spread of all
-// replicates overstates the estimate's scatter. When fewer than half of the replicates keep the
-// data's orders, the choice itself is in doubt, and the spread of all of them is the honest one.
+// replicates overstates the estimate's scatter. A replicate that takes in an order of noise besides
+// has a PV above the rest for the same reason, and letting those in overstated u by about 16 % on
+// the scans whose fit keeps only the real orders (docs/uncertainty.md). When the data show no order
+// in full (nothing beyond noise but on the edge), or fewer than half of the replicates keep the
+// data's orders, the choice itself is what is uncertain, and the spread of all replicates is the
+// honest one: held to the replicates that find nothing too, a PV of noise alone would be 0 +- 0.
 // The bias is that of all replicates, noise orders taken in included.
 double StandardUncertainty(const std::vector<double>& pv, const std::vector<char>& keeps_the_data_orders) {
   std::vector<double> kept;
@@ -545,8 +553,7 @@ NoiseCorrectedPv Solve(Rows data, const RowBases& bases, const NoiseCorrectedPvO
       const Estimate replica = FromCoefficients(std::move(coefficients), row_sigma, bases, options);
       pv[static_cast<std::size_t>(b)] = replica.fitted_pv;
       keeps_the_data_orders[static_cast<std::size_t>(b)] =
-          std::includes(replica.kept_in_full.begin(), replica.kept_in_full.end(),
-                        estimate.kept_in_full.begin(), estimate.kept_in_full.end());
+          !estimate.shows_an_order_in_full || replica.kept_in_full == estimate.kept_in_full;
     }
   });
   const double mean =

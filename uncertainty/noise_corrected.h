@@ -18,8 +18,9 @@
 // normal noise of each value's sigma, repeats the whole estimate (the choice of orders included) on each, and
 // gives (the data sets drawn from the fit with its orders kept in part at full size)
 //   bias = mean(PV*) - PV(fit at full size),   value = max(0, PV(fit) - bias),
-//   u = standard deviation of the PV* whose fits keep in full every order the data's fit keeps in
-//       full (of all PV* when fewer than half do).
+//   u = standard deviation of the PV* whose fits keep in full just the orders the data's fit keeps
+//       in full (of all PV* when the data's fit keeps none in full beyond the mean and the orders
+//       the PV leaves out, or when fewer than half of the PV* do).
 // The noise is taken as independent from value to value; with sigmas_from_residuals its level
 // is the data's own: the sigmas are scaled by sqrt(chi-square / dof) of the fit (the Birge
 // ratio) before the bootstrap.

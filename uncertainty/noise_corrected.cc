@@ -5,6 +5,7 @@
 #include <cmath>
 #include <limits>
 #include <numbers>
+#include <numeric>
 #include <random>
 
 #include "core/error.h"
@@ -387,6 +388,7 @@ std::vector<std::string> NoiseCorrectedPvOptions::Problems() const {
   rule(max_order >= 0, "max_order", max_order, ">= 0");
   rule(pv_from_order >= 0 && pv_from_order <= max_order, "pv_from_order", pv_from_order, "0..max_order");
   rule(replicates >= 20, "replicates", replicates, ">= 20");
+  rule(inner_replicates == 0 || inner_replicates >= 2, "inner_replicates", inner_replicates, "0 or >= 2");
   rule(across_rows_keep_sd > 0.0, "across_rows_keep_sd", across_rows_keep_sd, "> 0");
   return problems;
 }
@@ -522,6 +524,7 @@ NoiseCorrectedPv Solve(Rows data, const RowBases& bases, const NoiseCorrectedPvO
   result.order = estimate.order;
   result.rows_used = static_cast<int>(n_rows);
   result.replicates = options.replicates;
+  result.inner_replicates = options.inner_replicates;
 
   // Each data set is the fitted rows plus normal noise of each value's sigma. Where the sigma is
   // one value along each row on a shared basis (the map's rows), the noise of the row's
@@ -533,6 +536,7 @@ NoiseCorrectedPv Solve(Rows data, const RowBases& bases, const NoiseCorrectedPvO
   const Eigen::Index functions = bases.functions();
   std::vector<double> pv(static_cast<std::size_t>(options.replicates));
   std::vector<char> keeps_the_data_orders(pv.size(), 0);
+  std::vector<double> corrected(pv.size(), 0.0), inner_variance(pv.size(), 0.0);
   RunOnWorkers(2, [&](int worker) {
     for (int b = worker; b < options.replicates; b += 2) {
       std::seed_seq seeds{options.seed, static_cast<std::uint64_t>(b)};
@@ -550,8 +554,38 @@ NoiseCorrectedPv Solve(Rows data, const RowBases& bases, const NoiseCorrectedPvO
             replicate(i, j) = estimate.fitted(i, j) + sigma(i, j) * normal(rng);
         coefficients = bases.Coefficients(replicate);
       }
-      const Estimate replica = FromCoefficients(std::move(coefficients), row_sigma, bases, options);
+      Eigen::MatrixXd replica_kept;
+      const Estimate replica =
+          FromCoefficients(std::move(coefficients), row_sigma, bases, options, &replica_kept);
       pv[static_cast<std::size_t>(b)] = replica.fitted_pv;
+      // The double bootstrap: the replicate's own bias, from data sets drawn from its fit.
+      if (options.inner_replicates > 0) {
+        const Eigen::MatrixXd replica_fitted =
+            draw_coefficients ? Eigen::MatrixXd() : bases.Rows(replica_kept);
+        double sum = 0.0, squares = 0.0;
+        for (int j = 0; j < options.inner_replicates; ++j) {
+          Eigen::MatrixXd inner;
+          if (draw_coefficients) {
+            inner = replica_kept;
+            for (Eigen::Index f = 0; f < functions; ++f)
+              for (Eigen::Index i = 0; i < n_rows; ++i) inner(i, f) += row_sigma[i] * normal(rng);
+          } else {
+            Eigen::MatrixXd rows(n_rows, columns);
+            for (Eigen::Index c = 0; c < columns; ++c)
+              for (Eigen::Index i = 0; i < n_rows; ++i)
+                rows(i, c) = replica_fitted(i, c) + sigma(i, c) * normal(rng);
+            inner = bases.Coefficients(rows);
+          }
+          const double inner_pv = FromCoefficients(std::move(inner), row_sigma, bases, options).fitted_pv;
+          sum += inner_pv, squares += inner_pv * inner_pv;
+        }
+        const double m = options.inner_replicates;
+        const double inner_mean = sum / m;
+        corrected[static_cast<std::size_t>(b)] =
+            std::max(0.0, replica.fitted_pv - (inner_mean - replica.world_pv));
+        inner_variance[static_cast<std::size_t>(b)] =
+            m > 1 ? (squares - m * inner_mean * inner_mean) / (m - 1) : 0.0;
+      }
       keeps_the_data_orders[static_cast<std::size_t>(b)] =
           !estimate.shows_an_order_in_full || replica.kept_in_full == estimate.kept_in_full;
     }
@@ -561,6 +595,19 @@ NoiseCorrectedPv Solve(Rows data, const RowBases& bases, const NoiseCorrectedPvO
   result.bias = mean - estimate.world_pv;
   result.value = std::max(0.0, result.fitted_pv - result.bias);  // a PV is never negative
   result.standard_uncertainty = StandardUncertainty(pv, keeps_the_data_orders);
+  result.dof = options.replicates - 1.0;
+  if (options.inner_replicates > 0) {
+    // The spread of the bias-corrected replicates, less what the inner draws' own scatter adds to
+    // each replicate's bias (their variance over m); its degrees of freedom by Welch-Satterthwaite.
+    const double spread = StandardUncertainty(corrected, keeps_the_data_orders);
+    const double n = options.replicates, m = options.inner_replicates;
+    const double noise = std::accumulate(inner_variance.begin(), inner_variance.end(), 0.0) / (n * m);
+    const double variance = std::max(spread * spread - noise, 0.0);
+    result.standard_uncertainty = std::sqrt(variance);
+    const double spread_part = spread * spread * spread * spread / (n - 1.0);
+    const double noise_part = noise * noise / (n * (m - 1.0));
+    result.dof = variance > 0.0 ? std::max(1.0, variance * variance / (spread_part + noise_part)) : n - 1.0;
+  }
   return result;
 }
 

@@ -54,6 +54,8 @@ struct WheelUncertaintyOptions {
   // Highest Legendre degree tried across the band (arc error). >= 1.
   int max_degree = 10;
   int replicates = 100;  // bootstrap data sets, >= 20 (u to about 7 %: 99 degrees of freedom)
+  // The bootstrap's seed, mixed with a digest of the observations: the same scan gives the same
+  // numbers, two scans independent draws.
   std::uint64_t seed = 20261203;
   [[nodiscard]] std::vector<std::string> Problems() const;
 };

@@ -2,6 +2,7 @@
 
 #include <Eigen/Dense>
 #include <algorithm>
+#include <boost/random/normal_distribution.hpp>
 #include <cmath>
 #include <limits>
 #include <numbers>
@@ -126,9 +127,10 @@ class RowBases {
   }
 
   // The rows of the functions `which` alone, where the PV is taken: at the columns (shared) or
-  // over the grid (positioned).
-  [[nodiscard]] Eigen::MatrixXd PvRows(const Eigen::MatrixXd& coefficients,
-                                       const std::vector<int>& which) const {
+  // over the grid (positioned), one row to a column of the result, so that each row's extremes
+  // are read from contiguous memory.
+  [[nodiscard]] Eigen::MatrixXd PvRowsAsColumns(const Eigen::MatrixXd& coefficients,
+                                                const std::vector<int>& which) const {
     const Eigen::MatrixXd& basis = shared() ? shared_ : grid_;
     const auto n = static_cast<Eigen::Index>(which.size());
     Eigen::MatrixXd c(coefficients.rows(), n), b(basis.rows(), n);
@@ -136,7 +138,7 @@ class RowBases {
       c.col(k) = coefficients.col(which[k]);
       b.col(k) = basis.col(which[k]);
     }
-    return c * b.transpose();
+    return b * c.transpose();
   }
 
  private:
@@ -263,11 +265,8 @@ Selection SelectOrders(const Eigen::MatrixXd& coefficients, const Eigen::VectorX
 double LargestRowPv(const Eigen::MatrixXd& coefficients, const RowBases& bases,
                     const std::vector<int>& shown) {
   if (shown.empty()) return 0.0;
-  const Eigen::MatrixXd values = bases.PvRows(coefficients, shown);
-  double pv = 0.0;
-  for (Eigen::Index r = 0; r < values.rows(); ++r)
-    pv = std::max(pv, values.row(r).maxCoeff() - values.row(r).minCoeff());
-  return pv;
+  const Eigen::MatrixXd values = bases.PvRowsAsColumns(coefficients, shown);
+  return std::max(0.0, (values.colwise().maxCoeff() - values.colwise().minCoeff()).maxCoeff());
 }
 
 // Rows that are neighbours along a smooth coordinate (the map's axial nodes, the sections'
@@ -317,6 +316,10 @@ Estimate FromCoefficients(Eigen::MatrixXd coefficients, const Eigen::VectorXd& r
     *kept_coefficients = Eigen::MatrixXd::Zero(coefficients.rows(), coefficients.cols());
     for (const int j : selection.kept) kept_coefficients->col(j) = coefficients.col(j);
     estimate.world_pv = LargestRowPv(coefficients, bases, selection.shown);
+  }
+  if (kept_coefficients != nullptr && selection.partial.empty()) {
+    estimate.fitted_pv = estimate.world_pv;  // no order kept in part: the same rows
+    return estimate;
   }
   for (const auto& [order, weight] : selection.partial) {
     const auto [first, count] = Group(options.basis, order);
@@ -541,7 +544,9 @@ NoiseCorrectedPv Solve(Rows data, const RowBases& bases, const NoiseCorrectedPvO
     for (int b = worker; b < options.replicates; b += 2) {
       std::seed_seq seeds{options.seed, static_cast<std::uint64_t>(b)};
       std::mt19937_64 rng(seeds);
-      std::normal_distribution<double> normal(0.0, 1.0);
+      // Boost's ziggurat: standard normal deviates at less than half the cost of the standard
+      // library's polar method, which took a fifth of a 1e7-sample scan's processing.
+      boost::random::normal_distribution<double> normal(0.0, 1.0);
       Eigen::MatrixXd coefficients;
       if (draw_coefficients) {
         coefficients = kept_coefficients;

@@ -219,8 +219,8 @@ WheelUncertainty EvaluateWheelUncertainty(const WheelObservations& o, const Budg
     // A maximum over the band's rows: its bias depends on the data, and u must be the spread of
     // the bias-corrected estimate (NoiseCorrectedPvOptions::inner_replicates). Over the coverage
     // test's 1000 scans the runout's intervals covered 93.1 % with u the PVs' spread (the errors
-    // scattered by 1.19 u), 95.5 % with two inner data sets a replicate (1.05 u); the roundness
-    // 94.4 % (1.14 u) and 97.0 % (1.01 u).
+    // scattered by 1.19 u), 94.8 % with two inner data sets a replicate (1.06 u); the roundness
+    // 94.4 % (1.14 u) and 97.0 % (0.99 u).
     turn.inner_replicates = 2;
     // The rows are the band's axial nodes in order: each harmonic varies smoothly along them.
     turn.across_rows_max_degree = std::min(options.max_degree, static_cast<int>(band.size()) - 2);

@@ -547,21 +547,24 @@ NoiseCorrectedPv Solve(Rows data, const RowBases& bases, const NoiseCorrectedPvO
       // Boost's ziggurat: standard normal deviates at less than half the cost of the standard
       // library's polar method, which took a fifth of a 1e7-sample scan's processing.
       boost::random::normal_distribution<double> normal(0.0, 1.0);
-      Eigen::MatrixXd coefficients;
-      if (draw_coefficients) {
-        coefficients = kept_coefficients;
-        for (Eigen::Index j = 0; j < functions; ++j)
-          for (Eigen::Index i = 0; i < n_rows; ++i) coefficients(i, j) += row_sigma[i] * normal(rng);
-      } else {
+      // The raw coefficients of a data set drawn from a world given by its kept coefficients and,
+      // when values are drawn, its rows.
+      const auto draw = [&](const Eigen::MatrixXd& world, const Eigen::MatrixXd& world_rows) {
+        if (draw_coefficients) {
+          Eigen::MatrixXd coefficients = world;
+          for (Eigen::Index j = 0; j < functions; ++j)
+            for (Eigen::Index i = 0; i < n_rows; ++i) coefficients(i, j) += row_sigma[i] * normal(rng);
+          return coefficients;
+        }
         Eigen::MatrixXd replicate(n_rows, columns);
         for (Eigen::Index j = 0; j < columns; ++j)
           for (Eigen::Index i = 0; i < n_rows; ++i)
-            replicate(i, j) = estimate.fitted(i, j) + sigma(i, j) * normal(rng);
-        coefficients = bases.Coefficients(replicate);
-      }
+            replicate(i, j) = world_rows(i, j) + sigma(i, j) * normal(rng);
+        return bases.Coefficients(replicate);
+      };
       Eigen::MatrixXd replica_kept;
-      const Estimate replica =
-          FromCoefficients(std::move(coefficients), row_sigma, bases, options, &replica_kept);
+      const Estimate replica = FromCoefficients(draw(kept_coefficients, estimate.fitted), row_sigma, bases,
+                                                options, &replica_kept);
       pv[static_cast<std::size_t>(b)] = replica.fitted_pv;
       // The double bootstrap: the replicate's own bias, from data sets drawn from its fit.
       if (options.inner_replicates > 0) {
@@ -569,19 +572,8 @@ NoiseCorrectedPv Solve(Rows data, const RowBases& bases, const NoiseCorrectedPvO
             draw_coefficients ? Eigen::MatrixXd() : bases.Rows(replica_kept);
         double sum = 0.0, squares = 0.0;
         for (int j = 0; j < options.inner_replicates; ++j) {
-          Eigen::MatrixXd inner;
-          if (draw_coefficients) {
-            inner = replica_kept;
-            for (Eigen::Index f = 0; f < functions; ++f)
-              for (Eigen::Index i = 0; i < n_rows; ++i) inner(i, f) += row_sigma[i] * normal(rng);
-          } else {
-            Eigen::MatrixXd rows(n_rows, columns);
-            for (Eigen::Index c = 0; c < columns; ++c)
-              for (Eigen::Index i = 0; i < n_rows; ++i)
-                rows(i, c) = replica_fitted(i, c) + sigma(i, c) * normal(rng);
-            inner = bases.Coefficients(rows);
-          }
-          const double inner_pv = FromCoefficients(std::move(inner), row_sigma, bases, options).fitted_pv;
+          const double inner_pv =
+              FromCoefficients(draw(replica_kept, replica_fitted), row_sigma, bases, options).fitted_pv;
           sum += inner_pv, squares += inner_pv * inner_pv;
         }
         const double m = options.inner_replicates;
@@ -589,7 +581,7 @@ NoiseCorrectedPv Solve(Rows data, const RowBases& bases, const NoiseCorrectedPvO
         corrected[static_cast<std::size_t>(b)] =
             std::max(0.0, replica.fitted_pv - (inner_mean - replica.world_pv));
         inner_variance[static_cast<std::size_t>(b)] =
-            m > 1 ? (squares - m * inner_mean * inner_mean) / (m - 1) : 0.0;
+            (squares - m * inner_mean * inner_mean) / (m - 1);  // m >= 2
       }
       keeps_the_data_orders[static_cast<std::size_t>(b)] =
           !estimate.shows_an_order_in_full || replica.kept_in_full == estimate.kept_in_full;

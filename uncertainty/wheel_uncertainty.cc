@@ -42,7 +42,9 @@ std::string BootstrapSource(const NoiseCorrectedPv& pv, std::string_view basis) 
 // so that one scan always gives the same numbers and two scans draw independent streams. With
 // one stream for every scan, the Monte Carlo error of each figure's u (7 % at 100 replicates) was
 // the same in all of them: over 200 simulated scans it moved the coverage of one figure by up to
-// 2.3 points, and history's chi-square between scans would inherit it.
+// 2.3 points, and history's chi-square between scans would inherit it. FNV-1a rather than a
+// library's hash: its value is fixed by its definition, so the numbers do not move with a Boost or
+// standard-library version.
 std::uint64_t BootstrapSeed(const WheelObservations& o, std::uint64_t base) {
   std::uint64_t hash = 14695981039346656037ULL ^ base;
   const auto mix = [&hash](std::span<const double> values) {

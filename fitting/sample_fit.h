@@ -21,7 +21,9 @@
 //
 // The map for display and for runout and roundness comes from the same samples: rho(c_j, y_m)
 // is the node's circle at y_m plus the mean residual (slope-corrected) of the node's samples
-// within half an axial step of y_m; NaN where there are none. `arc_error_um` is the
+// within half an axial step of y_m, moved to y_m along the phases' mean residual profile (the runs
+// lie up to half a pitch from y_m, by an amount that moves with the phase); NaN where there are
+// none. `arc_error_um` is the
 // peak-to-valley of the runs' residuals in the band (one point a turn, as a section's points).
 
 #include <span>

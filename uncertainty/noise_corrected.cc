@@ -6,7 +6,6 @@
 #include <cmath>
 #include <limits>
 #include <numbers>
-#include <numeric>
 #include <random>
 
 #include "core/error.h"
@@ -391,7 +390,6 @@ std::vector<std::string> NoiseCorrectedPvOptions::Problems() const {
   rule(max_order >= 0, "max_order", max_order, ">= 0");
   rule(pv_from_order >= 0 && pv_from_order <= max_order, "pv_from_order", pv_from_order, "0..max_order");
   rule(replicates >= 20, "replicates", replicates, ">= 20");
-  rule(inner_replicates == 0 || inner_replicates >= 2, "inner_replicates", inner_replicates, "0 or >= 2");
   rule(across_rows_keep_sd > 0.0, "across_rows_keep_sd", across_rows_keep_sd, "> 0");
   return problems;
 }
@@ -527,7 +525,6 @@ NoiseCorrectedPv Solve(Rows data, const RowBases& bases, const NoiseCorrectedPvO
   result.order = estimate.order;
   result.rows_used = static_cast<int>(n_rows);
   result.replicates = options.replicates;
-  result.inner_replicates = options.inner_replicates;
 
   // Each data set is the fitted rows plus normal noise of each value's sigma. Where the sigma is
   // one value along each row on a shared basis (the map's rows), the noise of the row's
@@ -539,7 +536,6 @@ NoiseCorrectedPv Solve(Rows data, const RowBases& bases, const NoiseCorrectedPvO
   const Eigen::Index functions = bases.functions();
   std::vector<double> pv(static_cast<std::size_t>(options.replicates));
   std::vector<char> keeps_the_data_orders(pv.size(), 0);
-  std::vector<double> corrected(pv.size(), 0.0), inner_variance(pv.size(), 0.0);
   RunOnWorkers(2, [&](int worker) {
     for (int b = worker; b < options.replicates; b += 2) {
       std::seed_seq seeds{options.seed, static_cast<std::uint64_t>(b)};
@@ -547,11 +543,10 @@ NoiseCorrectedPv Solve(Rows data, const RowBases& bases, const NoiseCorrectedPvO
       // Boost's ziggurat: standard normal deviates at less than half the cost of the standard
       // library's polar method, which took a fifth of a 1e7-sample scan's processing.
       boost::random::normal_distribution<double> normal(0.0, 1.0);
-      // The raw coefficients of a data set drawn from a world given by its kept coefficients and,
-      // when values are drawn, its rows.
-      const auto draw = [&](const Eigen::MatrixXd& world, const Eigen::MatrixXd& world_rows) {
+      // The raw coefficients of a data set drawn from the fitted world.
+      const auto draw = [&]() {
         if (draw_coefficients) {
-          Eigen::MatrixXd coefficients = world;
+          Eigen::MatrixXd coefficients = kept_coefficients;
           for (Eigen::Index j = 0; j < functions; ++j)
             for (Eigen::Index i = 0; i < n_rows; ++i) coefficients(i, j) += row_sigma[i] * normal(rng);
           return coefficients;
@@ -559,30 +554,11 @@ NoiseCorrectedPv Solve(Rows data, const RowBases& bases, const NoiseCorrectedPvO
         Eigen::MatrixXd replicate(n_rows, columns);
         for (Eigen::Index j = 0; j < columns; ++j)
           for (Eigen::Index i = 0; i < n_rows; ++i)
-            replicate(i, j) = world_rows(i, j) + sigma(i, j) * normal(rng);
+            replicate(i, j) = estimate.fitted(i, j) + sigma(i, j) * normal(rng);
         return bases.Coefficients(replicate);
       };
-      Eigen::MatrixXd replica_kept;
-      const Estimate replica = FromCoefficients(draw(kept_coefficients, estimate.fitted), row_sigma, bases,
-                                                options, &replica_kept);
+      const Estimate replica = FromCoefficients(draw(), row_sigma, bases, options);
       pv[static_cast<std::size_t>(b)] = replica.fitted_pv;
-      // The double bootstrap: the replicate's own bias, from data sets drawn from its fit.
-      if (options.inner_replicates > 0) {
-        const Eigen::MatrixXd replica_fitted =
-            draw_coefficients ? Eigen::MatrixXd() : bases.Rows(replica_kept);
-        double sum = 0.0, squares = 0.0;
-        for (int j = 0; j < options.inner_replicates; ++j) {
-          const double inner_pv =
-              FromCoefficients(draw(replica_kept, replica_fitted), row_sigma, bases, options).fitted_pv;
-          sum += inner_pv, squares += inner_pv * inner_pv;
-        }
-        const double m = options.inner_replicates;
-        const double inner_mean = sum / m;
-        corrected[static_cast<std::size_t>(b)] =
-            std::max(0.0, replica.fitted_pv - (inner_mean - replica.world_pv));
-        inner_variance[static_cast<std::size_t>(b)] =
-            (squares - m * inner_mean * inner_mean) / (m - 1);  // m >= 2
-      }
       keeps_the_data_orders[static_cast<std::size_t>(b)] =
           !estimate.shows_an_order_in_full || replica.kept_in_full == estimate.kept_in_full;
     }
@@ -593,18 +569,6 @@ NoiseCorrectedPv Solve(Rows data, const RowBases& bases, const NoiseCorrectedPvO
   result.value = std::max(0.0, result.fitted_pv - result.bias);  // a PV is never negative
   result.standard_uncertainty = StandardUncertainty(pv, keeps_the_data_orders);
   result.dof = options.replicates - 1.0;
-  if (options.inner_replicates > 0) {
-    // The spread of the bias-corrected replicates, less what the inner draws' own scatter adds to
-    // each replicate's bias (their variance over m); its degrees of freedom by Welch-Satterthwaite.
-    const double spread = StandardUncertainty(corrected, keeps_the_data_orders);
-    const double n = options.replicates, m = options.inner_replicates;
-    const double noise = std::accumulate(inner_variance.begin(), inner_variance.end(), 0.0) / (n * m);
-    const double variance = std::max(spread * spread - noise, 0.0);
-    result.standard_uncertainty = std::sqrt(variance);
-    const double spread_part = spread * spread * spread * spread / (n - 1.0);
-    const double noise_part = noise * noise / (n * (m - 1.0));
-    result.dof = variance > 0.0 ? std::max(1.0, variance * variance / (spread_part + noise_part)) : n - 1.0;
-  }
   return result;
 }
 

@@ -61,12 +61,6 @@ struct NoiseCorrectedPvOptions {
   double across_rows_keep_sd = 3.0;
   // Scale the sigmas to the scatter of the values about the fit (see above).
   bool sigmas_from_residuals = true;
-  // Data sets drawn from each replicate's own fit to find its bias (a double bootstrap, Davison &
-  // Hinkley 1997, 3.9), so that u is the spread of the bias-corrected replicates, the inner draws'
-  // own scatter taken off; 0: u is the spread of the replicates' PVs. Where the bias depends on
-  // the data (a maximum over many rows: the runout, the roundness), subtracting it widens the
-  // estimate's scatter beyond the PVs' spread, by 16 % for the coverage test's runout. 0 or >= 2.
-  int inner_replicates = 0;
   // Seed of the bootstrap's random numbers: the same inputs give the same result.
   std::uint64_t seed = 20261203;
   // Empty when valid, else "NoiseCorrectedPvOptions::replicates = 3 violates >= 20".
@@ -78,14 +72,12 @@ struct NoiseCorrectedPv {
   double fitted_pv = 0.0;  // largest over the rows of the PV of the fitted rows
   double bias = 0.0;       // mean(PV*) - the PV of the fit with its orders kept in part at full size
   double value = 0.0;      // fitted_pv - bias: the noise-corrected estimate
-  double standard_uncertainty = 0.0;  // standard deviation of PV* (see above), or of the
-                                      // bias-corrected PV* with inner_replicates
+  double standard_uncertainty = 0.0;  // standard deviation of PV* (see above)
   int order = 0;                      // the highest order kept that the PV counts
   double sigma_scale = 1.0;           // the Birge ratio the sigmas were scaled by
   int rows_used = 0;                  // rows with enough values to fit
   int replicates = 0;
-  int inner_replicates = 0;
-  double dof = 0.0;  // of standard_uncertainty: replicates - 1, or Welch-Satterthwaite's (inner)
+  double dof = 0.0;  // of standard_uncertainty: replicates - 1
 };
 
 // `values` and `sigmas` hold `rows` rows of `columns` each, row-major; a NaN value is missing

@@ -617,7 +617,8 @@ std::vector<double> MeanResidualProfile(const std::vector<Circle>& circles, cons
 // First and second derivative (per mm, per mm^2) of `profile` at node m: from the five nodes
 // centred on it (errors of order h^4), else the three centred on it, else the three at the end
 // of the finite stretch; 0 where there are fewer than three. With three points only, a 1 um
-// profile wave of 3 mm period at 0.2 mm spacing left 17 nm of runout, with five 2 nm.
+// profile wave of 3 mm period at 0.2 mm spacing left 17 nm in a node's map over the phases, with
+// five 9 nm.
 std::array<double, 2> ProfileDerivatives(const std::vector<double>& f, std::size_t m, double h) {
   const auto finite = [&](long k) {
     return k >= 0 && static_cast<std::size_t>(k) < f.size() && std::isfinite(f[static_cast<std::size_t>(k)]);

@@ -7,9 +7,10 @@
 // noise (for the mean arc radius too: with a profile error the least-squares circle over the band
 // is not the model's 55.4423 mm, by some 0.09 mm here), except the max arc error's: the wheel
 // model's own sections over the band (TrueMaxArcErrorUm), computed here without the pipeline. CI runs
-// ARCWHEEL_COVERAGE_SCANS = 24 scans (default) and checks coverage loosely; the full count, e.g.
-//   ARCWHEEL_COVERAGE_SCANS=200 build/tests/tests_uncertainty_coverage_test
-// prints the figures (docs/uncertainty.md quotes them) and checks 93-97 %.
+// ARCWHEEL_COVERAGE_SCANS = 24 scans (default) and checks coverage loosely; from 200 scans it checks
+// 93-97 %, and the long test of record,
+//   ARCWHEEL_COVERAGE_SCANS=1000 build/tests/tests_uncertainty_coverage_test
+// prints the figures docs/uncertainty.md quotes (at 200, six figures all inside is a coin toss).
 
 #include <fmt/core.h>
 #include <gtest/gtest.h>

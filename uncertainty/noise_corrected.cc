@@ -543,21 +543,19 @@ NoiseCorrectedPv Solve(Rows data, const RowBases& bases, const NoiseCorrectedPvO
       // Boost's ziggurat: standard normal deviates at less than half the cost of the standard
       // library's polar method, which took a fifth of a 1e7-sample scan's processing.
       boost::random::normal_distribution<double> normal(0.0, 1.0);
-      // The raw coefficients of a data set drawn from the fitted world.
-      const auto draw = [&]() {
-        if (draw_coefficients) {
-          Eigen::MatrixXd coefficients = kept_coefficients;
-          for (Eigen::Index j = 0; j < functions; ++j)
-            for (Eigen::Index i = 0; i < n_rows; ++i) coefficients(i, j) += row_sigma[i] * normal(rng);
-          return coefficients;
-        }
+      Eigen::MatrixXd coefficients;
+      if (draw_coefficients) {
+        coefficients = kept_coefficients;
+        for (Eigen::Index j = 0; j < functions; ++j)
+          for (Eigen::Index i = 0; i < n_rows; ++i) coefficients(i, j) += row_sigma[i] * normal(rng);
+      } else {
         Eigen::MatrixXd replicate(n_rows, columns);
         for (Eigen::Index j = 0; j < columns; ++j)
           for (Eigen::Index i = 0; i < n_rows; ++i)
             replicate(i, j) = estimate.fitted(i, j) + sigma(i, j) * normal(rng);
-        return bases.Coefficients(replicate);
-      };
-      const Estimate replica = FromCoefficients(draw(), row_sigma, bases, options);
+        coefficients = bases.Coefficients(replicate);
+      }
+      const Estimate replica = FromCoefficients(std::move(coefficients), row_sigma, bases, options);
       pv[static_cast<std::size_t>(b)] = replica.fitted_pv;
       keeps_the_data_orders[static_cast<std::size_t>(b)] =
           !estimate.shows_an_order_in_full || replica.kept_in_full == estimate.kept_in_full;

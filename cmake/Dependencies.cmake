@@ -10,7 +10,11 @@ find_package(Threads REQUIRED)
 # Boost.Math (header-only): the chi-square distribution of the wheel model's Wald test (fitting/wheel_model_knots.cc).
 find_package(Boost 1.74 REQUIRED)
 # OpenCV: only the Delaunay triangulation (cv::Subdiv2D) for scattered error maps (polishing/).
-find_package(OpenCV REQUIRED COMPONENTS core imgproc)
+# Debian's libopencv-core-dev and libopencv-imgproc-dev carry no CMake package (libopencv-dev,
+# which does, pulls in every module and GDAL): the two libraries and their headers are found directly.
+find_path(OPENCV_INCLUDE_DIR opencv2/imgproc.hpp PATH_SUFFIXES opencv4 REQUIRED)
+find_library(OPENCV_CORE_LIBRARY opencv_core REQUIRED)
+find_library(OPENCV_IMGPROC_LIBRARY opencv_imgproc REQUIRED)
 # The robot's kinematics (polishing/robot_kinematics.cc): orocos KDL, the URDF parser urdfdom and
 # kdl_parser between them. kdl_parser's own CMake package (catkin-generated) looks for ROS's
 # ament tools, which Debian does not ship: its library and header are found directly.

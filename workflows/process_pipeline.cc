@@ -7,6 +7,7 @@
 #include <utility>
 #include <vector>
 
+#include "acquisition/scan_format.h"
 #include "acquisition/scan_reader.h"
 #include "core/error.h"
 #include "core/interrupt.h"
@@ -27,16 +28,10 @@ fitting::RunRecord MakeRecord(const std::string& scan_path, const ProcessPipelin
   // (docs/inputs.md).
   bool latin1_path = false;
   record.input_path = AsUtf8(scan_path, latin1_path);
-  const std::string extension = std::filesystem::path(scan_path).extension().string();
-  // The readers choose by extension (acquisition/scan_reader.h); a scan that no reader made (one
+  // The readers choose by the file name (acquisition/scan_format.h); a scan that no reader made (one
   // simulated in memory and handed over from Python) says so rather than borrow a file format.
-  if (extension == ".h5" || extension == ".hdf5") {
-    record.input_format = "hdf5";
-  } else if (extension == ".csv" || extension == ".txt") {
-    record.input_format = "csv";
-  } else {
-    record.input_format = "memory";
-  }
+  const std::optional<acquisition::ScanFormat> format = acquisition::ScanFormatOfName(scan_path);
+  record.input_format = format ? std::string(acquisition::InfoOf(*format).name) : "memory";
   record.metadata = scan.metadata;
   record.has_encoder = scan.has_encoder();
   const auto& p = options.processing;

@@ -8,8 +8,10 @@
 #include <utility>
 #include <vector>
 
+#include "acquisition/scan_format.h"
 #include "acquisition/scan_metadata_keys.h"
 #include "acquisition/scan_reader.h"
+#include "core/check.h"
 #include "core/error.h"
 #include "core/hdf5.h"
 
@@ -204,16 +206,15 @@ Scan ReadHdf5Scan(const hdf5::File& file, const ReadOptions& options) {
 }
 
 Scan ReadScan(const std::filesystem::path& path, const ReadOptions& options) {
-  std::string extension = path.extension().string();
-  for (char& c : extension) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  if (extension == ".h5" || extension == ".hdf5") return ReadHdf5Scan(path, options);
-  if (extension == ".csv" || extension == ".txt") {
-    if (options.while_reading) options.while_reading();
-    return ReadCsvScan(path);
+  switch (ScanFormatOfFile(path, "acquisition")) {
+    case ScanFormat::kHdf5:
+      return ReadHdf5Scan(path, options);
+    case ScanFormat::kCsv:
+      if (options.while_reading) options.while_reading();
+      return ReadCsvScan(path);
   }
-  throw Error(ErrorCode::kBadInput, "acquisition",
-              "'" + path.string() + "': unknown scan file type '" + extension +
-                  "' (expected .h5, .hdf5, .csv or .txt)");
+  ARCWHEEL_CHECK(false) << "scan format without a reader";
+  return {};
 }
 
 }  // namespace arcwheel::acquisition

@@ -6,6 +6,7 @@
 #include <limits>
 #include <nlohmann/json.hpp>
 
+#include "acquisition/scan_format.h"
 #include "acquisition/scan_reader.h"
 #include "acquisition/simulate.h"
 #include "core/error.h"
@@ -29,6 +30,26 @@ std::string Rows(const std::string& first_rows, char separator = ',') {
   for (int i = 0; i < 400; ++i)
     text += "0.5" + std::string(1, separator) + std::to_string(0.01 + i * 0.001) + "\n";
   return text;
+}
+
+// formats.md section 2 names two layouts and their extensions; case does not matter.
+TEST(ScanFormat, TheExtensionSelectsTheFormatInAnyCase) {
+  EXPECT_EQ(ScanFormatOfName("a/scan.h5"), ScanFormat::kHdf5);
+  EXPECT_EQ(ScanFormatOfName("SCAN.H5"), ScanFormat::kHdf5);
+  EXPECT_EQ(ScanFormatOfName("scan.Hdf5"), ScanFormat::kHdf5);
+  EXPECT_EQ(ScanFormatOfName("scan.CSV"), ScanFormat::kCsv);
+  EXPECT_EQ(ScanFormatOfName("scan.txt"), ScanFormat::kCsv);
+  EXPECT_EQ(ScanFormatOfName("scan.dat"), std::nullopt);
+  EXPECT_EQ(ScanFormatOfName("h5"), std::nullopt);
+  EXPECT_EQ(InfoOf(ScanFormat::kHdf5).name, "hdf5");
+  EXPECT_EQ(InfoOf(ScanFormat::kCsv).name, "csv");
+  EXPECT_EQ(ScanExtensionsText(), ".h5, .hdf5, .csv or .txt");
+}
+
+TEST(ScanFormat, AFileOfNoFormatIsRefusedNamingTheFileAndTheExtensions) {
+  const std::string message = ErrorMessageOf([] { (void)ScanFormatOfFile("dir/scan.dat", "acquisition"); });
+  EXPECT_THAT(message,
+              HasSubstr("'dir/scan.dat': unknown scan file type '.dat' (expected .h5, .hdf5, .csv or .txt)"));
 }
 
 TEST(CsvReader, FoldsAlarmWordsNanAndEmptyCellsIntoInvalidSamples) {

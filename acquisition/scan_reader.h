@@ -24,7 +24,8 @@ struct ReadOptions {
   std::function<void()> while_reading;
 };
 
-// By extension: .h5/.hdf5 -> ReadHdf5Scan, .csv/.txt -> ReadCsvScan; else Error{kBadInput}.
+// By the format the file name selects (scan_format.h, case-insensitive): .h5/.hdf5 -> ReadHdf5Scan,
+// .csv/.txt -> ReadCsvScan; else Error{kBadInput}.
 [[nodiscard]] Scan ReadScan(const std::filesystem::path& path, const ReadOptions& options = {});
 
 // formats.md 2.1: group /scan, dataset /scan/z, optional /scan/t, /scan/angle, /scan/y. The data

@@ -6,6 +6,7 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
+#include "acquisition/scan_format.h"
 #include "acquisition/simulate.h"
 #include "core/atomic_file.h"
 #include "core/error.h"
@@ -112,6 +113,20 @@ void WriteCsvScan(const Scan& scan, const std::string& path) {
     throw Error(ErrorCode::kIo, "acquisition.csv", "cannot write '" + path + "' (disk full?)");
   }
   outputs.Commit();
+}
+
+void WriteScan(const Scan& scan, bool float32, const std::filesystem::path& path) {
+  const std::optional<ScanFormat> format = ScanFormatOfName(path);
+  if (!format) {
+    throw Error(ErrorCode::kInvalidOption, "acquisition",
+                "output '" + path.string() + "' must end in " + ScanExtensionsText());
+  }
+  switch (*format) {
+    case ScanFormat::kHdf5:
+      return WriteHdf5Scan(scan, float32, path.string());
+    case ScanFormat::kCsv:
+      return WriteCsvScan(scan, path.string());
+  }
 }
 
 std::string TruthJson(const WheelModel& wheel, const ScanSettings& s, const SimulationCounts& counts,

@@ -22,6 +22,7 @@
 // The spindle turns at spindle_rpm_true; the file states spindle_rpm_nominal.
 
 #include <cstdint>
+#include <filesystem>
 #include <string>
 #include <vector>
 
@@ -129,6 +130,9 @@ struct SimulatedScan {
 // sensor alarm word -FFFFFFF and dropouts with `nan`.
 void WriteHdf5Scan(const Scan& scan, bool float32, const std::string& path);
 void WriteCsvScan(const Scan& scan, const std::string& path);
+// The writer of the format the file name selects (scan_format.h); Error{kInvalidOption} naming the
+// extensions when no format claims it. `float32` applies to HDF5.
+void WriteScan(const Scan& scan, bool float32, const std::filesystem::path& path);
 
 // The truth JSON: the model, the settings, the injected counts and per-phase truth at
 // `phases` equally spaced phases (arc radius, arc-centre axial and radial position in the rho frame).

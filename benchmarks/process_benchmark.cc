@@ -1,6 +1,6 @@
-// End-to-end `process` throughput: read a float32 HDF5 scan, despike, estimate the speed, build the
-// map, fit every phase, write summary.json and wheel_map.h5 (as `arcwheel process` does, less the
-// SHA-256, which runs on the second core there). Peak memory: benchmarks/process_bench.sh.
+// Stages of `process` in-process: the wheel model's fit, the despiker, and the mean arc radius
+// against the simulated truth at sizes beyond the test suite. `process` end to end, with its wall
+// time and peak memory, is timed by benchmarks/process_bench.sh on the binary itself.
 
 #include <benchmark/benchmark.h>
 
@@ -18,7 +18,6 @@
 
 #include "acquisition/scan_reader.h"
 #include "acquisition/simulate.h"
-#include "fitting/outputs.h"
 #include "fitting/wheel_fit.h"
 #include "fitting/wheel_model.h"
 #include "processing/despike.h"
@@ -49,25 +48,6 @@ const fs::path& ScanWithSamples(double samples) {
     acquisition::WriteHdf5Scan(simulated.scan, true, path.string());
   }
   return path;
-}
-
-void BM_ProcessEndToEnd(benchmark::State& state) {
-  const fs::path& scan_path = ScanWithSamples(static_cast<double>(state.range(0)));
-  const fs::path outdir = fs::temp_directory_path() / "arcwheel-bench-out";
-  std::size_t samples = 0;
-  for (auto _ : state) {
-    acquisition::Scan scan = acquisition::ReadScan(scan_path);
-    samples = scan.size();
-    fitting::RunRecord record;
-    record.input_path = scan_path.string();
-    record.metadata = scan.metadata;
-    const auto processed = processing::ProcessScan(std::move(scan), {});
-    const auto fit = fitting::FitWheel(processed.map, {});
-    fitting::WriteProcessOutputs(outdir, record, processed, fit);
-  }
-  state.counters["samples_per_s"] = benchmark::Counter(
-      static_cast<double>(samples) * static_cast<double>(state.iterations()), benchmark::Counter::kIsRate);
-  state.counters["samples"] = static_cast<double>(samples);
 }
 
 // The wheel model's fit alone (fitting/wheel_model.h), on a scan already processed and fitted per
@@ -236,8 +216,6 @@ BENCHMARK(BM_MeanRadiusAgainstTruth)
     ->Iterations(1)
     ->Unit(benchmark::kSecond)
     ->UseRealTime();
-
-BENCHMARK(BM_ProcessEndToEnd)->Arg(1'000'000)->Arg(10'000'000)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 }  // namespace
 

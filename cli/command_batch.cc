@@ -84,7 +84,7 @@ void AddBatchCommand(CLI::App& app) {
   CLI::App* cmd =
       app.add_subcommand("batch", "process many scans, each into OUTDIR/<scan name>, with an index");
   cmd->footer(
-      "INPUTS: scan files, folders (their *.h5, *.hdf5, *.csv), globs, and @LIST files (one path a\n"
+      "INPUTS: scan files, folders (their *.h5, *.hdf5, *.csv, *.txt), globs, and @LIST files (one path a\n"
       "line, # comments; relative paths from the list's folder). A scan's result folder is named\n"
       "after its file without the extension; two scans of one name are refused.\n"
       "Options after -- go unchanged to every `arcwheel process` (e.g. -- --phases 180 --no-model).\n"

@@ -5,6 +5,8 @@
 #include <filesystem>
 #include <optional>
 #include <string>
+#include <type_traits>
+#include <variant>
 #include <vector>
 
 #include "cli/commands.h"
@@ -17,6 +19,7 @@
 #include "schema/summary.h"
 #include "schema/wheel_map.h"
 #include "store/records.h"
+#include "workflows/process_options.h"
 #include "workflows/process_pipeline.h"
 #include "workflows/record.h"
 
@@ -97,6 +100,37 @@ void RunAndPrint(ProcessArgs& args) {
   }
 }
 
+// One row of the options table as a flag: a number, a switch, a file or a choice, whose unknown
+// name is reported with every other problem (ResolveProcessPipelineOptions).
+void AddTableOption(CLI::App* cmd, const workflows::ProcessOption& row,
+                    workflows::ProcessPipelineOptions& options) {
+  const std::string flag(row.flag);
+  const std::string help(row.help);
+  std::visit(
+      [&](const auto& value) {
+        using T = std::decay_t<decltype(value)>;
+        CLI::Option* option = nullptr;
+        if constexpr (std::is_same_v<T, bool*>) {
+          option = cmd->add_flag(flag, *value, help);
+        } else if constexpr (std::is_same_v<T, workflows::ChoiceRef>) {
+          option = cmd->add_option_function<std::string>(
+              flag,
+              [flag, value, &options](const std::string& name) {
+                workflows::SetChoice(flag, value, name, options);
+              },
+              help);
+          option->default_str(std::string(workflows::NameOf(value)));
+        } else {
+          option = cmd->add_option(flag, *value, help);
+        }
+        constexpr bool kTyped =
+            std::is_same_v<T, int*> || std::is_same_v<T, double*> || std::is_same_v<T, std::string*>;
+        if (row.show_default && kTyped) option->capture_default_str();
+        if (row.existing_file) option->check(CLI::ExistingFile);
+      },
+      row.field(options));
+}
+
 void Run(ProcessArgs& args) {
   workflows::RunRecorded(
       args.db, [&] { RunAndPrint(args); },
@@ -122,34 +156,9 @@ void AddProcessCommand(CLI::App& app) {
       ->required()
       ->check(CLI::ExistingFile);
   cmd->add_option("-o,--output", args->outdir, "output folder")->required();
-  auto& p = args->pipeline.processing;
-  cmd->add_option("--phases", p.map.phases, "phase nodes per turn")->capture_default_str();
-  cmd->add_option("--band-half-width-mm", args->pipeline.fit.band_half_width_mm,
-                  "half width of the grinding band")
-      ->capture_default_str();
-  cmd->add_option("--fit-span", args->pipeline.fit_span, "band: fit inside the band; full: the whole rim")
-      ->capture_default_str();
-  cmd->add_option("--axial-step-mm", p.map.axial_step_mm, "map node spacing (default one helix pitch)");
-  cmd->add_option("--knot-step-deg", p.map.knot_step_deg, "helix spline knot spacing (default 360/phases)");
-  cmd->add_option("--despike", args->pipeline.despike_method,
-                  "median (burst-safe), moving-mean (the paper's), none")
-      ->capture_default_str();
-  cmd->add_option("--despike-window", p.despike.window_half_width, "window half-width, samples")
-      ->capture_default_str();
-  cmd->add_option("--despike-threshold-um", p.despike.threshold_um,
-                  "rejection threshold (default: sigmas x noise)");
-  cmd->add_option("--despike-sigmas", p.despike.threshold_sigmas, "automatic threshold in noise sigmas")
-      ->capture_default_str();
-  cmd->add_option("--rpm-source", args->pipeline.rpm_source, "auto, nominal, encoder or estimate")
-      ->capture_default_str();
-  cmd->add_option("--stuck-run-deg", p.stuck_run_deg,
-                  "drop runs of equal readings lasting this much of a turn (stuck sensor); 0 keeps them")
-      ->capture_default_str();
-  cmd->add_option("--beam-offset-mm", p.beam_offset_mm, "correct a beam offset from the axis (method.md A.7)")
-      ->capture_default_str();
-  cmd->add_option("--wheel-radius-mm", p.wheel_radius_mm, "wheel radius for the beam-offset correction");
-  cmd->add_option("--min-points", args->pipeline.fit.min_points, "fewest section points for a usable phase")
-      ->capture_default_str();
+  for (const workflows::ProcessOption& option : workflows::ProcessOptionTable()) {
+    if (!option.flag.empty()) AddTableOption(cmd, option, args->pipeline);
+  }
   cmd->add_option("--report", args->report_formats,
                   "also render the inspection report: html,pdf (both are written)")
       ->delimiter(',')
@@ -157,24 +166,6 @@ void AddProcessCommand(CLI::App& app) {
   cmd->add_option("--tolerances", args->tolerance_file,
                   "tolerance file for the report's pass/fail (docs/reports.md)")
       ->check(CLI::ExistingFile);
-  cmd->add_option("--model-knots", args->pipeline.model.radius_knots,
-                  "knots per turn of the model's arc radius Ra(c); 0: chosen from the data, 1: constant")
-      ->capture_default_str();
-  cmd->add_option("--model-axial-knots", args->pipeline.model.axial_knots,
-                  "knots per turn of the model's arc-centre axial position a(c); 0: chosen, 1: constant")
-      ->capture_default_str();
-  cmd->add_option("--model-runout-knots", args->pipeline.model.runout_knots,
-                  "knots per turn of the model's arc-centre radial position b(c); 0: chosen")
-      ->capture_default_str();
-  cmd->add_option("--model-profile-step-mm", args->pipeline.model.profile_knot_step_mm,
-                  "knot spacing of the model's common profile error p(u)")
-      ->capture_default_str();
-  cmd->add_flag("--no-model", args->pipeline.no_model, "skip the wheel model (docs/wheel_model.md)");
-  cmd->add_option("--uncertainty", args->pipeline.uncertainty_budget_path,
-                  "type B uncertainty budget (docs/uncertainty.md); default: the simulated sensor's")
-      ->check(CLI::ExistingFile);
-  cmd->add_flag("--no-uncertainty", args->pipeline.no_uncertainty,
-                "leave the uncertainty budget and the noise-corrected figures out of summary.json");
   AddDbOption(cmd, args->db);
   cmd->add_flag("-q,--quiet", args->quiet, "no progress and no headline");
   cmd->add_flag("--timings", args->timings,

@@ -50,15 +50,7 @@ void Run(SimulateArgs& args) {
   args.settings.float32 = !args.float64;
   const acquisition::SimulatedScan simulated = acquisition::SimulateScan(args.wheel, args.settings);
   const std::filesystem::path output(args.output);
-  std::string extension = output.extension().string();
-  if (extension == ".h5" || extension == ".hdf5") {
-    acquisition::WriteHdf5Scan(simulated.scan, args.settings.float32, args.output);
-  } else if (extension == ".csv" || extension == ".txt") {
-    acquisition::WriteCsvScan(simulated.scan, args.output);
-  } else {
-    throw Error(ErrorCode::kInvalidOption, "simulate",
-                "output '" + args.output + "' must end in .h5, .hdf5, .csv or .txt");
-  }
+  acquisition::WriteScan(simulated.scan, args.settings.float32, output);
   const std::string truth_path = args.truth.empty() ? output.string() + ".truth.json" : args.truth;
   WriteFileAtomically(truth_path,
                       acquisition::TruthJson(args.wheel, args.settings, simulated.counts, args.truth_phases));
@@ -77,7 +69,7 @@ void AddSimulateCommand(CLI::App& app) {
       "The truth JSON (OUTPUT.truth.json unless --truth) holds the model, the settings and the\n"
       "per-phase arc radius and centre. Defaults are the paper's scan: 400 x 20 mm wheel, 500 rpm,\n"
       "100 mm/min, 100 us (about 1.3e5 samples).");
-  cmd->add_option("OUTPUT", args->output, "scan file to write (.h5/.hdf5 or .csv)")->required();
+  cmd->add_option("OUTPUT", args->output, "scan file to write (.h5/.hdf5 or .csv/.txt)")->required();
   cmd->add_option("--truth", args->truth, "truth JSON path");
   auto& w = args->wheel;
   auto& s = args->settings;

@@ -21,27 +21,16 @@ namespace {
 
 using arcwheel::ErrorCode;
 
-struct Command {
-  const char* name;
-  void (*add)(CLI::App&);
-};
-
-// The command table: add a row here and a command_<name>.cc beside this file.
-const std::vector<Command> kCommands = {
-    {"simulate", arcwheel::cli::AddSimulateCommand},
-    {"process", arcwheel::cli::AddProcessCommand},
-    {"fit", arcwheel::cli::AddFitCommand},
-    {"toolpath", arcwheel::cli::AddToolpathCommand},
-    {"report", arcwheel::cli::AddReportCommand},
-    {"compare", arcwheel::cli::AddCompareCommand},
-    {"history", arcwheel::cli::AddHistoryCommand},
-    {"frame", arcwheel::cli::AddFrameCommand},
-    {"transform", arcwheel::cli::AddTransformCommand},
-    {"headcenter", arcwheel::cli::AddHeadcenterCommand},
-    {"polish", arcwheel::cli::AddPolishCommand},
-    {"regenerate", arcwheel::cli::AddRegenerateCommand},
-    {"batch", arcwheel::cli::AddBatchCommand},
-    {"db", arcwheel::cli::AddDbCommand},
+// The command table: add a row here and a command_<name>.cc beside this file (each names its
+// command when it adds it).
+const std::vector<void (*)(CLI::App&)> kCommands = {
+    arcwheel::cli::AddSimulateCommand,  arcwheel::cli::AddProcessCommand,
+    arcwheel::cli::AddFitCommand,       arcwheel::cli::AddToolpathCommand,
+    arcwheel::cli::AddReportCommand,    arcwheel::cli::AddCompareCommand,
+    arcwheel::cli::AddHistoryCommand,   arcwheel::cli::AddFrameCommand,
+    arcwheel::cli::AddTransformCommand, arcwheel::cli::AddHeadcenterCommand,
+    arcwheel::cli::AddPolishCommand,    arcwheel::cli::AddRegenerateCommand,
+    arcwheel::cli::AddBatchCommand,     arcwheel::cli::AddDbCommand,
 };
 
 constexpr const char* kExitCodes =
@@ -130,7 +119,7 @@ int main(int argc, char** argv) {
   bool no_catch = false;
   app.add_flag("--no-catch", no_catch, "let errors escape main() so that a debugger stops at the throw");
   app.set_version_flag("--version", std::string("arcwheel ") + arcwheel::kVersion);
-  for (const Command& command : kCommands) command.add(app);
+  for (const auto add : kCommands) add(app);
   app.add_subcommand("version", "print the arcwheel version")->callback([] {
     fmt::print("arcwheel {}\n", arcwheel::kVersion);
   });

@@ -37,9 +37,4 @@ inline constexpr double kMemoryBudgetBytes = 4.0 * 1024.0 * 1024.0 * 1024.0;
       kMemoryBudgetBytes);
 }
 
-// The most items of `bytes_per_item` bytes that fit the budget (for messages and documentation).
-[[nodiscard]] inline double MemoryBudgetItems(double bytes_per_item) {
-  return kMemoryBudgetBytes / bytes_per_item;
-}
-
 }  // namespace arcwheel

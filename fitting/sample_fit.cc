@@ -509,22 +509,11 @@ SlopeTable Slopes(const std::vector<Circle>& circles, double y_low, double y_hig
   return table;
 }
 
-double Mean(const std::vector<double>& v) {
-  return std::accumulate(v.begin(), v.end(), 0.0) / static_cast<double>(v.size());
-}
-
-double Median(std::vector<double> values) {
-  if (values.empty()) return kNaN;
-  const auto middle = values.begin() + static_cast<long>(values.size() / 2);
-  std::nth_element(values.begin(), middle, values.end());
-  return *middle;
-}
-
 // The phase fits, their means, spreads and sigmas (nodes share no samples: the mean's variance is
 // the sum of the nodes' over n^2).
 void Summarise(const std::vector<Circle>& circles, const std::vector<NodeSums>& sums, double band_width_mm,
                bool full, double sigma_mm, const WheelFitOptions& options, WheelFit& out) {
-  std::vector<double> radii, axial, radial, sigmas, chi2;
+  int usable = 0;
   double var_radius = 0.0, var_axial = 0.0;
   for (std::size_t j = 0; j < circles.size(); ++j) {
     const NodeSums& s = sums[j];
@@ -549,52 +538,23 @@ void Summarise(const std::vector<Circle>& circles, const std::vector<NodeSums>& 
         fit.flag = "ill-conditioned: the radius is not determined";
       } else {
         fit.usable = true;
-        radii.push_back(c.r);
-        axial.push_back(c.a);
-        radial.push_back(c.b);
-        sigmas.push_back(fit.arc_radius_sigma_mm);
-        chi2.push_back(fit.chi2_per_dof);
+        ++usable;
         var_radius += covariance(2, 2);
         var_axial += covariance(0, 0);
-        out.max_arc_error_um = std::max(out.max_arc_error_um, fit.arc_error_um);
       }
     } else {
       fit.flag = flag;
     }
     out.phases.push_back(fit);
   }
-  if (radii.empty()) {
+  if (usable == 0) {
     throw Error(ErrorCode::kFitFailed, kStage,
                 "no phase gave a usable arc fit (phase 0: " + out.phases.front().flag + ")");
   }
-  const auto n = static_cast<double>(radii.size());
-  out.usable_phases = static_cast<int>(radii.size());
-  out.mean_arc_radius_mm = Mean(radii);
-  out.mean_center_axial_mm = Mean(axial);
-  out.mean_center_radial_mm = Mean(radial);
-  const auto [r_min, r_max] = std::minmax_element(radii.begin(), radii.end());
-  out.arc_radius_range_mm = *r_max - *r_min;
-  out.arc_radius_fluctuation_pct = out.arc_radius_range_mm / out.mean_arc_radius_mm * 100.0;
-  const auto [a_min, a_max] = std::minmax_element(axial.begin(), axial.end());
-  out.center_axial_deviation_mm = *a_max - *a_min;
-  double var = 0.0, noise = 0.0;
-  for (std::size_t k = 0; k < radii.size(); ++k) {
-    var += (radii[k] - out.mean_arc_radius_mm) * (radii[k] - out.mean_arc_radius_mm);
-    noise += sigmas[k] * sigmas[k];
-  }
-  out.arc_radius_std_mm = std::sqrt(var / std::max(1.0, n - 1.0));
-  out.arc_radius_noise_std_mm = std::sqrt(noise / n);
-  out.arc_radius_excess_std_mm =
-      std::sqrt(std::max(0.0, out.arc_radius_std_mm * out.arc_radius_std_mm -
-                                  out.arc_radius_noise_std_mm * out.arc_radius_noise_std_mm));
-  out.median_chi2_per_dof = Median(chi2);
+  SummariseUsablePhases(out);
+  const auto n = static_cast<double>(usable);
   out.mean_arc_radius_sigma_mm = std::sqrt(var_radius) / n;
   out.mean_center_axial_sigma_mm = std::sqrt(var_axial) / n;
-  const std::size_t n_phase = circles.size();
-  if (out.usable_phases < static_cast<int>(n_phase)) {
-    out.warnings.push_back(fmt::format("{} of {} phases were not usable and are left out of the means",
-                                       n_phase - static_cast<std::size_t>(out.usable_phases), n_phase));
-  }
 }
 
 // The mean over the phases of the cells' residuals at each axial node (NaN where no phase has one).

@@ -111,13 +111,6 @@ PhaseSolution FitSection(const processing::Section& section, double center_mm, d
   return out;
 }
 
-double Median(std::vector<double> values) {
-  if (values.empty()) return kNaN;
-  const auto middle = values.begin() + static_cast<long>(values.size() / 2);
-  std::nth_element(values.begin(), middle, values.end());
-  return *middle;
-}
-
 // Variance of the mean of parameter `row` (kAxialRow, kRadiusRow) over the usable phases,
 // exactly through the helix spline (neighbouring phases share spline coefficients, so their
 // errors correlate).
@@ -244,52 +237,13 @@ void SetBand(const processing::WheelMap& map, const CenteredFits& fits, const Wh
   }
 }
 
-double Mean(const std::vector<double>& v) {
-  return std::accumulate(v.begin(), v.end(), 0.0) / static_cast<double>(v.size());
-}
-
 // Copies the phase fits into `out` and sets the means, spreads and sigmas over the usable ones.
 void SummarisePhases(const std::vector<PhaseSolution>& solutions, const processing::WheelMap& map,
                      WheelFit& out) {
-  std::vector<double> radii, axial, radial, sigmas, chi2;
-  for (const auto& s : solutions) {
-    out.phases.push_back(s.fit);
-    if (!s.fit.usable) continue;
-    radii.push_back(s.fit.arc_radius_mm);
-    axial.push_back(s.fit.center_axial_mm);
-    radial.push_back(s.fit.center_radial_mm);
-    sigmas.push_back(s.fit.arc_radius_sigma_mm);
-    chi2.push_back(s.fit.chi2_per_dof);
-    out.max_arc_error_um = std::max(out.max_arc_error_um, s.fit.arc_error_um);
-  }
-  const auto n = static_cast<double>(radii.size());
-  out.usable_phases = static_cast<int>(radii.size());
-  out.mean_arc_radius_mm = Mean(radii);
-  out.mean_center_axial_mm = Mean(axial);
-  out.mean_center_radial_mm = Mean(radial);
-  const auto [r_min, r_max] = std::minmax_element(radii.begin(), radii.end());
-  out.arc_radius_range_mm = *r_max - *r_min;
-  out.arc_radius_fluctuation_pct = out.arc_radius_range_mm / out.mean_arc_radius_mm * 100.0;
-  const auto [a_min, a_max] = std::minmax_element(axial.begin(), axial.end());
-  out.center_axial_deviation_mm = *a_max - *a_min;
-  double var = 0.0, noise = 0.0;
-  for (std::size_t k = 0; k < radii.size(); ++k) {
-    var += (radii[k] - out.mean_arc_radius_mm) * (radii[k] - out.mean_arc_radius_mm);
-    noise += sigmas[k] * sigmas[k];
-  }
-  out.arc_radius_std_mm = std::sqrt(var / std::max(1.0, n - 1.0));
-  out.arc_radius_noise_std_mm = std::sqrt(noise / n);
-  out.arc_radius_excess_std_mm =
-      std::sqrt(std::max(0.0, out.arc_radius_std_mm * out.arc_radius_std_mm -
-                                  out.arc_radius_noise_std_mm * out.arc_radius_noise_std_mm));
-  out.median_chi2_per_dof = Median(chi2);
+  for (const auto& s : solutions) out.phases.push_back(s.fit);
+  SummariseUsablePhases(out);
   out.mean_arc_radius_sigma_mm = SigmaOfMean(solutions, kRadiusRow, map);
   out.mean_center_axial_sigma_mm = SigmaOfMean(solutions, kAxialRow, map);
-  const std::size_t n_phase = map.n_phase();
-  if (out.usable_phases < static_cast<int>(n_phase)) {
-    out.warnings.push_back(fmt::format("{} of {} phases were not usable and are left out of the means",
-                                       n_phase - static_cast<std::size_t>(out.usable_phases), n_phase));
-  }
 }
 
 bool InBand(double y_mm, const WheelFit& fit) {
@@ -376,12 +330,6 @@ std::vector<std::string> WheelFitOptions::Problems() const {
     problems.push_back(fmt::format("min_phase_coverage = {} violates (0, 1]", min_phase_coverage));
   for (const std::string& p : circle.Problems()) problems.push_back("circle." + p);
   return problems;
-}
-
-FitSpan ParseFitSpan(const std::string& name) {
-  if (name == "band") return FitSpan::kBand;
-  if (name == "full") return FitSpan::kFull;
-  throw Error(ErrorCode::kInvalidOption, kStage, "unknown fit span '" + name + "' (expected band or full)");
 }
 
 WheelFit FitWheel(const processing::WheelMap& map, const WheelFitOptions& options) {

@@ -24,8 +24,6 @@ struct WheelFitOptions {
   [[nodiscard]] std::vector<std::string> Problems() const;
 };
 
-[[nodiscard]] FitSpan ParseFitSpan(const std::string& name);
-
 struct PhaseFit {
   double arc_radius_mm = 0, arc_radius_sigma_mm = 0;
   double center_axial_mm = 0, center_axial_sigma_mm = 0;
@@ -66,6 +64,14 @@ struct WheelFit {
 // Throws Error{kFitFailed} when no phase gives a usable fit, kBadInput when the band lies
 // outside the scanned span.
 [[nodiscard]] WheelFit FitWheel(const processing::WheelMap& map, const WheelFitOptions& options);
+
+// The headline figures over the usable phases of fit.phases (method.md A.6): their count, the
+// means, the arc radius's range, fluctuation and standard deviations (of the fits, of the noise and
+// the excess beyond it), the arc centre's axial deviation, the median chi-square per degree of
+// freedom, the largest arc error, and a warning when some phases are left out. At least one phase
+// must be usable. The sigmas of the means are the caller's: they depend on whether the phases
+// share samples.
+void SummariseUsablePhases(WheelFit& fit);
 
 // Runout and roundness at the map's axial nodes in the band, the mean profile error and the form
 // error, for a fit whose phases, means and band are already set (FitWheel's last steps; the

@@ -9,6 +9,7 @@
 #include <numbers>
 
 #include "core/error.h"
+#include "core/statistics.h"
 
 namespace arcwheel::frames {
 namespace {
@@ -29,12 +30,6 @@ constexpr std::array<Channel, 7> kChannels = {{
     {"My_Nmm", &ForceRecord::my_Nmm},
     {"Mz_Nmm", &ForceRecord::mz_Nmm},
 }};
-
-double Median(std::vector<double> values) {
-  const auto middle = values.begin() + static_cast<std::ptrdiff_t>(values.size() / 2);
-  std::nth_element(values.begin(), middle, values.end());
-  return *middle;
-}
 
 }  // namespace
 

@@ -50,9 +50,6 @@ class BandedSpd {
   [[nodiscard]] double Inverse(std::size_t i, std::size_t j) const {
     return i <= j ? z_[i][j - i] : z_[j][i - j];
   }
-  // Frees the selected inverse (Inverse and InverseInBand may not be called after). Swapped out:
-  // `z_ = {}` would pick the initializer-list assignment, which keeps the capacity.
-  void ReleaseSelectedInverse() { BandRows().swap(z_); }
   [[nodiscard]] bool HasSelectedInverse() const { return z_.size() == n_; }
   // Inverse(i, i + d) for d = 0..3.
   [[nodiscard]] double InverseInBand(std::size_t i, int d) const {

@@ -505,26 +505,6 @@ std::vector<std::string> DespikeOptions::Problems() const {
   return problems;
 }
 
-DespikeMethod ParseDespikeMethod(const std::string& name) {
-  if (name == "median") return DespikeMethod::kMedian;
-  if (name == "moving-mean") return DespikeMethod::kMovingMean;
-  if (name == "none") return DespikeMethod::kNone;
-  throw Error(ErrorCode::kInvalidOption, "processing.despike",
-              "unknown method '" + name + "' (expected median, moving-mean or none)");
-}
-
-std::string DespikeMethodName(DespikeMethod method) {
-  switch (method) {
-    case DespikeMethod::kMedian:
-      return "median";
-    case DespikeMethod::kMovingMean:
-      return "moving-mean";
-    case DespikeMethod::kNone:
-      return "none";
-  }
-  return "none";
-}
-
 DespikeResult Despike(std::span<double> z_mm, double noise_sigma_mm, const DespikeOptions& options) {
   return DespikeSamples(z_mm, noise_sigma_mm, options);
 }

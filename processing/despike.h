@@ -33,9 +33,6 @@ struct DespikeOptions {
   [[nodiscard]] std::vector<std::string> Problems() const;
 };
 
-[[nodiscard]] DespikeMethod ParseDespikeMethod(const std::string& name);
-[[nodiscard]] std::string DespikeMethodName(DespikeMethod method);
-
 struct DespikeResult {
   std::size_t rejected = 0;          // samples replaced or dropped
   double threshold_um = 0.0;         // the threshold used

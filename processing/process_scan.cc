@@ -203,29 +203,6 @@ std::vector<std::string> ProcessOptions::Problems() const {
   return problems;
 }
 
-RpmSource ParseRpmSource(const std::string& name) {
-  if (name == "auto") return RpmSource::kAuto;
-  if (name == "nominal") return RpmSource::kNominal;
-  if (name == "encoder") return RpmSource::kEncoder;
-  if (name == "estimate") return RpmSource::kEstimate;
-  throw Error(ErrorCode::kInvalidOption, kStage,
-              "unknown rpm source '" + name + "' (expected auto, nominal, encoder or estimate)");
-}
-
-std::string RpmSourceName(RpmSource source) {
-  switch (source) {
-    case RpmSource::kAuto:
-      return "auto";
-    case RpmSource::kNominal:
-      return "nominal";
-    case RpmSource::kEncoder:
-      return "encoder";
-    case RpmSource::kEstimate:
-      return "estimate";
-  }
-  return "auto";
-}
-
 ProcessedScan ProcessScan(acquisition::Scan scan, const ProcessOptions& options) {
   return ProcessScanInPlace(scan, options);
 }

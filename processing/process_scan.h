@@ -40,9 +40,6 @@ struct ProcessOptions {
   [[nodiscard]] std::vector<std::string> Problems() const;
 };
 
-[[nodiscard]] RpmSource ParseRpmSource(const std::string& name);
-[[nodiscard]] std::string RpmSourceName(RpmSource source);
-
 struct ProcessedScan {
   std::size_t samples = 0;
   std::size_t valid_samples = 0;  // before despiking

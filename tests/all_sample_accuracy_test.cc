@@ -323,7 +323,8 @@ TEST(SampleFitRuns, ALinearScanGivesTheFitsOfTheSampleBySamplePath) {
     workflows::ProcessPipelineOptions options;
     options.no_model = true;
     options.no_uncertainty = true;
-    options.rpm_source = "nominal";  // the same phase whichever columns the scan has
+    options.processing.rpm_source =
+        processing::RpmSource::kNominal;  // the same phase whichever columns the scan has
     Progress progress(false);
     fits.push_back(workflows::RunProcessPipeline(std::move(simulated.scan), "", "", options, progress).fit);
   }

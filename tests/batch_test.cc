@@ -229,6 +229,26 @@ TEST(Batch, RefusesAProcessOptionTypoBeforeRunningAnything) {
   EXPECT_FALSE(fs::exists(dir / "out"));
 }
 
+// A folder's scans are the files of every extension `process` reads, in any case: the record of
+// each names the format its reader used; a file of another type is left out.
+TEST(Batch, TakesEveryExtensionProcessReadsInAnyCase) {
+  TempDir dir;
+  fs::create_directories(dir / "scans");
+  const std::map<std::string, std::string> format_of = {
+      {"a.h5", "hdf5"}, {"b.HDF5", "hdf5"}, {"c.Csv", "csv"}, {"d.txt", "csv"}, {"e.TXT", "csv"}};
+  int seed = 1;
+  for (const auto& [name, format] : format_of) Simulate(dir / "scans" / name, seed++, 55.0);
+  WriteText(dir / "scans" / "notes.md", "not a scan\n");
+  const auto run = RunArcwheel("batch " + (dir / "scans").string() + " -o " + (dir / "out").string() +
+                               " -- --no-model --no-uncertainty");
+  ASSERT_EQ(run.exit_status, 0) << run.output;
+  EXPECT_EQ(ReadJson(dir / "out" / "index.json")["scans"].size(), format_of.size());
+  for (const auto& [name, format] : format_of) {
+    const json summary = ReadJson(dir / "out" / fs::path(name).stem() / "summary.json");
+    EXPECT_EQ(summary["input"]["format"], format) << name;
+  }
+}
+
 // A list file names scans relative to itself; the process options reach every child (the
 // summaries record the phases used).
 TEST(Batch, TakesAListFileAndPassesTheProcessOptionsThrough) {

@@ -7,6 +7,7 @@
 #include <regex>
 #include <sstream>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "acquisition/simulate.h"
@@ -47,6 +48,20 @@ TEST(Cli, SimulateThenProcessWritesTheContractKeys) {
               4 * s["mean_arc_radius_sigma_mm"].get<double>());
   // Runout of a pure 4 um eccentricity is 8 um, plus the noise's peak-to-valley.
   EXPECT_NEAR(s["max_runout_um"].get<double>(), 8.0, 1.5);
+}
+
+// The file name's extension selects the reader in any case, and the record names that reader's
+// format: an upper-case `SCAN.H5` is an HDF5 scan, not one from memory.
+TEST(Cli, AnUpperCaseExtensionIsReadAndRecordedAsItsFormat) {
+  TempDir dir;
+  for (const auto& [name, format] : {std::pair{"SCAN.H5", "hdf5"}, std::pair{"SCAN.TXT", "csv"}}) {
+    const std::filesystem::path scan = dir / name;
+    ASSERT_EQ(RunArcwheel("simulate " + scan.string() + " --feed-mm-per-min 400").exit_status, 0) << name;
+    const std::filesystem::path out = dir / (std::string(format) + "_out");
+    const auto run = RunArcwheel("process -q --no-model " + scan.string() + " -o " + out.string());
+    ASSERT_EQ(run.exit_status, 0) << run.output;
+    EXPECT_EQ(ReadJson(out / "summary.json")["input"]["format"], format) << name;
+  }
 }
 
 // --timings: a line per stage, in the order they ran, with wall time, CPU time of all threads and

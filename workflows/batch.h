@@ -12,7 +12,7 @@
 namespace arcwheel::workflows {
 
 struct BatchOptions {
-  // Scan files, folders (their *.h5, *.hdf5, *.csv), globs and @LIST files.
+  // Scan files, folders (their *.h5, *.hdf5, *.csv, *.txt), globs and @LIST files.
   std::vector<std::string> inputs;
   std::string outdir;
   int jobs = 1;  // scans processed at once, >= 1

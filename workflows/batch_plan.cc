@@ -6,6 +6,7 @@
 #include <fstream>
 #include <map>
 
+#include "acquisition/scan_format.h"
 #include "core/error.h"
 #include "workflows/batch_internal.h"
 
@@ -13,15 +14,7 @@ namespace arcwheel::workflows::batch {
 
 namespace {
 
-std::string Lower(std::string text) {
-  std::transform(text.begin(), text.end(), text.begin(), [](unsigned char c) { return std::tolower(c); });
-  return text;
-}
-
-bool IsScanFile(const fs::path& path) {
-  const std::string extension = Lower(path.extension().string());
-  return extension == ".h5" || extension == ".hdf5" || extension == ".csv";
-}
+bool IsScanFile(const fs::path& path) { return acquisition::ScanFormatOfName(path).has_value(); }
 
 std::vector<fs::path> ScansInFolder(const fs::path& folder) {
   std::vector<fs::path> scans;
@@ -74,7 +67,7 @@ std::vector<fs::path> ExpandInput(const std::string& input) {
     std::vector<fs::path> scans = ScansInFolder(input);
     if (scans.empty()) {
       throw Error(ErrorCode::kInvalidOption, kStage,
-                  fmt::format("the folder '{}' holds no .h5, .hdf5 or .csv scan", input));
+                  fmt::format("the folder '{}' holds no {} scan", input, acquisition::ScanExtensionsText()));
     }
     return scans;
   }

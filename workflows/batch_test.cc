@@ -33,10 +33,11 @@ std::vector<std::string> Names(const std::vector<batch::Scan>& scans) {
 
 TEST(BatchPlan, TakesAFoldersScansInOrderAndEachFileOnce) {
   TempDir dir;
-  for (const char* name : {"b.h5", "a.csv", "c.HDF5", "notes.txt"}) WriteText(dir / name, "x");
+  // Every extension `process` reads, in any case (a CSV scan may end in .txt); other files are not scans.
+  for (const char* name : {"b.h5", "a.csv", "c.HDF5", "d.TXT", "notes.md"}) WriteText(dir / name, "x");
   const std::vector<batch::Scan> scans =
       batch::PlanScans({dir.path().string(), (dir / "a.csv").string(), (dir / "b.h5").string()});
-  EXPECT_THAT(Names(scans), ::testing::ElementsAre("a", "b", "c"));
+  EXPECT_THAT(Names(scans), ::testing::ElementsAre("a", "b", "c", "d"));
 }
 
 TEST(BatchPlan, ReadsAListFileWithCommentsAndPathsRelativeToIt) {

@@ -1,13 +1,15 @@
 #include "workflows/process_pipeline.h"
 
-#include <fmt/core.h>
-
 #include <future>
 #include <span>
+#include <type_traits>
 #include <utility>
+#include <variant>
 #include <vector>
 
+#include "acquisition/scan_format.h"
 #include "acquisition/scan_reader.h"
+#include "core/check.h"
 #include "core/error.h"
 #include "core/interrupt.h"
 #include "core/sha256.h"
@@ -16,6 +18,7 @@
 #include "processing/helix_geometry.h"
 #include "schema/summary.h"
 #include "uncertainty/default_budget.h"
+#include "workflows/process_options.h"
 
 namespace arcwheel::workflows {
 namespace {
@@ -27,47 +30,34 @@ fitting::RunRecord MakeRecord(const std::string& scan_path, const ProcessPipelin
   // (docs/inputs.md).
   bool latin1_path = false;
   record.input_path = AsUtf8(scan_path, latin1_path);
-  const std::string extension = std::filesystem::path(scan_path).extension().string();
-  // The readers choose by extension (acquisition/scan_reader.h); a scan that no reader made (one
+  // The readers choose by the file name (acquisition/scan_format.h); a scan that no reader made (one
   // simulated in memory and handed over from Python) says so rather than borrow a file format.
-  if (extension == ".h5" || extension == ".hdf5") {
-    record.input_format = "hdf5";
-  } else if (extension == ".csv" || extension == ".txt") {
-    record.input_format = "csv";
-  } else {
-    record.input_format = "memory";
-  }
+  const std::optional<acquisition::ScanFormat> format = acquisition::ScanFormatOfName(scan_path);
+  record.input_format = format ? std::string(acquisition::InfoOf(*format).name) : "memory";
   record.metadata = scan.metadata;
   record.has_encoder = scan.has_encoder();
-  const auto& p = options.processing;
+  // The parameters as the options table records them, in its order; then what the record states
+  // beside the options.
+  ProcessPipelineOptions bound = options;
+  for (const ProcessOption& option : ProcessOptionTable()) {
+    if (option.record_key.empty()) continue;
+    const std::string key(option.record_key);
+    std::visit(
+        [&](const auto& value) {
+          using T = std::decay_t<decltype(value)>;
+          if constexpr (std::is_same_v<T, ChoiceRef>) {
+            record.text_parameters.emplace_back(key, std::string(NameOf(value)));
+          } else if constexpr (std::is_same_v<T, int*> || std::is_same_v<T, double*>) {
+            record.numeric_parameters.emplace_back(key, static_cast<double>(*value));
+          } else {
+            ARCWHEEL_CHECK(false) << "no record of option " << key;
+          }
+        },
+        option.field(bound));
+  }
   namespace parameter = schema::summary::processing;
-  record.numeric_parameters = {
-      {std::string(parameter::kPhases), p.map.phases},
-      {std::string(parameter::kBandHalfWidthMm), options.fit.band_half_width_mm},
-      {std::string(parameter::kDespikeWindowHalfWidth), p.despike.window_half_width},
-      {std::string(parameter::kDespikeThresholdUm), p.despike.threshold_um},
-      {std::string(parameter::kDespikeThresholdSigmas), p.despike.threshold_sigmas},
-      {std::string(parameter::kDespikeMinThresholdUm), p.despike.min_threshold_um},
-      {std::string(parameter::kSpeedMaxHarmonic), p.speed.max_harmonic},
-      {std::string(parameter::kSpeedSignificanceSigmas), p.speed.significance_sigmas},
-      {std::string(parameter::kMapMinSupport), p.map.min_support},
-      {std::string(parameter::kMapMaxSigmaRatio), p.map.max_sigma_ratio},
-      {std::string(parameter::kFitMinPoints), options.fit.min_points},
-      {std::string(parameter::kFitMinBandCoverage), options.fit.min_band_coverage},
-      {std::string(parameter::kRunoutMinPhaseCoverage), options.fit.min_phase_coverage},
-      {std::string(parameter::kBeamOffsetMm), p.beam_offset_mm},
-      {std::string(parameter::kWheelRadiusMm), p.wheel_radius_mm},
-      {std::string(parameter::kStuckRunDeg), p.stuck_run_deg},
-      {std::string(parameter::kModelKnots), options.model.radius_knots},
-      {std::string(parameter::kModelAxialKnots), options.model.axial_knots},
-      {std::string(parameter::kModelRunoutKnots), options.model.runout_knots},
-      {std::string(parameter::kModelProfileStepMm), options.model.profile_knot_step_mm},
-  };
-  record.text_parameters = {{std::string(parameter::kDespikeMethod), options.despike_method},
-                            {std::string(parameter::kRpmSource), options.rpm_source},
-                            {std::string(parameter::kFitSpan), options.fit_span},
-                            {std::string(parameter::kFilter), "none"},
-                            {std::string(parameter::kModel), options.no_model ? "off" : "on"}};
+  record.text_parameters.emplace_back(parameter::kFilter, "none");
+  record.text_parameters.emplace_back(parameter::kModel, options.no_model ? "off" : "on");
   return record;
 }
 
@@ -87,19 +77,6 @@ std::optional<fitting::WheelModel> FitModelUnlessOff(const ProcessPipelineOption
     if (e.code() != ErrorCode::kFitFailed) throw;
     processed.warnings.push_back(std::string("no wheel model: ") + e.what());
     return std::nullopt;
-  }
-}
-
-// The value of a choice option, or a problem in the form of Problems(): "--flag = value violates
-// one of ...".
-template <typename Parse, typename Value>
-void ParseChoice(const char* flag, const std::string& text, const char* choices, Parse parse, Value& value,
-                 std::vector<std::string>& problems) {
-  try {
-    value = parse(text);
-  } catch (const Error& e) {
-    if (e.code() != ErrorCode::kInvalidOption) throw;
-    problems.push_back(fmt::format("{} = {} violates {}", flag, text, choices));
   }
 }
 
@@ -224,13 +201,7 @@ ProcessPipelineResult RunOnScan(acquisition::Scan scan, const std::string& scan_
 void ResolveProcessPipelineOptions(ProcessPipelineOptions& options) {
   // Every bad option of both stages in one message, before the scan is read: the fit's would
   // otherwise surface only after the whole scan had been processed.
-  std::vector<std::string> problems;
-  ParseChoice("--despike", options.despike_method, "median, moving-mean or none",
-              processing::ParseDespikeMethod, options.processing.despike.method, problems);
-  ParseChoice("--rpm-source", options.rpm_source, "auto, nominal, encoder or estimate",
-              processing::ParseRpmSource, options.processing.rpm_source, problems);
-  ParseChoice("--fit-span", options.fit_span, "band or full", fitting::ParseFitSpan, options.fit.fit_span,
-              problems);
+  std::vector<std::string> problems = options.binding_problems;
   for (std::string& problem : options.processing.Problems()) problems.push_back(std::move(problem));
   for (std::string& problem : options.fit.Problems()) problems.push_back(std::move(problem));
   if (!options.no_model) {

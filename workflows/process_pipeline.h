@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "acquisition/scan.h"
 #include "core/progress.h"
@@ -21,18 +22,13 @@
 
 namespace arcwheel::workflows {
 
-// Every option of `arcwheel process` that reaches the computation, at the command's defaults.
+// Every option of `arcwheel process` that reaches the computation, at the command's defaults; the
+// command line, Python and the run record bind them from one table (process_options.h).
 struct ProcessPipelineOptions {
   processing::ProcessOptions processing;
   fitting::WheelFitOptions fit;
   fitting::WheelModelOptions model;
   bool no_model = false;  // skip the wheel model
-  // The choice options as the command line spells them: "median", "moving-mean" or "none";
-  // "auto", "nominal", "encoder" or "estimate"; "band" or "full". The pipeline parses them into
-  // the structs above (processing.despike.method, processing.rpm_source, fit.fit_span).
-  std::string despike_method = "median";
-  std::string rpm_source = "auto";
-  std::string fit_span = "band";
   // The uncertainty of every headline figure (docs/uncertainty.md): the type B budget file
   // (`--uncertainty FILE`; empty = the default budget of the simulated sensor), read and checked
   // with the other options, before the scan; `no_uncertainty` leaves summary.json without it.
@@ -43,11 +39,14 @@ struct ProcessPipelineOptions {
   // scan: with the uncertainty, every toleranced quantity is decided by the file's rule (ISO
   // 14253-1 by default) and summary.json's "uncertainty" carries the rule and the decisions.
   std::optional<reports::Tolerances> tolerances;
+  // Problems met while the options were bound from text (an unknown choice, process_options.h),
+  // reported by ResolveProcessPipelineOptions with every other problem.
+  std::vector<std::string> binding_problems;
   // Filled by ResolveProcessPipelineOptions from uncertainty_budget_path.
   std::optional<uncertainty::BudgetFile> uncertainty_budget;
 };
 
-// Parses the choice options into the structs and checks every option of both stages (and of the
+// Checks every option of both stages (and of the
 // model unless no_model); throws one Error{kInvalidOption, "process"} listing every problem.
 void ResolveProcessPipelineOptions(ProcessPipelineOptions& options);
 

@@ -119,7 +119,8 @@ def process(scan_or_path: Union[Scan, str, os.PathLike], output_dir: Union[str, 
     """Runs `arcwheel process` on a scan file or a Scan (read_scan, simulate) and returns a Result.
 
     options are the command's, in snake_case (PROCESS_OPTIONS holds them with their defaults), e.g.
-    phases=180, band_half_width_mm=6.0, despike="moving-mean", no_model=True. With output_dir, the
+    phases=180, band_half_width_mm=6.0, despike="moving-mean", no_model=True, uncertainty="budget.json",
+    no_uncertainty=True. With output_dir, the
     command's files (summary.json, wheel_map.h5) are written there too, and with report=True its
     HTML and PDF report (tolerances: a tolerance file, docs/reports.md).
 
@@ -127,6 +128,8 @@ def process(scan_or_path: Union[Scan, str, os.PathLike], output_dir: Union[str, 
     Raises InvalidOptionError, BadInputError, IoError or FitFailedError; Ctrl-C raises
     KeyboardInterrupt (and leaves no partial output file).
     """
+    if options.get("uncertainty") is not None:
+        options["uncertainty"] = os.fspath(options["uncertainty"])
     parts = _arcwheel._process(scan_or_path, output_dir=_path_or_none(output_dir), report=report,
                                tolerances=_path_or_none(tolerances), **options)
     return Result(**parts)

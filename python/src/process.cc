@@ -4,7 +4,9 @@
 #include <cmath>
 #include <filesystem>
 #include <string>
+#include <type_traits>
 #include <utility>
+#include <variant>
 #include <vector>
 
 #include "core/progress.h"
@@ -14,6 +16,7 @@
 #include "reports/tolerances.h"
 #include "schema/summary.h"
 #include "schema/wheel_map.h"
+#include "workflows/process_options.h"
 #include "workflows/process_pipeline.h"
 
 namespace arcwheel::python {
@@ -22,48 +25,44 @@ namespace {
 using Options = workflows::ProcessPipelineOptions;
 namespace h5 = schema::wheel_map;
 
-// The options of `arcwheel process` that reach the computation, named as its flags in snake_case.
+// The options of `arcwheel process` that reach the computation (workflows/process_options.h), named
+// as its flags in snake_case.
+OptionField<Options> FieldOf(const workflows::ProcessOption& row) {
+  const std::string flag(row.flag);
+  return {workflows::KeywordOf(row.flag),
+          [row](const Options& options) {
+            return std::visit(
+                [](const auto& value) -> py::object {
+                  if constexpr (std::is_same_v<std::decay_t<decltype(value)>, workflows::ChoiceRef>) {
+                    return py::str(std::string(workflows::NameOf(value)));
+                  } else {
+                    return py::cast(*value);
+                  }
+                },
+                row.field(const_cast<Options&>(options)));
+          },
+          [row, flag](Options& options, py::handle given) {
+            std::visit(
+                [&](const auto& value) {
+                  using T = std::decay_t<decltype(value)>;
+                  if constexpr (std::is_same_v<T, workflows::ChoiceRef>) {
+                    workflows::SetChoice(flag, value, given.cast<std::string>(), options);
+                  } else {
+                    *value = given.cast<std::remove_pointer_t<T>>();
+                  }
+                },
+                row.field(options));
+          }};
+}
+
 const std::vector<OptionField<Options>>& ProcessFields() {
-  static const std::vector<OptionField<Options>> fields = {
-      Field<Options>(
-          "phases", [](Options & o) -> auto& { return o.processing.map.phases; }),
-      Field<Options>(
-          "band_half_width_mm", [](Options & o) -> auto& { return o.fit.band_half_width_mm; }),
-      Field<Options>(
-          "fit_span", [](Options & o) -> auto& { return o.fit_span; }),
-      Field<Options>(
-          "axial_step_mm", [](Options & o) -> auto& { return o.processing.map.axial_step_mm; }),
-      Field<Options>(
-          "knot_step_deg", [](Options & o) -> auto& { return o.processing.map.knot_step_deg; }),
-      Field<Options>(
-          "despike", [](Options & o) -> auto& { return o.despike_method; }),
-      Field<Options>(
-          "despike_window", [](Options & o) -> auto& { return o.processing.despike.window_half_width; }),
-      Field<Options>(
-          "despike_threshold_um", [](Options & o) -> auto& { return o.processing.despike.threshold_um; }),
-      Field<Options>(
-          "despike_sigmas", [](Options & o) -> auto& { return o.processing.despike.threshold_sigmas; }),
-      Field<Options>(
-          "rpm_source", [](Options & o) -> auto& { return o.rpm_source; }),
-      Field<Options>(
-          "stuck_run_deg", [](Options & o) -> auto& { return o.processing.stuck_run_deg; }),
-      Field<Options>(
-          "beam_offset_mm", [](Options & o) -> auto& { return o.processing.beam_offset_mm; }),
-      Field<Options>(
-          "wheel_radius_mm", [](Options & o) -> auto& { return o.processing.wheel_radius_mm; }),
-      Field<Options>(
-          "min_points", [](Options & o) -> auto& { return o.fit.min_points; }),
-      Field<Options>(
-          "model_knots", [](Options & o) -> auto& { return o.model.radius_knots; }),
-      Field<Options>(
-          "model_axial_knots", [](Options & o) -> auto& { return o.model.axial_knots; }),
-      Field<Options>(
-          "model_runout_knots", [](Options & o) -> auto& { return o.model.runout_knots; }),
-      Field<Options>(
-          "model_profile_step_mm", [](Options & o) -> auto& { return o.model.profile_knot_step_mm; }),
-      Field<Options>(
-          "no_model", [](Options & o) -> auto& { return o.no_model; }),
-  };
+  static const std::vector<OptionField<Options>> fields = [] {
+    std::vector<OptionField<Options>> made;
+    for (const workflows::ProcessOption& row : workflows::ProcessOptionTable()) {
+      if (!row.flag.empty()) made.push_back(FieldOf(row));
+    }
+    return made;
+  }();
   return fields;
 }
 

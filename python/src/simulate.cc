@@ -168,18 +168,6 @@ acquisition::Scan AsWritten(acquisition::Scan scan, bool float32) {
   return scan;
 }
 
-void WriteScanFile(const acquisition::Scan& scan, bool float32, const std::filesystem::path& output) {
-  const std::string extension = output.extension().string();
-  if (extension == ".h5" || extension == ".hdf5") {
-    acquisition::WriteHdf5Scan(scan, float32, output.string());
-  } else if (extension == ".csv" || extension == ".txt") {
-    acquisition::WriteCsvScan(scan, output.string());
-  } else {
-    throw Error(ErrorCode::kInvalidOption, "simulate",
-                "output '" + output.string() + "' must end in .h5, .hdf5, .csv or .txt");
-  }
-}
-
 py::tuple Simulate(const std::optional<std::filesystem::path>& output,
                    const std::optional<std::filesystem::path>& truth, const py::kwargs& kwargs) {
   SimulateOptions given;
@@ -190,7 +178,7 @@ py::tuple Simulate(const std::optional<std::filesystem::path>& output,
     acquisition::SimulatedScan simulated = acquisition::SimulateScan(o.wheel, o.settings);
     std::string text = acquisition::TruthJson(o.wheel, o.settings, simulated.counts, o.truth_phases);
     if (output) {
-      WriteScanFile(simulated.scan, o.settings.float32, *output);
+      acquisition::WriteScan(simulated.scan, o.settings.float32, *output);
       WriteFileAtomically(truth ? *truth : std::filesystem::path(output->string() + ".truth.json"), text);
       simulated.scan.path = output->string();
     }

@@ -117,3 +117,16 @@ def test_options_change_the_computation(simulated):
     assert result.summary["band_half_width_mm"] == 3.0
     assert set(arcwheel.PROCESS_OPTIONS) >= {"phases", "despike", "rpm_source", "no_model", "model_knots"}
     assert arcwheel.PROCESS_OPTIONS["phases"] == 360
+
+
+def test_the_uncertainty_options_reach_the_pipeline(simulated, tmp_path):
+    path, _, _ = simulated
+    without = arcwheel.process(path, no_model=True, no_uncertainty=True)
+    assert "uncertainty" not in without.summary
+    assert arcwheel.PROCESS_OPTIONS["no_uncertainty"] is False
+    assert arcwheel.PROCESS_OPTIONS["uncertainty"] == ""
+    # A budget file is read before the scan: one that is not JSON is refused, naming the file.
+    budget = tmp_path / "budget.json"
+    budget.write_text("{ not json")
+    with pytest.raises(arcwheel.InvalidOptionError, match="budget.json"):
+        arcwheel.process(path, no_model=True, uncertainty=budget)

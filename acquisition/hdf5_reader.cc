@@ -142,18 +142,13 @@ Scan ReadHeader(const hdf5::File& file) {
   return scan;
 }
 
-// The vector of `scan` that holds the values of `name`.
-template <typename T>
-std::vector<T>& ColumnOf(Scan& scan, const std::string& name) {
-  if constexpr (std::is_same_v<T, float>) {
-    return scan.z_float_mm;
-  } else {
-    if (name == "/scan/z") return scan.z_mm;
-    for (const auto& [column, member] : kColumns) {
-      if (name == column) return scan.*member;
-    }
-    throw Error(ErrorCode::kInternal, kStage, "no scan column for " + name);
+// The vector of `scan` that holds the double values of `name`.
+std::vector<double>& DoubleColumnOf(Scan& scan, const std::string& name) {
+  if (name == "/scan/z") return scan.z_mm;
+  for (const auto& [column, member] : kColumns) {
+    if (name == column) return scan.*member;
   }
+  throw Error(ErrorCode::kInternal, kStage, "no scan column for " + name);
 }
 
 // Invalid markers, then formats.md 2.3.
@@ -183,24 +178,29 @@ Scan ReadHdf5Scan(const std::filesystem::path& path, const ReadOptions& options)
   const hdf5::File file = hdf5::File::OpenReadOnly(path);
   if (!handed) return ReadHdf5Scan(file, options);
   Scan scan = ReadHeader(file);
-  const auto take = [&](const std::string& name, auto type) {
-    using T = decltype(type);
-    if (std::optional<std::vector<T>> values = arrays.Take<T>(name))
-      ColumnOf<T>(scan, name) = std::move(*values);
+  // The float32 readings stay in the pages the child wrote (the largest column, and the one a
+  // large scan has); the double columns are copied out into vectors.
+  if (auto z = arrays.Map<float>("/scan/z")) scan.z_float_mm = FloatColumn(z->values, std::move(z->mapping));
+  const auto take = [&](const std::string& name) {
+    if (std::optional<std::vector<double>> values = arrays.Take<double>(name))
+      DoubleColumnOf(scan, name) = std::move(*values);
   };
-  take("/scan/z", float{});
-  take("/scan/z", double{});
-  for (const auto& [name, member] : kColumns) take(name, double{});
+  take("/scan/z");
+  for (const auto& [name, member] : kColumns) take(name);
   return Finish(std::move(scan), file);
 }
 
 Scan ReadHdf5Scan(const hdf5::File& file, const ReadOptions& options) {
   Scan scan = ReadHeader(file);
   ReadColumns(file, scan.metadata, options, [&](const std::string& name, std::size_t count, auto type) {
-    using T = decltype(type);
-    std::vector<T>& column = ColumnOf<T>(scan, name);
-    column.resize(count);
-    return std::span<T>(column);
+    if constexpr (std::is_same_v<decltype(type), float>) {
+      scan.z_float_mm = std::vector<float>(count);
+      return std::span<float>(scan.z_float_mm);
+    } else {
+      std::vector<double>& column = DoubleColumnOf(scan, name);
+      column.resize(count);
+      return std::span<double>(column);
+    }
   });
   return Finish(std::move(scan), file);
 }

@@ -106,6 +106,40 @@ TEST(Hdf5Reader, ComparesTheInvalidValueInTheFilesOwnType) {
   EXPECT_EQ(scan.CountValid(), 399u);
 }
 
+TEST(Hdf5Reader, KeepsFloat32ReadingsInTheChildsPagesAndCopiesThemAsValues) {
+  TempDir dir;
+  std::vector<float> z(5000);
+  for (std::size_t i = 0; i < z.size(); ++i) z[i] = 0.5f + static_cast<float>(i) / 1024.0f;
+  z[10] = std::numeric_limits<float>::quiet_NaN();
+  {
+    auto file = hdf5::File::Create(dir / "scan.h5");
+    file.CreateGroup("/scan");
+    file.WriteFloats("/scan/z", z, {z.size()});
+    file.WriteAttribute("/scan", "spindle_rpm", 500.0);
+    file.WriteAttribute("/scan", "feed_mm_per_min", 100.0);
+    file.WriteAttribute("/scan", "sample_period_s", 0.001);
+  }
+  ReadOptions options;
+  options.keep_float32 = true;
+  Scan scan = ReadHdf5Scan(dir / "scan.h5", options);
+  ASSERT_TRUE(scan.holds_float());
+  ASSERT_EQ(scan.z_float_mm.size(), z.size());
+  for (std::size_t i = 0; i < z.size(); ++i) {
+    if (i == 10) {
+      EXPECT_TRUE(std::isnan(scan.z_float_mm[i]));
+    } else {
+      ASSERT_EQ(scan.z_float_mm[i], z[i]) << i;
+    }
+  }
+  // A copy is the copy's own: writing to the scan's readings leaves it as read.
+  const Scan copy = scan;
+  scan.z_float_mm[0] = -2.0f;
+  EXPECT_EQ(copy.z_float_mm[0], z[0]);
+  Scan moved = std::move(scan);
+  EXPECT_EQ(moved.z_float_mm[0], -2.0f);
+  EXPECT_EQ(moved.z_float_mm.size(), z.size());
+}
+
 TEST(Hdf5Reader, RefusesColumnsOfDifferentLengths) {
   TempDir dir;
   {
@@ -155,7 +189,7 @@ TEST(Readers, ShippedPaperScanMatchesItsTruthFile) {
 TEST(Scan, WideningToDoubleKeepsTheReadingsAndFreesTheFloats) {
   Scan scan;
   scan.z_float_mm = {1.5f, std::numeric_limits<float>::quiet_NaN(), -0.25f, 1e-7f};
-  const std::vector<float> floats = scan.z_float_mm;
+  const std::vector<float> floats(scan.z_float_mm.begin(), scan.z_float_mm.end());
   scan.WidenToDouble();
   ASSERT_EQ(scan.z_mm.size(), floats.size());
   for (std::size_t i = 0; i < floats.size(); ++i) {
@@ -166,7 +200,7 @@ TEST(Scan, WideningToDoubleKeepsTheReadingsAndFreesTheFloats) {
     }
   }
   EXPECT_FALSE(scan.holds_float());
-  EXPECT_EQ(scan.z_float_mm.capacity(), 0u);  // the float copy's memory is given back
+  EXPECT_EQ(scan.z_float_mm.data(), nullptr);  // the float copy's memory is given back
 }
 
 }  // namespace

@@ -2,7 +2,11 @@
 // A raw helical wheel scan as read from disk (formats.md section 2), before any processing.
 
 #include <cstddef>
+#include <initializer_list>
+#include <iterator>
+#include <memory>
 #include <optional>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -31,6 +35,44 @@ struct ScanMetadata {
   std::vector<std::string> notes;
 };
 
+// float32 readings, held in a vector of this process or in the pages that a reader's child process
+// filled and this process has mapped (core/hdf5.h, SharedArrays::Map): a 1e8-sample scan's 400 MB
+// then reach the processing without a copy. Writable in place either way; a copy is a vector.
+class FloatColumn {
+ public:
+  FloatColumn() = default;
+  FloatColumn(std::vector<float> values) : owned_(std::move(values)), values_(owned_) {}  // NOLINT
+  FloatColumn(std::initializer_list<float> values) : FloatColumn(std::vector<float>(values)) {}
+  // `values` live as long as `owner` (a mapping, say) does.
+  FloatColumn(std::span<float> values, std::shared_ptr<void> owner)
+      : owner_(std::move(owner)), values_(values) {}
+  FloatColumn(const FloatColumn& other) : FloatColumn(std::vector<float>(other.begin(), other.end())) {}
+  FloatColumn(FloatColumn&& other) noexcept { *this = std::move(other); }
+  FloatColumn& operator=(const FloatColumn& other) { return *this = FloatColumn(other); }
+  FloatColumn& operator=(FloatColumn&& other) noexcept;
+  ~FloatColumn() = default;
+
+  [[nodiscard]] float* begin() { return values_.data(); }
+  [[nodiscard]] float* end() { return values_.data() + values_.size(); }
+  [[nodiscard]] const float* begin() const { return values_.data(); }
+  [[nodiscard]] const float* end() const { return values_.data() + values_.size(); }
+  [[nodiscard]] auto rbegin() const { return std::make_reverse_iterator(end()); }
+  [[nodiscard]] auto rend() const { return std::make_reverse_iterator(begin()); }
+  [[nodiscard]] float* data() { return values_.data(); }
+  [[nodiscard]] const float* data() const { return values_.data(); }
+  [[nodiscard]] std::size_t size() const { return values_.size(); }
+  [[nodiscard]] bool empty() const { return values_.empty(); }
+  [[nodiscard]] float& operator[](std::size_t i) { return values_[i]; }
+  [[nodiscard]] float operator[](std::size_t i) const { return values_[i]; }
+  // Gives the memory back (a vector's capacity, or the mapping).
+  void Release() { *this = FloatColumn(); }
+
+ private:
+  std::vector<float> owned_;
+  std::shared_ptr<void> owner_;
+  std::span<float> values_;
+};
+
 // Column-wise samples. `z_mm` always has one entry per row of the file; invalid samples are NaN
 // (the readers fold invalid_value, the range limits and alarm words into NaN). The optional
 // columns are empty when absent, else as long as z_mm.
@@ -42,7 +84,7 @@ struct Scan {
   // (ReadOptions::keep_float32): z_mm is then empty. Every processing step reads them widened to
   // double, exactly, so the results are those of z_mm; a 1e8-sample scan takes 400 MB instead of
   // 800 MB.
-  std::vector<float> z_float_mm;
+  FloatColumn z_float_mm;
   std::vector<double> t_s;
   std::vector<double> angle_deg;
   std::vector<double> y_mm;

@@ -106,7 +106,7 @@ namespace {
 // outside [low, high] (compared in double, as for readings held in double). Written without
 // branches so that the compiler vectorizes it: this pass touches every sample of the scan.
 template <typename T, typename IsSentinel>
-void MarkInvalid(std::vector<T>& readings, double low, double high, IsSentinel is_sentinel) {
+void MarkInvalid(std::span<T> readings, double low, double high, IsSentinel is_sentinel) {
   constexpr T kNaN = std::numeric_limits<T>::quiet_NaN();
   constexpr double kMax = std::numeric_limits<double>::max();
   for (T& z : readings) {
@@ -127,7 +127,8 @@ void ApplyInvalidMarkers(Scan& scan, SentinelComparison comparison) {
   const double high = m.range_max_mm.value_or(std::numeric_limits<double>::infinity());
   const bool has_sentinel = m.invalid_value.has_value() && comparison != SentinelComparison::kDone;
   const double sentinel = m.invalid_value.value_or(0.0);
-  VisitReadings(scan, [&](auto& readings) {
+  VisitReadings(scan, [&](auto& column) {
+    const std::span readings(column);
     if (!has_sentinel) {
       MarkInvalid(readings, low, high, [](auto) { return false; });
     } else if (comparison == SentinelComparison::kAsFloat) {

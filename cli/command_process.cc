@@ -146,10 +146,12 @@ void AddProcessCommand(CLI::App& app) {
   cmd->footer(
       "Steps: trim invalid ends; drop stuck-sensor runs; estimate the noise; despike; unwrap the helix "
       "(encoder, or the\n"
-      "spindle speed estimated from the data when it differs significantly from nominal); fit a\n"
-      "least-squares cubic spline along the helix; sample it at every phase on every turn; fit a\n"
-      "circle to each phase's section inside the band (Ceres, with 1-sigma uncertainties); map the\n"
-      "sections onto a regular (phase, axial) grid for runout and roundness.\n"
+      "spindle speed estimated from the data when it differs significantly from nominal); lay out the\n"
+      "map's nodes (every phase, one helix pitch apart over the axial span all phases cover); fit a\n"
+      "circle to each phase's samples inside the band (least squares over every sample, with 1-sigma\n"
+      "uncertainties); set each map node to its phase's circle plus the mean residual of the samples\n"
+      "around it, for runout and roundness; fit the wheel model over every sample; estimate the\n"
+      "uncertainty of the headline figures.\n"
       "Runout is the wheel's plus the spindle's error motion: one sensor cannot separate them.\n"
       "Outputs are written under temporary names and renamed when complete.");
   cmd->add_option("SCAN", args->scan_path, "raw scan, .h5/.hdf5 or .csv/.txt (formats.md section 2)")

@@ -61,6 +61,21 @@ class SharedArrays {
     return {static_cast<T*>(Allocate(name, count, sizeof(T))), count};
   }
   // In the parent, after ReadInChildProcess returned true: the array the child stored under
+  // `name` as values of T, mapped into this process (the child's own pages, not a copy) and kept
+  // mapped while `mapping` lives; nothing when it stored none such.
+  template <typename T>
+  struct Mapped {
+    std::span<T> values;
+    std::shared_ptr<void> mapping;
+  };
+  template <typename T>
+  [[nodiscard]] std::optional<Mapped<T>> Map(const std::string& name) {
+    const Entry* entry = Find(name, sizeof(T));
+    if (entry == nullptr) return std::nullopt;
+    std::shared_ptr<void> mapping = Map(*entry);
+    return Mapped<T>{{static_cast<T*>(mapping.get()), entry->count}, std::move(mapping)};
+  }
+  // In the parent, after ReadInChildProcess returned true: the array the child stored under
   // `name` as values of T, or nothing when it stored none such.
   template <typename T>
   [[nodiscard]] std::optional<std::vector<T>> Take(const std::string& name) {
@@ -97,6 +112,7 @@ class SharedArrays {
   [[nodiscard]] bool ReadDirectory();
   [[nodiscard]] const Entry* Find(const std::string& name, std::size_t value_bytes) const;
   void MoveOut(const Entry& entry, const std::function<void(const void*, std::size_t)>& append);
+  [[nodiscard]] std::shared_ptr<void> Map(const Entry& entry) const;
 
   int fd_ = -1;
   std::size_t end_ = 4096;  // the directory's page comes first

@@ -106,6 +106,30 @@ TEST(ReadInChildProcess, HandsTheChildsArraysToTheParentExactly) {
   EXPECT_FALSE(arrays.Take<float>("absent").has_value());
 }
 
+TEST(ReadInChildProcess, MapsTheChildsArrayIntoTheParentWritableAndAlive) {
+  // 3e6 floats (12 MB, many pages): the child's values, i / 4, exactly; the mapping outlives the
+  // arrays' memory file and takes writes.
+  constexpr std::size_t kFloats = 3'000'000;
+  std::optional<SharedArrays::Mapped<float>> floats;
+  {
+    SharedArrays arrays;
+    ASSERT_TRUE(ReadInChildProcess(kPath, arrays, [](SharedArrays& shared) {
+      const std::span<float> values = shared.Allocate<float>("z", kFloats);
+      for (std::size_t i = 0; i < kFloats; ++i) values[i] = static_cast<float>(i) * 0.25f;
+    }));
+    floats = arrays.Map<float>("z");
+    EXPECT_FALSE(arrays.Map<double>("z").has_value()) << "z was stored as float, not double";
+    EXPECT_FALSE(arrays.Map<float>("absent").has_value());
+  }
+  ASSERT_TRUE(floats.has_value());
+  ASSERT_EQ(floats->values.size(), kFloats);
+  for (std::size_t i = 0; i < kFloats; i += 999)
+    ASSERT_EQ(floats->values[i], static_cast<float>(i) * 0.25f) << i;
+  EXPECT_EQ(floats->values.back(), static_cast<float>(kFloats - 1) * 0.25f);
+  floats->values[7] = -1.0f;
+  EXPECT_EQ(floats->values[7], -1.0f);
+}
+
 TEST(ReadInChildProcess, LeavesARefusedReadToTheCaller) {
   SharedArrays arrays;
   EXPECT_FALSE(ReadInChildProcess(kPath, arrays, [](SharedArrays& shared) {

@@ -604,6 +604,20 @@ std::array<double, 2> ProfileDerivatives(const std::vector<double>& f, std::size
   return {0.0, 0.0};
 }
 
+// The typical 1-sigma of a map value from the noise: the median over the cells with a value of
+// sigma / sqrt(samples in the cell), each value resting on the mean residual of its cell's samples
+// (summary.json's map_sigma_um); 0 when no cell has one.
+double MedianValueSigma(const CellSums& cells, const processing::WheelMap& map) {
+  std::vector<double> sigmas;
+  for (std::size_t cell = 0; cell < map.rho_mm.size(); ++cell) {
+    if (std::isfinite(map.rho_mm[cell])) sigmas.push_back(map.noise_sigma_mm / std::sqrt(cells.count[cell]));
+  }
+  if (sigmas.empty()) return 0.0;
+  const auto middle = sigmas.begin() + static_cast<long>(sigmas.size() / 2);
+  std::nth_element(sigmas.begin(), middle, sigmas.end());
+  return *middle;
+}
+
 // The map from the last pass's cells: the node's circle plus the cell's mean residual, moved to
 // the axial node along the wheel's mean residual profile. A node's run on one turn lies up to
 // half a pitch from the node, and where along that half pitch depends on the phase (the helix
@@ -631,6 +645,7 @@ void SetMap(const std::vector<Circle>& circles, const CellSums& cells, processin
       map.rho_mm[cell] = circles[j].At(map.y_mm[m]) + cells.residual[cell] / count - moved;
     }
   }
+  map.map_sigma_mm = MedianValueSigma(cells, map);
 }
 
 // The sections' points from the last pass's bins: mean residual, position and its noise sigma.

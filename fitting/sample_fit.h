@@ -35,8 +35,10 @@
 namespace arcwheel::fitting {
 
 // `rho_mm` per sample (NaN = invalid or despiked), in the order `geometry` addresses them.
-// Replaces the map's values (map.rho_mm) by the sample-based map described above and returns the
-// fits and every metric of WheelFit from it. Throws as FitWheel.
+// Sets the map's values (map.rho_mm, at the nodes that processing::PlanWheelMap laid out) to the
+// sample-based map described above and their typical sigma (map.map_sigma_mm: the median over the
+// cells with a value of sigma / sqrt(the cell's samples)), and returns the fits and every metric
+// of WheelFit from them. Throws as FitWheel.
 [[nodiscard]] WheelFit FitWheelToSamples(std::span<const double> rho_mm,
                                          const processing::HelixGeometry& geometry, processing::WheelMap& map,
                                          const WheelFitOptions& options);

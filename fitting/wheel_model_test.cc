@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "acquisition/simulate.h"
+#include "fitting/sample_fit.h"
 #include "processing/process_scan.h"
 
 namespace arcwheel::fitting {
@@ -31,10 +32,9 @@ struct Modelled {
 Modelled Model(const acquisition::WheelModel& wheel, const ScanSettings& settings,
                const WheelModelOptions& options) {
   acquisition::Scan scan = acquisition::SimulateScan(wheel, settings).scan;
-  const processing::ProcessedScan processed =
-      processing::ProcessScanInPlace(scan, processing::ProcessOptions{});
-  const WheelFit fit = FitWheel(processed.map, WheelFitOptions{});
+  processing::ProcessedScan processed = processing::ProcessScanInPlace(scan, processing::ProcessOptions{});
   const processing::HelixGeometry geometry(scan, processed.rpm_used);
+  const WheelFit fit = FitWheelToSamples(scan.z_mm, geometry, processed.map, WheelFitOptions{});
   return {wheel, settings, fit, FitWheelModel(scan.z_mm, geometry, processed.map, fit, options)};
 }
 
@@ -317,8 +317,8 @@ struct WarmStartScan {
   explicit WarmStartScan(unsigned seed)
       : scan(acquisition::SimulateScan(LobedWheelWithProfileError(), Settings(seed)).scan),
         processed(processing::ProcessScanInPlace(scan, processing::ProcessOptions{})),
-        fit(FitWheel(processed.map, WheelFitOptions{})),
-        geometry(scan, processed.rpm_used) {}
+        geometry(scan, processed.rpm_used),
+        fit(FitWheelToSamples(scan.z_mm, geometry, processed.map, WheelFitOptions{})) {}
   static ScanSettings Settings(unsigned seed) {
     ScanSettings settings = NoisyScan(seed, 0.5);
     settings.sample_period_s = 50e-6;
@@ -326,8 +326,8 @@ struct WarmStartScan {
   }
   acquisition::Scan scan;
   processing::ProcessedScan processed;
-  WheelFit fit;
   processing::HelixGeometry geometry;
+  WheelFit fit;
 };
 
 // A noisy lobed wheel scanned at 20 kHz (2.6e5 samples), modelled with a warm-up on every 13th

@@ -23,7 +23,7 @@ constexpr const char* kStage = "processing";
 
 // rho = radius_sign * z, in place (exact in float and double); invalid samples stay NaN.
 template <typename T>
-void ToRadialCoordinate(const acquisition::Scan& scan, std::vector<T>& rho) {
+void ToRadialCoordinate(const acquisition::Scan& scan, std::span<T> rho) {
   if (scan.metadata.radius_sign < 0) {
     for (T& v : rho) v = -v;
   }
@@ -31,7 +31,7 @@ void ToRadialCoordinate(const acquisition::Scan& scan, std::vector<T>& rho) {
 
 // method.md A.7: a beam at lateral offset e reads h = sqrt(R^2 - e^2) of a rim at radius R.
 // With the sensor's zero at radius R0 (rho = h - R0): R = sqrt((R0 + rho)^2 + e^2).
-void CorrectBeamOffset(std::vector<double>& rho, double offset_mm, double apex_radius_mm) {
+void CorrectBeamOffset(std::span<double> rho, double offset_mm, double apex_radius_mm) {
   std::vector<double> finite;
   for (std::size_t i = 0; i < rho.size(); i += std::max<std::size_t>(1, rho.size() / 100000)) {
     if (std::isfinite(rho[i])) finite.push_back(rho[i]);
@@ -95,7 +95,7 @@ void CheckSamplesPerTurn(const acquisition::Scan& scan, std::optional<double> sa
 
 // Step 1: the span from the first to the last valid sample (DropStuckSensorRuns counts them).
 template <typename T>
-void FindValidSpan(const std::vector<T>& rho, ProcessedScan& out) {
+void FindValidSpan(std::span<const T> rho, ProcessedScan& out) {
   const auto finite = [](T v) { return std::isfinite(static_cast<double>(v)); };
   const auto first = std::find_if(rho.begin(), rho.end(), finite);
   const auto last = std::find_if(rho.rbegin(), rho.rend(), finite);
@@ -105,7 +105,7 @@ void FindValidSpan(const std::vector<T>& rho, ProcessedScan& out) {
 
 // Drops runs of equal readings (a stuck sensor); refuses a scan that is nothing else.
 template <typename T>
-void DropStuckSensorRuns(const acquisition::Scan& scan, std::vector<T>& rho, std::size_t min_run,
+void DropStuckSensorRuns(const acquisition::Scan& scan, std::span<T> rho, std::size_t min_run,
                          ProcessedScan& out) {
   out.stuck = DropStuckReadings(rho, min_run);
   out.valid_samples = out.stuck.valid;
@@ -126,7 +126,7 @@ void DropStuckSensorRuns(const acquisition::Scan& scan, std::vector<T>& rho, std
 
 // Steps 2-3: noise, despiking, and the noise again of what is left.
 template <typename T>
-void DespikeAndEstimateNoise(std::vector<T>& rho, const DespikeOptions& options, ProcessedScan& out) {
+void DespikeAndEstimateNoise(std::span<T> rho, const DespikeOptions& options, ProcessedScan& out) {
   out.noise_sigma_mm = EstimateNoiseSigmaMm(std::span<const T>(rho));
   out.despike = Despike(std::span<T>(rho), out.noise_sigma_mm, options);
   // The noise that matters for the sigmas is that of the samples the map is built from.
@@ -139,7 +139,7 @@ void DespikeAndEstimateNoise(std::vector<T>& rho, const DespikeOptions& options,
 }
 
 // Step 4, when a beam offset is given.
-void CorrectBeamOffsetIfAsked(const acquisition::Scan& scan, std::vector<double>& rho,
+void CorrectBeamOffsetIfAsked(const acquisition::Scan& scan, std::span<double> rho,
                               const ProcessOptions& options) {
   if (options.beam_offset_mm == 0.0) return;
   double radius = options.wheel_radius_mm;
@@ -203,23 +203,23 @@ std::vector<std::string> ProcessOptions::Problems() const {
   return problems;
 }
 
-ProcessedScan ProcessScan(acquisition::Scan scan, const ProcessOptions& options) {
-  return ProcessScanInPlace(scan, options);
-}
-
 namespace {
+
+// Whose estimate fills the map's values: the helix spline's sections (ProcessScan), or none yet,
+// the sample fit's to come (ProcessScanInPlace).
+enum class MapValues { kFromHelixSpline, kLeftToTheSampleFit };
 
 // The steps on the readings, in float or double as the scan holds them.
 template <typename T>
-ProcessedScan ProcessReadings(acquisition::Scan& scan, std::vector<T>& rho, const ProcessOptions& options,
-                              std::optional<double> samples_per_turn) {
+ProcessedScan ProcessReadings(acquisition::Scan& scan, std::span<T> rho, const ProcessOptions& options,
+                              std::optional<double> samples_per_turn, MapValues values) {
   ProcessedScan out;
   StageClock& clock = out.timings;
   out.samples = scan.size();
   out.warnings = scan.metadata.notes;  // what the reader noticed comes first
   clock.Start("valid span");
   ToRadialCoordinate(scan, rho);
-  FindValidSpan(rho, out);
+  FindValidSpan(std::span<const T>(rho), out);
   ThrowIfInterrupted();
 
   clock.Start("stuck readings");
@@ -235,14 +235,16 @@ ProcessedScan ProcessReadings(acquisition::Scan& scan, std::vector<T>& rho, cons
 
   ReturnFreedMemory();  // the speed estimate's and the despiker's arrays
   const HelixGeometry geometry(scan, out.rpm_used);
-  out.map = BuildWheelMap(std::span<const T>(rho), geometry, out.noise_sigma_mm, out.despike.indices,
-                          options.map, &clock);
+  out.map = values == MapValues::kFromHelixSpline
+                ? BuildWheelMap(std::span<const T>(rho), geometry, out.noise_sigma_mm, out.despike.indices,
+                                options.map, &clock)
+                : PlanWheelMap(std::span<const T>(rho), geometry, out.noise_sigma_mm, out.despike.indices,
+                               options.map, &clock);
   return out;
 }
 
-}  // namespace
-
-ProcessedScan ProcessScanInPlace(acquisition::Scan& scan, const ProcessOptions& options) {
+// Steps 1-5 on the scan's readings in place, then the map as `values` says.
+ProcessedScan ProcessInPlace(acquisition::Scan& scan, const ProcessOptions& options, MapValues values) {
   CheckOptions(scan, options);
   const std::optional<double> samples_per_turn = SamplesPerTurn(scan);
   CheckSamplesPerTurn(scan, samples_per_turn);
@@ -251,8 +253,19 @@ ProcessedScan ProcessScanInPlace(acquisition::Scan& scan, const ProcessOptions& 
   if (options.beam_offset_mm != 0.0 || options.despike.method == DespikeMethod::kMovingMean) {
     scan.WidenToDouble();
   }
-  return acquisition::VisitReadings(
-      scan, [&](auto& rho) { return ProcessReadings(scan, rho, options, samples_per_turn); });
+  return acquisition::VisitReadings(scan, [&](auto& rho) {
+    return ProcessReadings(scan, std::span(rho), options, samples_per_turn, values);
+  });
+}
+
+}  // namespace
+
+ProcessedScan ProcessScan(acquisition::Scan scan, const ProcessOptions& options) {
+  return ProcessInPlace(scan, options, MapValues::kFromHelixSpline);
+}
+
+ProcessedScan ProcessScanInPlace(acquisition::Scan& scan, const ProcessOptions& options) {
+  return ProcessInPlace(scan, options, MapValues::kLeftToTheSampleFit);
 }
 
 }  // namespace arcwheel::processing

@@ -3,7 +3,8 @@
 //   1. the valid span (invalid ends trimmed),
 //   2. noise from second differences, 3. despiking,
 //   4. beam-offset correction (optional), 5. spindle speed (encoder, estimate, or nominal),
-//   6. helix spline and wheel map.
+//   6. the wheel map: from the helix spline's sections (ProcessScan), or its nodes alone, for the
+//      sample fit to estimate (ProcessScanInPlace, the `process` path).
 
 #include <cstddef>
 #include <string>
@@ -61,9 +62,11 @@ struct ProcessedScan {
 // is processed within about twice its own size). Move the scan in when it is not needed after.
 [[nodiscard]] ProcessedScan ProcessScan(acquisition::Scan scan, const ProcessOptions& options);
 
-// As ProcessScan, but the radial coordinate the map was built from (despiked; NaN where invalid)
-// stays in the scan's readings (z_float_mm or z_mm, see acquisition::VisitReadings), for the wheel
-// model's fit of every sample (fitting/wheel_model.h).
+// The `process` path: as ProcessScan up to the map, whose nodes and coverage counts it lays out
+// (PlanWheelMap) and whose values it leaves to the per-phase fits of every sample
+// (fitting::FitWheelToSamples), the one estimate of them. The radial coordinate (despiked; NaN
+// where invalid) stays in the scan's readings (z_float_mm or z_mm, see acquisition::VisitReadings)
+// for those fits and the wheel model's (fitting/wheel_model.h).
 [[nodiscard]] ProcessedScan ProcessScanInPlace(acquisition::Scan& scan, const ProcessOptions& options);
 
 }  // namespace arcwheel::processing

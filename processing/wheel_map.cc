@@ -354,6 +354,82 @@ void CountCoverage(std::span<const T> rho, const HelixGeometry& geometry,
   }
 }
 
+// The axial nodes from y_low to y_high, one axial step apart (one helix pitch unless asked), and
+// the map's values all NaN.
+void SetAxialNodes(double y_low, double y_high, const MapOptions& options, WheelMap& map) {
+  map.axial_step_mm = options.axial_step_mm > 0 ? options.axial_step_mm : std::abs(map.pitch_mm);
+  const auto n_y = static_cast<std::size_t>(std::floor((y_high - y_low) / map.axial_step_mm + 1e-9)) + 1;
+  map.y_mm.resize(n_y);
+  for (std::size_t m = 0; m < n_y; ++m) map.y_mm[m] = y_low + static_cast<double>(m) * map.axial_step_mm;
+  map.rho_mm.assign(map.n_phase() * n_y, kNaN);
+}
+
+// The phase nodes 0, 360 / phases, ...
+std::vector<double> PhaseNodes(int phases) {
+  std::vector<double> nodes(static_cast<std::size_t>(phases));
+  for (std::size_t j = 0; j < nodes.size(); ++j) nodes[j] = 360.0 * static_cast<double>(j) / phases;
+  return nodes;
+}
+
+// The axial span that every phase node covers: the helix crosses each node on every turn, and
+// the span runs from the last of the nodes' first crossings inside the valid samples [u_first,
+// u_last] to the first of their last ones. The crossings are stepped a turn at a time from the
+// first at or after u_first, as the helix spline's sections were, so that the nodes are those
+// its sections' ends gave (the same on the shipped scans, whose spline kept every end point).
+std::pair<double, double> CommonAxialSpan(const HelixGeometry& geometry, std::span<const double> phase_deg,
+                                          double u_first, double u_last) {
+  double y_low = -std::numeric_limits<double>::infinity();
+  double y_high = std::numeric_limits<double>::infinity();
+  for (const double phase : phase_deg) {
+    const double first = phase + 360.0 * std::ceil((u_first - phase) / 360.0);
+    double last = first;
+    for (double next = first + 360.0; next <= u_last; next += 360.0) last = next;
+    if (!(last > first)) continue;  // a node crossed once or never bounds nothing
+    const double y_first = geometry.AxialAtPhase(first);
+    const double y_last = geometry.AxialAtPhase(last);
+    y_low = std::max(y_low, std::min(y_first, y_last));
+    y_high = std::min(y_high, std::max(y_first, y_last));
+  }
+  return {y_low, y_high};
+}
+
+// The first and one past the last finite reading.
+template <typename T>
+std::pair<std::size_t, std::size_t> ValidSpan(std::span<const T> rho) {
+  std::size_t first = 0;
+  while (first < rho.size() && !std::isfinite(static_cast<double>(rho[first]))) ++first;
+  std::size_t last = rho.size();
+  while (last > first && !std::isfinite(static_cast<double>(rho[last - 1]))) --last;
+  return {first, last};
+}
+
+template <typename T>
+WheelMap Plan(std::span<const T> rho, const HelixGeometry& geometry, double noise_sigma_mm,
+              std::span<const std::size_t> despiked, const MapOptions& options, StageClock* clock) {
+  ThrowIfProblems(ErrorCode::kInvalidOption, "processing.map", options.Problems());
+  if (clock != nullptr) clock->Start("map nodes and coverage");
+  const auto valid = static_cast<std::size_t>(
+      std::count_if(rho.begin(), rho.end(), [](T v) { return std::isfinite(static_cast<double>(v)); }));
+  WheelMap map;
+  map.noise_sigma_mm = noise_sigma_mm;
+  map.knot_step_deg = ChooseKnotStep(options, geometry, valid);
+  map.pitch_mm = geometry.PitchMm();
+  map.phase_deg = PhaseNodes(options.phases);
+  const auto [first, last] = ValidSpan(rho);
+  const auto [y_low, y_high] =
+      first < last
+          ? CommonAxialSpan(geometry, map.phase_deg, geometry.PhaseAt(first), geometry.PhaseAt(last - 1))
+          : std::pair<double, double>{0.0, 0.0};
+  if (!(y_high > y_low)) {
+    throw Error(ErrorCode::kBadInput, "processing.map",
+                "the valid samples do not cover a common axial span at all phases");
+  }
+  SetAxialNodes(y_low, y_high, options, map);
+  CountCoverage(rho, geometry, despiked, y_low, map);
+  if (clock != nullptr) clock->Stop();
+  return map;
+}
+
 template <typename T>
 WheelMap Build(std::span<const T> rho, const HelixGeometry& geometry, double noise_sigma_mm,
                std::span<const std::size_t> despiked, const MapOptions& options, StageClock* clock) {
@@ -369,10 +445,9 @@ WheelMap Build(std::span<const T> rho, const HelixGeometry& geometry, double noi
 
   if (clock != nullptr) clock->Start("sections and map");
   const auto n_phase = static_cast<std::size_t>(options.phases);
-  map.phase_deg.resize(n_phase);
+  map.phase_deg = PhaseNodes(options.phases);
   map.sections.resize(n_phase);
   for (std::size_t j = 0; j < n_phase; ++j) {
-    map.phase_deg[j] = 360.0 * static_cast<double>(j) / options.phases;
     map.sections[j] = SampleSection(*spline, geometry, map.phase_deg[j], options.min_support);
   }
   spline->ReleaseValues();  // the sections were their last use
@@ -392,11 +467,8 @@ WheelMap Build(std::span<const T> rho, const HelixGeometry& geometry, double noi
   }
   ThrowIfInterrupted();
 
-  map.axial_step_mm = options.axial_step_mm > 0 ? options.axial_step_mm : std::abs(map.pitch_mm);
-  const auto n_y = static_cast<std::size_t>(std::floor((y_high - y_low) / map.axial_step_mm + 1e-9)) + 1;
-  map.y_mm.resize(n_y);
-  for (std::size_t m = 0; m < n_y; ++m) map.y_mm[m] = y_low + static_cast<double>(m) * map.axial_step_mm;
-  map.rho_mm.assign(n_phase * n_y, kNaN);
+  SetAxialNodes(y_low, y_high, options, map);
+  const std::size_t n_y = map.n_y();
   for (std::size_t j = 0; j < n_phase; ++j) {
     InterpolateSection(map.sections[j], map.y_mm, map.pitch_mm, std::span(map.rho_mm).subspan(j * n_y, n_y));
   }
@@ -428,6 +500,16 @@ std::vector<std::string> MapOptions::Problems() const {
 WheelMap BuildWheelMap(std::span<const double> rho_mm, const HelixGeometry& geometry, double noise_sigma_mm,
                        std::span<const std::size_t> despiked, const MapOptions& options, StageClock* clock) {
   return Build(rho_mm, geometry, noise_sigma_mm, despiked, options, clock);
+}
+
+WheelMap PlanWheelMap(std::span<const double> rho_mm, const HelixGeometry& geometry, double noise_sigma_mm,
+                      std::span<const std::size_t> despiked, const MapOptions& options, StageClock* clock) {
+  return Plan(rho_mm, geometry, noise_sigma_mm, despiked, options, clock);
+}
+
+WheelMap PlanWheelMap(std::span<const float> rho_mm, const HelixGeometry& geometry, double noise_sigma_mm,
+                      std::span<const std::size_t> despiked, const MapOptions& options, StageClock* clock) {
+  return Plan(rho_mm, geometry, noise_sigma_mm, despiked, options, clock);
 }
 
 WheelMap BuildWheelMap(std::span<const float> rho_mm, const HelixGeometry& geometry, double noise_sigma_mm,

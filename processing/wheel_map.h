@@ -67,4 +67,14 @@ struct WheelMap {
                                      double noise_sigma_mm, std::span<const std::size_t> despiked,
                                      const MapOptions& options, StageClock* clock = nullptr);
 
+// The map's nodes without their values, for the sample fit to estimate (fitting/sample_fit.h):
+// the phase and axial nodes over the axial span that every phase node covers (CommonAxialSpan in
+// the .cc), the coverage counts, rho_mm all NaN, no sections, no spline.
+[[nodiscard]] WheelMap PlanWheelMap(std::span<const double> rho_mm, const HelixGeometry& geometry,
+                                    double noise_sigma_mm, std::span<const std::size_t> despiked,
+                                    const MapOptions& options, StageClock* clock = nullptr);
+[[nodiscard]] WheelMap PlanWheelMap(std::span<const float> rho_mm, const HelixGeometry& geometry,
+                                    double noise_sigma_mm, std::span<const std::size_t> despiked,
+                                    const MapOptions& options, StageClock* clock = nullptr);
+
 }  // namespace arcwheel::processing

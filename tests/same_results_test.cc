@@ -76,11 +76,12 @@ nlohmann::json SigmaOf(const nlohmann::json& object, const std::string& key) {
 // `key` is the name of the innermost object key above the leaf.
 // The top-level keys that the all-sample per-phase fits (issue 29) left as they were: what the
 // scan, the noise, the despiking and the speed give. The d837b52 references predate those fits.
+// (map_sigma_um comes from the fits' map cells since issue 44.)
 bool UpstreamOfTheFits(const std::string& name) {
   static const std::set<std::string> kKeys = {
-      "map_sigma_um",          "noise_sigma_um",     "processing",          "scan",
-      "spindle_rpm_estimated", "spindle_rpm_fitted", "spindle_rpm_nominal", "spindle_rpm_sigma",
-      "spindle_rpm_source"};
+      "noise_sigma_um",        "processing",         "scan",
+      "spindle_rpm_estimated", "spindle_rpm_fitted", "spindle_rpm_nominal",
+      "spindle_rpm_sigma",     "spindle_rpm_source"};
   return kKeys.contains(name);
 }
 

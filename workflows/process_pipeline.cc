@@ -80,8 +80,7 @@ std::optional<fitting::WheelModel> FitModelUnlessOff(const ProcessPipelineOption
   }
 }
 
-// The headline figures' uncertainty from the per-phase fits and the map (before the spline goes:
-// nothing here reads it, but the map must still hold every node).
+// The headline figures' uncertainty from the per-phase fits and the map.
 uncertainty::WheelUncertainty EvaluateUncertainty(const ProcessPipelineOptions& options,
                                                   const acquisition::ScanMetadata& metadata,
                                                   const processing::ProcessedScan& processed,
@@ -159,11 +158,7 @@ ProcessPipelineResult RunOnScan(acquisition::Scan scan, const std::string& scan_
   clock.Append(result.processed.timings);
   progress.Update("fitting", 0.7);
   clock.Start("per-phase fits");
-  // The fits are of the samples (fitting/sample_fit.h): the helix spline (23 MB at 1e8 samples)
-  // is not read again.
-  result.processed.map.spline.reset();
-  // Nor are the sections (24 MB at 1e8 samples); their typical sigma stays (map.map_sigma_mm).
-  std::vector<processing::Section>().swap(result.processed.map.sections);
+  // The map's values and their sigma are the per-phase fits' (fitting/sample_fit.h).
   result.fit = acquisition::VisitReadings(scan, [&](const auto& rho) {
     return fitting::FitWheelToSamples(std::span(rho),
                                       processing::HelixGeometry(scan, result.processed.rpm_used),

@@ -40,8 +40,9 @@ py::dict MetadataDict(const acquisition::ScanMetadata& m) {
 }
 
 // A read-only numpy view of `values`, kept alive by the Python Scan `owner`; None when empty.
-template <typename T>
-py::object View(const std::vector<T>& values, const py::object& owner) {
+template <typename Values>
+py::object View(const Values& values, const py::object& owner) {
+  using T = std::remove_cvref_t<decltype(*values.data())>;
   if (values.empty()) return py::none();
   py::array_t<T> array({static_cast<py::ssize_t>(values.size())}, {static_cast<py::ssize_t>(sizeof(T))},
                        values.data(), owner);

@@ -162,7 +162,7 @@ SimulateOptions Resolved(SimulateOptions o) {
 // The scan as it reads back from the file simulate writes: float32 readings unless float64.
 acquisition::Scan AsWritten(acquisition::Scan scan, bool float32) {
   if (!float32 || scan.holds_float()) return scan;
-  scan.z_float_mm.assign(scan.z_mm.begin(), scan.z_mm.end());
+  scan.z_float_mm = std::vector<float>(scan.z_mm.begin(), scan.z_mm.end());
   scan.z_mm.clear();
   scan.z_mm.shrink_to_fit();
   return scan;

@@ -3,6 +3,7 @@
 #include <fmt/core.h>
 
 #include <future>
+#include <nlohmann/json.hpp>
 #include <span>
 #include <utility>
 #include <vector>

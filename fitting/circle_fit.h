@@ -11,18 +11,9 @@
 #include <string>
 #include <vector>
 
+#include "fitting/circle_fit_options.h"
+
 namespace arcwheel::fitting {
-
-enum class FitStatus { kNotRun, kConverged, kNoConvergence, kDegenerate };
-
-struct CircleFitOptions {
-  int max_iterations = 100;  // Levenberg-Marquardt iterations, >= 1
-  // Covariance scale: if true, the weights are 1/sigma_i and the covariance is (J^T W J)^-1
-  // (known noise); if false it is scaled by the residual variance RSS/(n-3) (unknown noise).
-  bool weights_are_inverse_sigmas = false;
-  // Empty when valid, else one line per violation with its value: "max_iterations = 0 violates >= 1".
-  [[nodiscard]] std::vector<std::string> Problems() const;
-};
 
 struct CircleFit {
   Eigen::Vector2d center_mm = Eigen::Vector2d::Zero();

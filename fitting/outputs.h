@@ -3,7 +3,7 @@
 // files are staged under temporary names and renamed together only when both are complete.
 
 #include <filesystem>
-#include <nlohmann/json.hpp>
+#include <nlohmann/json_fwd.hpp>
 #include <string>
 #include <utility>
 #include <vector>

@@ -4,7 +4,7 @@
 #include <string>
 #include <vector>
 
-#include "fitting/circle_fit.h"
+#include "fitting/circle_fit_options.h"
 #include "processing/wheel_map.h"
 
 namespace arcwheel::fitting {

@@ -7,7 +7,7 @@
 // and every JSON file that arcwheel writes for a frame or a fit has these keys at the top level,
 // so that any of them can be given to `arcwheel transform apply`.
 
-#include <nlohmann/json.hpp>
+#include <nlohmann/json_fwd.hpp>
 #include <span>
 #include <string>
 

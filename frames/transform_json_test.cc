@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
+#include <nlohmann/json.hpp>
 
 #include "core/error.h"
 

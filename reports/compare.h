@@ -11,7 +11,7 @@
 // Writes OUTDIR/compare.json, OUTDIR/compare.html and OUTDIR/compare.pdf together.
 
 #include <filesystem>
-#include <nlohmann/json.hpp>
+#include <nlohmann/json_fwd.hpp>
 #include <string>
 #include <vector>
 

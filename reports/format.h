@@ -8,7 +8,7 @@
 // significant digits with trailing zeros dropped ("0.19968", "500").
 
 #include <cstdint>
-#include <nlohmann/json.hpp>
+#include <nlohmann/json_fwd.hpp>
 #include <string>
 #include <string_view>
 

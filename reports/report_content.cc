@@ -9,6 +9,7 @@
 
 #include "core/number_format.h"
 #include "core/version.h"
+#include "reports/report_inputs.h"
 #include "reports/statistics.h"
 #include "schema/summary.h"
 

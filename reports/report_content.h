@@ -7,10 +7,11 @@
 
 #include "reports/format.h"
 #include "reports/plot.h"
-#include "reports/report_inputs.h"
 #include "reports/tolerances.h"
 
 namespace arcwheel::reports {
+
+struct ReportInputs;  // reports/report_inputs.h
 
 struct KeyValue {
   std::string key;

@@ -19,6 +19,7 @@
 #include "core/testing/testing.h"
 #include "reports/browser_check.h"
 #include "reports/report_fixture.h"
+#include "reports/report_inputs.h"
 
 namespace arcwheel::reports {
 namespace {

@@ -2,7 +2,7 @@
 // What `history`, `compare` and `db export` ask of the results store (docs/store.md).
 
 #include <filesystem>
-#include <nlohmann/json.hpp>
+#include <nlohmann/json_fwd.hpp>
 #include <optional>
 #include <string>
 #include <utility>

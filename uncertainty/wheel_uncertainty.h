@@ -6,7 +6,7 @@
 // The inputs are plain arrays, filled by the process pipeline from its per-phase fits and map.
 
 #include <map>
-#include <nlohmann/json.hpp>
+#include <nlohmann/json_fwd.hpp>
 #include <optional>
 #include <span>
 #include <string>

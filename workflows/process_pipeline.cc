@@ -1,6 +1,7 @@
 #include "workflows/process_pipeline.h"
 
 #include <future>
+#include <nlohmann/json.hpp>
 #include <span>
 #include <type_traits>
 #include <utility>

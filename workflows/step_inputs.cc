@@ -1,5 +1,7 @@
 #include "workflows/step_inputs.h"
 
+#include <nlohmann/json.hpp>
+
 #include "core/error.h"
 #include "core/json_text.h"
 #include "core/sha256.h"

@@ -4,7 +4,7 @@
 // options and the arcwheel version, in `step_inputs.json`, written last.
 
 #include <filesystem>
-#include <nlohmann/json.hpp>
+#include <nlohmann/json_fwd.hpp>
 #include <string>
 #include <utility>
 #include <vector>

@@ -15,6 +15,28 @@
 #include "workflows/steps.h"
 
 namespace arcwheel::cli {
+namespace {
+
+// The segments slowed for the robot's joints, and what they cost (docs/polishing.md).
+void PrintSlowed(const polishing::TimeScaling& slowing) {
+  if (slowing.slowed.empty()) return;
+  double most = 1.0;
+  std::size_t most_target = 0;
+  for (const polishing::SlowedSegment& s : slowing.slowed) {
+    if (s.slowed_s / s.planned_s > most) {
+      most = s.slowed_s / s.planned_s;
+      most_target = s.target + 1;
+    }
+  }
+  fmt::print(
+      "slowed {} segments for the robot's joints (most: into target {}, {:.3g} times as long): {:.4g} s "
+      "added, adding up to {:.4g} nm of removal (RMS {:.4g} nm) at ({:.3f}, {:.3f}) mm, in the prediction; "
+      "listed in polish_summary.json robot.slowed_segments\n",
+      slowing.slowed.size(), most_target, most, slowing.added_time_s, slowing.added.max_nm,
+      slowing.added.rms_nm, slowing.added.max_at_mm.x(), slowing.added.max_at_mm.y());
+}
+
+}  // namespace
 
 void AddPolishCommand(CLI::App& app) {
   struct Arguments {
@@ -47,7 +69,9 @@ void AddPolishCommand(CLI::App& app) {
     workflows::RunRecorded(
         arguments->db,
         [&] {
-          (void)workflows::RunPolishStep(arguments->job, std::nullopt, arguments->output);
+          const polishing::PolishRunReport report =
+              workflows::RunPolishStep(arguments->job, std::nullopt, arguments->output);
+          PrintSlowed(report.slowing);
           if (!arguments->report_formats.empty()) {
             // Drawn from the files just written, exactly as `arcwheel report OUTDIR` would.
             const reports::WrittenPolishReports written = reports::WritePolishReports(arguments->output);

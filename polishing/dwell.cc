@@ -556,6 +556,17 @@ DwellSolution SolveDwell(const ErrorMap& target, const surfaces::Aperture& apert
   return solution;
 }
 
+ErrorMap RemovalOfDwell(const ErrorMap& like, const surfaces::Aperture& aperture,
+                        std::span<const Eigen::Vector2d> contact_xy_mm, std::span<const double> dwell_s,
+                        const RemovalFunction& removal) {
+  ARCWHEEL_CHECK(contact_xy_mm.size() == dwell_s.size()) << dwell_s.size() << " dwells";
+  removal.Check();
+  const Rows rows = ApertureRows(like, aperture);
+  const Removal a(like, rows, contact_xy_mm, removal, true);
+  const Eigen::Map<const Eigen::VectorXd> t(dwell_s.data(), static_cast<Eigen::Index>(dwell_s.size()));
+  return Scatter(like, rows, a * Eigen::VectorXd(t));
+}
+
 std::vector<std::string> DwellOptions::Problems() const {
   std::vector<std::string> problems;
   const auto require = [&problems](bool ok, const std::string& text) {

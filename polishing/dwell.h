@@ -148,6 +148,13 @@ struct DwellSolution {
                                        std::span<const Eigen::Vector2d> path_xy_mm,
                                        const RemovalFunction& removal, const DwellOptions& options);
 
+// The removal (um) of `dwell_s` (s) at the contact points `contact_xy_mm` over the aperture nodes
+// of `like` (NaN elsewhere): the products SolveDwell predicts with (FFT convolutions when the
+// points lie on the map's grid, else the sparse matrix), for a path the robot runs as written.
+[[nodiscard]] ErrorMap RemovalOfDwell(const ErrorMap& like, const surfaces::Aperture& aperture,
+                                      std::span<const Eigen::Vector2d> contact_xy_mm,
+                                      std::span<const double> dwell_s, const RemovalFunction& removal);
+
 // The (x, y) steps between consecutive points (first: 0): the chords of a path in a plane.
 [[nodiscard]] std::vector<double> PlanarChordsMm(std::span<const Eigen::Vector2d> path_xy_mm);
 

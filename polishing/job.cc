@@ -89,6 +89,7 @@ void ReadPrecession(JsonSection& s, PolishJob& job) {
   job.precession.tilt_deg = s.RequiredNumber("tilt_deg");
   job.precession.precession_rate_rpm = s.RequiredNumber("precession_rate_rpm");
   job.precession.bonnet_radius_mm = s.Number("bonnet_radius_mm", 0.0);
+  job.precession.max_step_deg = s.Number("max_step_deg", PathPrecession{}.max_step_deg);
 }
 
 // The error_map section: the file, its format and, for interferometer maps, the placement in the
@@ -224,6 +225,8 @@ void ReadRobot(JsonSection& s, const std::filesystem::path& job_path, PolishJob&
       s.Number("min_wrist_margin_deg", RobotMargins{}.min_wrist_margin_deg);
   job.robot.margins.max_joint_speed_ratio =
       s.Number("max_joint_speed_ratio", RobotMargins{}.max_joint_speed_ratio);
+  job.robot.margins.max_added_residual_nm =
+      s.Number("max_added_residual_nm", RobotMargins{}.max_added_residual_nm);
   for (std::string& p : job.robot.margins.Problems()) problems.push_back(std::move(p));
   if (!job.robot.model) return;
   if (job.robot.urdf_override.empty())
@@ -387,6 +390,38 @@ struct Plan {
   std::vector<PolishingPoint> points;
 };
 
+// The prediction, residual and times of the targets as the robot runs them: each target's dwell
+// at its own contact point. Used where the targets are not the dwell points.
+void PredictFromTargets(const PolishJob& job, Plan& plan) {
+  std::vector<Eigen::Vector2d> contact;
+  std::vector<double> dwell_s;
+  DwellSolution& d = plan.report.dwell;
+  std::fill(d.dwell_s.begin(), d.dwell_s.end(), 0.0);
+  for (const PolishingPoint& p : plan.points) {
+    contact.push_back(p.contact_xy_mm);
+    dwell_s.push_back(p.dwell_s);
+    d.dwell_s[p.dwell_point] += p.dwell_s;
+  }
+  d.predicted_removal_um = RemovalOfDwell(plan.target, job.aperture, contact, dwell_s, job.removal);
+  d.residual_um = d.predicted_removal_um;
+  for (std::size_t k = 0; k < d.residual_um.error_um.size(); ++k)
+    d.residual_um.error_um[k] = plan.target.error_um[k] - d.predicted_removal_um.error_um[k];
+  d.after = StatisticsInAperture(d.residual_um, job.aperture);
+  d.total_time_s = 0.0;
+  for (const double t : dwell_s) d.total_time_s += t;
+}
+
+void TargetSpeeds(Plan& plan) {
+  const auto speed = [](const PolishingPoint& a, const PolishingPoint& b) {
+    return a.speed_mm_s < b.speed_mm_s;
+  };
+  plan.report.points = plan.points.size();
+  plan.report.max_speed_mm_s =
+      std::max_element(plan.points.begin() + 1, plan.points.end(), speed)->speed_mm_s;
+  plan.report.min_speed_mm_s =
+      std::min_element(plan.points.begin() + 1, plan.points.end(), speed)->speed_mm_s;
+}
+
 Plan MakePlan(const PolishJob& job) {
   const std::vector<Eigen::Vector2d> path = job.path_pattern == PathPattern::kSpiral
                                                 ? SpiralPath(job.aperture, job.path)
@@ -399,18 +434,34 @@ Plan MakePlan(const PolishJob& job) {
   const std::vector<double> chord_mm = TcpChordsMm(TcpPositionsMm(*job.surface, path, job.precession));
   report.dwell = SolveDwell(plan.target, job.aperture, path, chord_mm, job.removal, job.dwell);
   plan.points = BuildPolishingPath(*job.surface, path, report.dwell, job.robot_side, job.precession);
-  report.points = plan.points.size();
-  report.max_speed_mm_s =
-      *std::max_element(report.dwell.speed_mm_s.begin() + 1, report.dwell.speed_mm_s.end());
-  report.min_speed_mm_s =
-      *std::min_element(report.dwell.speed_mm_s.begin() + 1, report.dwell.speed_mm_s.end());
+  if (plan.points.size() != path.size()) PredictFromTargets(job, plan);
+  TargetSpeeds(plan);
   return plan;
+}
+
+std::vector<double> SegmentTimes(std::span<const PolishingPoint> points) {
+  std::vector<double> out;
+  out.reserve(points.size());
+  for (const PolishingPoint& p : points) out.push_back(p.dwell_s);
+  return out;
 }
 
 std::vector<Eigen::Vector3d> TargetPositions(std::span<const PolishingPoint> points) {
   std::vector<Eigen::Vector3d> out;
   out.reserve(points.size());
   for (const PolishingPoint& p : points) out.push_back(p.position_mm);
+  return out;
+}
+
+json SlowedJson(const TimeScaling& scaling) {
+  namespace key = schema::polish::summary::robot::slowed_segments;
+  json out = json::array();
+  for (const SlowedSegment& s : scaling.slowed) {
+    out.push_back({{key::kTarget, s.target + 1},
+                   {key::kJoint, s.joint},
+                   {key::kPlannedS, s.planned_s},
+                   {key::kSlowedS, s.slowed_s}});
+  }
   return out;
 }
 
@@ -437,7 +488,7 @@ WorkObjectProposal ProposeWorkObject(const PolishJob& job) {
   }
   const Plan plan = MakePlan(job);
   return ProposeWorkObjectOrigin(*job.robot_kinematics, job.robot.margins, plan.points, job.tool,
-                                 job.work_object, job.robot.world_from_base, plan.report.dwell.dwell_s,
+                                 job.work_object, job.robot.world_from_base, SegmentTimes(plan.points),
                                  job.source.string());
 }
 
@@ -468,15 +519,27 @@ PolishRunReport RunPolishJob(const PolishJob& job, const std::filesystem::path& 
   Plan plan = MakePlan(job);
   const ErrorMap& target = plan.target;
   PolishRunReport& report = plan.report;
-  const std::vector<PolishingPoint>& points = plan.points;
   if (job.robot_kinematics) {
-    // Refused here, before anything is written, when the robot cannot run the path.
+    // Refused here, before anything is written, when the robot cannot run the path. First the
+    // joints without their speeds (over an unbounded time no joint is too fast), then the
+    // segments a joint cannot run at the dwell's speed slowed to what it can, then every check.
+    const std::string name = job.source.string();
     const std::vector<Eigen::Isometry3d> poses =
-        FlangePosesInBase(points, job.tool, job.work_object, job.robot.world_from_base);
-    const std::vector<Eigen::Vector3d> targets = TargetPositions(points);
-    report.robot = SolveRobotPath(*job.robot_kinematics, job.robot.margins, poses, report.dwell.dwell_s,
-                                  job.source.string(), targets);
+        FlangePosesInBase(plan.points, job.tool, job.work_object, job.robot.world_from_base);
+    const std::vector<Eigen::Vector3d> targets = TargetPositions(plan.points);
+    const std::vector<double> unbounded(plan.points.size(), std::numeric_limits<double>::infinity());
+    const RobotPath joints =
+        SolveRobotPath(*job.robot_kinematics, job.robot.margins, poses, unbounded, name, targets);
+    report.slowing = SlowDownToJointSpeeds(plan.points, *job.robot_kinematics, joints, target, job.aperture,
+                                           job.removal, job.robot.margins, name);
+    if (!report.slowing.slowed.empty()) {
+      PredictFromTargets(job, plan);
+      TargetSpeeds(plan);
+    }
+    report.robot = SolveRobotPath(*job.robot_kinematics, job.robot.margins, poses, SegmentTimes(plan.points),
+                                  name, targets);
   }
+  const std::vector<PolishingPoint>& points = plan.points;
 
   const std::vector<std::string> comments = {fmt::format("arcwheel {} polish, job '{}'", kVersion, job.name),
                                              fmt::format("surface: {}", job.surface->Describe()),
@@ -518,7 +581,15 @@ PolishRunReport RunPolishJob(const PolishJob& job, const std::filesystem::path& 
                             {key::robot::kMaxJointSpeedRatio, r.max_speed_ratio},
                             {key::robot::kLargestJointSpeedRatio, r.largest_speed_ratio},
                             {key::robot::kLargestJointSpeedJoint, r.largest_speed_joint},
-                            {key::robot::kLimitsDeg, r.limits_deg}};
+                            {key::robot::kLimitsDeg, r.limits_deg},
+                            {key::robot::kSlowedSegments, SlowedJson(report.slowing)},
+                            {key::robot::kAddedTimeS, report.slowing.added_time_s},
+                            {key::robot::kAddedRemoval,
+                             {{key::robot::added_removal::kPvNm, report.slowing.added.pv_nm},
+                              {key::robot::added_removal::kRmsNm, report.slowing.added.rms_nm},
+                              {key::robot::added_removal::kMaxNm, report.slowing.added.max_nm},
+                              {key::robot::added_removal::kMaxAtMm,
+                               {report.slowing.added.max_at_mm.x(), report.slowing.added.max_at_mm.y()}}}}};
   }
 
   OutputSet outputs;

@@ -15,6 +15,7 @@
 #include "polishing/robot_kinematics.h"
 #include "polishing/robot_model.h"
 #include "polishing/robot_program.h"
+#include "polishing/time_scaling.h"
 #include "polishing/tool_frame.h"
 #include "surfaces/surface.h"
 
@@ -70,17 +71,22 @@ inline constexpr double kBytesPerRemovalMatrixEntry = 18.0;
 [[nodiscard]] std::vector<std::string> SizeProblems(const PolishJob& job);
 
 struct PolishRunReport {
+  // The dwell as the robot runs it: where the targets are not the dwell points (a precession's
+  // steps, slowed segments) its dwell_s, prediction, residual and total time are the targets'.
   DwellSolution dwell;
-  std::size_t points = 0;
+  std::size_t points = 0;  // robot targets: rows of polishing_path.csv
   double max_speed_mm_s = 0.0;
   double min_speed_mm_s = 0.0;
   std::optional<RobotPath> robot;  // the robot's solution, when the job names a robot
+  TimeScaling slowing;             // the segments slowed for the robot's joints (none: empty)
 };
 
 // Solves the dwell and writes OUTDIR/polishing_path.csv, polish.mod (RAPID), residual_map.csv and
 // polish_summary.json (and robot_joints.csv with a robot), all or none. With a robot the path is
-// solved for it first (SolveRobotPath: reach, joint limits, wrist singularity, one configuration,
-// joint speeds) and refused before anything is written. Throws Error{kBadInput, "polishing.job"}
+// solved for it first (SolveRobotPath: reach, joint limits, wrist singularity, one configuration),
+// the segments where a joint would be too fast are slowed (SlowDownToJointSpeeds, their removal
+// added to the prediction), the joint speeds checked, and the path refused before anything is
+// written when it fails. Throws Error{kBadInput, "polishing.job"}
 // for a map node or a path point off the surface, Error{kBadInput, "polishing.robot"} for a path
 // the robot cannot run, and whatever SolveDwell throws.
 PolishRunReport RunPolishJob(const PolishJob& job, const std::filesystem::path& output_folder);

@@ -43,6 +43,9 @@ std::vector<std::string> RobotMargins::Problems() const {
     problems.push_back(
         fmt::format("robot.min_wrist_margin_deg = {} violates 0 <= value < 90", min_wrist_margin_deg));
   }
+  if (!(max_added_residual_nm >= 0.0 && std::isfinite(max_added_residual_nm))) {
+    problems.push_back(fmt::format("robot.max_added_residual_nm = {} violates >= 0", max_added_residual_nm));
+  }
   if (!(max_joint_speed_ratio > 0.0 && max_joint_speed_ratio <= 1.0)) {
     problems.push_back(
         fmt::format("robot.max_joint_speed_ratio = {} violates 0 < value <= 1", max_joint_speed_ratio));

@@ -46,11 +46,16 @@ struct RobotModel {
 // Margins a path must keep (robot.* job keys). Every target's joints must stay at least
 // min_joint_margin_deg inside every joint limit, joint 5 at least min_wrist_margin_deg away from 0
 // (the wrist singularity, where joints 4 and 6 line up), and every joint's speed at the programmed
-// TCP speed at most max_joint_speed_ratio of the joint's maximum speed.
+// TCP speed at most max_joint_speed_ratio of the joint's maximum speed. A segment whose joint
+// would be faster is slowed (time_scaling.h) as long as the removal that adds stays within
+// max_added_residual_nm everywhere.
 struct RobotMargins {
   double min_joint_margin_deg = 5.0;   // [0, 90)
   double min_wrist_margin_deg = 10.0;  // [0, 90)
   double max_joint_speed_ratio = 0.9;  // (0, 1]
+  // Largest removal the slowed segments may add at any aperture node, nm, >= 0 (10 nm: a tenth
+  // of the 0.1 um form tolerance of a polished optic, and a sixtieth of the 633 nm wavelength).
+  double max_added_residual_nm = 10.0;
   // Empty when valid, else one line per violation naming the job key and the value.
   [[nodiscard]] std::vector<std::string> Problems() const;
 };

@@ -4,6 +4,7 @@
 #include <fmt/format.h>
 
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <cmath>
 #include <iterator>
 #include <numbers>
@@ -58,6 +59,68 @@ std::vector<double> TcpChordsMm(std::span<const Eigen::Vector3d> tcp_mm) {
   return chord_mm;
 }
 
+namespace {
+
+constexpr double kRadPerDeg = std::numbers::pi / 180.0;
+
+// The precession's fixed parts: tilt and rate in radians.
+struct Precessor {
+  const surfaces::Surface& surface;
+  RobotSide side;
+  const PathPrecession& precession;
+  double tilt_rad = precession.tilt_deg * kRadPerDeg;
+  double rate_rad_s = precession.precession_rate_rpm * 2.0 * std::numbers::pi / 60.0;
+
+  // The target over contact (x, y), the tool precessed to the phase of `elapsed_s` since the
+  // first target.
+  [[nodiscard]] PolishingPoint At(const Eigen::Vector2d& xy, double elapsed_s) const {
+    if (!surface.InDomain(xy.x(), xy.y())) {
+      throw Error(
+          ErrorCode::kBadInput, "polishing.path",
+          fmt::format("path point ({}, {}) mm is off the surface {}", xy.x(), xy.y(), surface.Describe()));
+    }
+    const Eigen::Matrix3d part_from_tool = ToolFrameAt(surface, xy.x(), xy.y(), side);
+    const Eigen::Vector3d c = -part_from_tool.col(2), a = part_from_tool.col(0);
+    const double alpha = rate_rad_s * elapsed_s;
+    const Eigen::Vector3d axis = std::sin(tilt_rad) * std::cos(alpha) * a +
+                                 std::sin(tilt_rad) * std::sin(alpha) * c.cross(a) + std::cos(tilt_rad) * c;
+    PolishingPoint point;
+    point.contact_xy_mm = xy;
+    point.position_mm = Eigen::Vector3d(xy.x(), xy.y(), surface.Evaluate(xy.x(), xy.y()).z_mm) +
+                        precession.bonnet_radius_mm * c;
+    point.orientation = AbbQuaternionFromRotation(
+        Eigen::Quaterniond::FromTwoVectors(-c, -axis).toRotationMatrix() * part_from_tool);
+    return point;
+  }
+
+  // Steps for a segment of `dwell_s` between contacts a and b: the tool turns by at most the
+  // axis's arc on its cone, 2 sin(theta / 2) w2 t (the frame's twist about the axis included),
+  // plus the normal's turn.
+  [[nodiscard]] int Steps(const Eigen::Vector2d& a, const Eigen::Vector2d& b, double dwell_s) const {
+    const double cone_rad = 2.0 * std::sin(0.5 * tilt_rad) * std::abs(rate_rad_s) * dwell_s;
+    const Eigen::Vector3d na = -ToolFrameAt(surface, a.x(), a.y(), side).col(2);
+    const Eigen::Vector3d nb = -ToolFrameAt(surface, b.x(), b.y(), side).col(2);
+    const double normal_rad = std::acos(std::clamp(na.dot(nb), -1.0, 1.0));
+    const double turn_deg = (cone_rad + normal_rad) / kRadPerDeg;
+    return std::max(1, static_cast<int>(std::ceil(turn_deg / precession.max_step_deg - 1e-12)));
+  }
+};
+
+void CheckDwellChords(std::span<const Eigen::Vector3d> tcp, const DwellSolution& dwell) {
+  if (dwell.chord_mm.empty()) return;
+  // A dwell solved on other chords (another precession, or the contact points' steps) would
+  // make the robot's times differ from the dwell the prediction assumed.
+  const std::vector<double> chord_mm = TcpChordsMm(tcp);
+  ARCWHEEL_CHECK(dwell.chord_mm.size() == chord_mm.size()) << dwell.chord_mm.size() << " chords";
+  for (std::size_t k = 0; k < chord_mm.size(); ++k) {
+    ARCWHEEL_CHECK(std::abs(dwell.chord_mm[k] - chord_mm[k]) <= 1e-12 * (1.0 + chord_mm[k]))
+        << "the dwell was solved for a TCP chord of " << dwell.chord_mm[k] << " mm into point " << k
+        << ", the robot runs " << chord_mm[k] << " mm";
+  }
+}
+
+}  // namespace
+
 std::vector<PolishingPoint> BuildPolishingPath(const surfaces::Surface& surface,
                                                std::span<const Eigen::Vector2d> path_xy_mm,
                                                const DwellSolution& dwell, RobotSide side,
@@ -68,43 +131,58 @@ std::vector<PolishingPoint> BuildPolishingPath(const surfaces::Surface& surface,
         fmt::format("{} path points but a dwell solution for {}", path_xy_mm.size(), dwell.dwell_s.size()));
   }
   const std::vector<Eigen::Vector3d> tcp = TcpPositionsMm(surface, path_xy_mm, precession);
-  if (!dwell.chord_mm.empty()) {
-    // A dwell solved on other chords (another precession, or the contact points' steps) would
-    // make the robot's times differ from the dwell the prediction assumed.
-    const std::vector<double> chord_mm = TcpChordsMm(tcp);
-    ARCWHEEL_CHECK(dwell.chord_mm.size() == chord_mm.size()) << dwell.chord_mm.size() << " chords";
-    for (std::size_t k = 0; k < chord_mm.size(); ++k) {
-      ARCWHEEL_CHECK(std::abs(dwell.chord_mm[k] - chord_mm[k]) <= 1e-12 * (1.0 + chord_mm[k]))
-          << "the dwell was solved for a TCP chord of " << dwell.chord_mm[k] << " mm into point " << k
-          << ", the robot runs " << chord_mm[k] << " mm";
-    }
-  }
-  double elapsed_s = 0.0;
+  CheckDwellChords(tcp, dwell);
   std::vector<PolishingPoint> points;
   points.reserve(path_xy_mm.size());
-  for (std::size_t k = 0; k < path_xy_mm.size(); ++k) {
-    const Eigen::Vector2d& p = path_xy_mm[k];
-    PolishingPoint point;
-    point.position_mm = tcp[k];
-    Eigen::Matrix3d frame = ToolFrameAt(surface, p.x(), p.y(), side);
-    elapsed_s += dwell.dwell_s[k];
-    if (precession.enabled && path_xy_mm.size() > 1) {
-      const Eigen::Vector3d c = -frame.col(2);
-      const Eigen::Vector2d d =
-          k > 0 ? Eigen::Vector2d(p - path_xy_mm[k - 1]) : Eigen::Vector2d(path_xy_mm[1] - p);
-      const surfaces::SurfacePoint sp = surface.Evaluate(p.x(), p.y());
-      const Eigen::Vector3d feed(d.x(), d.y(), sp.fx * d.x() + sp.fy * d.y());
-      const Eigen::Vector3d a = (feed - feed.dot(c) * c).normalized();
-      const double theta = precession.tilt_deg * std::numbers::pi / 180.0;
-      const double alpha = precession.precession_rate_rpm * 2.0 * std::numbers::pi / 60.0 * elapsed_s;
-      const Eigen::Vector3d axis = std::sin(theta) * std::cos(alpha) * a +
-                                   std::sin(theta) * std::sin(alpha) * c.cross(a) + std::cos(theta) * c;
-      frame = Eigen::Quaterniond::FromTwoVectors(-c, -axis).toRotationMatrix() * frame;
+  if (!precession.enabled) {
+    for (std::size_t k = 0; k < path_xy_mm.size(); ++k) {
+      const Eigen::Vector2d& p = path_xy_mm[k];
+      PolishingPoint point;
+      point.position_mm = tcp[k];
+      point.orientation = AbbQuaternionFromRotation(ToolFrameAt(surface, p.x(), p.y(), side));
+      point.speed_mm_s = dwell.speed_mm_s[k];
+      point.dwell_s = dwell.dwell_s[k];
+      point.contact_xy_mm = p;
+      point.dwell_point = k;
+      points.push_back(point);
     }
-    point.orientation = AbbQuaternionFromRotation(frame);
-    point.speed_mm_s = dwell.speed_mm_s[k];
-    point.dwell_s = dwell.dwell_s[k];
-    points.push_back(point);
+    return points;
+  }
+  const Precessor precessor{surface, side, precession};
+  PolishingPoint first = precessor.At(path_xy_mm[0], 0.0);
+  first.position_mm = tcp[0];
+  first.speed_mm_s = dwell.speed_mm_s[0];
+  first.dwell_s = dwell.dwell_s[0];
+  points.push_back(first);
+  double elapsed_s = dwell.dwell_s[0];
+  for (std::size_t k = 1; k < path_xy_mm.size(); ++k) {
+    const Eigen::Vector2d &a = path_xy_mm[k - 1], &b = path_xy_mm[k];
+    const int steps = precessor.Steps(a, b, dwell.dwell_s[k]);
+    const std::size_t segment_start = points.size();
+    // The steps' contacts, then their bonnet centres, then the time of each along the segment.
+    double length_mm = 0.0;
+    for (int s = 1; s <= steps; ++s) {
+      const double u = static_cast<double>(s) / steps;
+      PolishingPoint point = precessor.At(s == steps ? b : Eigen::Vector2d((1.0 - u) * a + u * b), 0.0);
+      if (s == steps) point.position_mm = tcp[k];  // the dwell point itself, as TcpPositionsMm placed it
+      length_mm += (point.position_mm - points.back().position_mm).norm();
+      point.dwell_point = k;
+      points.push_back(point);
+    }
+    // One step: the segment's own speed and dwell. Several: the segment's time kept, at the speed
+    // that runs the steps' (slightly longer) path in it.
+    const double speed_mm_s =
+        steps == 1 || !(dwell.dwell_s[k] > 0.0) ? dwell.speed_mm_s[k] : length_mm / dwell.dwell_s[k];
+    double along_s = 0.0;
+    for (std::size_t j = segment_start; j < points.size(); ++j) {
+      PolishingPoint& point = points[j];
+      point.speed_mm_s = speed_mm_s;
+      point.dwell_s =
+          steps == 1 ? dwell.dwell_s[k] : (point.position_mm - points[j - 1].position_mm).norm() / speed_mm_s;
+      along_s += point.dwell_s;
+      point.orientation = precessor.At(point.contact_xy_mm, elapsed_s + along_s).orientation;
+    }
+    elapsed_s += along_s;
   }
   return points;
 }
@@ -195,6 +273,9 @@ std::vector<std::string> PathPrecession::Problems() const {
   if (!(bonnet_radius_mm >= 0.0)) {
     problems.push_back(fmt::format("precession.bonnet_radius_mm = {} violates >= 0", bonnet_radius_mm));
   }
+  if (!(max_step_deg > 0.0 && max_step_deg <= 45.0))
+    problems.push_back(
+        fmt::format("precession.max_step_deg = {} violates 0 < max_step_deg <= 45", max_step_deg));
   return problems;
 }
 

@@ -17,24 +17,34 @@
 namespace arcwheel::polishing {
 
 struct PolishingPoint {
-  Eigen::Vector3d position_mm = Eigen::Vector3d::Zero();  // TCP = contact point, part frame
-  AbbQuaternion orientation;                              // tool frame in the part frame
-  double speed_mm_s = 0.0;                                // TCP speed into this point
-  double dwell_s = 0.0;                                   // dwell this point stands for
+  Eigen::Vector3d position_mm = Eigen::Vector3d::Zero();    // TCP = contact point, part frame
+  AbbQuaternion orientation;                                // tool frame in the part frame
+  double speed_mm_s = 0.0;                                  // TCP speed into this point
+  double dwell_s = 0.0;                                     // time of the TCP chord into this point
+  Eigen::Vector2d contact_xy_mm = Eigen::Vector2d::Zero();  // where the removal of that time falls
+  std::size_t dwell_point = 0;  // the dwell point (path point) whose segment this target lies on
 };
 
-// Bonnet continuous precession along the robot path (method.md C). At path point k the bonnet
-// axis is P_O = [a b c] (sin theta cos alpha, sin theta sin alpha, cos theta) with c the outward
-// normal, a the feed direction (from the previous point; for the first, towards the next) on the
-// tangent plane, b = c x a and alpha = w2 t_k, t_k the dwell accumulated up to point k. The tool
-// frame of ToolFrameAt is turned by the smallest rotation taking its z (-c) to -P_O, and the
-// target is the bonnet centre, contact + bonnet_radius c (the TCP of the tooldata is then the
-// bonnet centre): a spherical bonnet touches the surface at the same point at any tilt.
+// Bonnet continuous precession along the robot path (method.md C). At a target the bonnet axis is
+// P_O = [a b c] (sin theta cos alpha, sin theta sin alpha, cos theta) with c the outward normal,
+// a the x axis of ToolFrameAt (on the tangent plane, a function of the slopes only, so it turns
+// smoothly along any path), b = c x a and alpha = w2 t, t the time since the first target. The
+// tilt and the phase are continuous along the whole path, lead-in and lead-out (the extension)
+// included: the phase is measured from a direction that does not jump where the feed direction
+// does (a raster's turns), and the bonnet precesses at full tilt from the first target to the
+// last, so the footprint the dwell assumed holds wherever the removal reaches the aperture
+// (docs/polishing.md, "Precession"). The tool frame of ToolFrameAt is turned by the smallest
+// rotation taking its z (-c) to -P_O, and the target is the bonnet centre, contact +
+// bonnet_radius c (the TCP of the tooldata is then the bonnet centre): a spherical bonnet touches
+// the surface at the same point at any tilt.
 struct PathPrecession {
   bool enabled = false;
   double tilt_deg = 20.0;            // theta, [0, 90)
   double precession_rate_rpm = 5.0;  // w2, finite
   double bonnet_radius_mm = 0.0;     // >= 0
+  // A segment whose tool turns more than this (the precession over its dwell plus the normal's
+  // turn) is cut into targets this far apart, deg, (0, 45].
+  double max_step_deg = 1.0;
   // Empty when valid (or not enabled), else one line per violation naming the job key and the
   // value, e.g. "precession.tilt_deg = 90 violates 0 <= tilt_deg < 90".
   [[nodiscard]] std::vector<std::string> Problems() const;
@@ -55,8 +65,14 @@ struct PathPrecession {
 
 // Places the tool on the surface at each path point (ToolFrameAt, or precessed) with the dwell
 // solution's speed and dwell, which must have been solved on the chords of TcpPositionsMm for the
-// same precession (checked when the solution carries its chords). Throws Error{kBadInput, "polishing.path"}
-// naming the first point off the surface, Error{kInvalidOption} for precession options out of range.
+// same precession (checked when the solution carries its chords). With precession a segment whose
+// tool would turn more than max_step_deg is cut into m equal steps of the contact's (x, y): each
+// intermediate target is the bonnet centre over its own contact point with its own normal, and
+// the segment keeps its time: its steps run at the speed that covers their path in it (faster
+// than the dwell's speed by the curvature of the bonnet centres' path, about 1e-6 for 2 mm steps
+// at 440 mm), each step's dwell_s its chord / that speed, each phase that of its time.
+// Throws Error{kBadInput, "polishing.path"} naming the first point off the surface,
+// Error{kInvalidOption} for precession options out of range.
 [[nodiscard]] std::vector<PolishingPoint> BuildPolishingPath(const surfaces::Surface& surface,
                                                              std::span<const Eigen::Vector2d> path_xy_mm,
                                                              const DwellSolution& dwell, RobotSide side,

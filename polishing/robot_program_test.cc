@@ -104,33 +104,47 @@ TEST(RapidModule, DeclaresTargetsSpeedsToolAndWorkObjectAndMovesThroughEveryPoin
             "ENDMODULE\n");
 }
 
-TEST(BuildPolishingPath, PrecessesTheBonnetAxisAboutTheNormalAtTheTiltAndRate) {
+TEST(BuildPolishingPath, PrecessesTheBonnetAxisAboutTheNormalAtTheTiltAndRateInStepsOfAtMostOneDegree) {
   const Fixture f;
   const PathPrecession precession{
       .enabled = true, .tilt_deg = 20.0, .precession_rate_rpm = 5.0, .bonnet_radius_mm = 40.0};
   const auto points = BuildPolishingPath(f.surface, f.path, f.dwell, RobotSide::kPlusX, precession);
+  // 30 deg/s over dwells of up to 0.5 s turns the axis 15 deg on its 20 deg cone: cut into steps.
+  ASSERT_GT(points.size(), 3 * f.path.size());
   const double w2 = 5.0 * 2.0 * std::numbers::pi / 60.0;
   double elapsed = 0.0;
+  std::size_t path_point = 0;
   for (std::size_t k = 0; k < points.size(); ++k) {
-    elapsed += f.dwell.dwell_s[k];
-    // Independent outward normal of the convex paraboloid z = -r^2 / 1200.
-    const Eigen::Vector2d p = f.path[k];
+    elapsed += points[k].dwell_s;
+    // Independent outward normal of the convex paraboloid z = -r^2 / 1200, and its tool x axis
+    // (1, 0, f_x) towards +x.
+    const Eigen::Vector2d p = points[k].contact_xy_mm;
     const Eigen::Vector3d up = Eigen::Vector3d(p.x() / 600.0, p.y() / 600.0, 1.0).normalized();
+    const Eigen::Vector3d a = Eigen::Vector3d(1.0, 0.0, -p.x() / 600.0).normalized();
     const Eigen::Vector3d contact(p.x(), p.y(), -p.squaredNorm() / 1200.0);
     EXPECT_LT((points[k].position_mm - (contact + 40.0 * up)).norm(), 1e-12);
     const Eigen::Matrix3d frame = RotationFromAbbQuaternion(points[k].orientation);
     const Eigen::Vector3d axis = -frame.col(2);
     EXPECT_NEAR(std::acos(axis.dot(up)), 20.0 * std::numbers::pi / 180.0, 1e-9);
-    // Precession angle measured from the feed direction on the tangent plane.
-    const Eigen::Vector2d d =
-        k > 0 ? Eigen::Vector2d(f.path[k] - f.path[k - 1]) : Eigen::Vector2d(f.path[1] - f.path[0]);
-    Eigen::Vector3d a(d.x(), d.y(), -(p.x() * d.x() + p.y() * d.y()) / 600.0);
-    a = (a - a.dot(up) * up).normalized();
+    // The precession angle measured from tool x on the tangent plane, whatever the feed does.
     const Eigen::Vector3d tangential = axis - axis.dot(up) * up;
     const double alpha = std::atan2(tangential.dot(up.cross(a)), tangential.dot(a));
     EXPECT_NEAR(std::remainder(alpha - w2 * elapsed, 2.0 * std::numbers::pi), 0.0, 1e-9) << k;
     EXPECT_LT((frame.transpose() * frame - Eigen::Matrix3d::Identity()).norm(), 1e-12);
+    if (k > 0) {
+      const Eigen::Matrix3d before = RotationFromAbbQuaternion(points[k - 1].orientation);
+      EXPECT_LE(Eigen::AngleAxisd(before.transpose() * frame).angle(), std::numbers::pi / 180.0) << k;
+      // Each step lies on its segment, and the segment's last step on the path point.
+      EXPECT_TRUE(points[k].dwell_point == path_point || points[k].dwell_point == path_point + 1) << k;
+      path_point = points[k].dwell_point;
+      EXPECT_NEAR(points[k].dwell_s * points[k].speed_mm_s,
+                  (points[k].position_mm - points[k - 1].position_mm).norm(), 1e-12);
+    }
   }
+  EXPECT_EQ(path_point, f.path.size() - 1);
+  EXPECT_EQ(points.back().contact_xy_mm, f.path.back());
+  // Each segment keeps its time: its steps' speed is their path's length over it.
+  EXPECT_NEAR(elapsed, f.dwell.dwell_s[1] + f.dwell.dwell_s[2] + f.dwell.dwell_s[3], 1e-12);
   EXPECT_THROW((void)BuildPolishingPath(f.surface, f.path, f.dwell, RobotSide::kPlusX,
                                         {.enabled = true, .tilt_deg = 95.0}),
                Error);

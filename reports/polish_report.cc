@@ -254,6 +254,21 @@ std::vector<std::vector<ReportFigure>> JointRows(const PolishReportInputs& in) {
   return rows;
 }
 
+// Which segments were slowed for the joints and what that cost, or "none".
+std::string SlowedText(const PolishSummary& s) {
+  if (s.robot_slowed_targets.empty()) return "none: every joint runs the dwell's speeds";
+  constexpr std::size_t kListed = 8;
+  std::vector<std::string> listed;
+  for (std::size_t n = 0; n < std::min(kListed, s.robot_slowed_targets.size()); ++n)
+    listed.push_back(fmt::format("{} (x{:.3g})", s.robot_slowed_targets[n], s.robot_slowed_factor[n]));
+  if (s.robot_slowed_targets.size() > kListed) listed.push_back("...");
+  return fmt::format(
+      "{} segments slowed for the joints, into targets {}; {:.4g} s added, adding up to {:.4g} nm "
+      "of removal (RMS {:.4g} nm) at ({:.1f}, {:.1f}) mm, in the prediction",
+      s.robot_slowed_targets.size(), fmt::join(listed, ", "), s.robot_added_time_s, s.robot_added_max_nm,
+      s.robot_added_rms_nm, s.robot_added_max_at_mm[0], s.robot_added_max_at_mm[1]);
+}
+
 }  // namespace
 
 PolishReportContent ComposePolishReport(const PolishReportInputs& inputs) {
@@ -283,6 +298,7 @@ PolishReportContent ComposePolishReport(const PolishReportInputs& inputs) {
         {"Robot margins", fmt::format("joint limits >= {:.1f} deg, |joint 5| >= {:.1f} deg, "
                                       "joint speeds <= {:.3f} of their maxima",
                                       margin, s.robot_wrist_margin_deg, ratio)});
+    content.path.push_back({"Slowed segments", SlowedText(s)});
   }
   content.job = FlattenJson(s.job);
   return content;

@@ -225,6 +225,34 @@ std::string Dotted(std::string_view object, std::string_view name) {
 }
 
 // A file without schema_version was written before versions were recorded: read it as 1.0.
+// robot.slowed_segments, added_time_s and added_removal, when the summary has them.
+void ReadSlowedSegments(const JsonReader& r, PolishSummary& s) {
+  namespace key = schema::polish::summary::robot;
+  const std::string robot(schema::polish::summary::kRobot);
+  const std::string list = Dotted(robot, key::kSlowedSegments);
+  if (r.Find(list) == nullptr) return;
+  const json& segments = r.Require(list);
+  if (!segments.is_array()) r.Fail(list, "is not an array");
+  for (std::size_t n = 0; n < segments.size(); ++n) {
+    const JsonReader segment(segments[n], r.source());
+    const std::string at = fmt::format("{}[{}]", list, n);
+    if (!segments[n].is_object()) r.Fail(at, "is not a JSON object");
+    const double planned_s = segment.Number(std::string(key::slowed_segments::kPlannedS));
+    const double slowed_s = segment.Number(std::string(key::slowed_segments::kSlowedS));
+    if (!(planned_s > 0.0)) r.Fail(at + "." + std::string(key::slowed_segments::kPlannedS), "is not > 0");
+    s.robot_slowed_targets.push_back(segment.Count(std::string(key::slowed_segments::kTarget)));
+    s.robot_slowed_factor.push_back(slowed_s / planned_s);
+  }
+  s.robot_added_time_s = r.Number(Dotted(robot, key::kAddedTimeS));
+  const std::string added = Dotted(robot, key::kAddedRemoval);
+  s.robot_added_max_nm = r.Number(Dotted(added, key::added_removal::kMaxNm));
+  s.robot_added_rms_nm = r.Number(Dotted(added, key::added_removal::kRmsNm));
+  const json& at = r.Require(Dotted(added, key::added_removal::kMaxAtMm));
+  if (!at.is_array() || at.size() != 2 || !at[0].is_number() || !at[1].is_number())
+    r.Fail(Dotted(added, key::added_removal::kMaxAtMm), "is not [x, y]");
+  s.robot_added_max_at_mm = {at[0].get<double>(), at[1].get<double>()};
+}
+
 void CheckPolishSummaryVersion(const JsonReader& r) {
   const std::string name(schema::polish::summary::kSchemaVersion);
   const std::optional<std::string> version =
@@ -419,6 +447,7 @@ PolishSummary ParsePolishSummary(const std::string& text, const std::string& sou
       s.robot_min_limit_margin_deg[i] = margins[i];
       s.robot_max_speed_ratio[i] = ratios[i];
     }
+    ReadSlowedSegments(r, s);
   }
   s.total_time_text = r.NumberText(total_time);
   s.before_pv_text = r.NumberText(before_pv);

@@ -83,6 +83,15 @@ struct PolishSummary {
   std::array<double, 6> robot_min_limit_margin_deg{};
   std::array<double, 6> robot_max_speed_ratio{};
   double robot_wrist_margin_deg = 0.0;
+  // Segments slowed for the joints (summaries before they were reported: none): the target each
+  // runs into (a row of polishing_path.csv, 1 = first) and its slowed / planned time; their
+  // added time and the largest removal it adds, where, and its RMS.
+  std::vector<std::int64_t> robot_slowed_targets;
+  std::vector<double> robot_slowed_factor;
+  double robot_added_time_s = 0.0;
+  double robot_added_max_nm = 0.0;
+  double robot_added_rms_nm = 0.0;
+  std::array<double, 2> robot_added_max_at_mm{};
 };
 
 // robot_joints.csv: joints 1 - 6 (deg) at each target, in path order.

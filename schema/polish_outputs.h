@@ -80,6 +80,26 @@ inline constexpr std::string_view kLimitsDeg = "limits_deg";
 inline constexpr std::string_view kWristMarginDeg = "wrist_margin_deg";  // smallest |joint 5|
 inline constexpr std::string_view kLargestJointSpeedRatio = "largest_joint_speed_ratio";
 inline constexpr std::string_view kLargestJointSpeedJoint = "largest_joint_speed_joint";  // 1 - 6
+// The segments slowed where a joint could not run the dwell's speed (polishing/time_scaling.h),
+// in path order: the target the segment runs into (1 = the first row of polishing_path.csv), the
+// joint that set the time, the dwell's time and the slowed time. Empty: none.
+inline constexpr std::string_view kSlowedSegments = "slowed_segments";
+namespace slowed_segments {
+inline constexpr std::string_view kTarget = "target";
+inline constexpr std::string_view kJoint = "joint";
+inline constexpr std::string_view kPlannedS = "planned_s";
+inline constexpr std::string_view kSlowedS = "slowed_s";
+}  // namespace slowed_segments
+inline constexpr std::string_view kAddedTimeS = "added_time_s";  // their time added, s
+// The removal their added time adds over the aperture (included in "after"), nm: PV, RMS about
+// zero, the largest and where it lies [x, y] mm.
+inline constexpr std::string_view kAddedRemoval = "added_removal";
+namespace added_removal {
+inline constexpr std::string_view kPvNm = "pv_nm";
+inline constexpr std::string_view kRmsNm = "rms_nm";
+inline constexpr std::string_view kMaxNm = "max_nm";
+inline constexpr std::string_view kMaxAtMm = "max_at_mm";
+}  // namespace added_removal
 }  // namespace robot
 }  // namespace summary
 

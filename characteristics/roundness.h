@@ -34,7 +34,7 @@ struct RoundnessOptions {
 
 // The operator that made a value, as a drawing names it.
 struct RoundnessOperator {
-  std::optional<double> filter_cutoff_upr;  // nullopt: no filter
+  std::optional<double> filter_cutoff_upr = std::nullopt;  // nullopt: no filter
   Association association = Association::kMinimumZone;
   // In short, with the parameter: "RONt, 50 UPR, MZ"; "RONt, no filter, LS".
   [[nodiscard]] std::string Describe(std::string_view parameter = "RONt") const;

@@ -31,6 +31,7 @@ const std::vector<Command> kCommands = {
     {"simulate", arcwheel::cli::AddSimulateCommand},
     {"process", arcwheel::cli::AddProcessCommand},
     {"fit", arcwheel::cli::AddFitCommand},
+    {"roundness", arcwheel::cli::AddRoundnessCommand},
     {"toolpath", arcwheel::cli::AddToolpathCommand},
     {"report", arcwheel::cli::AddReportCommand},
     {"compare", arcwheel::cli::AddCompareCommand},

@@ -349,6 +349,24 @@ TEST(Cli, RoundnessReadsCartesianTraces) {
               nlohmann::json::parse(polar.output)["RONt_um"].get<double>(), 1e-9);
 }
 
+// A refused command line: its exit status and a part of its message.
+struct Refusal {
+  std::string arguments;
+  int exit_status;
+  std::string message;
+};
+
+// Each refusal: the exit status, the message, and no result (its first key) printed.
+void ExpectRefusals(const std::string& command, const std::string& result_key,
+                    const std::vector<Refusal>& cases) {
+  for (const Refusal& c : cases) {
+    const auto run = RunArcwheel(command + " " + c.arguments);
+    EXPECT_EQ(run.exit_status, c.exit_status) << c.arguments << ": " << run.output;
+    EXPECT_EQ(run.output.find(result_key), std::string::npos) << c.arguments << ": no result may be printed";
+    EXPECT_NE(run.output.find(c.message), std::string::npos) << c.arguments << ": " << run.output;
+  }
+}
+
 // Each refusal: non-zero exit, the file and line or option named, no result printed.
 TEST(Cli, RoundnessRefusesWhatItCannotEvaluate) {
   TempDir dir;
@@ -361,12 +379,7 @@ TEST(Cli, RoundnessRefusesWhatItCannotEvaluate) {
   WriteText(dir / "short.csv", LobedTrace(7, 360.0 / 7));
   WriteText(dir / "half.csv", LobedTrace(180, 0.5));
   WriteText(dir / "columns.csv", "angle,radius\n0,1\n");
-  struct Case {
-    std::string arguments;
-    int exit_status;
-    std::string message;
-  };
-  const std::vector<Case> cases = {
+  const std::vector<Refusal> cases = {
       {trace + " --association chebyshev", 2, "--association: chebyshev not in"},
       {trace + " --filter-upr spline", 2, "--filter-upr"},
       {trace + " --filter-upr 0", 2, "--filter-upr 0 violates > 0"},
@@ -380,13 +393,7 @@ TEST(Cli, RoundnessRefusesWhatItCannotEvaluate) {
       {(dir / "columns.csv").string(), 3,
        "columns.csv': the header names neither pair of columns angle_deg,radius_mm or x_mm,y_mm"},
   };
-  for (const Case& c : cases) {
-    const auto run = RunArcwheel("roundness " + c.arguments);
-    EXPECT_EQ(run.exit_status, c.exit_status) << c.arguments << ": " << run.output;
-    EXPECT_EQ(run.output.find("\"RONt_um\""), std::string::npos)
-        << c.arguments << ": no result may be printed";
-    EXPECT_NE(run.output.find(c.message), std::string::npos) << c.arguments << ": " << run.output;
-  }
+  ExpectRefusals("roundness", "\"RONt_um\"", cases);
 }
 
 // Minimum zone through the CLI: four contacts alternating on two circles 20 um apart, every other
@@ -440,12 +447,7 @@ TEST(Cli, FitCircleRefusesCollinearPointsAndUnknownAssociations) {
   WriteText(dir / "line.csv", "x_mm,y_mm\n0,1\n1,3\n2,5\n3,7\n");
   WriteText(dir / "two.csv", "x_mm,y_mm\n0,1\n1,3\n");
   WriteText(dir / "arc.csv", "x_mm,y_mm\n10,0\n9.9,1.41\n9.6,2.8\n9.2,3.9\n8.7,4.9\n");
-  struct Case {
-    std::string arguments;
-    int exit_status;
-    std::string message;
-  };
-  const std::vector<Case> cases = {
+  const std::vector<Refusal> cases = {
       {(dir / "line.csv").string(), 3, "line.csv': all 4 points lie on one line"},
       {(dir / "line.csv").string() + " --association minimum-zone", 3, "all 4 points lie on one line"},
       {(dir / "two.csv").string(), 3, "two.csv': a circle needs at least 3 points, got 2"},
@@ -453,13 +455,7 @@ TEST(Cli, FitCircleRefusesCollinearPointsAndUnknownAssociations) {
        "not defined for points within half a turn"},
       {(dir / "line.csv").string() + " --association chebyshev", 2, "--association: chebyshev not in"},
   };
-  for (const Case& c : cases) {
-    const auto run = RunArcwheel("fit circle " + c.arguments);
-    EXPECT_EQ(run.exit_status, c.exit_status) << c.arguments << ": " << run.output;
-    EXPECT_EQ(run.output.find("\"center\""), std::string::npos)
-        << c.arguments << ": no result may be printed";
-    EXPECT_NE(run.output.find(c.message), std::string::npos) << c.arguments << ": " << run.output;
-  }
+  ExpectRefusals("fit circle", "\"center\"", cases);
 }
 
 TEST(Cli, TheSameInputGivesByteIdenticalFiles) {

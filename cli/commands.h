@@ -12,6 +12,7 @@ namespace arcwheel::cli {
 void AddSimulateCommand(CLI::App& app);
 void AddProcessCommand(CLI::App& app);
 void AddFitCommand(CLI::App& app);
+void AddRoundnessCommand(CLI::App& app);
 void AddToolpathCommand(CLI::App& app);
 void AddReportCommand(CLI::App& app);
 void AddFrameCommand(CLI::App& app);

@@ -24,13 +24,11 @@ using arcwheel::ErrorCode;
 // The command table: add a row here and a command_<name>.cc beside this file (each names its
 // command when it adds it).
 const std::vector<void (*)(CLI::App&)> kCommands = {
-    arcwheel::cli::AddSimulateCommand,  arcwheel::cli::AddProcessCommand,
-    arcwheel::cli::AddFitCommand,       arcwheel::cli::AddToolpathCommand,
-    arcwheel::cli::AddReportCommand,    arcwheel::cli::AddCompareCommand,
-    arcwheel::cli::AddHistoryCommand,   arcwheel::cli::AddFrameCommand,
-    arcwheel::cli::AddTransformCommand, arcwheel::cli::AddHeadcenterCommand,
-    arcwheel::cli::AddPolishCommand,    arcwheel::cli::AddRegenerateCommand,
-    arcwheel::cli::AddBatchCommand,     arcwheel::cli::AddDbCommand,
+    arcwheel::cli::AddSimulateCommand,   arcwheel::cli::AddProcessCommand,    arcwheel::cli::AddFitCommand,
+    arcwheel::cli::AddRoundnessCommand,  arcwheel::cli::AddToolpathCommand,   arcwheel::cli::AddReportCommand,
+    arcwheel::cli::AddCompareCommand,    arcwheel::cli::AddHistoryCommand,    arcwheel::cli::AddFrameCommand,
+    arcwheel::cli::AddTransformCommand,  arcwheel::cli::AddHeadcenterCommand, arcwheel::cli::AddPolishCommand,
+    arcwheel::cli::AddRegenerateCommand, arcwheel::cli::AddBatchCommand,      arcwheel::cli::AddDbCommand,
 };
 
 constexpr const char* kExitCodes =

@@ -2,6 +2,8 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <regex>
@@ -298,6 +300,179 @@ TEST(Cli, FitCircleGivesTheExactLeastSquaresCircleOfAnOffsetShortArc) {
   EXPECT_EQ(fit["n"].get<int>(), n);
 }
 
+// ---- fit circle --association and roundness (formats.md sections 4 and 8) ----------------------
+
+// A closed trace: an eccentric circle (e = 10 um) with 2 um of 3-lobe form, every 1 deg.
+std::string LobedTrace(int n = 360, double step_deg = 1.0) {
+  std::ostringstream out;
+  out.precision(17);
+  out << "angle_deg,radius_mm\n";
+  for (int i = 0; i < n; ++i) {
+    const double t = step_deg * i * M_PI / 180.0;
+    out << step_deg * i << "," << 20.0 + 0.01 * std::cos(t - 0.5) + 0.002 * std::cos(3 * t) << "\n";
+  }
+  return out.str();
+}
+
+TEST(Cli, RoundnessReportsTheParametersAndTheOperator) {
+  TempDir dir;
+  WriteText(dir / "trace.csv", LobedTrace());
+  const auto run = RunArcwheel("roundness " + (dir / "trace.csv").string() + " --filter-upr 50");
+  ASSERT_EQ(run.exit_status, 0) << run.output;
+  const auto out = nlohmann::json::parse(run.output);
+  // 2 um lobes at 3 UPR pass a 50 UPR filter at 2^-(3/50)^2 = 0.9975: RONt = 4 * 0.9975 um.
+  const double lobe_um = 2.0 * std::pow(2.0, -(3.0 / 50) * (3.0 / 50));
+  EXPECT_NEAR(out["RONt_um"].get<double>(), 2 * lobe_um, 1e-3 * lobe_um);
+  EXPECT_NEAR(out["RONp_um"].get<double>(), lobe_um, 1e-3 * lobe_um);
+  EXPECT_NEAR(out["RONv_um"].get<double>(), lobe_um, 1e-3 * lobe_um);
+  EXPECT_NEAR(out["RONq_um"].get<double>(), lobe_um / std::sqrt(2.0), 1e-3 * lobe_um);
+  EXPECT_EQ(out["association"], "minimum-zone");
+  EXPECT_EQ(out["filter"]["type"], "gaussian");
+  EXPECT_EQ(out["filter"]["cutoff_upr"].get<double>(), 50.0);
+  EXPECT_EQ(out["operator"], "RONt, 50 UPR, MZ");
+  EXPECT_EQ(out["support_point_indices"].size(), 4u);
+  ASSERT_EQ(out["harmonics"].size(), 179u);
+  EXPECT_NEAR(out["harmonics"][0]["amplitude_um"].get<double>(), 10.0, 1e-6);
+  EXPECT_NEAR(out["harmonics"][2]["amplitude_um"].get<double>(), 2.0, 1e-6);
+  const auto unfiltered =
+      RunArcwheel("roundness " + (dir / "trace.csv").string() + " --no-filter --association least-squares");
+  ASSERT_EQ(unfiltered.exit_status, 0) << unfiltered.output;
+  const auto ls = nlohmann::json::parse(unfiltered.output);
+  EXPECT_NEAR(ls["RONt_um"].get<double>(), 4.0, 4e-3);
+  EXPECT_EQ(ls["filter"]["type"], "none");
+  EXPECT_FALSE(ls.contains("support_point_indices"));
+}
+
+// x_mm,y_mm gives the same trace as angle_deg,radius_mm.
+TEST(Cli, RoundnessReadsCartesianTraces) {
+  TempDir dir;
+  std::ostringstream out;
+  out.precision(17);
+  out << "x_mm,y_mm\n";
+  for (int i = 0; i < 360; ++i) {
+    const double t = i * M_PI / 180.0;
+    const double r = 20.0 + 0.01 * std::cos(t - 0.5) + 0.002 * std::cos(3 * t);
+    out << r * std::cos(t) << "," << r * std::sin(t) << "\n";
+  }
+  WriteText(dir / "xy.csv", out.str());
+  WriteText(dir / "polar.csv", LobedTrace());
+  const auto xy = RunArcwheel("roundness " + (dir / "xy.csv").string());
+  const auto polar = RunArcwheel("roundness " + (dir / "polar.csv").string());
+  ASSERT_EQ(xy.exit_status, 0) << xy.output;
+  ASSERT_EQ(polar.exit_status, 0) << polar.output;
+  EXPECT_NEAR(nlohmann::json::parse(xy.output)["RONt_um"].get<double>(),
+              nlohmann::json::parse(polar.output)["RONt_um"].get<double>(), 1e-9);
+}
+
+// A refused command line: its exit status and a part of its message.
+struct Refusal {
+  std::string arguments;
+  int exit_status;
+  std::string message;
+};
+
+// Each refusal: the exit status, the message, and no result (its first key) printed.
+void ExpectRefusals(const std::string& command, const std::string& result_key,
+                    const std::vector<Refusal>& cases) {
+  for (const Refusal& c : cases) {
+    const auto run = RunArcwheel(command + " " + c.arguments);
+    EXPECT_EQ(run.exit_status, c.exit_status) << c.arguments << ": " << run.output;
+    EXPECT_EQ(run.output.find(result_key), std::string::npos) << c.arguments << ": no result may be printed";
+    EXPECT_NE(run.output.find(c.message), std::string::npos) << c.arguments << ": " << run.output;
+  }
+}
+
+// Each refusal: non-zero exit, the file and line or option named, no result printed.
+TEST(Cli, RoundnessRefusesWhatItCannotEvaluate) {
+  TempDir dir;
+  const std::string trace = (dir / "trace.csv").string();
+  WriteText(dir / "trace.csv", LobedTrace());
+  std::string gap = LobedTrace();
+  const auto line_of_100 = gap.find("\n100,");
+  gap.erase(line_of_100, gap.find('\n', line_of_100 + 1) - line_of_100);
+  WriteText(dir / "gap.csv", gap);
+  WriteText(dir / "short.csv", LobedTrace(7, 360.0 / 7));
+  WriteText(dir / "half.csv", LobedTrace(180, 0.5));
+  WriteText(dir / "columns.csv", "angle,radius\n0,1\n");
+  const std::vector<Refusal> cases = {
+      {trace + " --association chebyshev", 2, "--association: chebyshev not in"},
+      {trace + " --filter-upr spline", 2, "--filter-upr"},
+      {trace + " --filter-upr 0", 2, "--filter-upr 0 violates > 0"},
+      {trace + " --filter-upr -5", 2, "--filter-upr -5 violates > 0"},
+      {trace + " --filter-upr 181", 2,
+       "--filter-upr 181 is above half the 360 points of '" + trace + "' (180 UPR)"},
+      {trace + " --filter-upr 50 --no-filter", 2, "excludes"},
+      {(dir / "short.csv").string(), 3, "short.csv': a closed profile needs at least 8 points, got 7"},
+      {(dir / "gap.csv").string(), 3, "the largest gap is 2 deg, from line 101 to line 102"},
+      {(dir / "half.csv").string(), 3, "half.csv': the angles are not equally spaced over one turn"},
+      {(dir / "columns.csv").string(), 3,
+       "columns.csv': the header names neither pair of columns angle_deg,radius_mm or x_mm,y_mm"},
+  };
+  ExpectRefusals("roundness", "\"RONt_um\"", cases);
+}
+
+// Minimum zone through the CLI: four contacts alternating on two circles 20 um apart, every other
+// point strictly between, far from the origin.
+TEST(Cli, FitCircleGivesTheMinimumZoneWithItsSupportPoints) {
+  TempDir dir;
+  std::ostringstream out;
+  out.precision(17);
+  out << "x_mm,y_mm\n";
+  const double cx = 3000.0, cy = -4000.0;
+  const std::vector<int> support = {10, 55, 100, 150};
+  for (int i = 0; i < 200; ++i) {
+    const double t = 2 * M_PI * i / 200;
+    const auto k = std::find(support.begin(), support.end(), i) - support.begin();
+    const double r = k < 4 ? (k % 2 == 0 ? 40.01 : 39.99) : 40.0 + 0.008 * std::sin(7.0 * i);
+    out << cx + r * std::cos(t) << "," << cy + r * std::sin(t) << "\n";
+  }
+  WriteText(dir / "points.csv", out.str());
+  const auto run = RunArcwheel("fit circle " + (dir / "points.csv").string() + " --association minimum-zone");
+  ASSERT_EQ(run.exit_status, 0) << run.output;
+  const auto fit = nlohmann::json::parse(run.output);
+  EXPECT_NEAR(fit["center"][0].get<double>(), cx, 1e-7);
+  EXPECT_NEAR(fit["center"][1].get<double>(), cy, 1e-7);
+  EXPECT_NEAR(fit["radius_inner_mm"].get<double>(), 39.99, 1e-7);
+  EXPECT_NEAR(fit["radius_outer_mm"].get<double>(), 40.01, 1e-7);
+  EXPECT_NEAR(fit["zone_width_mm"].get<double>(), 0.02, 1e-7);
+  EXPECT_EQ(fit["association"], "minimum-zone");
+  std::vector<int> found = fit["support_point_indices"].get<std::vector<int>>();
+  std::sort(found.begin(), found.end());
+  EXPECT_EQ(found, support);
+  EXPECT_EQ(fit["n"].get<int>(), 200);
+  for (const char* association : {"maximum-inscribed", "minimum-circumscribed"}) {
+    const auto other =
+        RunArcwheel("fit circle " + (dir / "points.csv").string() + " --association " + association);
+    ASSERT_EQ(other.exit_status, 0) << other.output;
+    const auto circle = nlohmann::json::parse(other.output);
+    EXPECT_EQ(circle["association"], association);
+    // The zone's inner circle is inscribed and its outer circle encloses: the largest inscribed
+    // circle is no smaller, the smallest enclosing one no larger.
+    if (std::string(association) == "maximum-inscribed") {
+      EXPECT_GE(circle["radius"].get<double>(), 39.99 - 1e-9);
+    } else {
+      EXPECT_LE(circle["radius"].get<double>(), 40.01 + 1e-9);
+    }
+    EXPECT_GE(circle["support_point_indices"].size(), 2u);
+  }
+}
+
+TEST(Cli, FitCircleRefusesCollinearPointsAndUnknownAssociations) {
+  TempDir dir;
+  WriteText(dir / "line.csv", "x_mm,y_mm\n0,1\n1,3\n2,5\n3,7\n");
+  WriteText(dir / "two.csv", "x_mm,y_mm\n0,1\n1,3\n");
+  WriteText(dir / "arc.csv", "x_mm,y_mm\n10,0\n9.9,1.41\n9.6,2.8\n9.2,3.9\n8.7,4.9\n");
+  const std::vector<Refusal> cases = {
+      {(dir / "line.csv").string(), 3, "line.csv': all 4 points lie on one line"},
+      {(dir / "line.csv").string() + " --association minimum-zone", 3, "all 4 points lie on one line"},
+      {(dir / "two.csv").string(), 3, "two.csv': a circle needs at least 3 points, got 2"},
+      {(dir / "arc.csv").string() + " --association minimum-circumscribed", 3,
+       "not defined for points within half a turn"},
+      {(dir / "line.csv").string() + " --association chebyshev", 2, "--association: chebyshev not in"},
+  };
+  ExpectRefusals("fit circle", "\"center\"", cases);
+}
+
 TEST(Cli, TheSameInputGivesByteIdenticalFiles) {
   TempDir dir;
   for (const char* name : {"a.h5", "b.h5"}) {
@@ -334,8 +509,8 @@ TEST(Cli, HelpAndABareCallListEveryCommand) {
   EXPECT_EQ(help.exit_status, 0);
   EXPECT_EQ(bare.exit_status, 1);
   for (const char* command :
-       {"simulate", "process", "fit", "toolpath", "report", "compare", "history", "frame", "transform",
-        "headcenter", "polish", "regenerate", "batch", "version", "help"}) {
+       {"simulate", "process", "fit", "roundness", "toolpath", "report", "compare", "history", "frame",
+        "transform", "headcenter", "polish", "regenerate", "batch", "version", "help"}) {
     const std::string line = "\n  " + std::string(command) + " ";
     EXPECT_NE(help.output.find(line), std::string::npos) << command << " missing from:\n" << help.output;
     EXPECT_NE(bare.output.find(line), std::string::npos) << command << " missing from:\n" << bare.output;

@@ -87,8 +87,10 @@ std::vector<ProcessOption> MakeTable() {
       // Options that the record states otherwise (the map's steps as used, "model": on or off).
       {"--axial-step-mm", "map node spacing (default one helix pitch)", "",
        [](Options& o) -> OptionRef { return &o.processing.map.axial_step_mm; }, false},
-      {"--knot-step-deg", "knot spacing of the library's helix spline, recorded in summary.json; process fits none (default 360/phases)", "",
-       [](Options& o) -> OptionRef { return &o.processing.map.knot_step_deg; }, false},
+      {"--knot-step-deg",
+       "knot spacing of the library's helix spline, recorded in summary.json; process fits none (default "
+       "360/phases)",
+       "", [](Options& o) -> OptionRef { return &o.processing.map.knot_step_deg; }, false},
       {"--no-model", "skip the wheel model (docs/wheel_model.md)", "",
        [](Options& o) -> OptionRef { return &o.no_model; }, false},
       {"--uncertainty", "type B uncertainty budget (docs/uncertainty.md); default: the simulated sensor's",

@@ -1,0 +1,145 @@
+#include "characteristics/gaussian_filter.h"
+
+#include <fftw3.h>
+#include <fmt/core.h>
+
+#include <cmath>
+#include <complex>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <numbers>
+
+#include "core/error.h"
+
+namespace arcwheel::characteristics {
+namespace {
+
+constexpr std::string_view kStage = "characteristics.filter";
+
+struct FftwFree {
+  void operator()(void* memory) const { fftw_free(memory); }
+};
+using RealBuffer = std::unique_ptr<double[], FftwFree>;
+using ComplexBuffer = std::unique_ptr<fftw_complex[], FftwFree>;
+
+RealBuffer AllocateReal(std::size_t n) { return RealBuffer(fftw_alloc_real(n)); }
+ComplexBuffer AllocateComplex(std::size_t n) { return ComplexBuffer(fftw_alloc_complex(n)); }
+
+// FFTW's planner is not thread-safe, its plans are: one pair of plans per profile length, made
+// once under a lock and executed on each call's own (equally aligned, fftw_malloc) buffers.
+struct Plans {
+  fftw_plan forward = nullptr;
+  fftw_plan inverse = nullptr;
+};
+
+Plans PlansFor(std::size_t n) {
+  static std::mutex mutex;
+  static std::map<std::size_t, Plans> plans;
+  const std::lock_guard<std::mutex> lock(mutex);
+  auto found = plans.find(n);
+  if (found != plans.end()) return found->second;
+  RealBuffer real = AllocateReal(n);
+  ComplexBuffer spectrum = AllocateComplex(n / 2 + 1);
+  const int size = static_cast<int>(n);
+  Plans made;
+  made.forward = fftw_plan_dft_r2c_1d(size, real.get(), spectrum.get(), FFTW_ESTIMATE);
+  made.inverse = fftw_plan_dft_c2r_1d(size, spectrum.get(), real.get(), FFTW_ESTIMATE);
+  return plans.emplace(n, made).first->second;
+}
+
+// The n / 2 + 1 coefficients X_k = sum_j x_j exp(-2 pi i j k / n).
+ComplexBuffer Spectrum(std::span<const double> values) {
+  const std::size_t n = values.size();
+  RealBuffer real = AllocateReal(n);
+  std::copy(values.begin(), values.end(), real.get());
+  ComplexBuffer spectrum = AllocateComplex(n / 2 + 1);
+  fftw_execute_dft_r2c(PlansFor(n).forward, real.get(), spectrum.get());
+  return spectrum;
+}
+
+void RequireClosedProfile(std::size_t n) {
+  if (n < 8)
+    throw Error(ErrorCode::kBadInput, kStage,
+                fmt::format("a closed profile needs at least 8 points, got {}", n));
+}
+
+}  // namespace
+
+double GaussianAlpha() { return std::sqrt(std::numbers::ln2 / std::numbers::pi); }
+
+double GaussianTransmission(double k, double cutoff) {
+  const double ratio = GaussianAlpha() * k / cutoff;
+  return std::exp(-std::numbers::pi * ratio * ratio);
+}
+
+std::vector<double> FilterClosedProfile(std::span<const double> values, double cutoff_upr) {
+  const std::size_t n = values.size();
+  RequireClosedProfile(n);
+  if (!(cutoff_upr > 0) || !(cutoff_upr <= 0.5 * static_cast<double>(n))) {
+    throw Error(ErrorCode::kInvalidOption, kStage,
+                fmt::format("cut-off {} UPR violates 0 < cut-off <= {} (half the {} points of the profile)",
+                            cutoff_upr, 0.5 * static_cast<double>(n), n));
+  }
+  ComplexBuffer spectrum = Spectrum(values);
+  // The inverse transform is unnormalised: 1 / n folded into the transmission.
+  const double inverse_n = 1.0 / static_cast<double>(n);
+  for (std::size_t k = 0; k <= n / 2; ++k) {
+    const double gain = GaussianTransmission(static_cast<double>(k), cutoff_upr) * inverse_n;
+    spectrum[k][0] *= gain;
+    spectrum[k][1] *= gain;
+  }
+  RealBuffer real = AllocateReal(n);
+  fftw_execute_dft_c2r(PlansFor(n).inverse, spectrum.get(), real.get());
+  return {real.get(), real.get() + n};
+}
+
+std::vector<double> HarmonicAmplitudes(std::span<const double> values, int max_harmonic) {
+  const std::size_t n = values.size();
+  RequireClosedProfile(n);
+  const std::size_t last =
+      std::min<std::size_t>(static_cast<std::size_t>(std::max(max_harmonic, 0)), (n + 1) / 2 - 1);
+  const ComplexBuffer spectrum = Spectrum(values);
+  std::vector<double> amplitudes(last);
+  for (std::size_t k = 1; k <= last; ++k) {
+    amplitudes[k - 1] = 2.0 * std::hypot(spectrum[k][0], spectrum[k][1]) / static_cast<double>(n);
+  }
+  return amplitudes;
+}
+
+std::vector<double> FilterOpenProfile(std::span<const double> values, double spacing_mm, double cutoff_mm) {
+  if (!(spacing_mm > 0) || !std::isfinite(spacing_mm) || !(cutoff_mm >= 5.0 * spacing_mm) ||
+      !std::isfinite(cutoff_mm)) {
+    throw Error(ErrorCode::kInvalidOption, kStage,
+                fmt::format("cut-off {} mm with spacing {} mm violates spacing > 0 and cut-off >= 5 spacings",
+                            cutoff_mm, spacing_mm));
+  }
+  const std::size_t n = values.size();
+  if (n < 2)
+    throw Error(ErrorCode::kBadInput, kStage,
+                fmt::format("an open profile needs at least 2 points, got {}", n));
+  // The weighting function over |x| <= lambda_c, where it has fallen to exp(-pi / alpha^2) = 7e-7.
+  const auto half_width = static_cast<std::ptrdiff_t>(std::floor(cutoff_mm / spacing_mm));
+  std::vector<double> weights(static_cast<std::size_t>(half_width) + 1);
+  const double width_mm = GaussianAlpha() * cutoff_mm;
+  for (std::size_t j = 0; j < weights.size(); ++j) {
+    const double x = static_cast<double>(j) * spacing_mm / width_mm;
+    weights[j] = std::exp(-std::numbers::pi * x * x);
+  }
+  const auto count = static_cast<std::ptrdiff_t>(n);
+  std::vector<double> mean_line(n);
+  for (std::ptrdiff_t i = 0; i < count; ++i) {
+    const std::ptrdiff_t first = std::max<std::ptrdiff_t>(0, i - half_width);
+    const std::ptrdiff_t last = std::min<std::ptrdiff_t>(count - 1, i + half_width);
+    double weighted = 0.0, total = 0.0;
+    for (std::ptrdiff_t j = first; j <= last; ++j) {
+      const double w = weights[static_cast<std::size_t>(std::abs(j - i))];
+      weighted += w * values[static_cast<std::size_t>(j)];
+      total += w;
+    }
+    mean_line[static_cast<std::size_t>(i)] = weighted / total;
+  }
+  return mean_line;
+}
+
+}  // namespace arcwheel::characteristics

@@ -403,17 +403,25 @@ std::pair<std::size_t, std::size_t> ValidSpan(std::span<const T> rho) {
   return {first, last};
 }
 
+// A map's settings before its nodes: the options checked, the noise, the knot step, the pitch.
 template <typename T>
-WheelMap Plan(std::span<const T> rho, const HelixGeometry& geometry, double noise_sigma_mm,
-              std::span<const std::size_t> despiked, const MapOptions& options, StageClock* clock) {
+WheelMap StartMap(std::span<const T> rho, const HelixGeometry& geometry, double noise_sigma_mm,
+                  const MapOptions& options) {
   ThrowIfProblems(ErrorCode::kInvalidOption, "processing.map", options.Problems());
-  if (clock != nullptr) clock->Start("map nodes and coverage");
   const auto valid = static_cast<std::size_t>(
       std::count_if(rho.begin(), rho.end(), [](T v) { return std::isfinite(static_cast<double>(v)); }));
   WheelMap map;
   map.noise_sigma_mm = noise_sigma_mm;
   map.knot_step_deg = ChooseKnotStep(options, geometry, valid);
   map.pitch_mm = geometry.PitchMm();
+  return map;
+}
+
+template <typename T>
+WheelMap Plan(std::span<const T> rho, const HelixGeometry& geometry, double noise_sigma_mm,
+              std::span<const std::size_t> despiked, const MapOptions& options, StageClock* clock) {
+  if (clock != nullptr) clock->Start("map nodes and coverage");
+  WheelMap map = StartMap(rho, geometry, noise_sigma_mm, options);
   map.phase_deg = PhaseNodes(options.phases);
   const auto [first, last] = ValidSpan(rho);
   const auto [y_low, y_high] =
@@ -433,14 +441,8 @@ WheelMap Plan(std::span<const T> rho, const HelixGeometry& geometry, double nois
 template <typename T>
 WheelMap Build(std::span<const T> rho, const HelixGeometry& geometry, double noise_sigma_mm,
                std::span<const std::size_t> despiked, const MapOptions& options, StageClock* clock) {
-  ThrowIfProblems(ErrorCode::kInvalidOption, "processing.map", options.Problems());
   if (clock != nullptr) clock->Start("helix spline");
-  const auto valid = static_cast<std::size_t>(
-      std::count_if(rho.begin(), rho.end(), [](T v) { return std::isfinite(static_cast<double>(v)); }));
-  WheelMap map;
-  map.noise_sigma_mm = noise_sigma_mm;
-  map.knot_step_deg = ChooseKnotStep(options, geometry, valid);
-  map.pitch_mm = geometry.PitchMm();
+  WheelMap map = StartMap(rho, geometry, noise_sigma_mm, options);
   auto spline = std::make_shared<HelixSpline>(rho, geometry, map.knot_step_deg);
 
   if (clock != nullptr) clock->Start("sections and map");

@@ -27,25 +27,46 @@ RealBuffer AllocateReal(std::size_t n) { return RealBuffer(fftw_alloc_real(n)); 
 ComplexBuffer AllocateComplex(std::size_t n) { return ComplexBuffer(fftw_alloc_complex(n)); }
 
 // FFTW's planner is not thread-safe, its plans are: one pair of plans per profile length, made
-// once under a lock and executed on each call's own (equally aligned, fftw_malloc) buffers.
+// once under a lock and executed on each call's own (equally aligned, fftw_malloc) buffers. The
+// cache destroys its plans at exit, so that a leak checker sees none.
 struct Plans {
   fftw_plan forward = nullptr;
   fftw_plan inverse = nullptr;
 };
 
+class PlanCache {
+ public:
+  PlanCache() = default;
+  PlanCache(const PlanCache&) = delete;
+  PlanCache& operator=(const PlanCache&) = delete;
+  ~PlanCache() {
+    for (auto& [n, made] : plans_) {
+      fftw_destroy_plan(made.forward);
+      fftw_destroy_plan(made.inverse);
+    }
+  }
+
+  Plans For(std::size_t n) {
+    const std::lock_guard<std::mutex> lock(mutex_);
+    auto found = plans_.find(n);
+    if (found != plans_.end()) return found->second;
+    RealBuffer real = AllocateReal(n);
+    ComplexBuffer spectrum = AllocateComplex(n / 2 + 1);
+    const int size = static_cast<int>(n);
+    Plans made;
+    made.forward = fftw_plan_dft_r2c_1d(size, real.get(), spectrum.get(), FFTW_ESTIMATE);
+    made.inverse = fftw_plan_dft_c2r_1d(size, spectrum.get(), real.get(), FFTW_ESTIMATE);
+    return plans_.emplace(n, made).first->second;
+  }
+
+ private:
+  std::mutex mutex_;
+  std::map<std::size_t, Plans> plans_;
+};
+
 Plans PlansFor(std::size_t n) {
-  static std::mutex mutex;
-  static std::map<std::size_t, Plans> plans;
-  const std::lock_guard<std::mutex> lock(mutex);
-  auto found = plans.find(n);
-  if (found != plans.end()) return found->second;
-  RealBuffer real = AllocateReal(n);
-  ComplexBuffer spectrum = AllocateComplex(n / 2 + 1);
-  const int size = static_cast<int>(n);
-  Plans made;
-  made.forward = fftw_plan_dft_r2c_1d(size, real.get(), spectrum.get(), FFTW_ESTIMATE);
-  made.inverse = fftw_plan_dft_c2r_1d(size, spectrum.get(), real.get(), FFTW_ESTIMATE);
-  return plans.emplace(n, made).first->second;
+  static PlanCache cache;
+  return cache.For(n);
 }
 
 // The n / 2 + 1 coefficients X_k = sum_j x_j exp(-2 pi i j k / n).

@@ -49,19 +49,19 @@ void AddPmacOptions(CLI::App& command, PmacArgs& pmac, bool required) {
       ->capture_default_str();
 }
 
-std::vector<std::string> PmacLines(const frames::Transform& workpiece_to_machine, const PmacArgs& pmac) {
+std::vector<std::string> PmacLines(const frames::Transform& machine_from_workpiece, const PmacArgs& pmac) {
   frames::PmacAxisOptions options{.coordinate_system = pmac.coordinate_system, .decimals = pmac.decimals};
   for (int k = 0; k < 3; ++k) {
     options.motors[k] = pmac.motors[k];
     options.counts_per_mm[k] = pmac.counts_per_mm[k];
   }
-  return frames::PmacAxisDefinitions(workpiece_to_machine, options);
+  return frames::PmacAxisDefinitions(machine_from_workpiece, options);
 }
 
 Eigen::Vector3d Point(const std::vector<double>& values) { return {values[0], values[1], values[2]}; }
 
 nlohmann::json FrameJson(const frames::WorkpieceFrame& frame, const std::array<Eigen::Vector3d, 3>& probes) {
-  const frames::Transform forward = frame.WorkpieceToMachine();
+  const frames::Transform forward = frame.MachineFromWorkpiece();
   // The top level is the workpiece -> machine transform, so the file works with `transform apply`.
   nlohmann::json out = frames::TransformToJson(forward);
   out["source_frame"] = "workpiece";
@@ -74,8 +74,8 @@ nlohmann::json FrameJson(const frames::WorkpieceFrame& frame, const std::array<E
                   {"angle_p2_p3_deg", frame.angle_p2_p3_deg}};
   out["probes_mm"] = {
       {"origin", vector(probes[0])}, {"x_point", vector(probes[1])}, {"xy_point", vector(probes[2])}};
-  out["workpiece_to_machine"] = frames::TransformToJson(forward);
-  out["machine_to_workpiece"] = frames::TransformToJson(frame.MachineToWorkpiece());
+  out["machine_from_workpiece"] = frames::TransformToJson(forward);
+  out["workpiece_from_machine"] = frames::TransformToJson(frame.WorkpieceFromMachine());
   out["formulas"] = "machine = P1 + [i j k] * workpiece; workpiece = [i j k]^T * (machine - P1)";
   return out;
 }
@@ -154,7 +154,7 @@ void AddFrameCommand(CLI::App& app) {
         fmt::format("workpiece frame: origin ({:.6f}, {:.6f}, {:.6f}) mm, angle P2-P1-P3 {:.3f} deg\n",
                     result.origin_mm.x(), result.origin_mm.y(), result.origin_mm.z(), result.angle_p2_p3_deg);
     if (!args->pmac.counts_per_mm.empty()) {
-      const std::vector<std::string> lines = PmacLines(result.WorkpieceToMachine(), args->pmac);
+      const std::vector<std::string> lines = PmacLines(result.MachineFromWorkpiece(), args->pmac);
       out["pmac_axis_definitions"] = lines;
       for (const std::string& line : lines) summary += "  " + line + "\n";
     }

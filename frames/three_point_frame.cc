@@ -42,7 +42,7 @@ std::vector<std::string> ThreePointFrameOptions::Problems() const {
   return problems;
 }
 
-Transform WorkpieceFrame::WorkpieceToMachine() const {
+Transform WorkpieceFrame::MachineFromWorkpiece() const {
   Transform t;
   t.model = TransformModel::kRigid3d;
   t.linear = axes;
@@ -50,7 +50,7 @@ Transform WorkpieceFrame::WorkpieceToMachine() const {
   return t;
 }
 
-Transform WorkpieceFrame::MachineToWorkpiece() const { return WorkpieceToMachine().Inverse(); }
+Transform WorkpieceFrame::WorkpieceFromMachine() const { return MachineFromWorkpiece().Inverse(); }
 
 WorkpieceFrame ThreePointFrame(const Eigen::Vector3d& p1_mm, const Eigen::Vector3d& p2_mm,
                                const Eigen::Vector3d& p3_mm, const ThreePointFrameOptions& options) {
@@ -107,10 +107,10 @@ std::vector<std::string> PmacAxisOptions::Problems() const {
   return problems;
 }
 
-std::vector<std::string> PmacAxisDefinitions(const Transform& workpiece_to_machine,
+std::vector<std::string> PmacAxisDefinitions(const Transform& machine_from_workpiece,
                                              const PmacAxisOptions& options) {
   ThrowIfProblems(ErrorCode::kInvalidOption, "frames.pmac", options.Problems());
-  const Eigen::Matrix3d linear = workpiece_to_machine.scale * workpiece_to_machine.linear;
+  const Eigen::Matrix3d linear = machine_from_workpiece.scale * machine_from_workpiece.linear;
   std::vector<std::string> lines = {fmt::format("&{}", options.coordinate_system)};
   constexpr std::array<char, 3> kAxes = {'X', 'Y', 'Z'};
   for (int n = 0; n < 3; ++n) {
@@ -120,7 +120,7 @@ std::vector<std::string> PmacAxisDefinitions(const Transform& workpiece_to_machi
       line += (k == 0 ? number : Signed(number)) + kAxes[k];
     }
     line += Signed(
-        PmacNumber(options.counts_per_mm[n] * workpiece_to_machine.translation_mm(n), options.decimals));
+        PmacNumber(options.counts_per_mm[n] * machine_from_workpiece.translation_mm(n), options.decimals));
     lines.push_back(line);
   }
   return lines;

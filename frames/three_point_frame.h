@@ -30,8 +30,8 @@ struct WorkpieceFrame {
   Eigen::Vector3d origin_mm = Eigen::Vector3d::Zero();  // P1, in machine coordinates
   Eigen::Matrix3d axes = Eigen::Matrix3d::Identity();   // columns i, j, k in machine coordinates
   double angle_p2_p3_deg = 90.0;                        // angle at P1 between P2 and P3
-  [[nodiscard]] Transform WorkpieceToMachine() const;   // rigid3d
-  [[nodiscard]] Transform MachineToWorkpiece() const;   // rigid3d
+  [[nodiscard]] Transform MachineFromWorkpiece() const;   // rigid3d
+  [[nodiscard]] Transform WorkpieceFromMachine() const;   // rigid3d
 };
 
 // Throws Error{kBadInput, "frames.three_point"} for coincident or collinear points or non-finite
@@ -57,7 +57,7 @@ struct PmacAxisOptions {
 //   A..C = counts_per_mm[n] * row n of [i j k],   D = counts_per_mm[n] * P1_n   (counts).
 // Machine coordinates are taken to be motor position / counts_per_mm (motor zero = machine zero).
 // Throws Error{kInvalidOption} for invalid options.
-[[nodiscard]] std::vector<std::string> PmacAxisDefinitions(const Transform& workpiece_to_machine,
+[[nodiscard]] std::vector<std::string> PmacAxisDefinitions(const Transform& machine_from_workpiece,
                                                            const PmacAxisOptions& options);
 
 }  // namespace arcwheel::frames

@@ -23,10 +23,10 @@ TEST(ThreePointFrame, RecoversAKnownRotatedAndShiftedFrame) {
   // The method.md formulas: P' = P1 + [i j k] P and P = [i j k]^T (P' - P1).
   const Eigen::Vector3d p_in_workpiece(12.0, -7.0, 3.5);
   const Eigen::Vector3d p_in_machine = origin + axes * p_in_workpiece;
-  EXPECT_TRUE(frame.WorkpieceToMachine().ApplyToPoint(p_in_workpiece).isApprox(p_in_machine, 1e-13));
-  EXPECT_TRUE(frame.MachineToWorkpiece().ApplyToPoint(p_in_machine).isApprox(p_in_workpiece, 1e-11));
+  EXPECT_TRUE(frame.MachineFromWorkpiece().ApplyToPoint(p_in_workpiece).isApprox(p_in_machine, 1e-13));
+  EXPECT_TRUE(frame.WorkpieceFromMachine().ApplyToPoint(p_in_machine).isApprox(p_in_workpiece, 1e-11));
   // P3 lies in the workpiece XY plane with positive y.
-  const Eigen::Vector3d p3_in_workpiece = frame.MachineToWorkpiece().ApplyToPoint(p3);
+  const Eigen::Vector3d p3_in_workpiece = frame.WorkpieceFromMachine().ApplyToPoint(p3);
   EXPECT_NEAR(p3_in_workpiece.z(), 0.0, 1e-11);
   EXPECT_GT(p3_in_workpiece.y(), 0.0);
 }
@@ -54,14 +54,14 @@ TEST(PmacAxisDefinitions, ReproduceTheMotorCountsOfTheFrame) {
       ThreePointFrame(origin, origin + axes.col(0) * 50.0, origin + axes.col(1) * 50.0);
   const PmacAxisOptions options{
       .coordinate_system = 2, .motors = {4, 5, 6}, .counts_per_mm = {10000.0, 10000.0, -5000.0}};
-  const auto lines = PmacAxisDefinitions(frame.WorkpieceToMachine(), options);
+  const auto lines = PmacAxisDefinitions(frame.MachineFromWorkpiece(), options);
   ASSERT_EQ(lines.size(), 4u);
   EXPECT_EQ(lines[0], "&2");
   // cos(0.25) = 0.968912421710645, sin(0.25) = 0.247403959254523.
   EXPECT_EQ(lines[1], "#4->9689.124217X-2474.039593Y+0Z+1000000");
   EXPECT_EQ(lines[2], "#5->2474.039593X+9689.124217Y+0Z+500000");
   EXPECT_EQ(lines[3], "#6->0X+0Y-5000Z+100000");
-  EXPECT_THROW((void)PmacAxisDefinitions(frame.WorkpieceToMachine(), {.motors = {1, 1, 2}}), Error);
+  EXPECT_THROW((void)PmacAxisDefinitions(frame.MachineFromWorkpiece(), {.motors = {1, 1, 2}}), Error);
 }
 
 }  // namespace

@@ -188,9 +188,9 @@ std::vector<PolishingPoint> BuildPolishingPath(const surfaces::Surface& surface,
 }
 
 Eigen::Vector3d ToolData::CorrectedTcpMm() const {
-  const Eigen::Matrix3d flange_R_tool = RotationFromAbbQuaternion(orientation);
+  const Eigen::Matrix3d flange_from_tool = RotationFromAbbQuaternion(orientation);
   return tcp_mm +
-         flange_R_tool * Eigen::Vector3d(removal_centre_offset_mm.x(), removal_centre_offset_mm.y(), 0.0);
+         flange_from_tool * Eigen::Vector3d(removal_centre_offset_mm.x(), removal_centre_offset_mm.y(), 0.0);
 }
 
 std::string PolishingPathCsv(std::span<const PolishingPoint> points, std::span<const std::string> comments) {

@@ -9,7 +9,7 @@
 //    (1, 0, f_x) normalised, with its sign chosen towards the robot (+x or -x of the part frame);
 //  - tool y (eq. 5): z cross x.
 // The frame is returned as a rotation matrix whose columns are the tool axes in the part frame
-// (part_R_tool), so p_in_part = R p_in_tool.
+// (part_from_tool), so p_in_part = R p_in_tool.
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>

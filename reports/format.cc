@@ -10,6 +10,9 @@
 namespace arcwheel::reports {
 namespace {
 
+// format.h names the default of FormatSignificant without including the formatter's header.
+static_assert(kMaxShownDigits == 7);
+
 // The typographic minus: a hyphen reads as a dash. A value that rounds to zero loses its sign.
 std::string WithMinus(std::string text) {
   if (text.empty() || text.front() != '-') return text;

@@ -1,11 +1,12 @@
 #pragma once
-// The reports' one number formatter: every number a report prints (tables, captions, legends)
-// goes through these functions, so that a quantity has the same unit and digits everywhere.
+// The reports' typography over the one number formatter (core/number_format.h): every number a
+// report prints (tables, captions, legends) goes through these functions, so that a quantity has
+// the same unit and digits everywhere, and the same digits as the terminal shows.
 //
 // Rules: a minus sign is U+2212 ("−"), as in plot ticks; a value that rounds to zero has no sign;
 // a value that is not finite prints as "n/a"; integers print as integers ("360", not "360.0");
-// numbers without a fixed scale (processing parameters, limits as given) keep at most six
-// significant digits with trailing zeros dropped ("0.19968", "500").
+// numbers without a fixed scale (processing parameters, limits as given) keep at most
+// kMaxShownDigits (seven) significant digits with trailing zeros dropped ("0.1996798", "500").
 
 #include <cstdint>
 #include <nlohmann/json_fwd.hpp>
@@ -47,8 +48,8 @@ inline constexpr Unit kWear_um_per_h{"µm/h", 3};
 [[nodiscard]] std::string FormatWithSigma(double value, double sigma, Unit unit);
 
 // At most `digits` significant digits, trailing zeros (and a bare point) dropped: 0.19967978 ->
-// "0.19968", 500.0 -> "500", 1e-7 -> "1e−07". For numbers without a fixed scale.
-[[nodiscard]] std::string FormatSignificant(double value, int digits = 6);
+// "0.1996798", 500.0 -> "500", 1e-7 -> "1e−07". For numbers without a fixed scale.
+[[nodiscard]] std::string FormatSignificant(double value, int digits = 7);
 
 // A duration with the unit that suits it: 5e-6 -> "5 µs", 1e-4 -> "0.1 ms", 2.5 -> "2.50 s", 754 -> "12.6
 // min", 7200 -> "2.00 h".

@@ -24,13 +24,14 @@ TEST(FormatValue, WritesTheUnitsDigitsAndSymbol) {
   EXPECT_EQ(FormatWithSigma(-90.04, 2.31, units::kAngle_deg), "−90.0 ± 2.3 deg");
 }
 
-TEST(FormatSignificant, KeepsSixDigitsAndWritesWholeNumbersWhole) {
-  EXPECT_EQ(FormatSignificant(0.19967978891870555), "0.19968");
+TEST(FormatSignificant, KeepsSevenDigitsAndWritesWholeNumbersWhole) {
+  EXPECT_EQ(FormatSignificant(0.19967978891870555), "0.1996798");
   EXPECT_EQ(FormatSignificant(500.0), "500");
   EXPECT_EQ(FormatSignificant(360.0), "360");
   EXPECT_EQ(FormatSignificant(0.1), "0.1");
   EXPECT_EQ(FormatSignificant(-2.5e-7), "−2.5e-07");
-  EXPECT_EQ(FormatSignificant(1234567.89), "1.23457e+06");
+  EXPECT_EQ(FormatSignificant(1234567.89), "1234568");
+  EXPECT_EQ(FormatSignificant(12345678.9), "1.234568e+07");
 }
 
 TEST(FormatDuration, PicksTheUnitThatSuitsTheDuration) {
@@ -50,7 +51,7 @@ TEST(FormatHeight, WritesNanometreResidualsInNanometres) {
 TEST(FormatJsonValue, WritesIntegersAsIntegersAndLongNumbersShort) {
   EXPECT_EQ(FormatJsonValue(nlohmann::json(360)), "360");
   EXPECT_EQ(FormatJsonValue(nlohmann::json(8.0)), "8");
-  EXPECT_EQ(FormatJsonValue(nlohmann::json(0.19967978891870555)), "0.19968");
+  EXPECT_EQ(FormatJsonValue(nlohmann::json(0.19967978891870555)), "0.1996798");
   EXPECT_EQ(FormatJsonValue(nlohmann::json("band")), "band");
   EXPECT_EQ(FormatJsonValue(nlohmann::json::parse("[1, 2.5, true]")), "[1, 2.5, true]");
   EXPECT_EQ(FormatJsonValue(nlohmann::json(-3)), "−3");

@@ -72,7 +72,7 @@ frames::Transform ReadCalibration(const std::string& path) {
   return frames::TransformFromJson(ReadJsonFile(path, kHeadcenterStage), path);
 }
 
-Eigen::Vector2d ToMachine(const frames::Transform& calibration, const Eigen::Vector2d& sensor) {
+Eigen::Vector2d MachineFromSensor(const frames::Transform& calibration, const Eigen::Vector2d& sensor) {
   return calibration.ApplyToPoint({sensor.x(), sensor.y(), 0.0}).head<2>();
 }
 
@@ -113,7 +113,7 @@ HeadcenterSolve SolveHeadcenterRecord(const std::string& record, const std::stri
   out["tare"] = TareJson(options, solved.tare);
   if (!calibration_path.empty()) {
     const frames::Transform calibration = ReadCalibration(calibration_path);
-    const Eigen::Vector2d machine = ToMachine(calibration, solved.centre.centre_mm);
+    const Eigen::Vector2d machine = MachineFromSensor(calibration, solved.centre.centre_mm);
     const Eigen::Matrix2d rotation = calibration.scale * calibration.linear.topLeftCorner<2, 2>();
     const Eigen::Matrix2d covariance = rotation * solved.centre.covariance_mm2 * rotation.transpose();
     out["calibration"] = calibration_path;
@@ -173,7 +173,7 @@ HeadcenterMoves TabulateHeadcenterMoves(const std::string& records_path, const s
   for (const RecordRow& row : rows) {
     const Solved solved = SolveRecord(row.path, options, tare);
     const Eigen::Vector2d solved_mm =
-        calibration ? ToMachine(*calibration, solved.centre.centre_mm) : solved.centre.centre_mm;
+        calibration ? MachineFromSensor(*calibration, solved.centre.centre_mm) : solved.centre.centre_mm;
     samples.push_back({row.position_mm, solved_mm, row.path});
     nlohmann::json record = CentreJson(row.path, solved);
     record["commanded_mm"] = Pair(row.position_mm);

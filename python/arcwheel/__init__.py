@@ -267,8 +267,8 @@ def history(folders=None, *, wheel: Optional[str] = None, since: Optional[str] =
 def frame(p1, p2, p3, *, min_separation_mm: float = 1e-3, min_angle_deg: float = 0.1) -> dict:
     """`arcwheel frame` (docs/frames.md): the three-point workpiece frame from probed P1 (origin),
     P2 (on +X) and P3 (in the XY plane, +Y side), machine coordinates in mm. Returns {"origin_mm"
-    (3,), "axes" (3, 3) (columns i, j, k), "angle_p2_p3_deg", "workpiece_to_machine" and
-    "machine_to_workpiece" (4, 4), "transform": the transform JSON the command writes}.
+    (3,), "axes" (3, 3) (columns i, j, k), "angle_p2_p3_deg", "machine_from_workpiece" and
+    "workpiece_from_machine" (4, 4), "transform": the transform JSON the command writes}.
     Raises BadInputError (stage "frames.three_point") for coincident or collinear points."""
     return _arcwheel._frame(list(map(float, p1)), list(map(float, p2)), list(map(float, p3)),
                             min_separation_mm, min_angle_deg)

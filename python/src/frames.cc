@@ -67,9 +67,9 @@ py::dict Frame(const std::vector<double>& p1, const std::vector<double>& p2, con
     for (int c = 0; c < 3; ++c) axes.push_back(frame.axes(r, c));
   d["axes"] = ToNumpy(std::move(axes), {3, 3});
   d["angle_p2_p3_deg"] = frame.angle_p2_p3_deg;
-  d["workpiece_to_machine"] = Matrix(frame.WorkpieceToMachine());
-  d["machine_to_workpiece"] = Matrix(frame.MachineToWorkpiece());
-  d["transform"] = ParseJson(frames::TransformToJson(frame.WorkpieceToMachine()).dump());
+  d["machine_from_workpiece"] = Matrix(frame.MachineFromWorkpiece());
+  d["workpiece_from_machine"] = Matrix(frame.WorkpieceFromMachine());
+  d["transform"] = ParseJson(frames::TransformToJson(frame.MachineFromWorkpiece()).dump());
   return d;
 }
 

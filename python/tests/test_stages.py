@@ -212,9 +212,9 @@ def test_frame_of_three_probed_points_is_the_rotation_they_span():
     np.testing.assert_allclose(result["axes"], np.column_stack([i, j, np.cross(i, j)]), atol=1e-12)
     np.testing.assert_allclose(result["origin_mm"], p1)
     point = np.array([3.0, 4.0, 5.0, 1.0])
-    np.testing.assert_allclose(result["workpiece_to_machine"] @ point, np.append(p1 + 3 * i + 4 * j + 5 * np.cross(i, j), 1),
+    np.testing.assert_allclose(result["machine_from_workpiece"] @ point, np.append(p1 + 3 * i + 4 * j + 5 * np.cross(i, j), 1),
                                atol=1e-12)
-    np.testing.assert_allclose(result["machine_to_workpiece"] @ result["workpiece_to_machine"], np.eye(4), atol=1e-12)
+    np.testing.assert_allclose(result["workpiece_from_machine"] @ result["machine_from_workpiece"], np.eye(4), atol=1e-12)
     with pytest.raises(arcwheel.BadInputError) as error:
         arcwheel.frame(p1, p1 + i, p1 + 2 * i)
     assert error.value.stage == "frames.three_point"

@@ -7,10 +7,10 @@
 #include <complex>
 #include <map>
 #include <memory>
-#include <mutex>
 #include <numbers>
 
 #include "core/error.h"
+#include "core/fftw_planner.h"
 
 namespace arcwheel::characteristics {
 namespace {
@@ -27,16 +27,16 @@ RealBuffer AllocateReal(std::size_t n) { return RealBuffer(fftw_alloc_real(n)); 
 ComplexBuffer AllocateComplex(std::size_t n) { return ComplexBuffer(fftw_alloc_complex(n)); }
 
 // FFTW's planner is not thread-safe, its plans are: one pair of plans per profile length, made
-// once under a lock and executed on each call's own (equally aligned, fftw_malloc) buffers.
+// once under the planner's lock (which also guards the map) and executed on each call's own
+// (equally aligned, fftw_malloc) buffers. Single-threaded: a profile is short.
 struct Plans {
   fftw_plan forward = nullptr;
   fftw_plan inverse = nullptr;
 };
 
 Plans PlansFor(std::size_t n) {
-  static std::mutex mutex;
   static std::map<std::size_t, Plans> plans;
-  const std::lock_guard<std::mutex> lock(mutex);
+  const FftwPlanner planner(1);
   auto found = plans.find(n);
   if (found != plans.end()) return found->second;
   RealBuffer real = AllocateReal(n);

@@ -6,30 +6,20 @@
 #include <cmath>
 #include <complex>
 #include <cstdlib>
-#include <mutex>
 #include <utility>
 
 #include "core/check.h"
+#include "core/fftw_planner.h"
 #include "core/parallel.h"
 
 namespace arcwheel::polishing::internal {
 namespace {
 
-// FFTW's planner is not thread-safe; executing a plan is.
-std::mutex& PlannerMutex() {
-  static std::mutex mutex;
-  return mutex;
-}
-
 // Transforms of at least this many cells run on every core (FFTW's threads): below it, waking the
 // threads costs more than they save.
 constexpr std::size_t kThreadedCells = std::size_t{1} << 18;
 
-// FFTW's threads are set up once per process; call with the planner mutex held.
-int PlanThreads(std::size_t cells) {
-  static const bool ready = fftw_init_threads() != 0;
-  return ready && cells >= kThreadedCells ? WorkerCount(0) : 1;
-}
+int PlanThreads(std::size_t cells) { return cells >= kThreadedCells ? WorkerCount(0) : 1; }
 
 // The whole number of steps from `origin` to `value`, if it lies within kGridTolerance of one.
 std::optional<int> GridIndex(double value, double origin, double step) {
@@ -88,19 +78,20 @@ struct FftRemoval::Workspace {
   Workspace(int r, int c) : rows(r), columns(c) {
     const std::size_t cells = static_cast<std::size_t>(r) * c;
     const std::size_t half = static_cast<std::size_t>(r) * (c / 2 + 1);
-    const std::lock_guard<std::mutex> lock(PlannerMutex());
-    fftw_plan_with_nthreads(PlanThreads(cells));
     grid = fftw_alloc_real(cells);
     spectrum = fftw_alloc_complex(half);
     ARCWHEEL_CHECK(grid != nullptr && spectrum != nullptr) << "FFT arrays of " << r << " x " << c;
+    const FftwPlanner planner(PlanThreads(cells));
     forward = fftw_plan_dft_r2c_2d(r, c, grid, spectrum, FFTW_ESTIMATE);
     inverse = fftw_plan_dft_c2r_2d(r, c, spectrum, grid, FFTW_ESTIMATE);
     ARCWHEEL_CHECK(forward != nullptr && inverse != nullptr) << "FFT plans of " << r << " x " << c;
   }
   ~Workspace() {
-    const std::lock_guard<std::mutex> lock(PlannerMutex());
-    fftw_destroy_plan(forward);
-    fftw_destroy_plan(inverse);
+    {
+      const FftwPlanner planner;
+      fftw_destroy_plan(forward);
+      fftw_destroy_plan(inverse);
+    }
     fftw_free(grid);
     fftw_free(spectrum);
   }

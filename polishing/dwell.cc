@@ -4,6 +4,7 @@
 
 #include <Eigen/SparseCore>
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <numbers>
@@ -124,20 +125,22 @@ class Removal {
   [[nodiscard]] Eigen::VectorXd Transposed(const Eigen::VectorXd& rows) const {
     return fft_ ? fft_->ApplyTranspose(rows) : Eigen::VectorXd(sparse_.transpose() * rows);
   }
-  // The same products into vectors the caller keeps: no allocation per iteration.
-  void Multiply(const Eigen::VectorXd& dwell_s, Eigen::VectorXd& rows) const {
+  // A^T residual for the residual the last Residual call wrote (the FFT products keep it placed),
+  // into a vector the caller keeps: no allocation per iteration.
+  void Gradient(const Eigen::VectorXd& residual, Eigen::VectorXd& gradient) const {
     if (fft_) {
-      fft_->Apply(dwell_s, rows);
+      fft_->GradientOfResidual(residual, gradient);
     } else {
-      rows.noalias() = sparse_ * dwell_s;
+      gradient.noalias() = sparse_.transpose() * residual;
     }
   }
-  void MultiplyTransposed(const Eigen::VectorXd& rows, Eigen::VectorXd& dwell_s) const {
-    if (fft_) {
-      fft_->ApplyTranspose(rows, dwell_s);
-    } else {
-      dwell_s.noalias() = sparse_.transpose() * rows;
-    }
+  // residual = A t - target; returns its norm.
+  double Residual(const Eigen::VectorXd& dwell_s, const Eigen::VectorXd& target,
+                  Eigen::VectorXd& residual) const {
+    if (fft_) return fft_->Residual(dwell_s, target, residual);
+    residual.noalias() = sparse_ * dwell_s;
+    residual -= target;
+    return residual.norm();
   }
   [[nodiscard]] Eigen::Index cols() const { return points_; }
   [[nodiscard]] long Nonzeros() const { return fft_ ? fft_->Nonzeros() : sparse_.nonZeros(); }
@@ -308,6 +311,38 @@ struct Fit {
 // small, first residual, a round would polish far below where the first solve stopped.
 constexpr int kWarmStartIterations = 100;
 
+// Of one projected gradient step: ||t - previous||^2, ||t||^2 and (y - t).(t - previous).
+struct StepSums {
+  double change = 0.0, dwell = 0.0, uphill = 0.0;
+};
+
+// t = clamp(y - step gradient) and its sums in one pass over the vectors, on every core (on a
+// million points each pass is memory-bound and costs a fair part of what a transform does). Each
+// block's sums are taken while the block is still in cache.
+StepSums ProjectedStep(const Eigen::VectorXd& y, const Eigen::VectorXd& gradient, double step,
+                       const Bounds& bounds, const Eigen::VectorXd& previous, Eigen::VectorXd& t) {
+  std::array<StepSums, internal::kPassBlocks> blocks{};
+  internal::ForEachBlock(
+      static_cast<std::size_t>(t.size()), [&](std::size_t begin, std::size_t end, int block) {
+        const auto b = static_cast<Eigen::Index>(begin), n = static_cast<Eigen::Index>(end - begin);
+        auto ts = t.segment(b, n);
+        ts = (y.segment(b, n) - step * gradient.segment(b, n))
+                 .cwiseMax(bounds.lower.segment(b, n))
+                 .cwiseMin(bounds.upper.segment(b, n));
+        StepSums& sums = blocks[static_cast<std::size_t>(block)];
+        sums.change = (ts - previous.segment(b, n)).squaredNorm();
+        sums.dwell = ts.squaredNorm();
+        sums.uphill = (y.segment(b, n) - ts).dot(ts - previous.segment(b, n));
+      });
+  StepSums total;
+  for (const StepSums& sums : blocks) {
+    total.change += sums.change;
+    total.dwell += sums.dwell;
+    total.uphill += sums.uphill;
+  }
+  return total;
+}
+
 Fit ProjectedGradient(const Removal& a, const Eigen::VectorXd& target, const Bounds& bounds, double step,
                       const Eigen::VectorXd& start, std::optional<double> stall_reference, bool warm,
                       const DwellOptions& options) {
@@ -319,26 +354,28 @@ Fit ProjectedGradient(const Removal& a, const Eigen::VectorXd& target, const Bou
   double momentum = 1.0;
   std::vector<double> history;
   for (fit.iterations = 1; fit.iterations <= options.max_iterations; ++fit.iterations) {
-    a.Multiply(y, residual);
-    residual -= target;
-    const double residual_norm = residual.norm();
+    const double residual_norm = a.Residual(y, target, residual);
     if (fit.iterations == 1) fit.first_residual_norm = stall_reference.value_or(residual_norm);
     if (Stalled(residual_norm, fit.iterations, fit.first_residual_norm, options, history)) {
       fit.converged = true;
       break;
     }
-    a.MultiplyTransposed(residual, gradient);
+    a.Gradient(residual, gradient);
     previous.swap(t);
-    t = (y - step * gradient).cwiseMax(bounds.lower).cwiseMin(bounds.upper);
-    const double change = (t - previous).norm();
-    if (change <= options.relative_tolerance * t.norm() && (!warm || fit.iterations > kWarmStartIterations)) {
+    const StepSums sums = ProjectedStep(y, gradient, step, bounds, previous, t);
+    if (std::sqrt(sums.change) <= options.relative_tolerance * std::sqrt(sums.dwell) &&
+        (!warm || fit.iterations > kWarmStartIterations)) {
       fit.converged = true;
       break;
     }
     // O'Donoghue & Candes (2015): restart the momentum when it points uphill.
-    if ((y - t).dot(t - previous) > 0.0) momentum = 1.0;
+    if (sums.uphill > 0.0) momentum = 1.0;
     const double next = 0.5 * (1.0 + std::sqrt(1.0 + 4.0 * momentum * momentum));
-    y = t + ((momentum - 1.0) / next) * (t - previous);
+    const double push = (momentum - 1.0) / next;
+    internal::ForEachBlock(static_cast<std::size_t>(t.size()), [&](std::size_t begin, std::size_t end, int) {
+      const auto b = static_cast<Eigen::Index>(begin), n = static_cast<Eigen::Index>(end - begin);
+      y.segment(b, n) = t.segment(b, n) + push * (t.segment(b, n) - previous.segment(b, n));
+    });
     momentum = next;
   }
   fit.iterations = std::min(fit.iterations, options.max_iterations);
@@ -367,20 +404,20 @@ constexpr int kMaxFilterSteps = 60;
 Fit InverseFilterIterations(const internal::FftRemoval& f, const Removal& a, const Eigen::VectorXd& target,
                             const Bounds& bounds, double reference, const DwellOptions& options) {
   Fit fit;
-  Eigen::VectorXd t =
-      f.InverseFilter(target, kFilterStartDamping).cwiseMax(bounds.lower).cwiseMin(bounds.upper);
+  Eigen::VectorXd t;
+  f.InverseFilter(target, kFilterStartDamping, true, t);
+  t = t.cwiseMax(bounds.lower).cwiseMin(bounds.upper);
   Eigen::VectorXd residual(target.size()), best_residual;
   fit.first_residual_norm = std::numeric_limits<double>::infinity();
   std::vector<double> history;
   double damping = kFilterStepDamping;
   for (fit.iterations = 1; fit.iterations <= kMaxFilterSteps; ++fit.iterations) {
-    a.Multiply(t, residual);
-    residual -= target;
-    const double norm = residual.norm();
+    const double norm = a.Residual(t, target, residual);
     if (norm < fit.first_residual_norm) {
+      // Kept by swapping: t and the residual are written afresh before they are read again.
       fit.first_residual_norm = norm;
-      fit.dwell_s = t;
-      best_residual = residual;
+      fit.dwell_s.swap(t);
+      best_residual.swap(residual);
     } else {
       damping *= 3.0;
       if (damping > kMaxFilterStepDamping) break;
@@ -390,7 +427,8 @@ Fit InverseFilterIterations(const internal::FftRemoval& f, const Removal& a, con
         history[history.size() - 1 - kFilterStallSteps] - history.back() <=
             options.stall_improvement * reference)
       break;
-    t = (fit.dwell_s - f.InverseFilter(best_residual, damping)).cwiseMax(bounds.lower).cwiseMin(bounds.upper);
+    f.InverseFilter(best_residual, damping, true, t);
+    t = (fit.dwell_s - t).cwiseMax(bounds.lower).cwiseMin(bounds.upper);
   }
   fit.iterations = std::min(fit.iterations, kMaxFilterSteps);
   fit.converged = true;

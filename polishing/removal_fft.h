@@ -14,6 +14,8 @@
 // step: below 1e-9 of the peak rate over the footprint, for a footprint wider than one step).
 
 #include <Eigen/Core>
+#include <cstddef>
+#include <functional>
 #include <memory>
 #include <optional>
 #include <span>
@@ -26,6 +28,16 @@ namespace arcwheel::polishing::internal {
 
 // Largest distance of a dwell point from a grid node, in grid steps, for the FFT products.
 inline constexpr double kGridTolerance = 1e-9;
+
+// The solve's element-wise passes over its vectors (a million points: memory-bound, and as many
+// as the transforms' time when run on one core) split [0, n) into kPassBlocks blocks and run
+// pass(begin, end, block) on each, on every core once n reaches kParallelElements. The blocks do
+// not depend on the core count: sums formed per block and added in block order come out the same
+// on every machine.
+inline constexpr int kPassBlocks = 16;
+inline constexpr std::size_t kParallelElements = std::size_t{1} << 16;
+void ForEachBlock(std::size_t n,
+                  const std::function<void(std::size_t begin, std::size_t end, int block)>& pass);
 
 class FftRemoval {
  public:
@@ -43,6 +55,13 @@ class FftRemoval {
   // The same into vectors the caller keeps (resized if need be): no allocation per product.
   void Apply(const Eigen::VectorXd& dwell_s, Eigen::VectorXd& rows) const;
   void ApplyTranspose(const Eigen::VectorXd& rows, Eigen::VectorXd& dwell_s) const;
+  // residual = A t - target, in the same pass as its norm, which it returns; the same pass places
+  // it on the row cells for GradientOfResidual.
+  double Residual(const Eigen::VectorXd& dwell_s, const Eigen::VectorXd& target,
+                  Eigen::VectorXd& residual) const;
+  // A^T residual, for the residual the last Residual call wrote (and unchanged since): the
+  // least-squares gradient, from the placed residual. Any other vector is placed afresh.
+  void GradientOfResidual(const Eigen::VectorXd& residual, Eigen::VectorXd& dwell_s) const;
   // Entries of the sparse matrix that these products stand for: (row, point) pairs with a rate > 0.
   [[nodiscard]] long Nonzeros() const { return nonzeros_; }
   // An upper bound of ||A||^2, the largest eigenvalue of A^T A: the largest |spectrum|^2 of the
@@ -58,18 +77,28 @@ class FftRemoval {
   // spectrum, a preconditioned gradient of the least-squares problem.
   [[nodiscard]] Eigen::VectorXd InverseFilter(const Eigen::VectorXd& rows, double relative_damping,
                                               bool extend = true) const;
+  // The same into a vector the caller keeps.
+  void InverseFilter(const Eigen::VectorXd& rows, double relative_damping, bool extend,
+                     Eigen::VectorXd& dwell_s) const;
 
  private:
   struct Workspace;  // FFTW plans and arrays
   FftRemoval() = default;
-  // The work grid convolved with the removal function, or correlated with it (A^T), in place.
-  void Convolve(bool correlate) const;
+  // `input` (a grid of the workspace) convolved with the removal function, or correlated with it
+  // (A^T), into the work grid.
+  void Convolve(const double* input, bool correlate) const;
   [[nodiscard]] double* ClearedGrid() const;
+  // The grid that holds the dwell at the point cells (0 elsewhere), or the row values at the row
+  // cells, filled from `values`.
+  [[nodiscard]] const double* PointGrid(const Eigen::VectorXd& values) const;
+  [[nodiscard]] const double* RowGrid(const Eigen::VectorXd& values) const;
 
   int origin_i_ = 0, origin_j_ = 0;  // map index of FFT cell (0, 0)
   std::vector<int> row_cell_;        // FFT cell of each row node
   std::vector<int> point_cell_;      // FFT cell of each dwell point
-  int rows_ = 0, columns_ = 0;       // FFT size
+  bool points_share_cells_ = false;  // two or more points in one cell: their dwells add up
+  bool rows_share_cells_ = false;
+  int rows_ = 0, columns_ = 0;  // FFT size
   long nonzeros_ = 0;
   std::shared_ptr<Workspace> work_;  // one FftRemoval serves one thread at a time
 };

@@ -48,7 +48,7 @@ struct Rows {
 Rows ApertureRows(const ErrorMap& target, const surfaces::Aperture& aperture) {
   Rows rows;
   rows.row_of_node.assign(target.error_um.size(), -1);
-  std::vector<double> values;
+  rows.node.reserve(target.error_um.size());
   for (int j = 0; j < target.grid.ny; ++j) {
     for (int i = 0; i < target.grid.nx; ++i) {
       const int index = j * target.grid.nx + i;
@@ -56,14 +56,15 @@ Rows ApertureRows(const ErrorMap& target, const surfaces::Aperture& aperture) {
         continue;
       rows.row_of_node[index] = static_cast<int>(rows.node.size());
       rows.node.push_back(index);
-      values.push_back(target.error_um[index]);
     }
   }
   if (rows.node.empty()) {
     throw Error(ErrorCode::kBadInput, kStage,
                 fmt::format("empty aperture: no target node lies inside {}", aperture.Describe()));
   }
-  rows.target = Eigen::Map<const Eigen::VectorXd>(values.data(), static_cast<Eigen::Index>(values.size()));
+  rows.target.resize(static_cast<Eigen::Index>(rows.node.size()));
+  for (std::size_t r = 0; r < rows.node.size(); ++r)
+    rows.target[static_cast<Eigen::Index>(r)] = target.error_um[rows.node[r]];
   return rows;
 }
 
@@ -196,7 +197,8 @@ Bounds DwellBounds(std::span<const double> chord_mm, const DwellOptions& o) {
 
 void CheckReachable(const Removal& a, const Rows& rows, const ErrorMap& map, const Bounds& b,
                     const DwellOptions& o) {
-  const Eigen::VectorXd excess = a * b.lower - rows.target;
+  Eigen::VectorXd excess;
+  a.Residual(b.lower, rows.target, excess);
   Eigen::Index worst = 0;
   const double most = excess.maxCoeff(&worst);
   if (most <= kOvershootToleranceUm) return;
@@ -436,8 +438,8 @@ Fit InverseFilterIterations(const internal::FftRemoval& f, const Removal& a, con
 }
 
 ErrorMap Scatter(const ErrorMap& like, const Rows& rows, const Eigen::VectorXd& values) {
-  ErrorMap out = like;
-  std::fill(out.error_um.begin(), out.error_um.end(), std::numeric_limits<double>::quiet_NaN());
+  ErrorMap out{.grid = like.grid};
+  out.error_um.assign(like.error_um.size(), std::numeric_limits<double>::quiet_NaN());
   for (std::size_t r = 0; r < rows.node.size(); ++r)
     out.error_um[rows.node[r]] = values[static_cast<Eigen::Index>(r)];
   return out;

@@ -9,6 +9,7 @@
 #include <array>
 #include <cmath>
 #include <complex>
+#include <cstddef>
 #include <cstdint>
 #include <cstdlib>
 #include <utility>
@@ -20,11 +21,11 @@
 namespace arcwheel::polishing::internal {
 namespace {
 
-// Transforms of at least this many cells run on every core (FFTW's threads): below it, waking the
-// threads costs more than they save.
+// Transforms of at least this many cells run on every core: below it, starting the threads costs
+// more than they save.
 constexpr std::size_t kThreadedCells = std::size_t{1} << 18;
 
-int PlanThreads(std::size_t cells) { return cells >= kThreadedCells ? WorkerCount(0) : 1; }
+int TransformWorkers(std::size_t cells) { return cells >= kThreadedCells ? WorkerCount(0) : 1; }
 
 // The whole number of steps from `origin` to `value`, if it lies within kGridTolerance of one.
 std::optional<int> GridIndex(double value, double origin, double step) {
@@ -133,34 +134,210 @@ class ZeroedPages {
 // Bytes rounded up to whole cache lines (past SIMD alignment): each array starts on one.
 constexpr std::size_t Lines(std::size_t bytes) { return (bytes + 63) / 64 * 64; }
 
+// Grid rows per row plan; half-spectrum columns per column block: eight complex values are one
+// 128-byte line, so a block's copy in and out moves whole cache lines, and the block (rows x 128
+// bytes, 128 kB for 1024 rows) stays in a core's L2 cache through its transforms.
+constexpr int kRowBlock = 8;
+constexpr int kColumnBlock = 8;
+
+// Complex values per row of a half spectrum as stored: the columns / 2 + 1 there are, padded to
+// whole 64-byte lines so that a column block's row is two lines, not three.
+int SpectrumStride(int columns) { return (columns / 2 + 1 + 3) / 4 * 4; }
+
+// work(index, worker) for index = 0 .. count - 1, each worker taking an equal run of indices
+// (neighbouring blocks share cache lines at their edges: runs keep them on one core).
+template <class Work>
+void ForEachIndex(int count, int workers, const Work& work) {
+  if (workers <= 1) {
+    for (int index = 0; index < count; ++index) work(index, 0);
+    return;
+  }
+  RunOnWorkers(workers, [&work, count, workers](int worker) {
+    const int first = count * worker / workers, last = count * (worker + 1) / workers;
+    for (int index = first; index < last; ++index) work(index, worker);
+  });
+}
+
+// The 2-D transforms between a real rows x columns grid and its half spectrum (rows x (columns / 2
+// + 1), row-major as FFTW's 2-D r2c gives it, rows SpectrumStride(columns) apart), made of 1-D
+// FFTW plans: the rows kRowBlock at a time, then the spectrum's columns copied kColumnBlock at a
+// time into a buffer where they lie side by side, transformed there and copied back. That is the
+// shape of plan FFTW_MEASURE picks for a 1024 x 1024 grid on two threads (a forward and inverse
+// pair in 2.8 ms), which FFTW_ESTIMATE's 2-D plan, transforming the columns in place at their
+// stride, does not (5.3 ms); and a convolution multiplies each column block by the kernel's
+// spectrum between its forward and inverse transforms, while the block is in cache. The row and
+// column blocks are shared out to the workers; a block's arithmetic does not depend on which
+// worker runs it, so the result is the same for any number of cores. The plans are FFTW_ESTIMATE
+// plans of fixed shapes: the same plans, hence the same rounding, on every run (FFTW_MEASURE
+// chooses by timing, and takes longer to plan than the whole solve then takes).
+class GridTransforms {
+ public:
+  // For the workspace's 64-byte-aligned `grid` and `spectrum` and one column buffer of rows x
+  // kColumnBlock complex values per worker in `buffers`. Every grid transformed must be aligned
+  // as `grid` (FFTW's new-array execution).
+  GridTransforms(int rows, int columns, int workers, double* grid, fftw_complex* spectrum,
+                 fftw_complex* buffers)
+      : rows_(rows),
+        columns_(columns),
+        half_(columns / 2 + 1),
+        stride_(SpectrumStride(columns)),
+        workers_(workers),
+        grid_(grid),
+        spectrum_(spectrum),
+        buffers_(buffers) {
+    const FftwPlanner planner(1);
+    const int n[] = {columns};
+    const auto row_plans = [&](int block, fftw_plan& forward, fftw_plan& inverse) {
+      if (block == 0) return;
+      forward = fftw_plan_many_dft_r2c(1, n, block, grid, nullptr, 1, columns, spectrum, nullptr, 1, stride_,
+                                       FFTW_ESTIMATE | FFTW_PRESERVE_INPUT);
+      inverse = fftw_plan_many_dft_c2r(1, n, block, spectrum, nullptr, 1, stride_, grid, nullptr, 1, columns,
+                                       FFTW_ESTIMATE);
+      ARCWHEEL_CHECK(forward != nullptr && inverse != nullptr) << "row plans of " << columns;
+    };
+    row_plans(kRowBlock, row_forward_[0], row_inverse_[0]);
+    row_plans(rows % kRowBlock, row_forward_[1], row_inverse_[1]);
+    const int m[] = {rows};
+    const auto column_plans = [&](int width, fftw_plan& forward, fftw_plan& inverse) {
+      if (width == 0) return;
+      forward = fftw_plan_many_dft(1, m, width, buffers, nullptr, width, 1, buffers, nullptr, width, 1,
+                                   FFTW_FORWARD, FFTW_ESTIMATE);
+      inverse = fftw_plan_many_dft(1, m, width, buffers, nullptr, width, 1, buffers, nullptr, width, 1,
+                                   FFTW_BACKWARD, FFTW_ESTIMATE);
+      ARCWHEEL_CHECK(forward != nullptr && inverse != nullptr) << "column plans of " << rows;
+    };
+    column_plans(kColumnBlock, column_forward_[0], column_inverse_[0]);
+    column_plans(half_ % kColumnBlock, column_forward_[1], column_inverse_[1]);
+  }
+  ~GridTransforms() {
+    const FftwPlanner planner;
+    for (fftw_plan* plans : {row_forward_, row_inverse_, column_forward_, column_inverse_}) {
+      for (int k = 0; k < 2; ++k) {
+        if (plans[k] != nullptr) fftw_destroy_plan(plans[k]);
+      }
+    }
+  }
+  GridTransforms(const GridTransforms&) = delete;
+  GridTransforms& operator=(const GridTransforms&) = delete;
+
+  // spectrum = the half spectrum of `input`.
+  void Forward(const double* input) const {
+    RowsForward(input);
+    Columns([this](fftw_complex* buffer, int, int width) { Execute(column_forward_, width, buffer); });
+  }
+  // grid = the unnormalised inverse of the spectrum, which it overwrites.
+  void Inverse() const {
+    Columns([this](fftw_complex* buffer, int, int width) { Execute(column_inverse_, width, buffer); });
+    RowsInverse();
+  }
+  // grid = the unnormalised inverse of the half spectrum of `input` with each value z at index k
+  // (row * SpectrumStride(columns) + column) replaced by multiply(z, k); overwrites the spectrum.
+  template <class Multiply>
+  void Filter(const double* input, const Multiply& multiply) const {
+    RowsForward(input);
+    Columns([this, &multiply](fftw_complex* buffer, int first, int width) {
+      Execute(column_forward_, width, buffer);
+      for (int j = 0; j < rows_; ++j) {
+        double* z = &buffer[static_cast<std::size_t>(j) * width][0];
+        const std::size_t k = static_cast<std::size_t>(j) * stride_ + first;
+        for (int b = 0; b < width; ++b) multiply(z + 2 * b, k + b);
+      }
+      Execute(column_inverse_, width, buffer);
+    });
+    RowsInverse();
+  }
+
+ private:
+  void Execute(const fftw_plan (&plans)[2], int width, fftw_complex* buffer) const {
+    fftw_execute_dft(plans[width == kColumnBlock ? 0 : 1], buffer, buffer);
+  }
+  void RowsForward(const double* input) const {
+    ForEachIndex((rows_ + kRowBlock - 1) / kRowBlock, workers_, [this, input](int block, int) {
+      const std::size_t j = static_cast<std::size_t>(block) * kRowBlock;
+      // FFTW takes the input through the plan's pointer type; it keeps it (FFTW_PRESERVE_INPUT).
+      fftw_execute_dft_r2c(row_forward_[j + kRowBlock <= static_cast<std::size_t>(rows_) ? 0 : 1],
+                           const_cast<double*>(input) + j * columns_, spectrum_ + j * stride_);
+    });
+  }
+  void RowsInverse() const {
+    ForEachIndex((rows_ + kRowBlock - 1) / kRowBlock, workers_, [this](int block, int) {
+      const std::size_t j = static_cast<std::size_t>(block) * kRowBlock;
+      fftw_execute_dft_c2r(row_inverse_[j + kRowBlock <= static_cast<std::size_t>(rows_) ? 0 : 1],
+                           spectrum_ + j * stride_, grid_ + j * columns_);
+    });
+  }
+  // work(buffer, first column, width) on each column block, copied into the worker's buffer
+  // (row j's values at buffer[j * width ...]) and back.
+  template <class Work>
+  void Columns(const Work& work) const {
+    ForEachIndex((half_ + kColumnBlock - 1) / kColumnBlock, workers_, [this, &work](int block, int worker) {
+      const int first = block * kColumnBlock, width = std::min(kColumnBlock, half_ - first);
+      fftw_complex* buffer = buffers_ + static_cast<std::size_t>(worker) * rows_ * kColumnBlock;
+      double* column = &spectrum_[first][0];
+      double* packed = &buffer[0][0];
+      if (width == kColumnBlock) {
+        CopyBlock<2 * kColumnBlock>(column, 2 * stride_, packed, 2 * kColumnBlock, 2 * kColumnBlock);
+        work(buffer, first, width);
+        CopyBlock<2 * kColumnBlock>(packed, 2 * kColumnBlock, column, 2 * stride_, 2 * kColumnBlock);
+      } else {
+        CopyBlock<0>(column, 2 * stride_, packed, 2 * width, 2 * width);
+        work(buffer, first, width);
+        CopyBlock<0>(packed, 2 * width, column, 2 * stride_, 2 * width);
+      }
+    });
+  }
+  // `length` doubles of each of the rows from `from` (rows `from_stride` apart) to `to`; with a
+  // Length fixed at compile time the copy of a row is a few vector moves, not a call.
+  template <int Length>
+  void CopyBlock(const double* from, int from_stride, double* to, int to_stride, int length) const {
+    for (int j = 0; j < rows_; ++j) {
+      const double* source = from + static_cast<std::ptrdiff_t>(j) * from_stride;
+      double* target = to + static_cast<std::ptrdiff_t>(j) * to_stride;
+      if constexpr (Length > 0) {
+        for (int k = 0; k < Length; ++k) target[k] = source[k];
+      } else {
+        for (int k = 0; k < length; ++k) target[k] = source[k];
+      }
+    }
+  }
+
+  int rows_, columns_, half_, stride_, workers_;
+  double* grid_;
+  fftw_complex* spectrum_;
+  fftw_complex* buffers_;
+  fftw_plan row_forward_[2] = {}, row_inverse_[2] = {};        // kRowBlock rows, the rows left over
+  fftw_plan column_forward_[2] = {}, column_inverse_[2] = {};  // kColumnBlock columns, the rest
+};
+
 }  // namespace
 
-// Real grids, a half spectrum and the two plans between them. FFTW_ESTIMATE plans: the same plan,
-// hence the same rounding, on every run (FFTW_MEASURE picks by timing, and takes longer to plan
-// a million cells than the whole solve then takes). The point and row grids keep zeros outside
-// their cells, so a product writes its values there and transforms from there (the plans keep
-// their input: out-of-place r2c) with no clearing pass.
+// Real grids, a half spectrum and the transforms between them. The point and row grids keep zeros
+// outside their cells, so a product writes its values there and transforms from there (the
+// forward transforms keep their input) with no clearing pass.
 struct FftRemoval::Workspace {
-  int rows = 0, columns = 0;
+  int rows = 0, columns = 0, workers = 1;
   ZeroedPages pages;
   double* grid = nullptr;        // the transforms' output, and the input of the filters
   double* point_grid = nullptr;  // the dwell at the point cells
-  double* row_grid = nullptr;    // the row values at the row cells, right after the point grid
+  double* row_grid = nullptr;    // the row values at the row cells
   fftw_complex* spectrum = nullptr;
-  std::complex<double>* kernel = nullptr;  // the removal function's spectrum, scaled by 1 / size
+  std::complex<double>* kernel = nullptr;   // the removal function's spectrum, scaled by 1 / size
+  std::complex<double>* support = nullptr;  // its support's, for the entry count (Make)
   // For the extended inverse filter, the row each cell takes its value from (-1: none), found on
   // its first call.
   int* nearest_row = nullptr;
   bool nearest_found = false;
   // The row grid holds the residual that Residual wrote to this vector's data (nullptr: none).
   const double* placed_residual = nullptr;
-  fftw_plan forward = nullptr, inverse = nullptr;
+  std::optional<GridTransforms> transforms;
 
   Workspace(int r, int c)
       : rows(r),
         columns(c),
-        pages(Lines(Cells() * sizeof(double)) + Lines(2 * Cells() * sizeof(double)) +
-              2 * Lines(HalfCells() * sizeof(fftw_complex)) + Lines(Cells() * sizeof(int))) {
+        workers(TransformWorkers(Cells())),
+        pages(3 * Lines(Cells() * sizeof(double)) + 3 * Lines(SpectrumSize() * sizeof(fftw_complex)) +
+              Lines(Cells() * sizeof(int)) +
+              Lines(static_cast<std::size_t>(workers) * r * kColumnBlock * sizeof(fftw_complex))) {
     char* next = pages.data();
     const auto take = [&next](std::size_t bytes) {
       char* at = next;
@@ -168,39 +345,26 @@ struct FftRemoval::Workspace {
       return at;
     };
     grid = reinterpret_cast<double*>(take(Cells() * sizeof(double)));
-    point_grid = reinterpret_cast<double*>(take(2 * Cells() * sizeof(double)));
-    row_grid = point_grid + Cells();
-    spectrum = reinterpret_cast<fftw_complex*>(take(HalfCells() * sizeof(fftw_complex)));
-    kernel = reinterpret_cast<std::complex<double>*>(take(HalfCells() * sizeof(fftw_complex)));
+    point_grid = reinterpret_cast<double*>(take(Cells() * sizeof(double)));
+    row_grid = reinterpret_cast<double*>(take(Cells() * sizeof(double)));
+    spectrum = reinterpret_cast<fftw_complex*>(take(SpectrumSize() * sizeof(fftw_complex)));
+    kernel = reinterpret_cast<std::complex<double>*>(take(SpectrumSize() * sizeof(fftw_complex)));
+    support = reinterpret_cast<std::complex<double>*>(take(SpectrumSize() * sizeof(fftw_complex)));
     nearest_row = reinterpret_cast<int*>(take(Cells() * sizeof(int)));
-    const FftwPlanner planner(PlanThreads(Cells()));
-    forward = fftw_plan_dft_r2c_2d(r, c, grid, spectrum, FFTW_ESTIMATE | FFTW_PRESERVE_INPUT);
-    inverse = fftw_plan_dft_c2r_2d(r, c, spectrum, grid, FFTW_ESTIMATE);
-    ARCWHEEL_CHECK(forward != nullptr && inverse != nullptr) << "FFT plans of " << r << " x " << c;
-  }
-  ~Workspace() {
-    const FftwPlanner planner;
-    fftw_destroy_plan(forward);
-    fftw_destroy_plan(inverse);
+    auto* buffers = reinterpret_cast<fftw_complex*>(
+        take(static_cast<std::size_t>(workers) * r * kColumnBlock * sizeof(fftw_complex)));
+    transforms.emplace(r, c, workers, grid, spectrum, buffers);
   }
   Workspace(const Workspace&) = delete;
   Workspace& operator=(const Workspace&) = delete;
 
   [[nodiscard]] std::size_t Cells() const { return static_cast<std::size_t>(rows) * columns; }
-  [[nodiscard]] std::size_t HalfCells() const { return static_cast<std::size_t>(rows) * (columns / 2 + 1); }
+  // Complex values of a stored half spectrum, padding included (zero there).
+  [[nodiscard]] std::size_t SpectrumSize() const {
+    return static_cast<std::size_t>(rows) * SpectrumStride(columns);
+  }
   [[nodiscard]] std::complex<double>* Spectrum() const {
     return reinterpret_cast<std::complex<double>*>(spectrum);
-  }
-  // The point and row grids together, as room for a half spectrum (2 rows x columns reals hold
-  // rows x (columns / 2 + 1) complex values); the caller clears them after.
-  [[nodiscard]] std::complex<double>* Scratch() const {
-    ARCWHEEL_CHECK(columns >= 2) << columns;
-    return reinterpret_cast<std::complex<double>*>(point_grid);
-  }
-  // Of `input`, into the spectrum.
-  void Forward(const double* input) const {
-    // FFTW takes the input through the plan's pointer type; it keeps it (FFTW_PRESERVE_INPUT).
-    fftw_execute_dft_r2c(forward, const_cast<double*>(input), spectrum);
   }
 };
 
@@ -274,41 +438,37 @@ std::optional<FftRemoval> FftRemoval::Make(const ErrorMap& map, std::span<const 
       support[c] = 1.0;
     }
   }
-  const double scale = 1.0 / static_cast<double>(w.Cells());  // FFTW's inverse is unnormalised
-  w.Forward(w.grid);
-  for (std::size_t k = 0; k < w.HalfCells(); ++k) w.kernel[k] = w.Spectrum()[k] * scale;
+  const double scale = 1.0 / static_cast<double>(w.Cells());  // the inverse is unnormalised
+  w.transforms->Forward(w.grid);
+  for (std::size_t k = 0; k < w.SpectrumSize(); ++k) w.kernel[k] = w.Spectrum()[k] * scale;
 
   // The sparse matrix's entry count: for each row node, the points whose footprint covers it.
-  w.Forward(support);
-  std::complex<double>* support_spectrum = w.Scratch();
-  std::copy(w.Spectrum(), w.Spectrum() + w.HalfCells(), support_spectrum);
+  w.transforms->Forward(support);
+  std::fill(support, support + w.Cells(), 0.0);
+  std::complex<double>* support_spectrum = w.support;
+  std::copy(w.Spectrum(), w.Spectrum() + w.SpectrumSize(), support_spectrum);
   double* points = f.ClearedGrid();
   for (const int c : f.point_cell_) points[c] += 1.0;
-  w.Forward(points);
-  std::complex<double>* spectrum = w.Spectrum();
-  for (std::size_t k = 0; k < w.HalfCells(); ++k) spectrum[k] *= support_spectrum[k] * scale;
-  fftw_execute(w.inverse);
+  w.transforms->Filter(points, [support_spectrum, scale](double* z, std::size_t k) {
+    const std::complex<double> product = std::complex<double>(z[0], z[1]) * (support_spectrum[k] * scale);
+    z[0] = product.real();
+    z[1] = product.imag();
+  });
   for (const int c : f.row_cell_) f.nonzeros_ += std::lround(w.grid[c]);
-  std::fill(w.point_grid, w.point_grid + 2 * w.Cells(), 0.0);
   return f;
 }
 
 void FftRemoval::Convolve(const double* input, bool correlate) const {
   Workspace& w = *work_;
-  w.Forward(input);
   // Written out: std::complex's operator* checks every product for NaN (C99 Annex G) and keeps
   // the loop from vectorising; the spectra are finite, and the arithmetic is the same.
-  double* spectrum = &w.spectrum[0][0];
   const double* kernel = reinterpret_cast<const double*>(w.kernel);
   const double sign = correlate ? -1.0 : 1.0;  // A^T: the kernel's complex conjugate
-  ForEachBlock(w.HalfCells(), [spectrum, kernel, sign](std::size_t begin, std::size_t end, int) {
-    for (std::size_t k = 2 * begin; k < 2 * end; k += 2) {
-      const double a = spectrum[k], b = spectrum[k + 1], c = kernel[k], d = sign * kernel[k + 1];
-      spectrum[k] = a * c - b * d;
-      spectrum[k + 1] = a * d + b * c;
-    }
+  w.transforms->Filter(input, [kernel, sign](double* z, std::size_t k) {
+    const double a = z[0], b = z[1], c = kernel[2 * k], d = sign * kernel[2 * k + 1];
+    z[0] = a * c - b * d;
+    z[1] = a * d + b * c;
   });
-  fftw_execute(w.inverse);
 }
 
 namespace {
@@ -344,7 +504,7 @@ double FftRemoval::NormSquaredBound() const {
   const Workspace& w = *work_;
   const double n = static_cast<double>(w.Cells());  // the stored spectrum is scaled by 1 / n
   double most = 0.0;
-  for (std::size_t k = 0; k < w.HalfCells(); ++k) most = std::max(most, std::norm(w.kernel[k]));
+  for (std::size_t k = 0; k < w.SpectrumSize(); ++k) most = std::max(most, std::norm(w.kernel[k]));
   return most * n * n;
 }
 
@@ -395,24 +555,18 @@ void FftRemoval::InverseFilter(const Eigen::VectorXd& rows, double relative_damp
     for (std::size_t r = 0; r < row_cell_.size(); ++r)
       cells[row_cell_[r]] = rows[static_cast<Eigen::Index>(r)];
   }
-  fftw_execute(w.forward);
   const double n = static_cast<double>(w.Cells());
   const double damping = relative_damping * relative_damping * NormSquaredBound();
-  double* spectrum = &w.spectrum[0][0];
   const double* kernel = reinterpret_cast<const double*>(w.kernel);
-  // spectrum *= conj(K) / ((|K|^2 + damping) n), K the kernel's own spectrum, written out (see
-  // Convolve).
-  ForEachBlock(w.HalfCells(), [spectrum, kernel, n, damping](std::size_t begin, std::size_t end, int) {
-    for (std::size_t k = 2 * begin; k < 2 * end; k += 2) {
-      const double kr = kernel[k] * n, ki = kernel[k + 1] * n;
-      const double q = (kr * kr + ki * ki + damping) * n;
-      const double c = kr / q, d = -ki / q;
-      const double a = spectrum[k], b = spectrum[k + 1];
-      spectrum[k] = a * c - b * d;
-      spectrum[k + 1] = a * d + b * c;
-    }
+  // z *= conj(K) / ((|K|^2 + damping) n), K the kernel's own spectrum, written out (see Convolve).
+  w.transforms->Filter(cells, [kernel, n, damping](double* z, std::size_t k) {
+    const double kr = kernel[2 * k] * n, ki = kernel[2 * k + 1] * n;
+    const double q = (kr * kr + ki * ki + damping) * n;
+    const double c = kr / q, d = -ki / q;
+    const double a = z[0], b = z[1];
+    z[0] = a * c - b * d;
+    z[1] = a * d + b * c;
   });
-  fftw_execute(w.inverse);
   Gather(cells, point_cell_, dwell_s);
 }
 

@@ -6,12 +6,13 @@
 // of grid steps, so the sum is the 2-D convolution of the removal function sampled at those steps
 // with the dwell placed on the grid: the same products as the sparse removal matrix, computed with
 // FFTW in O(N log N) instead of O(N x footprint). Transforms of 2^18 cells or more run on every
-// core (FFTW's threads). The removal function is the same at every
-// point (it is defined in the part's (x, y) projection), so the convolution holds over the whole
-// part, curved or not. A point counts as on the grid when it lies within kGridTolerance of a
-// grid step from a node; the kernel is sampled at the exact steps, so such a point's removal
-// differs from the sparse matrix's by at most that shift times the rate's slope (1e-9 of the
-// step: below 1e-9 of the peak rate over the footprint, for a footprint wider than one step).
+// core, their rows and column blocks shared out (removal_fft.cc, GridTransforms). The removal
+// function is the same at every point (it is defined in the part's (x, y) projection), so the
+// convolution holds over the whole part, curved or not. A point counts as on the grid when it
+// lies within kGridTolerance of a grid step from a node; the kernel is sampled at the exact steps,
+// so such a point's removal differs from the sparse matrix's by at most that shift times the
+// rate's slope (1e-9 of the step: below 1e-9 of the peak rate over the footprint, for a footprint
+// wider than one step).
 
 #include <Eigen/Core>
 #include <cstddef>

@@ -9,6 +9,7 @@
 #include <limits>
 #include <numbers>
 #include <optional>
+#include <utility>
 
 #include "core/check.h"
 #include "core/error.h"
@@ -126,6 +127,14 @@ class Removal {
   [[nodiscard]] Eigen::VectorXd Transposed(const Eigen::VectorXd& rows) const {
     return fft_ ? fft_->ApplyTranspose(rows) : Eigen::VectorXd(sparse_.transpose() * rows);
   }
+  // A t into a vector the caller keeps.
+  void Multiply(const Eigen::VectorXd& dwell_s, Eigen::VectorXd& rows) const {
+    if (fft_) {
+      fft_->Apply(dwell_s, rows);
+    } else {
+      rows.noalias() = sparse_ * dwell_s;
+    }
+  }
   // A^T residual for the residual the last Residual call wrote (the FFT products keep it placed),
   // into a vector the caller keeps: no allocation per iteration.
   void Gradient(const Eigen::VectorXd& residual, Eigen::VectorXd& gradient) const {
@@ -195,9 +204,9 @@ Bounds DwellBounds(std::span<const double> chord_mm, const DwellOptions& o) {
   return b;
 }
 
+// `excess`: a vector to work in.
 void CheckReachable(const Removal& a, const Rows& rows, const ErrorMap& map, const Bounds& b,
-                    const DwellOptions& o) {
-  Eigen::VectorXd excess;
+                    const DwellOptions& o, Eigen::VectorXd& excess) {
   a.Residual(b.lower, rows.target, excess);
   Eigen::Index worst = 0;
   const double most = excess.maxCoeff(&worst);
@@ -299,6 +308,14 @@ Eigen::VectorXd ShapedDwell(const Eigen::VectorXd& t, const Eigen::VectorXd& cho
   return out;
 }
 
+// The solve's work vectors, kept from the reachability check through the filter steps, the
+// gradient iterations and the shaping rounds to the final product: on a million points each is
+// 8 MB, too much to allocate and fault in afresh (~20 ms each on this virtual machine) for every
+// stage.
+struct WorkVectors {
+  Eigen::VectorXd previous, y, residual, gradient;
+};
+
 struct Fit {
   Eigen::VectorXd dwell_s;
   int iterations = 0;
@@ -346,13 +363,15 @@ StepSums ProjectedStep(const Eigen::VectorXd& y, const Eigen::VectorXd& gradient
 }
 
 Fit ProjectedGradient(const Removal& a, const Eigen::VectorXd& target, const Bounds& bounds, double step,
-                      const Eigen::VectorXd& start, std::optional<double> stall_reference, bool warm,
-                      const DwellOptions& options) {
+                      Eigen::VectorXd start, std::optional<double> stall_reference, bool warm,
+                      const DwellOptions& options, WorkVectors& work) {
   Fit fit;
-  // The vectors live across iterations: on a million points each is 8 MB, too much to allocate
-  // and fault in a few times per iteration.
-  Eigen::VectorXd t = start.cwiseMax(bounds.lower).cwiseMin(bounds.upper), previous = t, y = t;
-  Eigen::VectorXd residual(target.size()), gradient(t.size());
+  Eigen::VectorXd t = std::move(start);  // the start's vector becomes t
+  t = t.cwiseMax(bounds.lower).cwiseMin(bounds.upper);
+  Eigen::VectorXd &previous = work.previous, &y = work.y, &residual = work.residual,
+                  &gradient = work.gradient;
+  previous = t;
+  y = t;
   double momentum = 1.0;
   std::vector<double> history;
   for (fit.iterations = 1; fit.iterations <= options.max_iterations; ++fit.iterations) {
@@ -404,12 +423,12 @@ constexpr int kFilterStallSteps = 5;
 constexpr int kMaxFilterSteps = 60;
 
 Fit InverseFilterIterations(const internal::FftRemoval& f, const Removal& a, const Eigen::VectorXd& target,
-                            const Bounds& bounds, double reference, const DwellOptions& options) {
+                            const Bounds& bounds, double reference, const DwellOptions& options,
+                            WorkVectors& work) {
   Fit fit;
-  Eigen::VectorXd t;
+  Eigen::VectorXd &t = work.y, &residual = work.residual, &best_residual = work.gradient;
   f.InverseFilter(target, kFilterStartDamping, true, t);
   t = t.cwiseMax(bounds.lower).cwiseMin(bounds.upper);
-  Eigen::VectorXd residual(target.size()), best_residual;
   fit.first_residual_norm = std::numeric_limits<double>::infinity();
   std::vector<double> history;
   double damping = kFilterStepDamping;
@@ -526,33 +545,44 @@ DwellSolution SolveDwell(const ErrorMap& target, const surfaces::Aperture& apert
   const Rows rows = ApertureRows(target, aperture);
   const Removal a(target, rows, path, removal, options.fft_products);
   Bounds bounds = DwellBounds(chord_mm, options);
-  CheckReachable(a, rows, target, bounds, options);
+  WorkVectors work;
+  CheckReachable(a, rows, target, bounds, options, work.residual);
   AddLeastDwell(bounds, path, options);
 
   // Start from the correlation A^T b scaled to fit best: the right shape at low frequencies. Its
   // residual norm is the stall test's reference, whatever the start.
   Eigen::VectorXd start = a.Transposed(rows.target);
-  const Eigen::VectorXd at = a * start;
-  const double fit_scale = at.squaredNorm() > 0.0 ? at.dot(rows.target) / at.squaredNorm() : 0.0;
-  start *= fit_scale;
-  const double correlation_residual = (fit_scale * at - rows.target).norm();
+  double fit_scale = 0.0, correlation_residual = 0.0;
+  {
+    Eigen::VectorXd at = a * start;
+    fit_scale = at.squaredNorm() > 0.0 ? at.dot(rows.target) / at.squaredNorm() : 0.0;
+    at = fit_scale * at - rows.target;
+    correlation_residual = at.norm();
+  }
   const bool spectral = options.inverse_filter_start && a.Fft() != nullptr;
   const double step = 1.0 / GradientLipschitz(a, spectral);
   Fit fit;
   std::optional<Fit> filtered;
-  if (spectral)
-    filtered = InverseFilterIterations(*a.Fft(), a, rows.target, bounds, correlation_residual, options);
+  if (spectral) {
+    // Its pages go to the filter's vectors (first touching 8 MB costs ~20 ms on this virtual
+    // machine); it is made again in the rare case that the filter does not fit better.
+    start = Eigen::VectorXd();
+    filtered = InverseFilterIterations(*a.Fft(), a, rows.target, bounds, correlation_residual, options, work);
+  }
   if (filtered && filtered->first_residual_norm < correlation_residual) {
     // Then the accelerated projected gradient from there, with the job's stopping rules: it
     // finishes what the filter leaves (the aperture's edge, where bounds are active; on a map
     // with steep edges most of the way). A shorter stall window would save most of its
     // iterations on smooth maps but stops short on such a map (removal_fft_test).
-    fit = ProjectedGradient(a, rows.target, bounds, step, filtered->dwell_s, correlation_residual, true,
-                            options);
+    fit = ProjectedGradient(a, rows.target, bounds, step, std::move(filtered->dwell_s), correlation_residual,
+                            true, options, work);
     fit.iterations += filtered->iterations;
     fit.first_residual_norm = correlation_residual;
   } else {
-    fit = ProjectedGradient(a, rows.target, bounds, step, start, std::nullopt, false, options);
+    if (start.size() == 0) start = a.Transposed(rows.target);
+    start *= fit_scale;
+    fit =
+        ProjectedGradient(a, rows.target, bounds, step, std::move(start), std::nullopt, false, options, work);
     fit.iterations += filtered ? filtered->iterations : 0;
   }
   const double stall_reference = fit.first_residual_norm;
@@ -574,14 +604,16 @@ DwellSolution SolveDwell(const ErrorMap& target, const surfaces::Aperture& apert
       if (added_um <= options.shaping_tolerance_um) break;
       if (solution.shaping_rounds == options.max_shaping_rounds) NotSettled(path, worst, added_um, options);
       ++solution.shaping_rounds;
-      fit = ProjectedGradient(a, rows.target, bounds, step, t, stall_reference, true, options);
+      fit =
+          ProjectedGradient(a, rows.target, bounds, step, std::move(t), stall_reference, true, options, work);
       solution.iterations += fit.iterations;
       solution.converged = solution.converged && fit.converged;
       t = std::move(fit.dwell_s);
     }
   }
 
-  const Eigen::VectorXd removed = a * t;
+  Eigen::VectorXd& removed = work.residual;
+  a.Multiply(t, removed);
   solution.nonzeros = a.Nonzeros();
   solution.fft_products = a.UsesFft();
   solution.dwell_s.assign(t.data(), t.data() + t.size());
@@ -590,7 +622,8 @@ DwellSolution SolveDwell(const ErrorMap& target, const surfaces::Aperture& apert
   solution.total_time_s = t.sum();
   solution.max_acceleration_mm_s2 = MaxAcceleration(solution.speed_mm_s, bounds.chord_mm);
   solution.predicted_removal_um = Scatter(target, rows, removed);
-  solution.residual_um = Scatter(target, rows, rows.target - removed);
+  removed = rows.target - removed;  // now the residual
+  solution.residual_um = Scatter(target, rows, removed);
   solution.before = StatisticsInAperture(target, aperture);
   solution.after = StatisticsInAperture(solution.residual_um, aperture);
   return solution;

@@ -156,6 +156,8 @@ class Removal {
   [[nodiscard]] long Nonzeros() const { return fft_ ? fft_->Nonzeros() : sparse_.nonZeros(); }
   [[nodiscard]] bool UsesFft() const { return fft_.has_value(); }
   [[nodiscard]] const internal::FftRemoval* Fft() const { return fft_ ? &*fft_ : nullptr; }
+  // The FFT products' workers, for the solve's passes; nullptr with the sparse matrix.
+  [[nodiscard]] WorkerPool* Pool() const { return fft_ ? fft_->Pool() : nullptr; }
 
  private:
   Eigen::Index points_;
@@ -339,10 +341,12 @@ struct StepSums {
 // million points each pass is memory-bound and costs a fair part of what a transform does). Each
 // block's sums are taken while the block is still in cache.
 StepSums ProjectedStep(const Eigen::VectorXd& y, const Eigen::VectorXd& gradient, double step,
-                       const Bounds& bounds, const Eigen::VectorXd& previous, Eigen::VectorXd& t) {
+                       const Bounds& bounds, const Eigen::VectorXd& previous, Eigen::VectorXd& t,
+                       WorkerPool* pool) {
   std::array<StepSums, internal::kPassBlocks> blocks{};
   internal::ForEachBlock(
-      static_cast<std::size_t>(t.size()), [&](std::size_t begin, std::size_t end, int block) {
+      static_cast<std::size_t>(t.size()),
+      [&](std::size_t begin, std::size_t end, int block) {
         const auto b = static_cast<Eigen::Index>(begin), n = static_cast<Eigen::Index>(end - begin);
         auto ts = t.segment(b, n);
         ts = (y.segment(b, n) - step * gradient.segment(b, n))
@@ -352,7 +356,8 @@ StepSums ProjectedStep(const Eigen::VectorXd& y, const Eigen::VectorXd& gradient
         sums.change = (ts - previous.segment(b, n)).squaredNorm();
         sums.dwell = ts.squaredNorm();
         sums.uphill = (y.segment(b, n) - ts).dot(ts - previous.segment(b, n));
-      });
+      },
+      pool);
   StepSums total;
   for (const StepSums& sums : blocks) {
     total.change += sums.change;
@@ -383,7 +388,7 @@ Fit ProjectedGradient(const Removal& a, const Eigen::VectorXd& target, const Bou
     }
     a.Gradient(residual, gradient);
     previous.swap(t);
-    const StepSums sums = ProjectedStep(y, gradient, step, bounds, previous, t);
+    const StepSums sums = ProjectedStep(y, gradient, step, bounds, previous, t, a.Pool());
     if (std::sqrt(sums.change) <= options.relative_tolerance * std::sqrt(sums.dwell) &&
         (!warm || fit.iterations > kWarmStartIterations)) {
       fit.converged = true;
@@ -393,10 +398,13 @@ Fit ProjectedGradient(const Removal& a, const Eigen::VectorXd& target, const Bou
     if (sums.uphill > 0.0) momentum = 1.0;
     const double next = 0.5 * (1.0 + std::sqrt(1.0 + 4.0 * momentum * momentum));
     const double push = (momentum - 1.0) / next;
-    internal::ForEachBlock(static_cast<std::size_t>(t.size()), [&](std::size_t begin, std::size_t end, int) {
-      const auto b = static_cast<Eigen::Index>(begin), n = static_cast<Eigen::Index>(end - begin);
-      y.segment(b, n) = t.segment(b, n) + push * (t.segment(b, n) - previous.segment(b, n));
-    });
+    internal::ForEachBlock(
+        static_cast<std::size_t>(t.size()),
+        [&](std::size_t begin, std::size_t end, int) {
+          const auto b = static_cast<Eigen::Index>(begin), n = static_cast<Eigen::Index>(end - begin);
+          y.segment(b, n) = t.segment(b, n) + push * (t.segment(b, n) - previous.segment(b, n));
+        },
+        a.Pool());
     momentum = next;
   }
   fit.iterations = std::min(fit.iterations, options.max_iterations);

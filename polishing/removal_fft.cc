@@ -21,11 +21,9 @@
 namespace arcwheel::polishing::internal {
 namespace {
 
-// Transforms of at least this many cells run on every core: below it, starting the threads costs
-// more than they save.
-constexpr std::size_t kThreadedCells = std::size_t{1} << 18;
-
-int TransformWorkers(std::size_t cells) { return cells >= kThreadedCells ? WorkerCount(0) : 1; }
+// The workspace's workers: every core from kParallelElements cells (the threads are kept for the
+// solve, so only their wake-up is paid per pass), else the calling thread alone.
+int Workers(std::size_t cells) { return cells >= kParallelElements ? WorkerCount(0) : 1; }
 
 // The whole number of steps from `origin` to `value`, if it lies within kGridTolerance of one.
 std::optional<int> GridIndex(double value, double origin, double step) {
@@ -73,7 +71,8 @@ bool SteadyAround(const RemovalFunction& removal, double x_mm, double y_mm, doub
 }  // namespace
 
 void ForEachBlock(std::size_t n,
-                  const std::function<void(std::size_t begin, std::size_t end, int block)>& pass) {
+                  const std::function<void(std::size_t begin, std::size_t end, int block)>& pass,
+                  WorkerPool* pool) {
   const auto run = [n, &pass](int block) {
     const std::size_t begin = n * static_cast<std::size_t>(block) / kPassBlocks;
     const std::size_t end = n * static_cast<std::size_t>(block + 1) / kPassBlocks;
@@ -83,10 +82,15 @@ void ForEachBlock(std::size_t n,
     for (int block = 0; block < kPassBlocks; ++block) run(block);
     return;
   }
-  const int workers = std::min(WorkerCount(0), kPassBlocks);
-  RunOnWorkers(workers, [&run, workers](int worker) {
+  const int workers = std::min(pool != nullptr ? pool->Workers() : WorkerCount(0), kPassBlocks);
+  const auto share = [&run, workers](int worker) {
     for (int block = worker; block < kPassBlocks; block += workers) run(block);
-  });
+  };
+  if (pool != nullptr && workers == pool->Workers()) {
+    pool->Run(share);
+  } else {
+    RunOnWorkers(workers, share);
+  }
 }
 
 namespace {
@@ -134,54 +138,55 @@ class ZeroedPages {
 // Bytes rounded up to whole cache lines (past SIMD alignment): each array starts on one.
 constexpr std::size_t Lines(std::size_t bytes) { return (bytes + 63) / 64 * 64; }
 
-// Grid rows per row plan; half-spectrum columns per column block: eight complex values are one
-// 128-byte line, so a block's copy in and out moves whole cache lines, and the block (rows x 128
-// bytes, 128 kB for 1024 rows) stays in a core's L2 cache through its transforms.
+// Grid rows per row plan; half-spectrum columns per column block. A column block of the spectrum
+// (rows x 8 complex values, 128 kB for 1024 rows) stays in a core's L2 cache through its
+// transforms and the product between them.
 constexpr int kRowBlock = 8;
 constexpr int kColumnBlock = 8;
 
-// Complex values per row of a half spectrum as stored: the columns / 2 + 1 there are, padded to
-// whole 64-byte lines so that a column block's row is two lines, not three.
-int SpectrumStride(int columns) { return (columns / 2 + 1 + 3) / 4 * 4; }
+// Complex values per row of a row block's buffer: the columns / 2 + 1 of a half spectrum's row,
+// padded to whole 64-byte lines.
+int BufferStride(int columns) { return (columns / 2 + 1 + 3) / 4 * 4; }
 
-// work(index, worker) for index = 0 .. count - 1, each worker taking an equal run of indices
-// (neighbouring blocks share cache lines at their edges: runs keep them on one core).
+// work(index, worker) for index = 0 .. count - 1, each worker taking an equal run of indices.
 template <class Work>
-void ForEachIndex(int count, int workers, const Work& work) {
+void ForEachIndex(int count, WorkerPool& pool, const Work& work) {
+  const int workers = pool.Workers();
   if (workers <= 1) {
     for (int index = 0; index < count; ++index) work(index, 0);
     return;
   }
-  RunOnWorkers(workers, [&work, count, workers](int worker) {
+  pool.Run([&work, count, workers](int worker) {
     const int first = count * worker / workers, last = count * (worker + 1) / workers;
     for (int index = first; index < last; ++index) work(index, worker);
   });
 }
 
-// The 2-D transforms between a real rows x columns grid and its half spectrum (rows x (columns / 2
-// + 1), row-major as FFTW's 2-D r2c gives it, rows SpectrumStride(columns) apart), made of 1-D
-// FFTW plans: the rows kRowBlock at a time, then the spectrum's columns copied kColumnBlock at a
-// time into a buffer where they lie side by side, transformed there and copied back. That is the
-// shape of plan FFTW_MEASURE picks for a 1024 x 1024 grid on two threads (a forward and inverse
-// pair in 2.8 ms), which FFTW_ESTIMATE's 2-D plan, transforming the columns in place at their
-// stride, does not (5.3 ms); and a convolution multiplies each column block by the kernel's
-// spectrum between its forward and inverse transforms, while the block is in cache. The row and
-// column blocks are shared out to the workers; a block's arithmetic does not depend on which
-// worker runs it, so the result is the same for any number of cores. The plans are FFTW_ESTIMATE
-// plans of fixed shapes: the same plans, hence the same rounding, on every run (FFTW_MEASURE
-// chooses by timing, and takes longer to plan than the whole solve then takes).
+// The 2-D transforms between a real rows x columns grid and its half spectrum (columns / 2 + 1
+// complex columns), made of 1-D FFTW plans. The spectrum is stored by column blocks: block b
+// (columns c0 = kColumnBlock b .. c0 + width - 1) holds row j's values at c0 rows + j width + (c -
+// c0), the block's columns side by side. A row block's transform goes to a small buffer and from
+// there into every column block, kRowBlock x width values in one run; a column block is then
+// transformed where it lies, with the convolution's product between its forward and inverse
+// transforms while it is in cache. FFTW_ESTIMATE's 2-D plan transforms the columns in place at the
+// stride of a row (a forward and inverse pair of a 1024 x 1024 grid on two threads: 5.3 ms, where
+// FFTW_MEASURE's plan, copying eight columns at a time into a buffer, takes 2.8 ms but 0.9 s to
+// plan). The row and column blocks are shared out to the workers; a block's arithmetic does not
+// depend on which worker runs it, so the result is the same for any number of cores. The plans
+// are FFTW_ESTIMATE plans of fixed shapes: the same plans, hence the same rounding, on every run.
 class GridTransforms {
  public:
-  // For the workspace's 64-byte-aligned `grid` and `spectrum` and one column buffer of rows x
-  // kColumnBlock complex values per worker in `buffers`. Every grid transformed must be aligned
-  // as `grid` (FFTW's new-array execution).
-  GridTransforms(int rows, int columns, int workers, double* grid, fftw_complex* spectrum,
+  // For the workspace's 64-byte-aligned `grid` and `spectrum` (rows x (columns / 2 + 1) complex
+  // values) and one row buffer of kRowBlock x BufferStride(columns) complex values per worker of
+  // `pool` in `buffers`. Every grid transformed must be aligned as `grid` (FFTW's new-array
+  // execution).
+  GridTransforms(int rows, int columns, WorkerPool& pool, double* grid, fftw_complex* spectrum,
                  fftw_complex* buffers)
       : rows_(rows),
         columns_(columns),
         half_(columns / 2 + 1),
-        stride_(SpectrumStride(columns)),
-        workers_(workers),
+        stride_(BufferStride(columns)),
+        pool_(pool),
         grid_(grid),
         spectrum_(spectrum),
         buffers_(buffers) {
@@ -189,9 +194,9 @@ class GridTransforms {
     const int n[] = {columns};
     const auto row_plans = [&](int block, fftw_plan& forward, fftw_plan& inverse) {
       if (block == 0) return;
-      forward = fftw_plan_many_dft_r2c(1, n, block, grid, nullptr, 1, columns, spectrum, nullptr, 1, stride_,
+      forward = fftw_plan_many_dft_r2c(1, n, block, grid, nullptr, 1, columns, buffers, nullptr, 1, stride_,
                                        FFTW_ESTIMATE | FFTW_PRESERVE_INPUT);
-      inverse = fftw_plan_many_dft_c2r(1, n, block, spectrum, nullptr, 1, stride_, grid, nullptr, 1, columns,
+      inverse = fftw_plan_many_dft_c2r(1, n, block, buffers, nullptr, 1, stride_, grid, nullptr, 1, columns,
                                        FFTW_ESTIMATE);
       ARCWHEEL_CHECK(forward != nullptr && inverse != nullptr) << "row plans of " << columns;
     };
@@ -200,9 +205,9 @@ class GridTransforms {
     const int m[] = {rows};
     const auto column_plans = [&](int width, fftw_plan& forward, fftw_plan& inverse) {
       if (width == 0) return;
-      forward = fftw_plan_many_dft(1, m, width, buffers, nullptr, width, 1, buffers, nullptr, width, 1,
+      forward = fftw_plan_many_dft(1, m, width, spectrum, nullptr, width, 1, spectrum, nullptr, width, 1,
                                    FFTW_FORWARD, FFTW_ESTIMATE);
-      inverse = fftw_plan_many_dft(1, m, width, buffers, nullptr, width, 1, buffers, nullptr, width, 1,
+      inverse = fftw_plan_many_dft(1, m, width, spectrum, nullptr, width, 1, spectrum, nullptr, width, 1,
                                    FFTW_BACKWARD, FFTW_ESTIMATE);
       ARCWHEEL_CHECK(forward != nullptr && inverse != nullptr) << "column plans of " << rows;
     };
@@ -223,85 +228,84 @@ class GridTransforms {
   // spectrum = the half spectrum of `input`.
   void Forward(const double* input) const {
     RowsForward(input);
-    Columns([this](fftw_complex* buffer, int, int width) { Execute(column_forward_, width, buffer); });
+    Columns([this](fftw_complex* block, std::size_t, int width) { Execute(column_forward_, width, block); });
   }
   // grid = the unnormalised inverse of the spectrum, which it overwrites.
   void Inverse() const {
-    Columns([this](fftw_complex* buffer, int, int width) { Execute(column_inverse_, width, buffer); });
+    Columns([this](fftw_complex* block, std::size_t, int width) { Execute(column_inverse_, width, block); });
     RowsInverse();
   }
   // grid = the unnormalised inverse of the half spectrum of `input` with each value z at index k
-  // (row * SpectrumStride(columns) + column) replaced by multiply(z, k); overwrites the spectrum.
+  // of the stored spectrum replaced by multiply(z, k); overwrites the spectrum.
   template <class Multiply>
   void Filter(const double* input, const Multiply& multiply) const {
     RowsForward(input);
-    Columns([this, &multiply](fftw_complex* buffer, int first, int width) {
-      Execute(column_forward_, width, buffer);
-      for (int j = 0; j < rows_; ++j) {
-        double* z = &buffer[static_cast<std::size_t>(j) * width][0];
-        const std::size_t k = static_cast<std::size_t>(j) * stride_ + first;
-        for (int b = 0; b < width; ++b) multiply(z + 2 * b, k + b);
-      }
-      Execute(column_inverse_, width, buffer);
+    Columns([this, &multiply](fftw_complex* block, std::size_t first, int width) {
+      Execute(column_forward_, width, block);
+      const std::size_t values = static_cast<std::size_t>(rows_) * width;
+      double* z = &block[0][0];
+      for (std::size_t k = 0; k < values; ++k) multiply(z + 2 * k, first + k);
+      Execute(column_inverse_, width, block);
     });
     RowsInverse();
   }
 
  private:
-  void Execute(const fftw_plan (&plans)[2], int width, fftw_complex* buffer) const {
-    fftw_execute_dft(plans[width == kColumnBlock ? 0 : 1], buffer, buffer);
+  void Execute(const fftw_plan (&plans)[2], int width, fftw_complex* block) const {
+    fftw_execute_dft(plans[width == kColumnBlock ? 0 : 1], block, block);
   }
-  void RowsForward(const double* input) const {
-    ForEachIndex((rows_ + kRowBlock - 1) / kRowBlock, workers_, [this, input](int block, int) {
-      const std::size_t j = static_cast<std::size_t>(block) * kRowBlock;
-      // FFTW takes the input through the plan's pointer type; it keeps it (FFTW_PRESERVE_INPUT).
-      fftw_execute_dft_r2c(row_forward_[j + kRowBlock <= static_cast<std::size_t>(rows_) ? 0 : 1],
-                           const_cast<double*>(input) + j * columns_, spectrum_ + j * stride_);
-    });
-  }
-  void RowsInverse() const {
-    ForEachIndex((rows_ + kRowBlock - 1) / kRowBlock, workers_, [this](int block, int) {
-      const std::size_t j = static_cast<std::size_t>(block) * kRowBlock;
-      fftw_execute_dft_c2r(row_inverse_[j + kRowBlock <= static_cast<std::size_t>(rows_) ? 0 : 1],
-                           spectrum_ + j * stride_, grid_ + j * columns_);
-    });
-  }
-  // work(buffer, first column, width) on each column block, copied into the worker's buffer
-  // (row j's values at buffer[j * width ...]) and back.
-  template <class Work>
-  void Columns(const Work& work) const {
-    ForEachIndex((half_ + kColumnBlock - 1) / kColumnBlock, workers_, [this, &work](int block, int worker) {
-      const int first = block * kColumnBlock, width = std::min(kColumnBlock, half_ - first);
-      fftw_complex* buffer = buffers_ + static_cast<std::size_t>(worker) * rows_ * kColumnBlock;
-      double* column = &spectrum_[first][0];
-      double* packed = &buffer[0][0];
-      if (width == kColumnBlock) {
-        CopyBlock<2 * kColumnBlock>(column, 2 * stride_, packed, 2 * kColumnBlock, 2 * kColumnBlock);
-        work(buffer, first, width);
-        CopyBlock<2 * kColumnBlock>(packed, 2 * kColumnBlock, column, 2 * stride_, 2 * kColumnBlock);
-      } else {
-        CopyBlock<0>(column, 2 * stride_, packed, 2 * width, 2 * width);
-        work(buffer, first, width);
-        CopyBlock<0>(packed, 2 * width, column, 2 * stride_, 2 * width);
-      }
-    });
-  }
-  // `length` doubles of each of the rows from `from` (rows `from_stride` apart) to `to`; with a
-  // Length fixed at compile time the copy of a row is a few vector moves, not a call.
-  template <int Length>
-  void CopyBlock(const double* from, int from_stride, double* to, int to_stride, int length) const {
-    for (int j = 0; j < rows_; ++j) {
-      const double* source = from + static_cast<std::ptrdiff_t>(j) * from_stride;
-      double* target = to + static_cast<std::ptrdiff_t>(j) * to_stride;
-      if constexpr (Length > 0) {
-        for (int k = 0; k < Length; ++k) target[k] = source[k];
-      } else {
-        for (int k = 0; k < length; ++k) target[k] = source[k];
+  [[nodiscard]] int RowBlocks() const { return (rows_ + kRowBlock - 1) / kRowBlock; }
+  [[nodiscard]] int ColumnBlocks() const { return (half_ + kColumnBlock - 1) / kColumnBlock; }
+  // Rows j0 .. j0 + count - 1 between the worker's row buffer and the column blocks.
+  template <bool kToBlocks>
+  void Shuffle(fftw_complex* buffer, int j0, int count) const {
+    for (int b = 0; b < ColumnBlocks(); ++b) {
+      const int c0 = b * kColumnBlock, width = std::min(kColumnBlock, half_ - c0);
+      double* block =
+          &spectrum_[static_cast<std::size_t>(c0) * rows_ + static_cast<std::size_t>(j0) * width][0];
+      for (int r = 0; r < count; ++r) {
+        double* row = &buffer[static_cast<std::size_t>(r) * stride_ + c0][0];
+        double* run = block + 2 * static_cast<std::size_t>(r) * width;
+        if (width == kColumnBlock) {
+          for (int k = 0; k < 2 * kColumnBlock; ++k)
+            (kToBlocks ? run[k] : row[k]) = (kToBlocks ? row[k] : run[k]);
+        } else {
+          for (int k = 0; k < 2 * width; ++k) (kToBlocks ? run[k] : row[k]) = (kToBlocks ? row[k] : run[k]);
+        }
       }
     }
   }
+  void RowsForward(const double* input) const {
+    ForEachIndex(RowBlocks(), pool_, [this, input](int block, int worker) {
+      const int j0 = block * kRowBlock, count = std::min(kRowBlock, rows_ - j0);
+      fftw_complex* buffer = buffers_ + static_cast<std::size_t>(worker) * kRowBlock * stride_;
+      // FFTW takes the input through the plan's pointer type; it keeps it (FFTW_PRESERVE_INPUT).
+      fftw_execute_dft_r2c(row_forward_[count == kRowBlock ? 0 : 1],
+                           const_cast<double*>(input) + static_cast<std::size_t>(j0) * columns_, buffer);
+      Shuffle<true>(buffer, j0, count);
+    });
+  }
+  void RowsInverse() const {
+    ForEachIndex(RowBlocks(), pool_, [this](int block, int worker) {
+      const int j0 = block * kRowBlock, count = std::min(kRowBlock, rows_ - j0);
+      fftw_complex* buffer = buffers_ + static_cast<std::size_t>(worker) * kRowBlock * stride_;
+      Shuffle<false>(buffer, j0, count);
+      fftw_execute_dft_c2r(row_inverse_[count == kRowBlock ? 0 : 1], buffer,
+                           grid_ + static_cast<std::size_t>(j0) * columns_);
+    });
+  }
+  // work(block, index of its first value, width) on each column block.
+  template <class Work>
+  void Columns(const Work& work) const {
+    ForEachIndex(ColumnBlocks(), pool_, [this, &work](int block, int) {
+      const int c0 = block * kColumnBlock, width = std::min(kColumnBlock, half_ - c0);
+      const std::size_t first = static_cast<std::size_t>(c0) * rows_;
+      work(spectrum_ + first, first, width);
+    });
+  }
 
-  int rows_, columns_, half_, stride_, workers_;
+  int rows_, columns_, half_, stride_;
+  WorkerPool& pool_;
   double* grid_;
   fftw_complex* spectrum_;
   fftw_complex* buffers_;
@@ -316,6 +320,7 @@ class GridTransforms {
 // forward transforms keep their input) with no clearing pass.
 struct FftRemoval::Workspace {
   int rows = 0, columns = 0, workers = 1;
+  WorkerPool pool;
   ZeroedPages pages;
   double* grid = nullptr;        // the transforms' output, and the input of the filters
   double* point_grid = nullptr;  // the dwell at the point cells
@@ -334,10 +339,11 @@ struct FftRemoval::Workspace {
   Workspace(int r, int c)
       : rows(r),
         columns(c),
-        workers(TransformWorkers(Cells())),
+        workers(Workers(Cells())),
+        pool(workers),
         pages(3 * Lines(Cells() * sizeof(double)) + 3 * Lines(SpectrumSize() * sizeof(fftw_complex)) +
               Lines(Cells() * sizeof(int)) +
-              Lines(static_cast<std::size_t>(workers) * r * kColumnBlock * sizeof(fftw_complex))) {
+              Lines(static_cast<std::size_t>(workers) * kRowBlock * BufferStride(c) * sizeof(fftw_complex))) {
     char* next = pages.data();
     const auto take = [&next](std::size_t bytes) {
       char* at = next;
@@ -352,16 +358,16 @@ struct FftRemoval::Workspace {
     support = reinterpret_cast<std::complex<double>*>(take(SpectrumSize() * sizeof(fftw_complex)));
     nearest_row = reinterpret_cast<int*>(take(Cells() * sizeof(int)));
     auto* buffers = reinterpret_cast<fftw_complex*>(
-        take(static_cast<std::size_t>(workers) * r * kColumnBlock * sizeof(fftw_complex)));
-    transforms.emplace(r, c, workers, grid, spectrum, buffers);
+        take(static_cast<std::size_t>(workers) * kRowBlock * BufferStride(c) * sizeof(fftw_complex)));
+    transforms.emplace(r, c, pool, grid, spectrum, buffers);
   }
   Workspace(const Workspace&) = delete;
   Workspace& operator=(const Workspace&) = delete;
 
   [[nodiscard]] std::size_t Cells() const { return static_cast<std::size_t>(rows) * columns; }
-  // Complex values of a stored half spectrum, padding included (zero there).
+  // Complex values of the stored half spectrum.
   [[nodiscard]] std::size_t SpectrumSize() const {
-    return static_cast<std::size_t>(rows) * SpectrumStride(columns);
+    return static_cast<std::size_t>(rows) * (columns / 2 + 1);
   }
   [[nodiscard]] std::complex<double>* Spectrum() const {
     return reinterpret_cast<std::complex<double>*>(spectrum);
@@ -476,29 +482,37 @@ namespace {
 // `values` into their cells of `grid`, whose other cells hold 0. Where cells repeat, the grid is
 // cleared and the values added in order.
 const double* Place(double* grid, std::size_t grid_cells, const std::vector<int>& cell, bool shared,
-                    const Eigen::VectorXd& values) {
+                    const Eigen::VectorXd& values, WorkerPool& pool) {
   if (shared) {
     std::fill(grid, grid + grid_cells, 0.0);
     for (std::size_t k = 0; k < cell.size(); ++k) grid[cell[k]] += values[static_cast<Eigen::Index>(k)];
     return grid;
   }
   const int* c = cell.data();
-  ForEachBlock(cell.size(), [grid, c, &values](std::size_t begin, std::size_t end, int) {
-    for (std::size_t k = begin; k < end; ++k) grid[c[k]] = values[static_cast<Eigen::Index>(k)];
-  });
+  ForEachBlock(
+      cell.size(),
+      [grid, c, &values](std::size_t begin, std::size_t end, int) {
+        for (std::size_t k = begin; k < end; ++k) grid[c[k]] = values[static_cast<Eigen::Index>(k)];
+      },
+      &pool);
   return grid;
 }
 
 // out[k] = grid[cell[k]].
-void Gather(const double* grid, const std::vector<int>& cell, Eigen::VectorXd& out) {
+void Gather(const double* grid, const std::vector<int>& cell, Eigen::VectorXd& out, WorkerPool& pool) {
   out.resize(static_cast<Eigen::Index>(cell.size()));
   const int* c = cell.data();
-  ForEachBlock(cell.size(), [grid, c, &out](std::size_t begin, std::size_t end, int) {
-    for (std::size_t k = begin; k < end; ++k) out[static_cast<Eigen::Index>(k)] = grid[c[k]];
-  });
+  ForEachBlock(
+      cell.size(),
+      [grid, c, &out](std::size_t begin, std::size_t end, int) {
+        for (std::size_t k = begin; k < end; ++k) out[static_cast<Eigen::Index>(k)] = grid[c[k]];
+      },
+      &pool);
 }
 
 }  // namespace
+
+WorkerPool* FftRemoval::Pool() const { return &work_->pool; }
 
 double FftRemoval::NormSquaredBound() const {
   const Workspace& w = *work_;
@@ -547,9 +561,12 @@ void FftRemoval::InverseFilter(const Eigen::VectorXd& rows, double relative_damp
       w.nearest_found = true;
     }
     const int* nearest = w.nearest_row;
-    ForEachBlock(w.Cells(), [cells, nearest, &rows](std::size_t begin, std::size_t end, int) {
-      for (std::size_t c = begin; c < end; ++c) cells[c] = nearest[c] >= 0 ? rows[nearest[c]] : 0.0;
-    });
+    ForEachBlock(
+        w.Cells(),
+        [cells, nearest, &rows](std::size_t begin, std::size_t end, int) {
+          for (std::size_t c = begin; c < end; ++c) cells[c] = nearest[c] >= 0 ? rows[nearest[c]] : 0.0;
+        },
+        &w.pool);
   } else {
     std::fill(cells, cells + w.Cells(), 0.0);
     for (std::size_t r = 0; r < row_cell_.size(); ++r)
@@ -567,7 +584,7 @@ void FftRemoval::InverseFilter(const Eigen::VectorXd& rows, double relative_damp
     z[0] = a * c - b * d;
     z[1] = a * d + b * c;
   });
-  Gather(cells, point_cell_, dwell_s);
+  Gather(cells, point_cell_, dwell_s, w.pool);
 }
 
 double* FftRemoval::ClearedGrid() const {
@@ -576,12 +593,12 @@ double* FftRemoval::ClearedGrid() const {
 }
 
 const double* FftRemoval::PointGrid(const Eigen::VectorXd& values) const {
-  return Place(work_->point_grid, work_->Cells(), point_cell_, points_share_cells_, values);
+  return Place(work_->point_grid, work_->Cells(), point_cell_, points_share_cells_, values, work_->pool);
 }
 
 const double* FftRemoval::RowGrid(const Eigen::VectorXd& values) const {
   work_->placed_residual = nullptr;
-  return Place(work_->row_grid, work_->Cells(), row_cell_, rows_share_cells_, values);
+  return Place(work_->row_grid, work_->Cells(), row_cell_, rows_share_cells_, values, work_->pool);
 }
 
 Eigen::VectorXd FftRemoval::Apply(const Eigen::VectorXd& dwell_s) const {
@@ -599,13 +616,13 @@ Eigen::VectorXd FftRemoval::ApplyTranspose(const Eigen::VectorXd& rows) const {
 void FftRemoval::Apply(const Eigen::VectorXd& dwell_s, Eigen::VectorXd& rows) const {
   ARCWHEEL_CHECK(dwell_s.size() == static_cast<Eigen::Index>(point_cell_.size())) << dwell_s.size();
   Convolve(PointGrid(dwell_s), false);
-  Gather(work_->grid, row_cell_, rows);
+  Gather(work_->grid, row_cell_, rows, work_->pool);
 }
 
 void FftRemoval::ApplyTranspose(const Eigen::VectorXd& rows, Eigen::VectorXd& dwell_s) const {
   ARCWHEEL_CHECK(rows.size() == static_cast<Eigen::Index>(row_cell_.size())) << rows.size();
   Convolve(RowGrid(rows), true);
-  Gather(work_->grid, point_cell_, dwell_s);
+  Gather(work_->grid, point_cell_, dwell_s, work_->pool);
 }
 
 double FftRemoval::Residual(const Eigen::VectorXd& dwell_s, const Eigen::VectorXd& target,
@@ -620,18 +637,21 @@ double FftRemoval::Residual(const Eigen::VectorXd& dwell_s, const Eigen::VectorX
   const int* cell = row_cell_.data();
   const bool place = !rows_share_cells_;  // else the cells' values add up: RowGrid places them
   std::array<double, kPassBlocks> squares{};
-  ForEachBlock(row_cell_.size(), [&](std::size_t begin, std::size_t end, int block) {
-    for (std::size_t r = begin; r < end; ++r) {
-      const auto i = static_cast<Eigen::Index>(r);
-      const double value = grid[cell[r]] - target[i];
-      residual[i] = value;
-      if (place) row_grid[cell[r]] = value;
-    }
-    // Its block still in cache; Eigen's sum vectorises.
-    squares[static_cast<std::size_t>(block)] =
-        residual.segment(static_cast<Eigen::Index>(begin), static_cast<Eigen::Index>(end - begin))
-            .squaredNorm();
-  });
+  ForEachBlock(
+      row_cell_.size(),
+      [&](std::size_t begin, std::size_t end, int block) {
+        for (std::size_t r = begin; r < end; ++r) {
+          const auto i = static_cast<Eigen::Index>(r);
+          const double value = grid[cell[r]] - target[i];
+          residual[i] = value;
+          if (place) row_grid[cell[r]] = value;
+        }
+        // Its block still in cache; Eigen's sum vectorises.
+        squares[static_cast<std::size_t>(block)] =
+            residual.segment(static_cast<Eigen::Index>(begin), static_cast<Eigen::Index>(end - begin))
+                .squaredNorm();
+      },
+      &w.pool);
   w.placed_residual = place ? residual.data() : nullptr;
   double sum = 0.0;
   for (const double s : squares) sum += s;
@@ -639,13 +659,13 @@ double FftRemoval::Residual(const Eigen::VectorXd& dwell_s, const Eigen::VectorX
 }
 
 void FftRemoval::GradientOfResidual(const Eigen::VectorXd& residual, Eigen::VectorXd& dwell_s) const {
-  const Workspace& w = *work_;
+  Workspace& w = *work_;
   if (w.placed_residual == nullptr || w.placed_residual != residual.data()) {
     ApplyTranspose(residual, dwell_s);
     return;
   }
   Convolve(w.row_grid, true);
-  Gather(w.grid, point_cell_, dwell_s);
+  Gather(w.grid, point_cell_, dwell_s, w.pool);
 }
 
 }  // namespace arcwheel::polishing::internal

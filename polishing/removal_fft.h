@@ -5,7 +5,7 @@
 // of the map's grid (extended beyond the map as far as the path goes), X_n - P_k is a whole number
 // of grid steps, so the sum is the 2-D convolution of the removal function sampled at those steps
 // with the dwell placed on the grid: the same products as the sparse removal matrix, computed with
-// FFTW in O(N log N) instead of O(N x footprint). Transforms of 2^18 cells or more run on every
+// FFTW in O(N log N) instead of O(N x footprint). Transforms of 2^16 cells or more run on every
 // core, their rows and column blocks shared out (removal_fft.cc, GridTransforms). The removal
 // function is the same at every point (it is defined in the part's (x, y) projection), so the
 // convolution holds over the whole part, curved or not. A point counts as on the grid when it
@@ -22,6 +22,7 @@
 #include <span>
 #include <vector>
 
+#include "core/parallel.h"
 #include "polishing/removal_function.h"
 #include "polishing/removal_target.h"
 
@@ -34,11 +35,12 @@ inline constexpr double kGridTolerance = 1e-9;
 // as the transforms' time when run on one core) split [0, n) into kPassBlocks blocks and run
 // pass(begin, end, block) on each, on every core once n reaches kParallelElements. The blocks do
 // not depend on the core count: sums formed per block and added in block order come out the same
-// on every machine.
+// on every machine. With a pool, its workers run the blocks (FftRemoval::Pool).
 inline constexpr int kPassBlocks = 16;
 inline constexpr std::size_t kParallelElements = std::size_t{1} << 16;
 void ForEachBlock(std::size_t n,
-                  const std::function<void(std::size_t begin, std::size_t end, int block)>& pass);
+                  const std::function<void(std::size_t begin, std::size_t end, int block)>& pass,
+                  WorkerPool* pool = nullptr);
 
 class FftRemoval {
  public:
@@ -65,6 +67,9 @@ class FftRemoval {
   void GradientOfResidual(const Eigen::VectorXd& residual, Eigen::VectorXd& dwell_s) const;
   // Entries of the sparse matrix that these products stand for: (row, point) pairs with a rate > 0.
   [[nodiscard]] long Nonzeros() const { return nonzeros_; }
+  // The workers that run the products' transforms and passes, kept for the solve (one on a grid
+  // below 2^16 cells), for the solve's own passes (ForEachBlock).
+  [[nodiscard]] WorkerPool* Pool() const;
   // An upper bound of ||A||^2, the largest eigenvalue of A^T A: the largest |spectrum|^2 of the
   // kernel (A is the circular convolution between two restrictions, which cannot lengthen a
   // vector). The Lipschitz constant of the least-squares gradient, without power iterations.

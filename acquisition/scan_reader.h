@@ -16,12 +16,17 @@
 
 namespace arcwheel::acquisition {
 
+struct ScanSettingsFile;  // acquisition/scan_settings.h
+
 struct ReadOptions {
   // float32 readings stay float32 (Scan::z_float_mm): half the memory, the same results.
   bool keep_float32 = false;
   // Work for this process while the file is read: called once, while a child process reads an
   // HDF5 file (after its fork, so it may start threads), else just before the read.
   std::function<void()> while_reading;
+  // formats.md 2.4: the settings from outside the file (`--scan-settings`), merged into the file's
+  // own before the scan is checked (ApplyScanSettings); null: none. Not owned.
+  const ScanSettingsFile* settings = nullptr;
 };
 
 // By the format the file name selects (scan_format.h, case-insensitive): .h5/.hdf5 -> ReadHdf5Scan,
@@ -34,9 +39,9 @@ struct ReadOptions {
 [[nodiscard]] Scan ReadHdf5Scan(const std::filesystem::path& path, const ReadOptions& options = {});
 
 // formats.md 2.2: `# key: value` lines, a header row, separators , ; or tab, decimal point.
-[[nodiscard]] Scan ReadCsvScan(const std::filesystem::path& path);
+[[nodiscard]] Scan ReadCsvScan(const std::filesystem::path& path, const ReadOptions& options = {});
 // The same from text already in memory; `name` stands for the file in messages.
-[[nodiscard]] Scan ParseCsvScan(std::string text, const std::string& name);
+[[nodiscard]] Scan ParseCsvScan(std::string text, const std::string& name, const ReadOptions& options = {});
 
 // formats.md 2.1 from an open file (e.g. an in-memory image, hdf5::File::OpenImage).
 [[nodiscard]] Scan ReadHdf5Scan(const hdf5::File& file, const ReadOptions& options = {});

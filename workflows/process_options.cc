@@ -95,6 +95,10 @@ std::vector<ProcessOption> MakeTable() {
        [](Options& o) -> OptionRef { return &o.no_model; }, false},
       {"--uncertainty", "type B uncertainty budget (docs/uncertainty.md); default: the simulated sensor's",
        "", [](Options& o) -> OptionRef { return &o.uncertainty_budget_path; }, false, true},
+      {"--scan-settings",
+       "JSON of the scan's settings the file lacks: spindle_rpm, feed_mm_per_min, sample_period_s, "
+       "start_y_mm, radius_sign, wheel_id, sensor, ... (formats.md 2.4)",
+       "", [](Options& o) -> OptionRef { return &o.scan_settings_path; }, false, true},
       {"--no-uncertainty", "leave the uncertainty budget and the noise-corrected figures out of summary.json",
        "", [](Options& o) -> OptionRef { return &o.no_uncertainty; }, false},
   };

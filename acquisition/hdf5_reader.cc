@@ -207,12 +207,19 @@ Scan ReadHdf5Scan(const hdf5::File& file, const ReadOptions& options) {
 }
 
 Scan ReadScan(const std::filesystem::path& path, const ReadOptions& options) {
-  switch (ScanFormatOfFile(path, "acquisition")) {
-    case ScanFormat::kHdf5:
-      return ReadHdf5Scan(path, options);
+  const ScanFormat format =
+      ScanFormatOfContent(path, options.format, !options.columns.empty(), "acquisition");
+  if (format == ScanFormat::kHdf5) return ReadHdf5Scan(path, options);
+  if (options.while_reading) options.while_reading();
+  switch (format) {
     case ScanFormat::kCsv:
-      if (options.while_reading) options.while_reading();
       return ReadCsvScan(path, options);
+    case ScanFormat::kSensorTool:
+    case ScanFormat::kKeyenceLk:
+    case ScanFormat::kColumns:
+      return ReadSensorScan(path, format, options);
+    case ScanFormat::kHdf5:
+      break;
   }
   ARCWHEEL_CHECK(false) << "scan format without a reader";
   return {};

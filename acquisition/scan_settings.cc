@@ -54,9 +54,7 @@ const std::string& TextOf(const ScanMetadata& m, std::string_view key) {
 
 std::string Shown(double value) { return fmt::format("{:.12g}", value); }
 
-bool SameNumber(double a, double b) {
-  return std::abs(a - b) <= 1e-12 * std::max(std::abs(a), std::abs(b));
-}
+bool SameNumber(double a, double b) { return std::abs(a - b) <= 1e-12 * std::max(std::abs(a), std::abs(b)); }
 
 }  // namespace
 
@@ -85,8 +83,9 @@ ScanSettingsFile ParseScanSettings(std::string_view text, const std::string& nam
     throw Error(ErrorCode::kInvalidOption, kStage, fmt::format("'{}' is not JSON: {}", name, e.what()));
   }
   if (!document.is_object()) {
-    throw Error(ErrorCode::kInvalidOption, kStage,
-                fmt::format("'{}' must hold one JSON object of settings, got {}", name, document.type_name()));
+    throw Error(
+        ErrorCode::kInvalidOption, kStage,
+        fmt::format("'{}' must hold one JSON object of settings, got {}", name, document.type_name()));
   }
   std::vector<std::string> problems;
   for (const auto& [key, value] : document.items()) {
@@ -103,7 +102,8 @@ ScanSettingsFile ParseScanSettings(std::string_view text, const std::string& nam
       }
       settings.texts.emplace_back(key, value.get<std::string>());
     } else {
-      problems.push_back(fmt::format("'{}' is not a scan setting (expected {})", key, ScanSettingsKeysText()));
+      problems.push_back(
+          fmt::format("'{}' is not a scan setting (expected {})", key, ScanSettingsKeysText()));
     }
   }
   if (!problems.empty()) {

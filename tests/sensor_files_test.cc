@@ -42,7 +42,8 @@ std::filesystem::path CsvWithout(const TempDir& dir, const std::string& name, co
 TEST(ScanSettings, FillWhatTheFileLacksAndTheSummarySaysWhereEachCameFrom) {
   TempDir dir;
   const auto scan = CsvWithout(dir, "scan", "spindle_rpm sample_period_s");
-  WriteText(dir / "settings.json", R"({"spindle_rpm": 500, "sample_period_s": 0.0001, "operator": "E. Abbe"})");
+  WriteText(dir / "settings.json",
+            R"({"spindle_rpm": 500, "sample_period_s": 0.0001, "operator": "E. Abbe"})");
   const auto run = RunArcwheel("process -q --no-model " + scan.string() + " -o " + (dir / "out").string() +
                                " --scan-settings " + (dir / "settings.json").string());
   ASSERT_EQ(run.exit_status, 0) << run.output;
@@ -100,8 +101,10 @@ TEST(ScanSettings, AnUnknownKeyOrAWrongTypeIsRefusedBeforeTheScanIsRead) {
   const auto run = RunArcwheel("process -q " + (dir / "scan.csv").string() + " -o " + (dir / "out").string() +
                                " --scan-settings " + (dir / "settings.json").string());
   EXPECT_EQ(run.exit_status, 2) << run.output;
-  EXPECT_NE(run.output.find("'feed_mm_per_min' must be a number, got \"100\""), std::string::npos) << run.output;
-  EXPECT_NE(run.output.find("'spindle_speed' is not a scan setting (expected spindle_rpm, "), std::string::npos)
+  EXPECT_NE(run.output.find("'feed_mm_per_min' must be a number, got \"100\""), std::string::npos)
+      << run.output;
+  EXPECT_NE(run.output.find("'spindle_speed' is not a scan setting (expected spindle_rpm, "),
+            std::string::npos)
       << run.output;
   EXPECT_FALSE(std::filesystem::exists(dir / "out"));
 }

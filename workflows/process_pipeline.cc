@@ -198,6 +198,15 @@ void ResolveProcessPipelineOptions(ProcessPipelineOptions& options) {
   // Every bad option of both stages in one message, before the scan is read: the fit's would
   // otherwise surface only after the whole scan had been processed.
   std::vector<std::string> problems = options.binding_problems;
+  if (!options.scan_format.empty()) {
+    try {
+      (void)acquisition::ScanFormatNamed(options.scan_format, "process");
+    } catch (const Error& e) {
+      problems.push_back(std::string(e.what()).substr(std::string("process: ").size()));
+    }
+  }
+  for (std::string& problem : acquisition::ColumnsOptionProblems(options.columns))
+    problems.push_back(std::move(problem));
   for (std::string& problem : options.processing.Problems()) problems.push_back(std::move(problem));
   for (std::string& problem : options.fit.Problems()) problems.push_back(std::move(problem));
   if (!options.no_model) {
@@ -228,10 +237,12 @@ ProcessPipelineResult RunProcessPipeline(const std::string& scan_path, const std
   const auto start_hash = [&] {
     sha256 = std::async(std::launch::async, [scan_path] { return Sha256OfFile(scan_path); });
   };
-  acquisition::Scan scan = acquisition::ReadScan(
-      scan_path, {.keep_float32 = true,
-                  .while_reading = start_hash,
-                  .settings = options.scan_settings ? &*options.scan_settings : nullptr});
+  acquisition::Scan scan =
+      acquisition::ReadScan(scan_path, {.keep_float32 = true,
+                                        .while_reading = start_hash,
+                                        .settings = options.scan_settings ? &*options.scan_settings : nullptr,
+                                        .format = options.scan_format,
+                                        .columns = options.columns});
   clock.Stop();
   if (!sha256.valid()) start_hash();  // a reader that had nothing to overlap
   return RunOnScan(std::move(scan), scan_path, std::move(sha256), outdir, options, progress,

@@ -41,6 +41,11 @@ struct ProcessPipelineOptions {
   // other options, before the scan; they fill what the file does not give, and a value the file
   // gives otherwise is refused (exit 2).
   std::string scan_settings_path;
+  // formats.md 2.4: the reader by name (`--format`: hdf5, csv, sensortool, keyence-lk, columns;
+  // empty: by the extension and a sniff of the header) and the column map of a delimited file
+  // (`--columns z=NAME[:UNIT],t=NAME[:UNIT],...`), both checked with the other options.
+  std::string scan_format;
+  std::string columns;
   // The tolerances (`--tolerances FILE`, reports/tolerances.h), read by the caller before the
   // scan: with the uncertainty, every toleranced quantity is decided by the file's rule (ISO
   // 14253-1 by default) and summary.json's "uncertainty" carries the rule and the decisions.

@@ -38,8 +38,8 @@ constexpr std::array<const char*, 4> kQuantityNames = {"z", "t", "angle", "y"};
 
 // Invalid markers, by kind (summary.json's input.invalid_markers).
 enum class Marker { kEmpty, kNan, kOutOfRangeHigh, kOutOfRangeLow, kAlarm, kWaiting };
-constexpr std::array<const char*, 6> kMarkerNames = {"empty",         "nan",   "out_of_range_high",
-                                                     "out_of_range_low", "alarm", "waiting"};
+constexpr std::array<const char*, 6> kMarkerNames = {
+    "empty", "nan", "out_of_range_high", "out_of_range_low", "alarm", "waiting"};
 
 std::string Lower(std::string_view text) {
   std::string lower(text);
@@ -66,7 +66,8 @@ std::vector<std::string_view> SplitCells(std::string_view line, char separator) 
   std::size_t start = 0;
   while (true) {
     const std::size_t next = line.find(separator, start);
-    cells.push_back(line.substr(start, next == std::string_view::npos ? std::string_view::npos : next - start));
+    cells.push_back(
+        line.substr(start, next == std::string_view::npos ? std::string_view::npos : next - start));
     if (next == std::string_view::npos) break;
     start = next + 1;
   }
@@ -162,8 +163,8 @@ std::vector<ColumnRequest> ParseColumnsOption(std::string_view text, std::vector
     const std::optional<Quantity> quantity =
         equals == std::string_view::npos ? std::nullopt : QuantityNamed(Trim(item.substr(0, equals)));
     if (!quantity) {
-      problems->push_back(fmt::format("--columns = '{}' violates QUANTITY=NAME[:UNIT] with QUANTITY z, t, angle or y",
-                                      item));
+      problems->push_back(
+          fmt::format("--columns = '{}' violates QUANTITY=NAME[:UNIT] with QUANTITY z, t, angle or y", item));
       continue;
     }
     std::string_view rest = item.substr(equals + 1);
@@ -173,18 +174,21 @@ std::vector<ColumnRequest> ParseColumnsOption(std::string_view text, std::vector
       rest = rest.substr(0, colon);
       if (!ScaleOf(*quantity, unit) && !(*quantity == Quantity::kAngle && Lower(unit) == "counts")) {
         problems->push_back(fmt::format("--columns = '{}' violates a unit of {}: {}", item,
-                                        kQuantityNames[static_cast<std::size_t>(*quantity)], UnitsOf(*quantity)));
+                                        kQuantityNames[static_cast<std::size_t>(*quantity)],
+                                        UnitsOf(*quantity)));
       }
     }
     const std::string_view name = Unquote(rest);
     if (name.empty()) problems->push_back(fmt::format("--columns = '{}' names no column", item));
-    if (std::any_of(requests.begin(), requests.end(), [&](const ColumnRequest& r) { return r.quantity == *quantity; })) {
-      problems->push_back(fmt::format("--columns names {} twice", kQuantityNames[static_cast<std::size_t>(*quantity)]));
+    if (std::any_of(requests.begin(), requests.end(),
+                    [&](const ColumnRequest& r) { return r.quantity == *quantity; })) {
+      problems->push_back(
+          fmt::format("--columns names {} twice", kQuantityNames[static_cast<std::size_t>(*quantity)]));
     }
     requests.push_back({*quantity, std::string(name), unit});
   }
-  if (problems->empty() &&
-      std::none_of(requests.begin(), requests.end(), [](const ColumnRequest& r) { return r.quantity == Quantity::kZ; })) {
+  if (problems->empty() && std::none_of(requests.begin(), requests.end(),
+                                        [](const ColumnRequest& r) { return r.quantity == Quantity::kZ; })) {
     problems->push_back("--columns names no z column (z=NAME[:UNIT])");
   }
   return requests;
@@ -270,8 +274,8 @@ class SensorParser {
     for (std::size_t i = 1; i < cells.size(); ++i) text += std::string(Trim(cells[i])) + " ";
     std::string_view rest = Trim(text);
     std::size_t digits = 0;
-    while (digits < rest.size() && (std::isdigit(static_cast<unsigned char>(rest[digits])) || rest[digits] == '.' ||
-                                    rest[digits] == ',')) {
+    while (digits < rest.size() && (std::isdigit(static_cast<unsigned char>(rest[digits])) ||
+                                    rest[digits] == '.' || rest[digits] == ',')) {
       ++digits;
     }
     std::string number(rest.substr(0, digits));
@@ -295,9 +299,11 @@ class SensorParser {
     const std::optional<double> period = PeriodOf(cells);
     if (!period) {
       std::string written;
-      for (std::size_t i = 1; i < cells.size(); ++i) written += std::string(i > 1 ? " " : "") + std::string(Trim(cells[i]));
-      Refuse(line_number_, fmt::format("'{}' is not a rate or period arcwheel reads ('{}'; e.g. 20 kHz, 50 us)",
-                                       Utf8(Trim(cells[0])), Utf8(written)));
+      for (std::size_t i = 1; i < cells.size(); ++i)
+        written += std::string(i > 1 ? " " : "") + std::string(Trim(cells[i]));
+      Refuse(line_number_,
+             fmt::format("'{}' is not a rate or period arcwheel reads ('{}'; e.g. 20 kHz, 50 us)",
+                         Utf8(Trim(cells[0])), Utf8(written)));
     }
     MetadataSetter setter(metadata);
     (void)setter.Claim("sample_period_s");
@@ -314,7 +320,8 @@ class SensorParser {
   void TakeColumnRow(std::string_view line) {
     separator_ = SeparatorOf(line);
     header_cells_.clear();
-    for (const std::string_view cell : SplitCells(line, separator_)) header_cells_.emplace_back(Unquote(cell));
+    for (const std::string_view cell : SplitCells(line, separator_))
+      header_cells_.emplace_back(Unquote(cell));
     header_line_ = line_number_;
   }
 
@@ -354,8 +361,9 @@ class SensorParser {
     }
     const std::optional<double> scale = ScaleOf(spec.quantity, spec.unit);
     if (!scale) {
-      Refuse(line, fmt::format("column '{}': unit '{}' is not one of {} ({})", Utf8(spec.header), Utf8(spec.unit),
-                               kQuantityNames[static_cast<std::size_t>(spec.quantity)], UnitsOf(spec.quantity)));
+      Refuse(line,
+             fmt::format("column '{}': unit '{}' is not one of {} ({})", Utf8(spec.header), Utf8(spec.unit),
+                         kQuantityNames[static_cast<std::size_t>(spec.quantity)], UnitsOf(spec.quantity)));
     }
     spec.scale = *scale;
   }
@@ -365,7 +373,8 @@ class SensorParser {
   void ReadSensorToolHeader(ScanMetadata& metadata) {
     std::string_view line;
     while (true) {
-      if (!NextLine(line)) RefuseFile("no column row (expected e.g. 'Acquisition time;Epoch time (ms);Distance1 (mm)')");
+      if (!NextLine(line))
+        RefuseFile("no column row (expected e.g. 'Acquisition time;Epoch time (ms);Distance1 (mm)')");
       const std::string_view trimmed = Trim(line);
       if (trimmed.empty()) continue;
       const std::string lower = Lower(trimmed);
@@ -397,7 +406,8 @@ class SensorParser {
     // the sensor samples slower than 1 kHz.
     if (const auto t = FindHeader([](const std::string& h) { return h.starts_with("acquisition time"); })) {
       Use(Quantity::kT, *t, "s");
-    } else if (const auto epoch = FindHeader([](const std::string& h) { return h.starts_with("epoch time"); })) {
+    } else if (const auto epoch =
+                   FindHeader([](const std::string& h) { return h.starts_with("epoch time"); })) {
       Use(Quantity::kT, *epoch, "ms");
     }
   }
@@ -426,8 +436,9 @@ class SensorParser {
         return;
       }
       const std::string first = Lower(Unquote(cells[0]));
-      const bool column_row = std::any_of(cells.begin(), cells.end(),
-                                          [](std::string_view c) { return Lower(Unquote(c)).starts_with("out"); });
+      const bool column_row = std::any_of(cells.begin(), cells.end(), [](std::string_view c) {
+        return Lower(Unquote(c)).starts_with("out");
+      });
       if (column_row) {
         TakeColumnRow(trimmed);
         break;
@@ -460,7 +471,8 @@ class SensorParser {
       const std::string_view trimmed = Trim(line);
       if (trimmed.empty()) continue;
       std::vector<std::string> cells;
-      for (const std::string_view cell : SplitCells(trimmed, SeparatorOf(trimmed))) cells.emplace_back(Unquote(cell));
+      for (const std::string_view cell : SplitCells(trimmed, SeparatorOf(trimmed)))
+        cells.emplace_back(Unquote(cell));
       const bool names_all = std::all_of(requests.begin(), requests.end(), [&](const ColumnRequest& r) {
         return std::find(cells.begin(), cells.end(), r.name) != cells.end();
       });
@@ -485,9 +497,9 @@ class SensorParser {
       if (found == header_cells_.end()) {
         std::string names;
         for (const std::string& h : header_cells_) names += (names.empty() ? "'" : ", '") + Utf8(h) + "'";
-        Refuse(header_line_, fmt::format("no column '{}' (--columns {}=...); the column row names {}",
-                                         Utf8(request.name), kQuantityNames[static_cast<std::size_t>(request.quantity)],
-                                         names));
+        Refuse(header_line_,
+               fmt::format("no column '{}' (--columns {}=...); the column row names {}", Utf8(request.name),
+                           kQuantityNames[static_cast<std::size_t>(request.quantity)], names));
       }
       const std::size_t index = static_cast<std::size_t>(found - header_cells_.begin());
       Use(request.quantity, index, request.unit.empty() ? DefaultUnit(request.quantity) : request.unit);
@@ -516,9 +528,8 @@ class SensorParser {
   }
 
   std::string KnownMarkersText() const {
-    return format_ == ScanFormat::kSensorTool
-               ? "an empty cell or nan"
-               : "an empty cell, nan, +FFFFFFF, -FFFFFFF, XXXXXXXX or -------";
+    return format_ == ScanFormat::kSensorTool ? "an empty cell or nan"
+                                              : "an empty cell, nan, +FFFFFFF, -FFFFFFF, XXXXXXXX or -------";
   }
 
   // A number as the tools write it: a leading '+', a decimal comma where ',' separates no cells.
@@ -578,8 +589,9 @@ class SensorParser {
           break;
       }
     }
-    const std::size_t estimate =
-        static_cast<std::size_t>(std::count(text_.begin() + static_cast<long>(position_), text_.end(), '\n')) + 1;
+    const std::size_t estimate = static_cast<std::size_t>(std::count(
+                                     text_.begin() + static_cast<long>(position_), text_.end(), '\n')) +
+                                 1;
     for (std::vector<double>* target : targets) target->reserve(estimate);
     std::array<std::size_t, kMarkerNames.size()> marker_counts{};
     std::array<std::size_t, kMarkerNames.size()> marker_order{};
@@ -620,7 +632,8 @@ class SensorParser {
             if (marker_counts[m]++ == 0) marker_order[markers_seen++] = m;
             value = kNaN;
           } else {
-            Refuse(line_number_, fmt::format("column '{}': '{}' is not a number", Utf8(spec.header), Utf8(cell)));
+            Refuse(line_number_,
+                   fmt::format("column '{}': '{}' is not a number", Utf8(spec.header), Utf8(cell)));
           }
           if (spec.quantity == Quantity::kT) {
             if (value < previous_time) {
@@ -656,17 +669,18 @@ class SensorParser {
       const double t0 = scan.t_s.front();
       for (double& t : scan.t_s) t -= t0;
       if (time_ties > 0) {
-        const auto t_column =
-            std::find_if(columns_.begin(), columns_.end(), [](const ColumnSpec& c) { return c.quantity == Quantity::kT; });
+        const auto t_column = std::find_if(columns_.begin(), columns_.end(),
+                                           [](const ColumnSpec& c) { return c.quantity == Quantity::kT; });
         scan.metadata.notes.push_back(fmt::format(
             "column '{}' repeats a time {} times (it resolves less than the sampling): not used; the times "
             "are the sample period's",
             Utf8(t_column->header), time_ties));
         scan.t_s.clear();
         scan.t_s.shrink_to_fit();
-        scan.read.columns.erase(std::remove_if(scan.read.columns.begin(), scan.read.columns.end(),
-                                               [](const ScanReadRecord::Column& c) { return c.quantity == "t"; }),
-                                scan.read.columns.end());
+        scan.read.columns.erase(
+            std::remove_if(scan.read.columns.begin(), scan.read.columns.end(),
+                           [](const ScanReadRecord::Column& c) { return c.quantity == "t"; }),
+            scan.read.columns.end());
       }
     }
   }
@@ -702,7 +716,8 @@ std::vector<std::string> ColumnsOptionProblems(std::string_view columns) {
   return problems;
 }
 
-Scan ParseSensorScan(std::string text, const std::string& name, ScanFormat format, const ReadOptions& options) {
+Scan ParseSensorScan(std::string text, const std::string& name, ScanFormat format,
+                     const ReadOptions& options) {
   ARCWHEEL_CHECK(format == ScanFormat::kSensorTool || format == ScanFormat::kKeyenceLk ||
                  format == ScanFormat::kColumns);
   SensorParser parser(name, std::move(text), format, options);

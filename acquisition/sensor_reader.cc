@@ -91,21 +91,22 @@ std::string UnitInHeader(std::string_view header) {
   return std::string(Trim(header.substr(open + 1, close - open - 1)));
 }
 
-// Scale from `unit` to the contract's unit of `quantity` (mm, s, deg); empty when the unit is not one
-// of that quantity. "counts" (angle) is scaled by the caller, from encoder_counts_per_rev.
+// The divisor from `unit` to the contract's unit of `quantity` (mm, s, deg): dividing by an exact
+// power of ten gives the double nearest the value in the contract's unit. Empty when the unit is not
+// one of that quantity. "counts" (angle) is scaled by the caller, from encoder_counts_per_rev.
 std::optional<double> ScaleOf(Quantity quantity, const std::string& unit) {
   const std::string u = Lower(unit);
   switch (quantity) {
     case Quantity::kZ:
     case Quantity::kY:
       if (u == "mm") return 1.0;
-      if (u == "um" || u == "\xC2\xB5m" || u == "\xCE\xBCm") return 1e-3;
-      if (u == "nm") return 1e-6;
+      if (u == "um" || u == "\xC2\xB5m" || u == "\xCE\xBCm") return 1e3;
+      if (u == "nm") return 1e6;
       return std::nullopt;
     case Quantity::kT:
       if (u == "s") return 1.0;
-      if (u == "ms") return 1e-3;
-      if (u == "us" || u == "\xC2\xB5s" || u == "\xCE\xBCs") return 1e-6;
+      if (u == "ms") return 1e3;
+      if (u == "us" || u == "\xC2\xB5s" || u == "\xCE\xBCs") return 1e6;
       return std::nullopt;
     case Quantity::kAngle:
       if (u == "deg" || u == "\xC2\xB0") return 1.0;
@@ -133,7 +134,8 @@ struct ColumnSpec {
   std::string header;  // as the column row writes it; for --columns, the name asked for
   std::size_t index = 0;
   std::string unit;
-  double scale = 1.0;
+  double factor = 1.0;  // value in the contract's unit = value as written * factor / divisor
+  double divisor = 1.0;
   bool clock_time = false;  // hh:mm:ss[.,]fff (sensorTOOL's acquisition time as a time of day)
 };
 
@@ -285,13 +287,14 @@ class SensorParser {
     if (number.empty() || error != std::errc() || end != number.data() + number.size() || !(value > 0.0)) {
       return std::nullopt;
     }
+    // Divided by exact powers of ten, so that "100 us" is the double nearest 1e-4 s, as "0.0001" is.
     const std::string unit = Lower(Trim(rest.substr(digits)));
     if (unit == "hz") return 1.0 / value;
     if (unit == "khz") return 1.0 / (value * 1e3);
     if (unit == "mhz") return 1.0 / (value * 1e6);
     if (unit == "s") return value;
-    if (unit == "ms") return value * 1e-3;
-    if (unit == "us" || unit == "\xC2\xB5s" || unit == "\xCE\xBCs") return value * 1e-6;
+    if (unit == "ms") return value / 1e3;
+    if (unit == "us" || unit == "\xC2\xB5s" || unit == "\xCE\xBCs") return value / 1e6;
     return std::nullopt;
   }
 
@@ -356,16 +359,17 @@ class SensorParser {
                                  "--scan-settings SETTINGS.json",
                                  Utf8(spec.header)));
       }
-      spec.scale = 360.0 / *counts;
+      spec.factor = 360.0;
+      spec.divisor = *counts;
       return;
     }
-    const std::optional<double> scale = ScaleOf(spec.quantity, spec.unit);
-    if (!scale) {
+    const std::optional<double> divisor = ScaleOf(spec.quantity, spec.unit);
+    if (!divisor) {
       Refuse(line,
              fmt::format("column '{}': unit '{}' is not one of {} ({})", Utf8(spec.header), Utf8(spec.unit),
                          kQuantityNames[static_cast<std::size_t>(spec.quantity)], UnitsOf(spec.quantity)));
     }
-    spec.scale = *scale;
+    spec.divisor = *divisor;
   }
 
   // sensorTOOL: header lines `key;value[;unit]` up to the column row, which starts with
@@ -620,7 +624,7 @@ class SensorParser {
             columns_[static_cast<std::size_t>(k)].clock_time = parsed = true;
           }
           if (parsed) {
-            value *= spec.scale;
+            value = value * spec.factor / spec.divisor;
           } else if (spec.quantity == Quantity::kZ) {
             const std::optional<Marker> marker = MarkerOf(cell);
             if (!marker) {

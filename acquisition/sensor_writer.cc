@@ -53,7 +53,8 @@ std::string SensorToolText(const Scan& scan) {
   for (std::size_t i = 0; i < scan.z_mm.size(); ++i) {
     const double t_s = scan.has_time() ? scan.t_s[i] - scan.t_s[0] : static_cast<double>(i) * period_s;
     const double z = scan.z_mm[i];
-    text += WithComma(fmt::format("{:.6f};{};", t_s, kEpochMs + static_cast<long long>(std::floor(t_s * 1e3))));
+    text +=
+        WithComma(fmt::format("{:.6f};{};", t_s, kEpochMs + static_cast<long long>(std::floor(t_s * 1e3))));
     if (std::isfinite(z)) text += WithComma(fmt::format("{:.6f}", z));
     text += "\r\n";
   }

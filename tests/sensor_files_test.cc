@@ -362,6 +362,37 @@ TEST(SensorLayout, SimulateAsEachSensorThenProcessWithItsSettingsRecoversTheTrut
   }
 }
 
+// `batch` passes --scan-settings to every scan, and reuses a finished scan only while the settings
+// file is unchanged.
+TEST(ScanSettings, BatchPassesThemToEveryScanAndAnEditedFileRunsThemAgain) {
+  TempDir dir;
+  for (const std::string name : {"wheel_a", "wheel_b"}) {
+    ASSERT_EQ(
+        RunArcwheel("simulate " + (dir / (name + ".csv")).string() +
+                    " --as keyence-lk --feed-mm-per-min 400 --settings " + (dir / "settings.json").string())
+            .exit_status,
+        0);
+  }
+  const std::string batch = "batch " + (dir / "wheel_a.csv").string() + " " + (dir / "wheel_b.csv").string() +
+                            " -o " + (dir / "out").string() + " -- --no-model --scan-settings " +
+                            (dir / "settings.json").string();
+  const auto first = RunArcwheel(batch);
+  ASSERT_EQ(first.exit_status, 0) << first.output;
+  EXPECT_NE(first.output.find("2 done, 0 reused, 0 failed"), std::string::npos) << first.output;
+  EXPECT_EQ(ReadJson(dir / "out" / "wheel_a" / "summary.json")["input"]["sources"]["spindle_rpm"],
+            "settings");
+  const auto again = RunArcwheel(batch);
+  EXPECT_NE(again.output.find("0 done, 2 reused, 0 failed"), std::string::npos) << again.output;
+  std::string edited = testing::ReadText(dir / "settings.json");
+  const std::string simulated = "\"simulated\"";  // the wheel id the simulator writes
+  ASSERT_NE(edited.find(simulated), std::string::npos) << edited;
+  edited.replace(edited.find(simulated), simulated.size(), "\"edited\"");
+  WriteText(dir / "settings.json", edited);
+  const auto edited_run = RunArcwheel(batch);
+  EXPECT_NE(edited_run.output.find("2 done, 0 reused, 0 failed"), std::string::npos) << edited_run.output;
+  EXPECT_EQ(ReadJson(dir / "out" / "wheel_b" / "summary.json")["scan"]["wheel_id"], "edited");
+}
+
 // --- Refusals: the file, the line and the column (or the key) named; nothing written -------------
 
 struct Refusal {

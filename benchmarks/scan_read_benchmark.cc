@@ -46,8 +46,9 @@ const Files& FilesWith(long samples) {
   const double feed_mm_per_min = 22.0 / duration_s * 60.0;
   std::mt19937 rng(20261205);
   std::normal_distribution<double> noise(0.0, 0.3e-3);
-  std::string contract = fmt::format(
-      "# spindle_rpm: 500\n# feed_mm_per_min: {:.17g}\n# sample_period_s: {}\nz_mm,t_s\n", feed_mm_per_min, kPeriodS);
+  std::string contract =
+      fmt::format("# spindle_rpm: 500\n# feed_mm_per_min: {:.17g}\n# sample_period_s: {}\nz_mm,t_s\n",
+                  feed_mm_per_min, kPeriodS);
   std::string sensortool =
       "\xEF\xBB\xBFsensorTOOL;1.9.0\r\nSensor;ILD2300\r\nMeasuring rate;100 kHz\r\n"
       "Acquisition time;Epoch time (ms);Distance1 (mm)\r\n";

@@ -18,7 +18,8 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   options.settings = &settings;
   try {
     const arcwheel::acquisition::Scan scan = arcwheel::acquisition::ParseSensorScan(
-        std::string(reinterpret_cast<const char*>(data), size), "fuzz.csv", arcwheel::acquisition::ScanFormat::kKeyenceLk, options);
+        std::string(reinterpret_cast<const char*>(data), size), "fuzz.csv",
+        arcwheel::acquisition::ScanFormat::kKeyenceLk, options);
     if (scan.z_mm.empty()) __builtin_trap();  // ValidateScan refuses empty scans
   } catch (const arcwheel::Error&) {
   }

@@ -10,8 +10,8 @@
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   try {
-    (void)arcwheel::acquisition::ParseScanSettings(std::string_view(reinterpret_cast<const char*>(data), size),
-                                                   "settings.json");
+    (void)arcwheel::acquisition::ParseScanSettings(
+        std::string_view(reinterpret_cast<const char*>(data), size), "settings.json");
   } catch (const arcwheel::Error&) {
   }
   return 0;

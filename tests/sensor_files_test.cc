@@ -393,6 +393,29 @@ TEST(ScanSettings, BatchPassesThemToEveryScanAndAnEditedFileRunsThemAgain) {
   EXPECT_EQ(ReadJson(dir / "out" / "wheel_b" / "summary.json")["scan"]["wheel_id"], "edited");
 }
 
+// `regenerate` reads the scan as `process` does, and redoes the wheel when the settings change.
+TEST(ScanSettings, RegenerateReadsASensorsFileWithThem) {
+  TempDir dir;
+  const auto scan = dir / "dressed.csv";
+  ASSERT_EQ(RunArcwheel("simulate " + scan.string() + " --as sensortool --feed-mm-per-min 400").exit_status,
+            0);
+  const std::string regenerate =
+      "regenerate --scan " + scan.string() + " --scan-settings " + scan.string() + ".settings.json --job " +
+      (testing::SourceDir() / "grinding" / "examples" / "trial_part.json").string() + " -o " +
+      (dir / "out").string();
+  const auto run = RunArcwheel(regenerate);
+  ASSERT_EQ(run.exit_status, 0) << run.output;
+  const auto s = ReadJson(dir / "out" / "wheel" / "summary.json");
+  EXPECT_EQ(s["input"]["format"], "sensortool");
+  EXPECT_EQ(s["input"]["sources"]["spindle_rpm"], "settings");
+  EXPECT_NE(RunArcwheel(regenerate).output.find("step 1/4 wheel: inputs unchanged"), std::string::npos);
+  WriteText(scan.string() + ".settings.json",
+            R"({"spindle_rpm": 500, "feed_mm_per_min": 400, "start_y_mm": -11})");
+  const auto again = RunArcwheel(regenerate);
+  ASSERT_EQ(again.exit_status, 0) << again.output;
+  EXPECT_EQ(again.output.find("step 1/4 wheel: inputs unchanged"), std::string::npos) << again.output;
+}
+
 // --- Refusals: the file, the line and the column (or the key) named; nothing written -------------
 
 struct Refusal {

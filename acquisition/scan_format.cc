@@ -134,8 +134,12 @@ ScanFormat ScanFormatOfFile(const std::filesystem::path& path, std::string_view 
 
 std::string ScanExtensionsText() {
   std::vector<std::string_view> all;
-  for (const ScanFormatInfo& info : kFormats)
-    all.insert(all.end(), info.extensions.begin(), info.extensions.end());
+  // The sensors' layouts share the contract CSV's extensions: each extension once.
+  for (const ScanFormatInfo& info : kFormats) {
+    for (const std::string_view extension : info.extensions) {
+      if (std::find(all.begin(), all.end(), extension) == all.end()) all.push_back(extension);
+    }
+  }
   std::string text;
   for (size_t i = 0; i < all.size(); ++i) {
     if (i > 0) text += i + 1 == all.size() ? " or " : ", ";

@@ -52,17 +52,19 @@ TEST(SniffScanFormat, TellsEachLayoutFromItsFirstLines) {
 }
 
 TEST(IsKeyenceLkValue, TakesASignAndSevenCharactersAndTheMarkers) {
-  for (const char* value : {"+01.2345", "-00.0120", "+1234.56", "-00001.2", "+FFFFFFF", "-FFFFFFF", "XXXXXXXX",
-                            "-------", "--------"}) {
+  for (const char* value : {"+01.2345", "-00.0120", "+1234.56", "-00001.2", "+FFFFFFF", "-FFFFFFF",
+                            "XXXXXXXX", "-------", "--------"}) {
     EXPECT_TRUE(IsKeyenceLkValue(value)) << value;
   }
-  for (const char* value : {"1.2345", "+1.2345", "+01.23456", "+0.1.234", "+FFFFFF", "XXXXXXX", "+ABCDEFG", ""}) {
+  for (const char* value :
+       {"1.2345", "+1.2345", "+01.23456", "+0.1.234", "+FFFFFF", "XXXXXXX", "+ABCDEFG", ""}) {
     EXPECT_FALSE(IsKeyenceLkValue(value)) << value;
   }
 }
 
 TEST(SensorToolReader, ReadsADecimalCommaAsExactlyThePointsNumber) {
-  std::string text = "sensorTOOL;1.9.0\r\nSensor;ILD2300\r\nMeasuring rate;1 kHz\r\nAcquisition time;Distance1 (mm)\r\n";
+  std::string text =
+      "sensorTOOL;1.9.0\r\nSensor;ILD2300\r\nMeasuring rate;1 kHz\r\nAcquisition time;Distance1 (mm)\r\n";
   std::vector<std::string> written;
   for (int i = 0; i < 400; ++i) {
     written.push_back(fmt::format("{:.6f}", 0.123456789 * std::sin(i * 0.37)));
@@ -91,12 +93,14 @@ TEST(SensorToolReader, DropsAnEpochTimeThatResolvesLessThanTheSampling) {
   std::string text = "sensorTOOL\r\nMeasuring rate;2 kHz\r\nEpoch time (ms);Distance1 (mm)\r\n";
   for (int i = 0; i < 800; ++i) text += fmt::format("{};0,5\r\n", 1505296800000 + i / 2);
   ReadOptions options;  // the file gives the period: no settings file needed but for the speed
-  const ScanSettingsFile settings = ParseScanSettings(R"({"spindle_rpm": 500, "feed_mm_per_min": 100})", "s.json");
+  const ScanSettingsFile settings =
+      ParseScanSettings(R"({"spindle_rpm": 500, "feed_mm_per_min": 100})", "s.json");
   options.settings = &settings;
   const Scan scan = ParseSensorScan(text, "export.csv", ScanFormat::kSensorTool, options);
   EXPECT_FALSE(scan.has_time());
   EXPECT_EQ(scan.metadata.sample_period_s, 0.0005);
-  EXPECT_THAT(scan.metadata.notes, ::testing::Contains(HasSubstr("column 'Epoch time (ms)' repeats a time 400 times")));
+  EXPECT_THAT(scan.metadata.notes,
+              ::testing::Contains(HasSubstr("column 'Epoch time (ms)' repeats a time 400 times")));
 }
 
 TEST(KeyenceLkReader, CountsEveryMarkerByKindInTheOrderMet) {

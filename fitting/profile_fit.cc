@@ -1,0 +1,110 @@
+#include "fitting/profile_fit.h"
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <vector>
+
+namespace arcwheel::fitting {
+namespace {
+
+// Longest lag of the autocorrelation sum, in section points.
+constexpr int kMaxLags = 200;
+
+// Each usable phase's residuals against its circle in the band, by point, NaN outside it.
+std::vector<std::vector<double>> BandResiduals(const processing::WheelMap& map, const WheelFit& fit) {
+  std::vector<std::vector<double>> residuals(map.n_phase());
+  for (std::size_t j = 0; j < map.n_phase(); ++j) {
+    const PhaseFit& f = fit.phases[j];
+    if (!f.usable) continue;
+    const processing::Section& s = map.sections[j];
+    residuals[j].assign(s.y_mm.size(), std::nan(""));
+    for (std::size_t k = 0; k < s.y_mm.size(); ++k) {
+      if (s.y_mm[k] < fit.band_low_mm || s.y_mm[k] > fit.band_high_mm) continue;
+      residuals[j][k] =
+          std::hypot(s.y_mm[k] - f.center_axial_mm, s.rho_mm[k] - f.center_radial_mm) - f.arc_radius_mm;
+    }
+  }
+  return residuals;
+}
+
+// Takes out the mean residual at each axial position (bins of the median point spacing): the
+// profile every phase shares.
+void RemoveSharedProfile(const processing::WheelMap& map, std::vector<std::vector<double>>& residuals) {
+  std::vector<double> spacing;
+  for (std::size_t j = 0; j < map.n_phase() && spacing.size() < 4096; ++j) {
+    const auto& y = map.sections[j].y_mm;
+    for (std::size_t k = 1; k < y.size(); ++k) spacing.push_back(y[k] - y[k - 1]);
+  }
+  std::nth_element(spacing.begin(), spacing.begin() + static_cast<long>(spacing.size() / 2), spacing.end());
+  const double bin =
+      spacing.empty() || !(spacing[spacing.size() / 2] > 0) ? 1.0 : spacing[spacing.size() / 2];
+  std::map<long, std::pair<double, int>> profile;
+  const auto key = [&](double y) { return std::lround(y / bin); };
+  for (std::size_t j = 0; j < residuals.size(); ++j) {
+    for (std::size_t k = 0; k < residuals[j].size(); ++k) {
+      if (!std::isfinite(residuals[j][k])) continue;
+      auto& [sum, count] = profile[key(map.sections[j].y_mm[k])];
+      sum += residuals[j][k];
+      ++count;
+    }
+  }
+  for (std::size_t j = 0; j < residuals.size(); ++j) {
+    for (std::size_t k = 0; k < residuals[j].size(); ++k) {
+      if (!std::isfinite(residuals[j][k])) continue;
+      const auto& [sum, count] = profile[key(map.sections[j].y_mm[k])];
+      residuals[j][k] -= sum / count;
+    }
+  }
+}
+
+ProfileResiduals Spread(const std::vector<std::vector<double>>& residuals) {
+  ProfileResiduals out;
+  double ss = 0.0, n = 0.0;
+  for (const auto& r : residuals) {
+    for (const double e : r) {
+      if (!std::isfinite(e)) continue;
+      ss += e * e;
+      n += 1.0;
+    }
+  }
+  out.sigma_mm = n > 0 ? std::sqrt(ss / n) : 0.0;
+  if (!(ss > 0)) return out;
+  double sum = 0.0;
+  for (int lag = 1; lag <= kMaxLags; ++lag) {
+    double products = 0.0, pairs = 0.0;
+    for (const auto& r : residuals) {
+      for (std::size_t k = static_cast<std::size_t>(lag); k < r.size(); ++k) {
+        if (!std::isfinite(r[k]) || !std::isfinite(r[k - static_cast<std::size_t>(lag)])) continue;
+        products += r[k] * r[k - static_cast<std::size_t>(lag)];
+        pairs += 1.0;
+      }
+    }
+    const double rho = pairs > 0 ? (products / pairs) / (ss / n) : 0.0;
+    if (!(rho > 0.0)) break;
+    sum += rho;
+    out.correlation_lags = lag;
+  }
+  out.correlation_factor = 1.0 + 2.0 * sum;
+  out.point_sigma_mm = out.sigma_mm * std::sqrt(out.correlation_factor);
+  return out;
+}
+
+}  // namespace
+
+WheelFit FitProfileWheel(processing::WheelMap& map, const WheelFitOptions& options,
+                         ProfileResiduals* residuals) {
+  const WheelFit first = FitWheel(map, options);
+  std::vector<std::vector<double>> e = BandResiduals(map, first);
+  RemoveSharedProfile(map, e);
+  const ProfileResiduals spread = Spread(e);
+  if (residuals != nullptr) *residuals = spread;
+  if (!(spread.point_sigma_mm > 0)) return first;
+  for (processing::Section& section : map.sections) {
+    std::fill(section.sigma_mm.begin(), section.sigma_mm.end(), spread.point_sigma_mm);
+  }
+  map.map_sigma_mm = spread.point_sigma_mm;
+  return FitWheel(map, options);
+}
+
+}  // namespace arcwheel::fitting

@@ -358,3 +358,19 @@ ProcessPipelineResult RunProcessPipeline(acquisition::Scan scan, std::string inp
 }
 
 }  // namespace arcwheel::workflows
+
+namespace arcwheel::workflows {
+
+ProcessPipelineResult RunProcessPipeline(acquisition::ProfileScan scan, std::string input_sha256,
+                                         const std::filesystem::path& outdir, ProcessPipelineOptions options,
+                                         Progress& progress) {
+  ResolveProcessPipelineOptions(options);
+  acquisition::ValidateProfileScan(scan);
+  std::promise<std::string> known;
+  known.set_value(std::move(input_sha256));
+  const std::string scan_path = scan.path;
+  return RunOnProfileScan(std::move(scan), scan_path, known.get_future(), outdir, options, progress,
+                          StageClock{});
+}
+
+}  // namespace arcwheel::workflows

@@ -90,21 +90,45 @@ ProfileResiduals Spread(const std::vector<std::vector<double>>& residuals) {
   return out;
 }
 
+// Every sigma of `fit` from points of sigma s0, for points of sigma s0 * scale: the covariances
+// are s^2 S S^T (wheel_fit.cc), so the phases' sigmas scale by `scale` and chi-square by its
+// inverse square; the means' sigmas (independent phases) scale as the phases'.
+void ScaleSigmas(double scale, WheelFit& fit) {
+  for (PhaseFit& phase : fit.phases) {
+    phase.arc_radius_sigma_mm *= scale;
+    phase.center_axial_sigma_mm *= scale;
+    phase.center_radial_sigma_mm *= scale;
+    phase.chi2_per_dof /= scale * scale;
+  }
+  const std::vector<std::string> warnings = fit.warnings;
+  SummariseUsablePhases(fit);
+  fit.warnings = warnings;
+  fit.mean_arc_radius_sigma_mm *= scale;
+  fit.mean_center_axial_sigma_mm *= scale;
+}
+
 }  // namespace
 
 WheelFit FitProfileWheel(processing::WheelMap& map, const WheelFitOptions& options,
                          ProfileResiduals* residuals) {
-  const WheelFit first = FitWheel(map, options);
-  std::vector<std::vector<double>> e = BandResiduals(map, first);
+  // The circles are unweighted (formats.md 3.1): the points' sigmas only scale the covariances, so
+  // one fit with a common sigma, rescaled, is the fit with the residuals' sigma.
+  const double provisional = map.noise_sigma_mm > 0 ? map.noise_sigma_mm : 1e-3;
+  for (processing::Section& section : map.sections) {
+    std::fill(section.sigma_mm.begin(), section.sigma_mm.end(), provisional);
+  }
+  WheelFit fit = FitWheel(map, options);
+  std::vector<std::vector<double>> e = BandResiduals(map, fit);
   RemoveSharedProfile(map, e);
   const ProfileResiduals spread = Spread(e);
   if (residuals != nullptr) *residuals = spread;
-  if (!(spread.point_sigma_mm > 0)) return first;
+  if (!(spread.point_sigma_mm > 0)) return fit;
   for (processing::Section& section : map.sections) {
     std::fill(section.sigma_mm.begin(), section.sigma_mm.end(), spread.point_sigma_mm);
   }
   map.map_sigma_mm = spread.point_sigma_mm;
-  return FitWheel(map, options);
+  ScaleSigmas(spread.point_sigma_mm / provisional, fit);
+  return fit;
 }
 
 }  // namespace arcwheel::fitting

@@ -7,7 +7,9 @@
 #include <charconv>
 #include <cmath>
 #include <fstream>
+#include <functional>
 #include <limits>
+#include <span>
 #include <sstream>
 
 #include "acquisition/profile_scan.h"
@@ -315,7 +317,10 @@ std::string ReadWholeFile(const std::filesystem::path& path, const std::string& 
 
 // The contract's layout: /profile/z [frames, points], /profile/x_mm [points] (or [frames, points],
 // every row the same), optional /profile/t and /profile/encoder [frames]; attributes on /profile.
-ProfileScan ReadProfileHdf5(const std::filesystem::path& path) {
+// `z_into` gives the room for /profile/z's values (the child's shared pages), or is null to leave
+// them to the caller (the parent, which takes what the child read).
+ProfileScan ReadProfileHdf5(const std::filesystem::path& path,
+                            const std::function<std::span<double>(std::size_t)>& z_into) {
   const std::string stage = StageOf(ScanFormat::kProfileHdf5);
   const hdf5::File file = hdf5::File::OpenReadOnly(path);
   ProfileScan scan;
@@ -328,7 +333,7 @@ ProfileScan ReadProfileHdf5(const std::filesystem::path& path) {
     refuse("no /profile/z and /profile/x_mm");
   const std::vector<hsize_t> shape = file.Shape("/profile/z");
   if (shape.size() != 2) refuse("/profile/z must be [frames, points]");
-  scan.z_mm = file.ReadDoubles("/profile/z");
+  if (z_into) file.ReadInto("/profile/z", z_into(file.NumericCount("/profile/z", sizeof(double))));
   const std::vector<hsize_t> x_shape = file.Shape("/profile/x_mm");
   const std::vector<double> x = file.ReadDoubles("/profile/x_mm");
   const std::size_t points = shape[1];
@@ -356,11 +361,6 @@ ProfileScan ReadProfileHdf5(const std::filesystem::path& path) {
       if (const auto value = file.ReadAttributeDouble("/profile", name)) setter.SetNumber(key, *value);
     } else if (const auto text = file.ReadAttributeString("/profile", name)) {
       setter.SetText(key, *text);
-    }
-  }
-  if (scan.metadata.invalid_value) {
-    for (double& z : scan.z_mm) {
-      if (z == *scan.metadata.invalid_value) z = kNaN;
     }
   }
   if (!scan.t_s.empty()) {
@@ -456,8 +456,24 @@ ProfileScan ReadProfileScan(const std::filesystem::path& path, ScanFormat format
   if (format != ScanFormat::kProfileHdf5) {
     return ParseProfileScan(ReadWholeFile(path, StageOf(format)), path.string(), format, settings);
   }
-  hdf5::ReadFirstInChildProcess(path, [&] { (void)ReadProfileHdf5(path); });
-  ProfileScan scan = ReadProfileHdf5(path);
+  // The readings are read once, in the child process that guards against libhdf5 crashing on a
+  // damaged file (core/hdf5.h); here only the header and the small columns are read again.
+  hdf5::SharedArrays arrays;
+  const bool handed = hdf5::ReadInChildProcess(path, arrays, [&](hdf5::SharedArrays& shared) {
+    (void)ReadProfileHdf5(path,
+                          [&](std::size_t count) { return shared.Allocate<double>("/profile/z", count); });
+  });
+  ProfileScan scan = ReadProfileHdf5(path, nullptr);
+  if (std::optional<std::vector<double>> z = handed ? arrays.Take<double>("/profile/z") : std::nullopt) {
+    scan.z_mm = std::move(*z);
+  } else {
+    scan.z_mm = hdf5::File::OpenReadOnly(path).ReadDoubles("/profile/z");
+  }
+  if (scan.metadata.invalid_value) {
+    for (double& z_mm : scan.z_mm) {
+      if (z_mm == *scan.metadata.invalid_value) z_mm = kNaN;
+    }
+  }
   ApplyProfileSettings(settings, scan);
   if (!scan.encoder.empty()) UnwrapEncoder(scan, StageOf(format));
   ValidateProfileScan(scan);

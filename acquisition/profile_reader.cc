@@ -161,7 +161,7 @@ class ProfileTextParser {
       double mode = 0.0;
       if (!ParseDouble(cells[i], mode))
         Refuse(fmt::format("column 'Trigger Mode': '{}' is not a number", cells[i]));
-      trigger_mode_ = static_cast<int>(mode);
+      trigger_mode_ = mode == 1.0 ? 1 : 0;  // 1: encoder; any other: the time says the phase
     }
     SkipSection();
   }

@@ -306,15 +306,6 @@ class ProfileTextParser {
   std::vector<double> frame_numbers_;
 };
 
-std::string ReadWholeFile(const std::filesystem::path& path, const std::string& stage) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw Error(ErrorCode::kIo, stage, "cannot open '" + path.string() + "'");
-  std::ostringstream buffer;
-  buffer << in.rdbuf();
-  if (in.bad()) throw Error(ErrorCode::kIo, stage, "cannot read '" + path.string() + "'");
-  return std::move(buffer).str();
-}
-
 // The contract's layout: /profile/z [frames, points], /profile/x_mm [points] (or [frames, points],
 // every row the same), optional /profile/t and /profile/encoder [frames]; attributes on /profile.
 // `z_into` gives the room for /profile/z's values (the child's shared pages), or is null to leave
@@ -419,8 +410,9 @@ bool IsProfileFormat(ScanFormat format) {
          format == ScanFormat::kKeyenceLj;
 }
 
-std::optional<ScanFormat> ProfileFormatOf(const std::filesystem::path& path, std::string_view forced) {
-  const ScanFormat format = ScanFormatOfContent(path, forced, false, "acquisition");
+std::optional<ScanFormat> ProfileFormatOf(const std::filesystem::path& path, std::string_view forced,
+                                          bool has_column_map) {
+  const ScanFormat format = ScanFormatOfContent(path, forced, has_column_map, "acquisition");
   if (IsProfileFormat(format)) return format;
   if (format != ScanFormat::kHdf5 || !forced.empty()) return std::nullopt;
   // Read first in a child process, as every HDF5 file a user gives (core/hdf5.h).

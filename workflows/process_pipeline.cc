@@ -319,7 +319,8 @@ ProcessPipelineResult RunProcessPipeline(const std::string& scan_path, const std
   // the child reads (this process only waits for it then).
   StageClock clock;
   clock.Start("reading");
-  if (const auto profile = acquisition::ProfileFormatOf(scan_path, options.scan_format)) {
+  if (const auto profile =
+          acquisition::ProfileFormatOf(scan_path, options.scan_format, !options.columns.empty())) {
     acquisition::ProfileScan scan = acquisition::ReadProfileScan(
         scan_path, *profile, options.scan_settings ? &*options.scan_settings : nullptr);
     std::future<std::string> hash =

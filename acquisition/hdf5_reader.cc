@@ -220,6 +220,12 @@ Scan ReadScan(const std::filesystem::path& path, const ReadOptions& options) {
       return ReadSensorScan(path, format, options);
     case ScanFormat::kHdf5:
       break;
+    case ScanFormat::kProfileHdf5:
+    case ScanFormat::kGocator:
+    case ScanFormat::kKeyenceLj:
+      throw Error(ErrorCode::kBadInput, "acquisition",
+                  "'" + path.string() + "' is a line-profile scan (" + std::string(InfoOf(format).name) +
+                      "): read it with ReadProfileScan (acquisition/profile_scan.h)");
   }
   ARCWHEEL_CHECK(false) << "scan format without a reader";
   return {};

@@ -81,14 +81,35 @@ bool SniffKeyenceLk(std::string_view head) {
   return false;
 }
 
-constexpr std::array<ScanFormatInfo, 5> kFormats = {{
+// An LMI Gocator CSV export: its first section is `Info`, whose header row starts `CSV Version`.
+bool SniffGocator(std::string_view head) {
+  const std::vector<std::string_view> lines = HeadLines(head, 4);
+  return lines.size() >= 2 && TrimBlanks(lines[0]) == "Info" &&
+         AsciiLowerCopy(lines[1]).starts_with("csv version");
+}
+
+// A Keyence LJ-V/LJ-X save: tab-separated rows of numbers, the first of them the X block.
+bool SniffKeyenceLj(std::string_view head) {
+  const std::vector<std::string_view> lines = HeadLines(head, 1);
+  if (lines.empty() || std::count(lines[0].begin(), lines[0].end(), '\t') < 7) return false;
+  return std::all_of(lines[0].begin(), lines[0].end(), [](char c) {
+    return c == '\t' || c == '-' || c == '+' || c == '.' || (c >= '0' && c <= '9');
+  });
+}
+
+constexpr std::array<ScanFormatInfo, 8> kFormats = {{
     {ScanFormat::kHdf5, "hdf5", kHdf5Extensions, nullptr, ""},
     {ScanFormat::kCsv, "csv", kTextExtensions, SniffCsv, "'# key: value' lines or a z_mm column"},
     {ScanFormat::kSensorTool, "sensortool", kTextExtensions, SniffSensorTool,
      "a 'sensorTOOL' line or a column row starting 'Acquisition time' or 'Epoch time (ms)'"},
+    {ScanFormat::kGocator, "gocator", kTextExtensions, SniffGocator,
+     "a first section 'Info' whose header row starts 'CSV Version'"},
+    {ScanFormat::kKeyenceLj, "keyence-lj", kTextExtensions, SniffKeyenceLj,
+     "a first row of at least 8 tab-separated numbers (the X block)"},
     {ScanFormat::kKeyenceLk, "keyence-lk", kTextExtensions, SniffKeyenceLk,
      "an 'LK-Navigator' line or fixed-width values such as +01.2345 or -FFFFFFF"},
     {ScanFormat::kColumns, "columns", kTextExtensions, nullptr, ""},
+    {ScanFormat::kProfileHdf5, "profile-hdf5", kHdf5Extensions, nullptr, ""},
 }};
 
 std::string LowerExtension(const std::filesystem::path& path) {

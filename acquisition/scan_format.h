@@ -15,7 +15,8 @@
 namespace arcwheel::acquisition {
 
 // The contract's layouts (formats.md 2.1, 2.2) and the sensors' own files (formats.md 2.4).
-enum class ScanFormat { kHdf5, kCsv, kSensorTool, kKeyenceLk, kColumns };
+// kProfileHdf5, kGocator and kKeyenceLj are line-profile layouts (acquisition/profile_scan.h).
+enum class ScanFormat { kHdf5, kCsv, kSensorTool, kKeyenceLk, kColumns, kProfileHdf5, kGocator, kKeyenceLj };
 
 struct ScanFormatInfo {
   ScanFormat format;

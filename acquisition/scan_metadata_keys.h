@@ -1,6 +1,7 @@
 #pragma once
 // Shared by the readers: metadata keys by name, and folding invalid markers into NaN.
 
+#include <filesystem>
 #include <set>
 #include <string>
 #include <string_view>
@@ -53,5 +54,9 @@ void ApplyInvalidMarkers(Scan& scan, SentinelComparison comparison);
 // The readers' last step: merges the settings from outside the file (options.settings,
 // scan_settings.h), then ValidateScan.
 void FinishScan(Scan& scan, const ReadOptions& options);
+
+// The whole file as text, for the readers of text layouts; Error{kIo, stage} naming it when it
+// cannot be read.
+[[nodiscard]] std::string ReadWholeFile(const std::filesystem::path& path, const std::string& stage);
 
 }  // namespace arcwheel::acquisition

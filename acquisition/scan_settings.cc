@@ -18,9 +18,18 @@ namespace {
 constexpr const char* kStage = "acquisition.settings";
 // Beside formats.md 2.1's keys: the encoder's counts per turn, for an angle column in counts.
 constexpr const char* kEncoderCountsPerRev = "encoder_counts_per_rev";
+// A line-profile sensor's calibrated placement (profile_scan.h, ProfilePlacement).
+constexpr const char* kProfileKeys[] = {"sensor_tilt_deg", "sensor_tilt_u_deg", "sensor_axial_offset_mm",
+                                        "sensor_axial_offset_u_mm"};
+
+bool IsOutsideMetadata(std::string_view key) {
+  return key == kEncoderCountsPerRev ||
+         std::find_if(std::begin(kProfileKeys), std::end(kProfileKeys),
+                      [&](const char* k) { return key == k; }) != std::end(kProfileKeys);
+}
 
 bool IsNumericKey(std::string_view key) {
-  return key == kEncoderCountsPerRev ||
+  return IsOutsideMetadata(key) ||
          std::find_if(std::begin(kNumericMetadataKeys), std::end(kNumericMetadataKeys),
                       [&](const char* k) { return key == k; }) != std::end(kNumericMetadataKeys);
 }
@@ -69,6 +78,7 @@ std::string ScanSettingsKeysText() {
   std::string text;
   for (const char* key : kNumericMetadataKeys) text += std::string(text.empty() ? "" : ", ") + key;
   text += std::string(", ") + kEncoderCountsPerRev;
+  for (const char* key : kProfileKeys) text += std::string(", ") + key;
   for (const char* key : kTextMetadataKeys) text += std::string(", ") + key;
   return text;
 }
@@ -132,7 +142,7 @@ void ApplyScanSettings(const ScanSettingsFile* settings, Scan& scan) {
     scan.read.settings_path = settings->path;
     MetadataSetter setter(m);
     for (const auto& [key, value] : settings->numbers) {
-      if (key == kEncoderCountsPerRev) {
+      if (IsOutsideMetadata(key)) {
         sources.emplace_back(key, "settings");
         continue;
       }
@@ -180,6 +190,7 @@ void ApplyScanSettings(const ScanSettingsFile* settings, Scan& scan) {
   };
   for (const char* key : kNumericMetadataKeys) record(key);
   record(kEncoderCountsPerRev);
+  for (const char* key : kProfileKeys) record(key);
   for (const char* key : kTextMetadataKeys) record(key);
 }
 

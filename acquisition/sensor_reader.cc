@@ -703,6 +703,8 @@ class SensorParser {
   std::string unused_keys_;
 };
 
+}  // namespace
+
 std::string ReadWholeFile(const std::filesystem::path& path, const std::string& stage) {
   std::ifstream in(path, std::ios::binary);
   if (!in) throw Error(ErrorCode::kIo, stage, "cannot open '" + path.string() + "'");
@@ -711,8 +713,6 @@ std::string ReadWholeFile(const std::filesystem::path& path, const std::string& 
   if (in.bad()) throw Error(ErrorCode::kIo, stage, "cannot read '" + path.string() + "'");
   return std::move(buffer).str();
 }
-
-}  // namespace
 
 std::vector<std::string> ColumnsOptionProblems(std::string_view columns) {
   std::vector<std::string> problems;

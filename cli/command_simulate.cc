@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "acquisition/profile_scan.h"
 #include "acquisition/scan_format.h"
 #include "acquisition/sensor_writer.h"
 #include "acquisition/simulate.h"
@@ -26,6 +27,7 @@ struct SimulateArgs {
   int truth_phases = 360;
   std::string as;             // a sensor's layout (sensortool, keyence-lk); empty: by the extension
   std::string settings_file;  // the settings file beside a sensor's layout
+  acquisition::ProfileScanSettings profile;  // with --as gocator, keyence-lj or profile-hdf5
 };
 
 // "ORDER:AMPLITUDE[:PHASE_DEG]"
@@ -44,6 +46,30 @@ std::vector<acquisition::Harmonic> ParseHarmonics(const std::vector<std::string>
   return harmonics;
 }
 
+// A line-profile scan of the same wheel: the layout, its settings file and the truth.
+void RunProfile(SimulateArgs& args, acquisition::ScanFormat format) {
+  acquisition::ProfileScanSettings& p = args.profile;
+  p.spindle_rpm = args.settings.spindle_rpm_nominal;
+  p.start_phase_deg = args.settings.start_phase_deg;
+  p.sensor_zero_radius_mm = args.settings.sensor_zero_radius_mm;
+  p.radius_sign = args.settings.radius_sign;
+  p.noise_um = args.settings.noise_um;
+  p.seed = args.settings.seed;
+  p.wheel_id = args.settings.wheel_id;
+  p.timestamp = args.settings.timestamp;
+  const acquisition::ProfileScan scan = acquisition::SimulateProfileScan(args.wheel, p);
+  acquisition::WriteProfileScan(scan, format, args.output);
+  const std::string settings_path =
+      args.settings_file.empty() ? args.output + ".settings.json" : args.settings_file;
+  WriteFileAtomically(settings_path, acquisition::ProfileScanSettingsJson(scan));
+  const std::string truth_path = args.truth.empty() ? args.output + ".truth.json" : args.truth;
+  const acquisition::SimulationCounts counts{.samples = scan.z_mm.size()};
+  WriteFileAtomically(truth_path,
+                      acquisition::TruthJson(args.wheel, args.settings, counts, args.truth_phases));
+  fmt::print("scan:  {} ({} frames of {} points)\ntruth: {}\nsettings: {}\n", args.output, scan.frames(),
+             scan.points(), truth_path, settings_path);
+}
+
 void Run(SimulateArgs& args) {
   args.wheel.arc_radius_harmonics_mm = ParseHarmonics(args.radius_harmonics, "--radius-harmonic");
   args.wheel.center_axial_harmonics_mm = ParseHarmonics(args.axial_harmonics, "--axial-harmonic");
@@ -52,6 +78,10 @@ void Run(SimulateArgs& args) {
     args.settings.sensor_zero_radius_mm = args.wheel.wheel_diameter_mm / 2.0 - 0.5;
   }
   args.settings.float32 = !args.float64;
+  if (!args.as.empty()) {
+    const acquisition::ScanFormat format = acquisition::ScanFormatNamed(args.as, "simulate");
+    if (acquisition::IsProfileFormat(format)) return RunProfile(args, format);
+  }
   const acquisition::SimulatedScan simulated = acquisition::SimulateScan(args.wheel, args.settings);
   const std::filesystem::path output(args.output);
   std::string settings_path;
@@ -84,10 +114,34 @@ void AddSimulateCommand(CLI::App& app) {
       "100 mm/min, 100 us (about 1.3e5 samples).");
   cmd->add_option("OUTPUT", args->output, "scan file to write (.h5/.hdf5 or .csv/.txt)")->required();
   cmd->add_option("--truth", args->truth, "truth JSON path");
-  cmd->add_option("--as", args->as,
-                  "write what the sensor's software would, with the settings it lacks beside it: sensortool "
-                  "(Micro-Epsilon CSV, decimal comma) or keyence-lk (LK-Navigator CSV)")
-      ->check(CLI::IsMember({"sensortool", "keyence-lk"}));
+  cmd->add_option(
+         "--as", args->as,
+         "write what the sensor's software would, with the settings it lacks beside it: sensortool "
+         "(Micro-Epsilon CSV, decimal comma) or keyence-lk (LK-Navigator CSV); or a line-profile scan: "
+         "gocator (LMI CSV export), keyence-lj (LJ-V/LJ-X save) or profile-hdf5")
+      ->check(CLI::IsMember({"sensortool", "keyence-lk", "gocator", "keyence-lj", "profile-hdf5"}));
+  auto& p = args->profile;
+  cmd->add_option("--points", p.points, "line profile: points per frame")->capture_default_str();
+  cmd->add_option("--frames-per-turn", p.frames_per_turn, "line profile: frames per turn")
+      ->capture_default_str();
+  cmd->add_option("--turns", p.turns, "line profile: turns scanned")->capture_default_str();
+  cmd->add_option("--encoder-counts-per-rev", p.encoder_counts_per_rev,
+                  "line profile: encoder counts per turn")
+      ->capture_default_str();
+  cmd->add_option("--sensor-tilt-deg", p.placement.tilt_deg,
+                  "line profile: the sensor's tilt to the wheel axis")
+      ->capture_default_str();
+  cmd->add_option("--sensor-tilt-u-deg", p.placement.tilt_u_deg,
+                  "line profile: its calibration's uncertainty")
+      ->capture_default_str();
+  cmd->add_option("--sensor-axial-offset-mm", p.placement.axial_offset_mm,
+                  "line profile: axial position of the sensor's X = 0")
+      ->capture_default_str();
+  cmd->add_option("--sensor-axial-offset-u-mm", p.placement.axial_offset_u_mm,
+                  "line profile: its calibration's uncertainty")
+      ->capture_default_str();
+  cmd->add_option("--point-dropout-rate", p.dropout_rate, "line profile: fraction of points invalid")
+      ->capture_default_str();
   cmd->add_option("--settings", args->settings_file,
                   "with --as: settings JSON path (default OUTPUT.settings.json)");
   auto& w = args->wheel;

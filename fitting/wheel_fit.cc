@@ -113,10 +113,21 @@ PhaseSolution FitSection(const processing::Section& section, double center_mm, d
 
 // Variance of the mean of parameter `row` (kAxialRow, kRadiusRow) over the usable phases,
 // exactly through the helix spline (neighbouring phases share spline coefficients, so their
-// errors correlate).
+// errors correlate); for a map without one, from the phases' own sigmas.
 double SigmaOfMean(const std::vector<PhaseSolution>& solutions, int row, const processing::WheelMap& map) {
   int usable = 0;
   for (const auto& s : solutions) usable += s.fit.usable ? 1 : 0;
+  if (!map.spline) {
+    // Sections of their own samples (a line-profile scan's frames): the phases' errors are
+    // independent, so the mean's variance is the sum of theirs over n^2.
+    double variance = 0.0;
+    for (const PhaseSolution& s : solutions) {
+      if (!s.fit.usable) continue;
+      const double sigma = row == kRadiusRow ? s.fit.arc_radius_sigma_mm : s.fit.center_axial_sigma_mm;
+      variance += sigma * sigma;
+    }
+    return usable > 0 ? std::sqrt(variance) / usable : 0.0;
+  }
   const double factor = map.spline->CovarianceFactorOfSum([&](const processing::HelixSpline::TermSink& add) {
     for (std::size_t j = 0; j < solutions.size(); ++j) {
       const PhaseSolution& s = solutions[j];

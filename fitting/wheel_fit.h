@@ -62,7 +62,9 @@ struct WheelFit {
 };
 
 // Throws Error{kFitFailed} when no phase gives a usable fit, kBadInput when the band lies
-// outside the scanned span.
+// outside the scanned span. A map without a helix spline (a line-profile scan's sections,
+// processing/profile_sections.h) has sections that share no samples: the sigmas of the means are
+// then the phases' own, combined as independent.
 [[nodiscard]] WheelFit FitWheel(const processing::WheelMap& map, const WheelFitOptions& options);
 
 // The headline figures over the usable phases of fit.phases (method.md A.6): their count, the

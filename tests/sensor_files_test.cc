@@ -9,6 +9,7 @@
 #include <filesystem>
 #include <fstream>
 #include <functional>
+#include <iterator>
 #include <map>
 #include <nlohmann/json.hpp>
 #include <string>
@@ -467,8 +468,13 @@ INSTANTIATE_TEST_SUITE_P(
             "AHeaderNoSniffClaims", "logger.txt", "Zeit;Weg\n0;1,5\n", kSettings, "", 3,
             "'{file}': its header is no format arcwheel knows; tried csv ('# key: value' lines or a z_mm "
             "column); sensortool (a 'sensorTOOL' line or a column row starting 'Acquisition time' or 'Epoch "
-            "time (ms)'); keyence-lk (an 'LK-Navigator' line or fixed-width values such as +01.2345 or "
-            "-FFFFFFF). Force a reader with --format NAME (hdf5, csv, sensortool, keyence-lk or columns)"},
+            "time (ms)'); gocator (a first section 'Info' whose header row starts 'CSV Version'); keyence-lj "
+            "(a "
+            "first row of at least 8 tab-separated numbers (the X block)); keyence-lk (an 'LK-Navigator' "
+            "line "
+            "or fixed-width values such as +01.2345 or -FFFFFFF). Force a reader with --format NAME (hdf5, "
+            "csv, "
+            "sensortool, gocator, keyence-lj, keyence-lk, columns or profile-hdf5)"},
         Refusal{"AMissingColumn", "logger.txt", "Messung 7\nZeit;Weg\n0;1,5\n", kSettings,
                 "--columns z=Abstand", 3,
                 "acquisition.columns: '{file}': no line names the columns 'Abstand' (--columns)"},
@@ -520,8 +526,43 @@ INSTANTIATE_TEST_SUITE_P(
                 "'{file}' line 1: column 'Winkel' holds encoder counts: give \"encoder_counts_per_rev\" in "
                 "--scan-settings"},
         Refusal{"AnUnknownFormatName", "export.csv", "never read\n", kSettings, "--format gocator-xyz", 2,
-                "--format = gocator-xyz violates hdf5, csv, sensortool, keyence-lk or columns"}),
+                "--format = gocator-xyz violates hdf5, csv, sensortool, gocator, keyence-lj, keyence-lk, "
+                "columns or "
+                "profile-hdf5"}),
     [](const ::testing::TestParamInfo<Refusal>& param_info) { return param_info.param.name; });
+
+// A line-profile scan as a user runs it: simulated as a Gocator export, processed with its settings
+// file; the same file with two frames swapped is refused naming the file, the line and the column,
+// exit 3, nothing written.
+TEST(ProfileScanCli, AGocatorExportIsProcessedAndOneWithFramesOutOfOrderRefused) {
+  TempDir dir;
+  const auto scan = dir / "gocator.csv";
+  const auto sim =
+      RunArcwheel("simulate " + scan.string() +
+                  " --as gocator --points 200 --frames-per-turn 100 --turns 2 --encoder-counts-per-rev 1000 "
+                  "--noise-um 1 --start-phase-deg 0.05");
+  ASSERT_EQ(sim.exit_status, 0) << sim.output;
+  const std::string settings = " --scan-settings " + scan.string() + ".settings.json --phases 50";
+  const auto run = RunArcwheel("process -q " + scan.string() + settings + " -o " + (dir / "out").string());
+  ASSERT_EQ(run.exit_status, 0) << run.output;
+  const auto s = ReadJson(dir / "out" / "summary.json");
+  EXPECT_EQ(s["input"]["format"], "gocator");
+  EXPECT_EQ(s["phases"]["phase_deg"].size(), 50u);
+  std::ifstream in(scan, std::ios::binary);
+  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const std::size_t frame1 = text.find("\r\n1,0,");
+  ASSERT_NE(frame1, std::string::npos);
+  text.replace(frame1 + 2, 1, "7");  // frame 7 before frame 2
+  const auto bad = dir / "bad.csv";
+  WriteText(bad, text);
+  const auto refused =
+      RunArcwheel("process -q " + bad.string() + settings + " -o " + (dir / "bad_out").string());
+  EXPECT_EQ(refused.exit_status, 3) << refused.output;
+  EXPECT_NE(refused.output.find("'" + bad.string() + "' line 15: column 'Frame': frame 2 after frame 7"),
+            std::string::npos)
+      << refused.output;
+  EXPECT_FALSE(std::filesystem::exists(dir / "bad_out"));
+}
 
 }  // namespace
 }  // namespace arcwheel

@@ -99,8 +99,10 @@ std::vector<ProcessOption> MakeTable() {
        "JSON of the scan's settings the file lacks: spindle_rpm, feed_mm_per_min, sample_period_s, "
        "start_y_mm, radius_sign, wheel_id, sensor, ... (formats.md 2.4)",
        "", [](Options& o) -> OptionRef { return &o.scan_settings_path; }, false, true},
-      {"--format", "the scan's reader: hdf5, csv, sensortool, keyence-lk or columns (default: sniffed)", "",
-       [](Options& o) -> OptionRef { return &o.scan_format; }, false},
+      {"--format",
+       "the scan's reader: hdf5, csv, sensortool, keyence-lk, columns; line profiles: gocator, keyence-lj, "
+       "profile-hdf5 (default: sniffed)",
+       "", [](Options& o) -> OptionRef { return &o.scan_format; }, false},
       {"--columns",
        "which column holds what, by header name and unit: z=NAME[:mm|um|nm],t=NAME[:s|ms|us],"
        "angle=NAME[:deg|counts],y=NAME[:mm]",

@@ -1,13 +1,16 @@
 #include "workflows/process_pipeline.h"
 
 #include <future>
+#include <limits>
 #include <nlohmann/json.hpp>
+#include <numbers>
 #include <span>
 #include <type_traits>
 #include <utility>
 #include <variant>
 #include <vector>
 
+#include "acquisition/profile_scan.h"
 #include "acquisition/scan_format.h"
 #include "acquisition/scan_reader.h"
 #include "core/check.h"
@@ -15,8 +18,10 @@
 #include "core/interrupt.h"
 #include "core/sha256.h"
 #include "core/text_encoding.h"
+#include "fitting/profile_fit.h"
 #include "fitting/sample_fit.h"
 #include "processing/helix_geometry.h"
+#include "processing/profile_sections.h"
 #include "schema/summary.h"
 #include "uncertainty/default_budget.h"
 #include "workflows/process_options.h"
@@ -81,11 +86,41 @@ std::optional<fitting::WheelModel> FitModelUnlessOff(const ProcessPipelineOption
   }
 }
 
-// The headline figures' uncertainty from the per-phase fits and the map.
+// A line-profile sensor's calibrated placement in the budget (docs/uncertainty.md). Tilt and
+// offset move every section rigidly, which leaves the arc radii, the arc errors, run-out and
+// roundness as they are; an error of the tilt moves each phase's arc centre along the axis by
+// its radial position times the angle, so the arc centre's axial deviation changes by the spread of
+// the centres' radial positions per radian. The offset moves every centre alike and changes none of
+// the budgeted figures: it is recorded with sensitivity 0.
+void AddPlacementInputs(const acquisition::ProfilePlacement& placement, const fitting::WheelFit& fit,
+                        uncertainty::BudgetFile& budget) {
+  double low = std::numeric_limits<double>::infinity(), high = -low;
+  for (const fitting::PhaseFit& phase : fit.phases) {
+    if (!phase.usable) continue;
+    low = std::min(low, phase.center_radial_mm);
+    high = std::max(high, phase.center_radial_mm);
+  }
+  const double per_deg = high > low ? (high - low) * std::numbers::pi / 180.0 : 0.0;
+  auto& inputs = budget.quantities[std::string(schema::summary::kCenterAxialDeviationMm)];
+  inputs.push_back({.input = {.name = "sensor_tilt",
+                              .source = "--scan-settings sensor_tilt_u_deg (calibration)",
+                              .unit = "deg",
+                              .spread = placement.tilt_u_deg,
+                              .sensitivity = per_deg}});
+  inputs.push_back({.input = {.name = "sensor_axial_offset",
+                              .source = "--scan-settings sensor_axial_offset_u_mm (calibration)",
+                              .unit = "mm",
+                              .spread = placement.axial_offset_u_mm,
+                              .sensitivity = 0.0}});
+}
+
+// The headline figures' uncertainty from the per-phase fits and the map; `placement`: a
+// line-profile sensor's, else null.
 uncertainty::WheelUncertainty EvaluateUncertainty(const ProcessPipelineOptions& options,
                                                   const acquisition::ScanMetadata& metadata,
                                                   const processing::ProcessedScan& processed,
-                                                  const fitting::WheelFit& fit) {
+                                                  const fitting::WheelFit& fit,
+                                                  const acquisition::ProfilePlacement* placement = nullptr) {
   const processing::WheelMap& map = processed.map;
   std::vector<double> radius, radius_sigma, axial, axial_sigma, radial;
   std::vector<char> usable;
@@ -121,19 +156,20 @@ uncertainty::WheelUncertainty EvaluateUncertainty(const ProcessPipelineOptions& 
       .section_residual_um = fit.section_residual_um,
       .section_y_mm = fit.section_y_mm,
       .section_sigma_um = fit.section_sigma_um};
-  uncertainty::WheelUncertainty result;
+  uncertainty::BudgetFile budget;
   if (options.uncertainty_budget) {
-    result =
-        uncertainty::EvaluateWheelUncertainty(observations, *options.uncertainty_budget, options.uncertainty);
-    result.budget_source = options.uncertainty_budget_path;
+    budget = *options.uncertainty_budget;
   } else {
     const double diameter = metadata.wheel_diameter_mm.value_or(400.0);
-    const uncertainty::BudgetFile budget = uncertainty::DefaultBudget(
+    budget = uncertainty::DefaultBudget(
         {.arc_radius_mm = fit.mean_arc_radius_mm,
          .band_half_width_mm = std::min(options.fit.band_half_width_mm, 0.9 * fit.mean_arc_radius_mm),
          .wheel_radius_mm = diameter / 2.0});
-    result = uncertainty::EvaluateWheelUncertainty(observations, budget, options.uncertainty);
   }
+  if (placement != nullptr) AddPlacementInputs(*placement, fit, budget);
+  uncertainty::WheelUncertainty result =
+      uncertainty::EvaluateWheelUncertainty(observations, budget, options.uncertainty);
+  if (options.uncertainty_budget) result.budget_source = options.uncertainty_budget_path;
   return result;
 }
 
@@ -144,6 +180,24 @@ void DecideTolerances(const reports::Tolerances& tolerances, uncertainty::WheelU
     specifications[key] = {.min = limit.min, .max = limit.max};
   uncertainty::DecideConformity(uncertainty, specifications,
                                 tolerances.rule.value_or(uncertainty::DecisionRule::kIso14253));
+}
+
+// Waits for the input's hash, writes the outputs and keeps the clock, for both kinds of scan.
+void FinishRun(std::future<std::string> sha256, const std::filesystem::path& outdir,
+               ProcessPipelineResult& result, StageClock& clock) {
+  clock.Start("waiting for the SHA-256");
+  result.record.input_sha256 = sha256.get();
+  ThrowIfInterrupted();
+  if (!outdir.empty()) {
+    clock.Start("writing");
+    const nlohmann::json uncertainty =
+        result.uncertainty ? uncertainty::WheelUncertaintyToJson(*result.uncertainty) : nlohmann::json();
+    fitting::WriteProcessOutputs(outdir, result.record, result.processed, result.fit,
+                                 result.model ? &*result.model : nullptr,
+                                 result.uncertainty ? &uncertainty : nullptr);
+  }
+  clock.Stop();
+  result.clock = std::move(clock);
 }
 
 // Everything after the scan is in memory. `sha256` delivers the input's hash (computed meanwhile
@@ -176,19 +230,51 @@ ProcessPipelineResult RunOnScan(acquisition::Scan scan, const std::string& scan_
     if (options.tolerances) DecideTolerances(*options.tolerances, *result.uncertainty);
   }
   progress.Update("writing", 0.9);
-  clock.Start("waiting for the SHA-256");
-  result.record.input_sha256 = sha256.get();
+  FinishRun(std::move(sha256), outdir, result, clock);
+  return result;
+}
+
+// A line-profile scan (docs/processing.md, "Line-profile scans"): its frames become the per-phase
+// sections (processing/profile_sections.h), fitted as a helical scan's are (fitting/profile_fit.h);
+// from the fits on, everything is as for a helical scan. The wheel model needs the helix's samples
+// and is not fitted.
+ProcessPipelineResult RunOnProfileScan(acquisition::ProfileScan scan, const std::string& scan_path,
+                                       std::future<std::string> sha256, const std::filesystem::path& outdir,
+                                       const ProcessPipelineOptions& options, Progress& progress,
+                                       StageClock clock) {
+  ProcessPipelineResult result;
+  acquisition::Scan carrier;
+  carrier.metadata = scan.metadata;
+  carrier.read = scan.read;
+  result.record = MakeRecord(scan_path, options, carrier);
+  result.record.has_encoder = !scan.encoder.empty();
+  progress.Update("processing", 0.3);
+  clock.Start("profile sections");
+  processing::ProfileSectionsResult sections = processing::BuildProfileSections(scan, options.processing.map);
+  processing::ProcessedScan& processed = result.processed;
+  processed.samples = scan.z_mm.size();
+  processed.valid_samples = sections.valid_points;
+  processed.last_valid = scan.z_mm.empty() ? 0 : scan.z_mm.size() - 1;
+  processed.noise_sigma_mm = sections.point_spread_mm;
+  processed.phase_source =
+      result.record.has_encoder ? processing::PhaseSource::kEncoder : processing::PhaseSource::kNominal;
+  processed.rpm_used = scan.metadata.spindle_rpm.value_or(0.0);
+  processed.map = std::move(sections.map);
+  if (!options.no_model) processed.warnings.push_back("no wheel model: it fits a helical scan's samples");
   ThrowIfInterrupted();
-  if (!outdir.empty()) {
-    clock.Start("writing");
-    const nlohmann::json uncertainty =
-        result.uncertainty ? uncertainty::WheelUncertaintyToJson(*result.uncertainty) : nlohmann::json();
-    fitting::WriteProcessOutputs(outdir, result.record, result.processed, result.fit,
-                                 result.model ? &*result.model : nullptr,
-                                 result.uncertainty ? &uncertainty : nullptr);
+  progress.Update("fitting", 0.7);
+  clock.Start("per-phase fits");
+  result.fit = fitting::FitProfileWheel(processed.map, options.fit);
+  const acquisition::ProfilePlacement placement = scan.placement;
+  scan = {};
+  if (!options.no_uncertainty) {
+    clock.Start("uncertainty");
+    result.uncertainty =
+        EvaluateUncertainty(options, result.record.metadata, processed, result.fit, &placement);
+    if (options.tolerances) DecideTolerances(*options.tolerances, *result.uncertainty);
   }
-  clock.Stop();
-  result.clock = std::move(clock);
+  progress.Update("writing", 0.9);
+  FinishRun(std::move(sha256), outdir, result, clock);
   return result;
 }
 
@@ -233,6 +319,15 @@ ProcessPipelineResult RunProcessPipeline(const std::string& scan_path, const std
   // the child reads (this process only waits for it then).
   StageClock clock;
   clock.Start("reading");
+  if (const auto profile =
+          acquisition::ProfileFormatOf(scan_path, options.scan_format, !options.columns.empty())) {
+    acquisition::ProfileScan scan = acquisition::ReadProfileScan(
+        scan_path, *profile, options.scan_settings ? &*options.scan_settings : nullptr);
+    std::future<std::string> hash =
+        std::async(std::launch::async, [scan_path] { return Sha256OfFile(scan_path); });
+    return RunOnProfileScan(std::move(scan), scan_path, std::move(hash), outdir, options, progress,
+                            std::move(clock));
+  }
   std::future<std::string> sha256;
   const auto start_hash = [&] {
     sha256 = std::async(std::launch::async, [scan_path] { return Sha256OfFile(scan_path); });
@@ -261,6 +356,22 @@ ProcessPipelineResult RunProcessPipeline(acquisition::Scan scan, std::string inp
   known.set_value(std::move(input_sha256));
   const std::string scan_path = scan.path;
   return RunOnScan(std::move(scan), scan_path, known.get_future(), outdir, options, progress, StageClock{});
+}
+
+}  // namespace arcwheel::workflows
+
+namespace arcwheel::workflows {
+
+ProcessPipelineResult RunProcessPipeline(acquisition::ProfileScan scan, std::string input_sha256,
+                                         const std::filesystem::path& outdir, ProcessPipelineOptions options,
+                                         Progress& progress) {
+  ResolveProcessPipelineOptions(options);
+  acquisition::ValidateProfileScan(scan);
+  std::promise<std::string> known;
+  known.set_value(std::move(input_sha256));
+  const std::string scan_path = scan.path;
+  return RunOnProfileScan(std::move(scan), scan_path, known.get_future(), outdir, options, progress,
+                          StageClock{});
 }
 
 }  // namespace arcwheel::workflows

@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "acquisition/profile_scan.h"
 #include "acquisition/scan.h"
 #include "acquisition/scan_settings.h"
 #include "core/progress.h"
@@ -86,6 +87,13 @@ struct ProcessPipelineResult {
 // The same for a scan already in memory, e.g. a simulated one: nothing is read or hashed, and the
 // record states scan.path and `input_sha256` as given (empty when the samples came from no file).
 [[nodiscard]] ProcessPipelineResult RunProcessPipeline(acquisition::Scan scan, std::string input_sha256,
+                                                       const std::filesystem::path& outdir,
+                                                       ProcessPipelineOptions options, Progress& progress);
+
+// The same for a line-profile scan already in memory (acquisition/profile_scan.h), e.g. a simulated
+// one; its placement and settings are taken as they are. docs/processing.md, "Line-profile scans".
+[[nodiscard]] ProcessPipelineResult RunProcessPipeline(acquisition::ProfileScan scan,
+                                                       std::string input_sha256,
                                                        const std::filesystem::path& outdir,
                                                        ProcessPipelineOptions options, Progress& progress);
 

@@ -174,6 +174,13 @@ ProcessPipelineResult RunOnScan(acquisition::Scan scan, const std::string& scan_
     clock.Start("uncertainty");
     result.uncertainty = EvaluateUncertainty(options, metadata, result.processed, result.fit);
     if (options.tolerances) DecideTolerances(*options.tolerances, *result.uncertainty);
+    clock.Start("characteristics");
+    result.characteristics =
+        EvaluateCharacteristics(options, result.processed.map, result.fit, *result.uncertainty,
+                                options.processing.wheel_radius_mm > 0.0
+                                    ? options.processing.wheel_radius_mm
+                                    : metadata.wheel_diameter_mm.value_or(400.0) / 2.0);
+    for (const std::string& warning : result.characteristics->warnings) result.processed.warnings.push_back(warning);
   }
   progress.Update("writing", 0.9);
   clock.Start("waiting for the SHA-256");
@@ -181,11 +188,13 @@ ProcessPipelineResult RunOnScan(acquisition::Scan scan, const std::string& scan_
   ThrowIfInterrupted();
   if (!outdir.empty()) {
     clock.Start("writing");
-    const nlohmann::json uncertainty =
-        result.uncertainty ? uncertainty::WheelUncertaintyToJson(*result.uncertainty) : nlohmann::json();
+    nlohmann::json later_stages = nlohmann::json::object();
+    if (result.uncertainty)
+      later_stages[schema::summary::kUncertainty] = uncertainty::WheelUncertaintyToJson(*result.uncertainty);
+    if (result.characteristics)
+      later_stages[schema::summary::kCharacteristics] = CharacteristicsToJson(*result.characteristics);
     fitting::WriteProcessOutputs(outdir, result.record, result.processed, result.fit,
-                                 result.model ? &*result.model : nullptr,
-                                 result.uncertainty ? &uncertainty : nullptr);
+                                 result.model ? &*result.model : nullptr, &later_stages);
   }
   clock.Stop();
   result.clock = std::move(clock);
@@ -207,6 +216,8 @@ void ResolveProcessPipelineOptions(ProcessPipelineOptions& options) {
     for (std::string& problem : options.uncertainty.Problems()) problems.push_back(std::move(problem));
   }
   ThrowIfProblems(ErrorCode::kInvalidOption, "process", problems);
+  // An operator that cannot be evaluated (an option, or a tolerance's) likewise.
+  if (!options.no_uncertainty) (void)CharacteristicOperators(options, options.processing.map.phases);
   // A bad budget is refused before the scan is read, with every problem it has (exit 2).
   if (!options.no_uncertainty && !options.uncertainty_budget_path.empty())
     options.uncertainty_budget = uncertainty::ReadBudget(options.uncertainty_budget_path);

@@ -1,0 +1,364 @@
+#include "characteristics/wheel_characteristics.h"
+
+#include <fmt/core.h>
+
+#include <algorithm>
+#include <bit>
+#include <cmath>
+#include <numbers>
+#include <numeric>
+#include <random>
+
+#include "characteristics/gaussian_filter.h"
+#include "characteristics/roundness.h"
+#include "core/error.h"
+
+namespace arcwheel::characteristics {
+namespace {
+
+constexpr std::string_view kStage = "characteristics.wheel";
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+// One evaluation of an operator on one node's points; NaN where it cannot be evaluated.
+using NodeOperator = double (*)(const FormOperator& op, std::span<const double> values,
+                                std::span<const double> coordinate, std::span<const double> extra);
+
+std::vector<double> PhaseGridDeg(std::size_t n_phase) {
+  std::vector<double> phase(n_phase);
+  for (std::size_t i = 0; i < n_phase; ++i) phase[i] = 360.0 * static_cast<double>(i) / static_cast<double>(n_phase);
+  return phase;
+}
+
+bool AllFinite(std::span<const double> values) {
+  return std::all_of(values.begin(), values.end(), [](double v) { return std::isfinite(v); });
+}
+
+// RONt (um) of one turn of radii about the spindle axis.
+double Roundness(const FormOperator& op, std::span<const double> radius_mm, std::span<const double> phase_deg,
+                 std::span<const double>) {
+  if (!AllFinite(radius_mm)) return kNaN;
+  const RoundnessResult result = EvaluateRoundness(
+      phase_deg, radius_mm,
+      {.filter_cutoff_upr = op.cutoff_upr, .association = *op.association, .max_harmonic_upr = 1});
+  return result.ront_um;
+}
+
+// Total indicator reading (um) of one turn about the spindle axis.
+double Runout(const FormOperator& op, std::span<const double> radius_mm, std::span<const double>,
+              std::span<const double>) {
+  if (!AllFinite(radius_mm)) return kNaN;
+  std::vector<double> turn(radius_mm.begin(), radius_mm.end());
+  if (op.cutoff_upr) turn = FilterClosedProfile(turn, *op.cutoff_upr);
+  const auto [low, high] = std::minmax_element(turn.begin(), turn.end());
+  return (*high - *low) * 1000.0;
+}
+
+// Peak-to-valley (um) of one section about its associated arc. `residual_um` are the points'
+// distances from the phase's least-squares arc minus its radius, at axial offsets `dy_mm` from
+// its centre; extra = {radius_mm, spacing_mm}.
+double ArcProfile(const FormOperator& op, std::span<const double> residual_um, std::span<const double> dy_mm,
+                  std::span<const double> extra) {
+  std::vector<double> r(residual_um.begin(), residual_um.end());
+  if (r.size() < 4) return kNaN;
+  if (op.cutoff_mm) r = FilterOpenProfile(r, extra[1], *op.cutoff_mm);
+  // The points in the section's plane about the arc's centre: their distance from it is the
+  // radius plus the residual, so the association sees the section as measured.
+  std::vector<double> x(r.size()), y(r.size());
+  for (std::size_t i = 0; i < r.size(); ++i) {
+    const double distance = extra[0] + r[i] / 1000.0;
+    x[i] = dy_mm[i];
+    y[i] = std::sqrt(std::max(0.0, distance * distance - dy_mm[i] * dy_mm[i]));
+  }
+  const AssociatedCircle circle = AssociateCircle(x, y, {.association = *op.association});
+  if (!circle.IsCertified()) return kNaN;
+  double low = std::numeric_limits<double>::infinity(), high = -low;
+  for (std::size_t i = 0; i < x.size(); ++i) {
+    const double d = std::hypot(x[i] - circle.center_x_mm, y[i] - circle.center_y_mm);
+    low = std::min(low, d);
+    high = std::max(high, d);
+  }
+  return (high - low) * 1000.0;
+}
+
+// The points of one node: values (with their 1-sigma, in the values' unit), the coordinate the
+// operator needs and its extra constants.
+struct Node {
+  std::vector<double> values, sigma, coordinate, extra;
+  std::vector<double> truth_estimate;  // the values with the noise's share taken out (the bootstrap's base)
+};
+
+// The largest of the nodes' values and its bootstrap (header). `noise_scale` converts a sigma
+// into the value's unit (um) to choose the candidates.
+FormCharacteristic LargestWithBootstrap(const FormOperator& op, NodeOperator evaluate, const std::vector<Node>& nodes,
+                                        std::span<const double> at, const CharacteristicsOptions& options,
+                                        double noise_um, std::uint64_t seed) {
+  FormCharacteristic out;
+  out.op = op;
+  out.per_node_um.assign(nodes.size(), kNaN);
+  for (std::size_t j = 0; j < nodes.size(); ++j) {
+    if (!nodes[j].values.empty())
+      out.per_node_um[j] = evaluate(op, nodes[j].values, nodes[j].coordinate, nodes[j].extra);
+    if (std::isfinite(out.per_node_um[j]) &&
+        (out.worst_index < 0 || out.per_node_um[j] > out.per_node_um[static_cast<std::size_t>(out.worst_index)]))
+      out.worst_index = static_cast<int>(j);
+  }
+  if (out.worst_index < 0) {
+    out.measured_um = out.value_um = out.u_um = kNaN;
+    return out;
+  }
+  out.measured_um = out.per_node_um[static_cast<std::size_t>(out.worst_index)];
+  out.worst_at = at[static_cast<std::size_t>(out.worst_index)];
+
+  std::vector<std::size_t> candidates;
+  for (std::size_t j = 0; j < nodes.size(); ++j) {
+    if (std::isfinite(out.per_node_um[j]) && out.per_node_um[j] >= out.measured_um - options.candidate_sigmas * noise_um)
+      candidates.push_back(j);
+  }
+  std::sort(candidates.begin(), candidates.end(),
+            [&](std::size_t a, std::size_t b) { return out.per_node_um[a] > out.per_node_um[b]; });
+  if (candidates.size() > static_cast<std::size_t>(options.max_candidates))
+    candidates.resize(static_cast<std::size_t>(options.max_candidates));
+
+  // The bootstrap simulates the noise about the best estimate of the noise-free profile (a
+  // node's `truth_estimate`: its harmonics shrunk by the noise, below), not about the measured
+  // one, whose peaks the noise has already raised: mean(f(estimate + noise)) - f(estimate) is the
+  // bias, their spread u.
+  std::mt19937_64 rng(seed);
+  std::normal_distribution<double> normal(0.0, 1.0);
+  std::vector<double> replicate_max, noisy;
+  std::vector<double> base(candidates.size(), kNaN);
+  for (std::size_t c = 0; c < candidates.size(); ++c) {
+    const Node& node = nodes[candidates[c]];
+    base[c] = evaluate(op, node.truth_estimate, node.coordinate, node.extra);
+  }
+  const double base_max = *std::max_element(base.begin(), base.end(), [](double x, double y) {
+    return !std::isfinite(x) || (std::isfinite(y) && y > x);
+  });
+  for (int b = 0; b < options.replicates; ++b) {
+    double largest = -std::numeric_limits<double>::infinity();
+    for (const std::size_t j : candidates) {
+      const Node& node = nodes[j];
+      noisy.resize(node.values.size());
+      for (std::size_t i = 0; i < noisy.size(); ++i) noisy[i] = node.truth_estimate[i] + node.sigma[i] * normal(rng);
+      const double value = evaluate(op, noisy, node.coordinate, node.extra);
+      if (std::isfinite(value)) largest = std::max(largest, value);
+    }
+    if (std::isfinite(largest)) replicate_max.push_back(largest);
+  }
+  out.replicates = static_cast<int>(replicate_max.size());
+  if (out.replicates < 2 || !std::isfinite(base_max)) {
+    out.value_um = out.measured_um;
+    out.u_um = kNaN;
+    return out;
+  }
+  const double mean = std::accumulate(replicate_max.begin(), replicate_max.end(), 0.0) / out.replicates;
+  double sum2 = 0.0;
+  for (const double v : replicate_max) sum2 += (v - mean) * (v - mean);
+  out.u_um = std::sqrt(sum2 / (out.replicates - 1));
+  out.bias_um = mean - base_max;
+  out.value_um = std::max(0.0, out.measured_um - out.bias_um);
+  return out;
+}
+
+// The seed mixed with the measured values, so that the same map gives the same numbers and two
+// scans independent draws.
+std::uint64_t MixedSeed(std::uint64_t seed, std::span<const double> values) {
+  std::uint64_t h = seed ^ 0x9e3779b97f4a7c15ULL;
+  for (const double v : values) {
+    if (!std::isfinite(v)) continue;
+    h ^= std::bit_cast<std::uint64_t>(v) + 0x9e3779b97f4a7c15ULL + (h << 6) + (h >> 2);
+  }
+  return h;
+}
+
+void CheckSizes(const WheelForm& form, std::size_t n_phase, std::size_t n_y) {
+  if (n_y == 0 || form.rho_mm.size() != n_phase * n_y || n_phase < 8 || form.arc_radius_mm.size() != n_phase ||
+      form.center_axial_mm.size() != n_phase || form.center_radial_mm.size() != n_phase ||
+      form.usable.size() != n_phase)
+    throw Error(ErrorCode::kBadInput, kStage,
+                fmt::format("the map ({} values, {} nodes) and the {} phase fits do not match", form.rho_mm.size(),
+                            n_y, form.arc_radius_mm.size()));
+  const std::size_t cells = n_phase * static_cast<std::size_t>(std::max(form.section_bins, 0));
+  if (form.section_residual_um.size() != cells || form.section_y_mm.size() != cells ||
+      form.section_sigma_um.size() != cells)
+    throw Error(ErrorCode::kBadInput, kStage, "the sections' arrays do not match their bins");
+}
+
+// The turns of the map at the band's nodes.
+std::vector<Node> TurnNodes(const WheelForm& form, std::size_t n_phase, const std::vector<double>& phase_deg,
+                            std::vector<double>& at) {
+  const std::size_t n_y = form.y_mm.size();
+  std::vector<Node> nodes;
+  for (std::size_t j = 0; j < n_y; ++j) {
+    const double y = form.y_mm[j];
+    if (y < form.band_low_mm || y > form.band_high_mm) continue;
+    Node node;
+    node.values.resize(n_phase);
+    for (std::size_t i = 0; i < n_phase; ++i) node.values[i] = form.radius_offset_mm + form.rho_mm[i * n_y + j];
+    node.sigma.assign(n_phase, form.map_sigma_mm);
+    node.coordinate = phase_deg;
+    if (!AllFinite(node.values)) node.values.clear();
+    // A noise-only harmonic exceeds nine times its expected power with probability exp(-9): over a
+    // turn's 180 harmonics, one profile in sixty keeps one.
+    if (!node.values.empty())
+      node.truth_estimate = form.map_sigma_mm > 0.0 ? SignificantHarmonics(node.values, form.map_sigma_mm, 9.0)
+                                                    : node.values;
+    nodes.push_back(std::move(node));
+    at.push_back(y);
+  }
+  if (nodes.empty())
+    throw Error(ErrorCode::kBadInput, kStage,
+                fmt::format("no axial node of the map lies in the band [{:g}, {:g}] mm", form.band_low_mm,
+                            form.band_high_mm));
+  return nodes;
+}
+
+// Each usable phase's section: the sections' bins where the fit gives them, else the map's
+// nodes in the band.
+std::vector<Node> SectionNodes(const WheelForm& form, std::size_t n_phase, const FormOperator& op) {
+  const std::size_t n_y = form.y_mm.size();
+  const std::size_t bins = static_cast<std::size_t>(std::max(form.section_bins, 0));
+  std::vector<Node> nodes(n_phase);
+  for (std::size_t p = 0; p < n_phase; ++p) {
+    if (form.usable[p] == 0 || !std::isfinite(form.arc_radius_mm[p])) continue;
+    Node& node = nodes[p];
+    const double a = form.center_axial_mm[p], radius = form.arc_radius_mm[p];
+    const auto add = [&](double y, double residual_um, double sigma_um) {
+      if (!std::isfinite(y) || !std::isfinite(residual_um)) return false;
+      node.coordinate.push_back(y - a);
+      node.values.push_back(residual_um);
+      node.sigma.push_back(std::isfinite(sigma_um) ? sigma_um : form.map_sigma_mm * 1000.0);
+      return true;
+    };
+    bool complete = true;
+    if (bins > 0) {
+      for (std::size_t b = 0; b < bins; ++b)
+        complete &= add(form.section_y_mm[p * bins + b], form.section_residual_um[p * bins + b],
+                        form.section_sigma_um[p * bins + b]);
+    } else {
+      for (std::size_t j = 0; j < n_y; ++j) {
+        const double y = form.y_mm[j];
+        if (y < form.band_low_mm || y > form.band_high_mm) continue;
+        const double rho = form.rho_mm[p * n_y + j];
+        const double residual_um = (std::hypot(y - a, rho - form.center_radial_mm[p]) - radius) * 1000.0;
+        complete &= add(y, residual_um, form.map_sigma_mm * 1000.0);
+      }
+    }
+    const double spacing = (form.band_high_mm - form.band_low_mm) /
+                           static_cast<double>(std::max<std::size_t>(node.values.size(), 1));
+    node.extra = {radius, spacing};
+    // A section's few points carry no spectrum to shrink: its bootstrap starts from them as measured.
+    node.truth_estimate = node.values;
+    // An open-profile filter needs the section's points equally spaced over the band.
+    if (op.cutoff_mm && (!complete || *op.cutoff_mm < 5.0 * spacing)) node.values.clear();
+  }
+  return nodes;
+}
+
+RoundnessSection WorstRoundnessSection(const FormCharacteristic& roundness,
+                                       const std::vector<Node>& turns, const std::vector<double>& at) {
+  RoundnessSection section;
+  if (roundness.worst_index < 0) return section;
+  const Node& node = turns[static_cast<std::size_t>(roundness.worst_index)];
+  section.y_mm = at[static_cast<std::size_t>(roundness.worst_index)];
+  section.phase_deg = node.coordinate;
+  const RoundnessResult result =
+      EvaluateRoundness(node.coordinate, node.values,
+                        {.filter_cutoff_upr = roundness.op.cutoff_upr, .association = *roundness.op.association});
+  section.filtered_radius_mm = roundness.op.cutoff_upr ? FilterClosedProfile(node.values, *roundness.op.cutoff_upr)
+                                                       : node.values;
+  section.reference = result.reference;
+  section.harmonic_amplitude_um = result.harmonic_amplitude_um;
+  return section;
+}
+
+}  // namespace
+
+std::string FormOperator::Describe() const {
+  std::string filter = "no filter";
+  if (cutoff_upr) filter = fmt::format("{:g} UPR", *cutoff_upr);
+  if (cutoff_mm) filter = fmt::format("λc {:g} mm", *cutoff_mm);
+  const std::string reference = association ? std::string(AssociationAbbreviation(*association)) : "spindle axis";
+  return fmt::format("{}, {}, {}", parameter, filter, reference);
+}
+
+FormOperator DefaultRoundnessOperator() {
+  return {.cutoff_upr = 50.0, .cutoff_mm = std::nullopt, .association = Association::kMinimumZone, .parameter = "RONt"};
+}
+
+FormOperator DefaultRunoutOperator() {
+  return {.cutoff_upr = 50.0, .cutoff_mm = std::nullopt, .association = std::nullopt, .parameter = "TIR"};
+}
+
+FormOperator DefaultArcProfileOperator() {
+  return {.cutoff_upr = std::nullopt,
+          .cutoff_mm = std::nullopt,
+          .association = Association::kMinimumZone,
+          .parameter = "PV"};
+}
+
+std::string RoundnessOperatorProblem(const FormOperator& op, int points_per_turn) {
+  if (op.cutoff_mm) return "a roundness profile is closed: its filter takes a cut-off in UPR, not in mm";
+  if (op.cutoff_upr && !(*op.cutoff_upr > 0.0 && *op.cutoff_upr <= points_per_turn / 2.0))
+    return fmt::format("the cut-off {:g} UPR is not in (0, {}] (half the {} points per turn)", *op.cutoff_upr,
+                       points_per_turn / 2, points_per_turn);
+  if (!op.association) return "roundness needs an association";
+  return "";
+}
+
+std::string RunoutOperatorProblem(const FormOperator& op, int points_per_turn) {
+  if (op.cutoff_mm) return "a run-out profile is closed: its filter takes a cut-off in UPR, not in mm";
+  if (op.cutoff_upr && !(*op.cutoff_upr > 0.0 && *op.cutoff_upr <= points_per_turn / 2.0))
+    return fmt::format("the cut-off {:g} UPR is not in (0, {}] (half the {} points per turn)", *op.cutoff_upr,
+                       points_per_turn / 2, points_per_turn);
+  if (op.association) return "circular run-out is taken about the datum axis: it takes no association";
+  return "";
+}
+
+std::string ArcProfileOperatorProblem(const FormOperator& op) {
+  if (op.cutoff_upr) return "an arc profile is open: its filter takes a cut-off wavelength in mm, not in UPR";
+  if (op.cutoff_mm && !(*op.cutoff_mm > 0.0)) return fmt::format("the cut-off {:g} mm is not above 0", *op.cutoff_mm);
+  if (!op.association) return "the arc profile needs an association";
+  if (*op.association == Association::kMaximumInscribed || *op.association == Association::kMinimumCircumscribed)
+    return fmt::format("the {} circle is not defined on an arc within half a turn (least-squares or minimum-zone)",
+                       AssociationName(*op.association));
+  return "";
+}
+
+std::vector<std::string> CharacteristicsOptions::Problems() const {
+  std::vector<std::string> problems;
+  if (replicates < 20) problems.push_back(fmt::format("replicates = {} violates >= 20", replicates));
+  if (!(candidate_sigmas > 0.0)) problems.push_back(fmt::format("candidate_sigmas = {:g} violates > 0", candidate_sigmas));
+  if (max_candidates < 1) problems.push_back(fmt::format("max_candidates = {} violates >= 1", max_candidates));
+  if (const std::string p = ArcProfileOperatorProblem(arc_profile); !p.empty()) problems.push_back("arc profile: " + p);
+  return problems;
+}
+
+WheelCharacteristics EvaluateWheelCharacteristics(const WheelForm& form, const CharacteristicsOptions& options) {
+  std::vector<std::string> problems = options.Problems();
+  const std::size_t n_phase = form.arc_radius_mm.size();
+  const int per_turn = static_cast<int>(n_phase);
+  if (const std::string p = RoundnessOperatorProblem(options.roundness, per_turn); !p.empty())
+    problems.push_back("roundness: " + p);
+  if (const std::string p = RunoutOperatorProblem(options.runout, per_turn); !p.empty())
+    problems.push_back("circular run-out: " + p);
+  ThrowIfProblems(ErrorCode::kInvalidOption, kStage, problems);
+  CheckSizes(form, n_phase, form.y_mm.size());
+
+  const std::vector<double> phase_deg = PhaseGridDeg(n_phase);
+  std::vector<double> node_y;
+  const std::vector<Node> turns = TurnNodes(form, n_phase, phase_deg, node_y);
+  const std::uint64_t seed = MixedSeed(options.seed, form.rho_mm);
+  const double map_sigma_um = form.map_sigma_mm * 1000.0;
+
+  WheelCharacteristics out;
+  out.roundness = LargestWithBootstrap(options.roundness, Roundness, turns, node_y, options, map_sigma_um, seed);
+  out.runout = LargestWithBootstrap(options.runout, Runout, turns, node_y, options, map_sigma_um, seed + 1);
+  const std::vector<Node> sections = SectionNodes(form, n_phase, options.arc_profile);
+  out.arc_profile =
+      LargestWithBootstrap(options.arc_profile, ArcProfile, sections, phase_deg, options, map_sigma_um, seed + 2);
+  out.worst_roundness_section = WorstRoundnessSection(out.roundness, turns, node_y);
+  return out;
+}
+
+}  // namespace arcwheel::characteristics

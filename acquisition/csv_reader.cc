@@ -321,15 +321,16 @@ std::string ReadWholeFile(const std::filesystem::path& path) {
 
 }  // namespace
 
-Scan ReadCsvScan(const std::filesystem::path& path) {
-  return ParseCsvScan(ReadWholeFile(path), path.string());
+Scan ReadCsvScan(const std::filesystem::path& path, const ReadOptions& options) {
+  return ParseCsvScan(ReadWholeFile(path), path.string(), options);
 }
 
-Scan ParseCsvScan(std::string text, const std::string& name) {
+Scan ParseCsvScan(std::string text, const std::string& name, const ReadOptions& options) {
   CsvParser parser(name, std::move(text));
   Scan scan = parser.Parse();
+  scan.read.format = "csv";
   ApplyInvalidMarkers(scan, SentinelComparison::kAsDouble);
-  ValidateScan(scan);
+  FinishScan(scan, options);
   return scan;
 }
 

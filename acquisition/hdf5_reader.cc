@@ -152,9 +152,10 @@ std::vector<double>& DoubleColumnOf(Scan& scan, const std::string& name) {
 }
 
 // Invalid markers, then formats.md 2.3.
-Scan Finish(Scan scan, const hdf5::File& file) {
+Scan Finish(Scan scan, const hdf5::File& file, const ReadOptions& options) {
+  scan.read.format = "hdf5";
   ApplyInvalidMarkers(scan, ComparisonOf(ReadZLayout(file)));
-  ValidateScan(scan);
+  FinishScan(scan, options);
   return scan;
 }
 
@@ -187,7 +188,7 @@ Scan ReadHdf5Scan(const std::filesystem::path& path, const ReadOptions& options)
   };
   take("/scan/z");
   for (const auto& [name, member] : kColumns) take(name);
-  return Finish(std::move(scan), file);
+  return Finish(std::move(scan), file, options);
 }
 
 Scan ReadHdf5Scan(const hdf5::File& file, const ReadOptions& options) {
@@ -202,16 +203,23 @@ Scan ReadHdf5Scan(const hdf5::File& file, const ReadOptions& options) {
       return std::span<double>(column);
     }
   });
-  return Finish(std::move(scan), file);
+  return Finish(std::move(scan), file, options);
 }
 
 Scan ReadScan(const std::filesystem::path& path, const ReadOptions& options) {
-  switch (ScanFormatOfFile(path, "acquisition")) {
-    case ScanFormat::kHdf5:
-      return ReadHdf5Scan(path, options);
+  const ScanFormat format =
+      ScanFormatOfContent(path, options.format, !options.columns.empty(), "acquisition");
+  if (format == ScanFormat::kHdf5) return ReadHdf5Scan(path, options);
+  if (options.while_reading) options.while_reading();
+  switch (format) {
     case ScanFormat::kCsv:
-      if (options.while_reading) options.while_reading();
-      return ReadCsvScan(path);
+      return ReadCsvScan(path, options);
+    case ScanFormat::kSensorTool:
+    case ScanFormat::kKeyenceLk:
+    case ScanFormat::kColumns:
+      return ReadSensorScan(path, format, options);
+    case ScanFormat::kHdf5:
+      break;
   }
   ARCWHEEL_CHECK(false) << "scan format without a reader";
   return {};

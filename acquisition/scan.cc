@@ -99,9 +99,14 @@ void ValidateScan(const Scan& scan) {
   CheckPositive(scan, meta.spindle_rpm, "spindle_rpm");
   CheckPositive(scan, meta.feed_mm_per_min, "feed_mm_per_min");
   CheckPositive(scan, meta.sample_period_s, "sample_period_s");
-  if (!scan.has_encoder() && !meta.spindle_rpm) Refuse(scan, "lacks spindle_rpm (and has no angle column)");
-  if (!scan.has_time() && !meta.sample_period_s) Refuse(scan, "lacks sample_period_s (and has no t column)");
-  if (!scan.has_axial() && !meta.feed_mm_per_min) Refuse(scan, "lacks feed_mm_per_min (and has no y column)");
+  // A sensor's own export rarely carries the settings: say which key supplies the missing one.
+  const auto lacks = [&](const char* key, const char* column) {
+    Refuse(scan, std::string("lacks ") + key + " (and has no " + column + " column): give \"" + key +
+                     "\" in the file's metadata or in --scan-settings SETTINGS.json");
+  };
+  if (!scan.has_encoder() && !meta.spindle_rpm) lacks("spindle_rpm", "angle");
+  if (!scan.has_time() && !meta.sample_period_s) lacks("sample_period_s", "t");
+  if (!scan.has_axial() && !meta.feed_mm_per_min) lacks("feed_mm_per_min", "y");
   if (meta.radius_sign != 1.0 && meta.radius_sign != -1.0) {
     Refuse(scan, "radius_sign must be +1 or -1, got " + Number(meta.radius_sign));
   }

@@ -8,6 +8,7 @@
 #include <optional>
 #include <span>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace arcwheel::acquisition {
@@ -33,6 +34,30 @@ struct ScanMetadata {
   // What the reader noticed and the user should see (summary.json `warnings`): keys it did not
   // use, text it read as Latin-1, an index column it skipped.
   std::vector<std::string> notes;
+  // The keys above (formats.md 2.1 names) that the file itself gave, in the order read; a key
+  // not listed holds its default. Settings from outside the file (scan_settings.h) may fill the
+  // others, never contradict these.
+  std::vector<std::string> file_keys;
+};
+
+// What a reader read, for summary.json's `input` (formats.md 2.4).
+struct ScanReadRecord {
+  // The format's name in scan_format.h ("csv", "sensortool", ...); empty for a scan no reader made.
+  std::string format;
+  // One quantity of the scan ("z", "t", "angle", "y") and the file's column that held it.
+  struct Column {
+    std::string quantity;
+    std::string name;  // the column's header as written (UTF-8)
+    std::string unit;  // the unit it was read in ("mm", "um", "ms", ...)
+  };
+  std::vector<Column> columns;
+  // Invalid samples by the marker that made them ("empty", "out_of_range_high", "alarm", ...), in
+  // the order first met; only markers that occurred.
+  std::vector<std::pair<std::string, std::size_t>> invalid_markers;
+  // The --scan-settings file, and for every setting in effect where it came from: "file" or
+  // "settings" (formats.md 2.1 key -> source), in the order of formats.md.
+  std::string settings_path;
+  std::vector<std::pair<std::string, std::string>> sources;
 };
 
 // float32 readings, held in a vector of this process or in the pages that a reader's child process
@@ -88,6 +113,7 @@ struct Scan {
   std::vector<double> t_s;
   std::vector<double> angle_deg;
   std::vector<double> y_mm;
+  ScanReadRecord read;
 
   [[nodiscard]] std::size_t size() const { return holds_float() ? z_float_mm.size() : z_mm.size(); }
   [[nodiscard]] bool holds_float() const { return !z_float_mm.empty(); }

@@ -7,6 +7,7 @@
 #include <limits>
 #include <type_traits>
 
+#include "acquisition/scan_settings.h"
 #include "core/error.h"
 #include "core/text_encoding.h"
 
@@ -49,6 +50,7 @@ std::string MetadataSetter::Claim(std::string_view key) {
     throw Error(ErrorCode::kBadInput, kStage,
                 "metadata '" + name + "' is given twice (keys match case-insensitively)");
   }
+  metadata_.file_keys.push_back(name);
   return name;
 }
 
@@ -138,6 +140,11 @@ void ApplyInvalidMarkers(Scan& scan, SentinelComparison comparison) {
       MarkInvalid(readings, low, high, [=](auto z) { return static_cast<double>(z) == sentinel; });
     }
   });
+}
+
+void FinishScan(Scan& scan, const ReadOptions& options) {
+  ApplyScanSettings(options.settings, scan);
+  ValidateScan(scan);
 }
 
 }  // namespace arcwheel::acquisition

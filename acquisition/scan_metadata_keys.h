@@ -6,6 +6,7 @@
 #include <string_view>
 
 #include "acquisition/scan.h"
+#include "acquisition/scan_reader.h"
 
 namespace arcwheel::acquisition {
 
@@ -48,5 +49,9 @@ enum class SentinelComparison {
 // Marks as NaN every z equal to metadata.invalid_value (see SentinelComparison), not finite, or
 // outside the range limits.
 void ApplyInvalidMarkers(Scan& scan, SentinelComparison comparison);
+
+// The readers' last step: merges the settings from outside the file (options.settings,
+// scan_settings.h), then ValidateScan.
+void FinishScan(Scan& scan, const ReadOptions& options);
 
 }  // namespace arcwheel::acquisition

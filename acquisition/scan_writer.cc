@@ -126,6 +126,8 @@ void WriteScan(const Scan& scan, bool float32, const std::filesystem::path& path
       return WriteHdf5Scan(scan, float32, path.string());
     case ScanFormat::kCsv:
       return WriteCsvScan(scan, path.string());
+    default:
+      break;  // the sensors' layouts are written by WriteSensorScan
   }
 }
 

@@ -7,10 +7,10 @@
 #include <complex>
 #include <map>
 #include <memory>
-#include <mutex>
 #include <numbers>
 
 #include "core/error.h"
+#include "core/fftw_planner.h"
 
 namespace arcwheel::characteristics {
 namespace {
@@ -27,8 +27,9 @@ RealBuffer AllocateReal(std::size_t n) { return RealBuffer(fftw_alloc_real(n)); 
 ComplexBuffer AllocateComplex(std::size_t n) { return ComplexBuffer(fftw_alloc_complex(n)); }
 
 // FFTW's planner is not thread-safe, its plans are: one pair of plans per profile length, made
-// once under a lock and executed on each call's own (equally aligned, fftw_malloc) buffers. The
-// cache destroys its plans at exit, so that a leak checker sees none.
+// once under the planner's lock and executed on each call's own (equally aligned, fftw_malloc)
+// buffers. Single-threaded: a profile is short. The cache destroys its plans at exit, so that a
+// leak checker sees none.
 struct Plans {
   fftw_plan forward = nullptr;
   fftw_plan inverse = nullptr;
@@ -36,10 +37,13 @@ struct Plans {
 
 class PlanCache {
  public:
-  PlanCache() = default;
+  // Takes the planner once so that its lock, a function-local static, is made before the cache
+  // and so outlives it: the destructor takes it again.
+  PlanCache() { const FftwPlanner planner; }
   PlanCache(const PlanCache&) = delete;
   PlanCache& operator=(const PlanCache&) = delete;
   ~PlanCache() {
+    const FftwPlanner planner;
     for (auto& [n, made] : plans_) {
       fftw_destroy_plan(made.forward);
       fftw_destroy_plan(made.inverse);
@@ -47,7 +51,7 @@ class PlanCache {
   }
 
   Plans For(std::size_t n) {
-    const std::lock_guard<std::mutex> lock(mutex_);
+    const FftwPlanner planner(1);
     auto found = plans_.find(n);
     if (found != plans_.end()) return found->second;
     RealBuffer real = AllocateReal(n);
@@ -60,7 +64,6 @@ class PlanCache {
   }
 
  private:
-  std::mutex mutex_;
   std::map<std::size_t, Plans> plans_;
 };
 

@@ -26,6 +26,11 @@ void AddRegenerateCommand(CLI::App& app) {
   cmd->add_option("--scan", args->scan, "raw wheel scan (.h5/.hdf5 or .csv)")
       ->required()
       ->check(CLI::ExistingFile);
+  cmd->add_option("--scan-settings", args->scan_settings,
+                  "the scan's settings the file lacks, as process --scan-settings (formats.md 2.4)")
+      ->check(CLI::ExistingFile);
+  cmd->add_option("--format", args->scan_format, "the scan's reader, as process --format (default: sniffed)");
+  cmd->add_option("--columns", args->columns, "which column holds what, as process --columns");
   cmd->add_option("--job", args->job, "toolpath job of the part (docs/grinding.md)")
       ->required()
       ->check(CLI::ExistingFile);

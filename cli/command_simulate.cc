@@ -6,6 +6,8 @@
 #include <string>
 #include <vector>
 
+#include "acquisition/scan_format.h"
+#include "acquisition/sensor_writer.h"
 #include "acquisition/simulate.h"
 #include "cli/commands.h"
 #include "core/atomic_file.h"
@@ -22,6 +24,8 @@ struct SimulateArgs {
   std::vector<std::string> radius_harmonics, axial_harmonics, radial_harmonics;
   bool float64 = false;
   int truth_phases = 360;
+  std::string as;             // a sensor's layout (sensortool, keyence-lk); empty: by the extension
+  std::string settings_file;  // the settings file beside a sensor's layout
 };
 
 // "ORDER:AMPLITUDE[:PHASE_DEG]"
@@ -50,11 +54,20 @@ void Run(SimulateArgs& args) {
   args.settings.float32 = !args.float64;
   const acquisition::SimulatedScan simulated = acquisition::SimulateScan(args.wheel, args.settings);
   const std::filesystem::path output(args.output);
-  acquisition::WriteScan(simulated.scan, args.settings.float32, output);
+  std::string settings_path;
+  if (args.as.empty()) {
+    acquisition::WriteScan(simulated.scan, args.settings.float32, output);
+  } else {
+    // What the sensor's software would write, and the settings it leaves out (formats.md 2.4).
+    acquisition::WriteSensorScan(simulated.scan, acquisition::ScanFormatNamed(args.as, "simulate"), output);
+    settings_path = args.settings_file.empty() ? output.string() + ".settings.json" : args.settings_file;
+    WriteFileAtomically(settings_path, acquisition::SensorScanSettingsJson(simulated.scan));
+  }
   const std::string truth_path = args.truth.empty() ? output.string() + ".truth.json" : args.truth;
   WriteFileAtomically(truth_path,
                       acquisition::TruthJson(args.wheel, args.settings, simulated.counts, args.truth_phases));
   fmt::print("scan:  {} ({} samples)\ntruth: {}\n", args.output, simulated.counts.samples, truth_path);
+  if (!settings_path.empty()) fmt::print("settings: {}\n", settings_path);
 }
 
 }  // namespace
@@ -71,6 +84,12 @@ void AddSimulateCommand(CLI::App& app) {
       "100 mm/min, 100 us (about 1.3e5 samples).");
   cmd->add_option("OUTPUT", args->output, "scan file to write (.h5/.hdf5 or .csv/.txt)")->required();
   cmd->add_option("--truth", args->truth, "truth JSON path");
+  cmd->add_option("--as", args->as,
+                  "write what the sensor's software would, with the settings it lacks beside it: sensortool "
+                  "(Micro-Epsilon CSV, decimal comma) or keyence-lk (LK-Navigator CSV)")
+      ->check(CLI::IsMember({"sensortool", "keyence-lk"}));
+  cmd->add_option("--settings", args->settings_file,
+                  "with --as: settings JSON path (default OUTPUT.settings.json)");
   auto& w = args->wheel;
   auto& s = args->settings;
   cmd->add_option("--wheel-diameter-mm", w.wheel_diameter_mm, "wheel diameter at the arc apex")

@@ -190,6 +190,20 @@ std::string SummaryJson(const RunRecord& record, const processing::ProcessedScan
                     {key::input::kValidSamples, processed.valid_samples},
                     {key::input::kDespikedSamples, processed.despike.rejected},
                     {key::input::kStuckSamples, processed.stuck.dropped}};
+  {
+    json columns = json::object();
+    for (const acquisition::ScanReadRecord::Column& c : record.read.columns)
+      columns[c.quantity] = {{key::input::kColumnName, c.name}, {key::input::kColumnUnit, c.unit}};
+    json markers = json::object();
+    for (const auto& [kind, count] : record.read.invalid_markers) markers[kind] = count;
+    json sources = json::object();
+    for (const auto& [setting, source] : record.read.sources) sources[setting] = source;
+    json& input = s[key::kInput];
+    input[key::input::kColumns] = std::move(columns);
+    input[key::input::kInvalidMarkers] = std::move(markers);
+    input[key::input::kScanSettings] = record.read.settings_path;
+    input[key::input::kSources] = std::move(sources);
+  }
   s[key::kScan] = {{key::scan::kWheelId, m.wheel_id},
                    {key::scan::kSensor, m.sensor},
                    {key::scan::kOperator, m.operator_name},

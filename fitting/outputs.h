@@ -18,8 +18,9 @@ namespace arcwheel::fitting {
 struct RunRecord {
   std::string input_path;
   std::string input_sha256;
-  std::string input_format;  // "hdf5", "csv", or "memory" for a scan no reader made
+  std::string input_format;  // a name of acquisition/scan_format.h, or "memory" for a scan no reader made
   acquisition::ScanMetadata metadata;
+  acquisition::ScanReadRecord read;  // what the reader read: columns, markers, settings' sources
   bool has_encoder = false;
   // Every processing parameter as used, in the order to print.
   std::vector<std::pair<std::string, double>> numeric_parameters;

@@ -27,11 +27,11 @@ struct ThreePointFrameOptions {
 };
 
 struct WorkpieceFrame {
-  Eigen::Vector3d origin_mm = Eigen::Vector3d::Zero();  // P1, in machine coordinates
-  Eigen::Matrix3d axes = Eigen::Matrix3d::Identity();   // columns i, j, k in machine coordinates
-  double angle_p2_p3_deg = 90.0;                        // angle at P1 between P2 and P3
-  [[nodiscard]] Transform MachineFromWorkpiece() const;   // rigid3d
-  [[nodiscard]] Transform WorkpieceFromMachine() const;   // rigid3d
+  Eigen::Vector3d origin_mm = Eigen::Vector3d::Zero();   // P1, in machine coordinates
+  Eigen::Matrix3d axes = Eigen::Matrix3d::Identity();    // columns i, j, k in machine coordinates
+  double angle_p2_p3_deg = 90.0;                         // angle at P1 between P2 and P3
+  [[nodiscard]] Transform MachineFromWorkpiece() const;  // rigid3d
+  [[nodiscard]] Transform WorkpieceFromMachine() const;  // rigid3d
 };
 
 // Throws Error{kBadInput, "frames.three_point"} for coincident or collinear points or non-finite

@@ -4,10 +4,12 @@
 
 #include <Eigen/SparseCore>
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <numbers>
 #include <optional>
+#include <utility>
 
 #include "core/check.h"
 #include "core/error.h"
@@ -47,7 +49,7 @@ struct Rows {
 Rows ApertureRows(const ErrorMap& target, const surfaces::Aperture& aperture) {
   Rows rows;
   rows.row_of_node.assign(target.error_um.size(), -1);
-  std::vector<double> values;
+  rows.node.reserve(target.error_um.size());
   for (int j = 0; j < target.grid.ny; ++j) {
     for (int i = 0; i < target.grid.nx; ++i) {
       const int index = j * target.grid.nx + i;
@@ -55,14 +57,15 @@ Rows ApertureRows(const ErrorMap& target, const surfaces::Aperture& aperture) {
         continue;
       rows.row_of_node[index] = static_cast<int>(rows.node.size());
       rows.node.push_back(index);
-      values.push_back(target.error_um[index]);
     }
   }
   if (rows.node.empty()) {
     throw Error(ErrorCode::kBadInput, kStage,
                 fmt::format("empty aperture: no target node lies inside {}", aperture.Describe()));
   }
-  rows.target = Eigen::Map<const Eigen::VectorXd>(values.data(), static_cast<Eigen::Index>(values.size()));
+  rows.target.resize(static_cast<Eigen::Index>(rows.node.size()));
+  for (std::size_t r = 0; r < rows.node.size(); ++r)
+    rows.target[static_cast<Eigen::Index>(r)] = target.error_um[rows.node[r]];
   return rows;
 }
 
@@ -124,7 +127,7 @@ class Removal {
   [[nodiscard]] Eigen::VectorXd Transposed(const Eigen::VectorXd& rows) const {
     return fft_ ? fft_->ApplyTranspose(rows) : Eigen::VectorXd(sparse_.transpose() * rows);
   }
-  // The same products into vectors the caller keeps: no allocation per iteration.
+  // A t into a vector the caller keeps.
   void Multiply(const Eigen::VectorXd& dwell_s, Eigen::VectorXd& rows) const {
     if (fft_) {
       fft_->Apply(dwell_s, rows);
@@ -132,17 +135,29 @@ class Removal {
       rows.noalias() = sparse_ * dwell_s;
     }
   }
-  void MultiplyTransposed(const Eigen::VectorXd& rows, Eigen::VectorXd& dwell_s) const {
+  // A^T residual for the residual the last Residual call wrote (the FFT products keep it placed),
+  // into a vector the caller keeps: no allocation per iteration.
+  void Gradient(const Eigen::VectorXd& residual, Eigen::VectorXd& gradient) const {
     if (fft_) {
-      fft_->ApplyTranspose(rows, dwell_s);
+      fft_->GradientOfResidual(residual, gradient);
     } else {
-      dwell_s.noalias() = sparse_.transpose() * rows;
+      gradient.noalias() = sparse_.transpose() * residual;
     }
+  }
+  // residual = A t - target; returns its norm.
+  double Residual(const Eigen::VectorXd& dwell_s, const Eigen::VectorXd& target,
+                  Eigen::VectorXd& residual) const {
+    if (fft_) return fft_->Residual(dwell_s, target, residual);
+    residual.noalias() = sparse_ * dwell_s;
+    residual -= target;
+    return residual.norm();
   }
   [[nodiscard]] Eigen::Index cols() const { return points_; }
   [[nodiscard]] long Nonzeros() const { return fft_ ? fft_->Nonzeros() : sparse_.nonZeros(); }
   [[nodiscard]] bool UsesFft() const { return fft_.has_value(); }
   [[nodiscard]] const internal::FftRemoval* Fft() const { return fft_ ? &*fft_ : nullptr; }
+  // The FFT products' workers, for the solve's passes; nullptr with the sparse matrix.
+  [[nodiscard]] WorkerPool* Pool() const { return fft_ ? fft_->Pool() : nullptr; }
 
  private:
   Eigen::Index points_;
@@ -191,9 +206,10 @@ Bounds DwellBounds(std::span<const double> chord_mm, const DwellOptions& o) {
   return b;
 }
 
+// `excess`: a vector to work in.
 void CheckReachable(const Removal& a, const Rows& rows, const ErrorMap& map, const Bounds& b,
-                    const DwellOptions& o) {
-  const Eigen::VectorXd excess = a * b.lower - rows.target;
+                    const DwellOptions& o, Eigen::VectorXd& excess) {
+  a.Residual(b.lower, rows.target, excess);
   Eigen::Index worst = 0;
   const double most = excess.maxCoeff(&worst);
   if (most <= kOvershootToleranceUm) return;
@@ -294,6 +310,14 @@ Eigen::VectorXd ShapedDwell(const Eigen::VectorXd& t, const Eigen::VectorXd& cho
   return out;
 }
 
+// The solve's work vectors, kept from the reachability check through the filter steps, the
+// gradient iterations and the shaping rounds to the final product: on a million points each is
+// 8 MB, too much to allocate and fault in afresh (~20 ms each on this virtual machine) for every
+// stage.
+struct WorkVectors {
+  Eigen::VectorXd previous, y, residual, gradient;
+};
+
 struct Fit {
   Eigen::VectorXd dwell_s;
   int iterations = 0;
@@ -308,37 +332,79 @@ struct Fit {
 // small, first residual, a round would polish far below where the first solve stopped.
 constexpr int kWarmStartIterations = 100;
 
+// Of one projected gradient step: ||t - previous||^2, ||t||^2 and (y - t).(t - previous).
+struct StepSums {
+  double change = 0.0, dwell = 0.0, uphill = 0.0;
+};
+
+// t = clamp(y - step gradient) and its sums in one pass over the vectors, on every core (on a
+// million points each pass is memory-bound and costs a fair part of what a transform does). Each
+// block's sums are taken while the block is still in cache.
+StepSums ProjectedStep(const Eigen::VectorXd& y, const Eigen::VectorXd& gradient, double step,
+                       const Bounds& bounds, const Eigen::VectorXd& previous, Eigen::VectorXd& t,
+                       WorkerPool* pool) {
+  std::array<StepSums, internal::kPassBlocks> blocks{};
+  internal::ForEachBlock(
+      static_cast<std::size_t>(t.size()),
+      [&](std::size_t begin, std::size_t end, int block) {
+        const auto b = static_cast<Eigen::Index>(begin), n = static_cast<Eigen::Index>(end - begin);
+        auto ts = t.segment(b, n);
+        ts = (y.segment(b, n) - step * gradient.segment(b, n))
+                 .cwiseMax(bounds.lower.segment(b, n))
+                 .cwiseMin(bounds.upper.segment(b, n));
+        StepSums& sums = blocks[static_cast<std::size_t>(block)];
+        sums.change = (ts - previous.segment(b, n)).squaredNorm();
+        sums.dwell = ts.squaredNorm();
+        sums.uphill = (y.segment(b, n) - ts).dot(ts - previous.segment(b, n));
+      },
+      pool);
+  StepSums total;
+  for (const StepSums& sums : blocks) {
+    total.change += sums.change;
+    total.dwell += sums.dwell;
+    total.uphill += sums.uphill;
+  }
+  return total;
+}
+
 Fit ProjectedGradient(const Removal& a, const Eigen::VectorXd& target, const Bounds& bounds, double step,
-                      const Eigen::VectorXd& start, std::optional<double> stall_reference, bool warm,
-                      const DwellOptions& options) {
+                      Eigen::VectorXd start, std::optional<double> stall_reference, bool warm,
+                      const DwellOptions& options, WorkVectors& work) {
   Fit fit;
-  // The vectors live across iterations: on a million points each is 8 MB, too much to allocate
-  // and fault in a few times per iteration.
-  Eigen::VectorXd t = start.cwiseMax(bounds.lower).cwiseMin(bounds.upper), previous = t, y = t;
-  Eigen::VectorXd residual(target.size()), gradient(t.size());
+  Eigen::VectorXd t = std::move(start);  // the start's vector becomes t
+  t = t.cwiseMax(bounds.lower).cwiseMin(bounds.upper);
+  Eigen::VectorXd &previous = work.previous, &y = work.y, &residual = work.residual,
+                  &gradient = work.gradient;
+  previous = t;
+  y = t;
   double momentum = 1.0;
   std::vector<double> history;
   for (fit.iterations = 1; fit.iterations <= options.max_iterations; ++fit.iterations) {
-    a.Multiply(y, residual);
-    residual -= target;
-    const double residual_norm = residual.norm();
+    const double residual_norm = a.Residual(y, target, residual);
     if (fit.iterations == 1) fit.first_residual_norm = stall_reference.value_or(residual_norm);
     if (Stalled(residual_norm, fit.iterations, fit.first_residual_norm, options, history)) {
       fit.converged = true;
       break;
     }
-    a.MultiplyTransposed(residual, gradient);
+    a.Gradient(residual, gradient);
     previous.swap(t);
-    t = (y - step * gradient).cwiseMax(bounds.lower).cwiseMin(bounds.upper);
-    const double change = (t - previous).norm();
-    if (change <= options.relative_tolerance * t.norm() && (!warm || fit.iterations > kWarmStartIterations)) {
+    const StepSums sums = ProjectedStep(y, gradient, step, bounds, previous, t, a.Pool());
+    if (std::sqrt(sums.change) <= options.relative_tolerance * std::sqrt(sums.dwell) &&
+        (!warm || fit.iterations > kWarmStartIterations)) {
       fit.converged = true;
       break;
     }
     // O'Donoghue & Candes (2015): restart the momentum when it points uphill.
-    if ((y - t).dot(t - previous) > 0.0) momentum = 1.0;
+    if (sums.uphill > 0.0) momentum = 1.0;
     const double next = 0.5 * (1.0 + std::sqrt(1.0 + 4.0 * momentum * momentum));
-    y = t + ((momentum - 1.0) / next) * (t - previous);
+    const double push = (momentum - 1.0) / next;
+    internal::ForEachBlock(
+        static_cast<std::size_t>(t.size()),
+        [&](std::size_t begin, std::size_t end, int) {
+          const auto b = static_cast<Eigen::Index>(begin), n = static_cast<Eigen::Index>(end - begin);
+          y.segment(b, n) = t.segment(b, n) + push * (t.segment(b, n) - previous.segment(b, n));
+        },
+        a.Pool());
     momentum = next;
   }
   fit.iterations = std::min(fit.iterations, options.max_iterations);
@@ -365,22 +431,22 @@ constexpr int kFilterStallSteps = 5;
 constexpr int kMaxFilterSteps = 60;
 
 Fit InverseFilterIterations(const internal::FftRemoval& f, const Removal& a, const Eigen::VectorXd& target,
-                            const Bounds& bounds, double reference, const DwellOptions& options) {
+                            const Bounds& bounds, double reference, const DwellOptions& options,
+                            WorkVectors& work) {
   Fit fit;
-  Eigen::VectorXd t =
-      f.InverseFilter(target, kFilterStartDamping).cwiseMax(bounds.lower).cwiseMin(bounds.upper);
-  Eigen::VectorXd residual(target.size()), best_residual;
+  Eigen::VectorXd &t = work.y, &residual = work.residual, &best_residual = work.gradient;
+  f.InverseFilter(target, kFilterStartDamping, true, t);
+  t = t.cwiseMax(bounds.lower).cwiseMin(bounds.upper);
   fit.first_residual_norm = std::numeric_limits<double>::infinity();
   std::vector<double> history;
   double damping = kFilterStepDamping;
   for (fit.iterations = 1; fit.iterations <= kMaxFilterSteps; ++fit.iterations) {
-    a.Multiply(t, residual);
-    residual -= target;
-    const double norm = residual.norm();
+    const double norm = a.Residual(t, target, residual);
     if (norm < fit.first_residual_norm) {
+      // Kept by swapping: t and the residual are written afresh before they are read again.
       fit.first_residual_norm = norm;
-      fit.dwell_s = t;
-      best_residual = residual;
+      fit.dwell_s.swap(t);
+      best_residual.swap(residual);
     } else {
       damping *= 3.0;
       if (damping > kMaxFilterStepDamping) break;
@@ -390,7 +456,8 @@ Fit InverseFilterIterations(const internal::FftRemoval& f, const Removal& a, con
         history[history.size() - 1 - kFilterStallSteps] - history.back() <=
             options.stall_improvement * reference)
       break;
-    t = (fit.dwell_s - f.InverseFilter(best_residual, damping)).cwiseMax(bounds.lower).cwiseMin(bounds.upper);
+    f.InverseFilter(best_residual, damping, true, t);
+    t = (fit.dwell_s - t).cwiseMax(bounds.lower).cwiseMin(bounds.upper);
   }
   fit.iterations = std::min(fit.iterations, kMaxFilterSteps);
   fit.converged = true;
@@ -398,8 +465,8 @@ Fit InverseFilterIterations(const internal::FftRemoval& f, const Removal& a, con
 }
 
 ErrorMap Scatter(const ErrorMap& like, const Rows& rows, const Eigen::VectorXd& values) {
-  ErrorMap out = like;
-  std::fill(out.error_um.begin(), out.error_um.end(), std::numeric_limits<double>::quiet_NaN());
+  ErrorMap out{.grid = like.grid};
+  out.error_um.assign(like.error_um.size(), std::numeric_limits<double>::quiet_NaN());
   for (std::size_t r = 0; r < rows.node.size(); ++r)
     out.error_um[rows.node[r]] = values[static_cast<Eigen::Index>(r)];
   return out;
@@ -486,33 +553,44 @@ DwellSolution SolveDwell(const ErrorMap& target, const surfaces::Aperture& apert
   const Rows rows = ApertureRows(target, aperture);
   const Removal a(target, rows, path, removal, options.fft_products);
   Bounds bounds = DwellBounds(chord_mm, options);
-  CheckReachable(a, rows, target, bounds, options);
+  WorkVectors work;
+  CheckReachable(a, rows, target, bounds, options, work.residual);
   AddLeastDwell(bounds, path, options);
 
   // Start from the correlation A^T b scaled to fit best: the right shape at low frequencies. Its
   // residual norm is the stall test's reference, whatever the start.
   Eigen::VectorXd start = a.Transposed(rows.target);
-  const Eigen::VectorXd at = a * start;
-  const double fit_scale = at.squaredNorm() > 0.0 ? at.dot(rows.target) / at.squaredNorm() : 0.0;
-  start *= fit_scale;
-  const double correlation_residual = (fit_scale * at - rows.target).norm();
+  double fit_scale = 0.0, correlation_residual = 0.0;
+  {
+    Eigen::VectorXd at = a * start;
+    fit_scale = at.squaredNorm() > 0.0 ? at.dot(rows.target) / at.squaredNorm() : 0.0;
+    at = fit_scale * at - rows.target;
+    correlation_residual = at.norm();
+  }
   const bool spectral = options.inverse_filter_start && a.Fft() != nullptr;
   const double step = 1.0 / GradientLipschitz(a, spectral);
   Fit fit;
   std::optional<Fit> filtered;
-  if (spectral)
-    filtered = InverseFilterIterations(*a.Fft(), a, rows.target, bounds, correlation_residual, options);
+  if (spectral) {
+    // Its pages go to the filter's vectors (first touching 8 MB costs ~20 ms on this virtual
+    // machine); it is made again in the rare case that the filter does not fit better.
+    start = Eigen::VectorXd();
+    filtered = InverseFilterIterations(*a.Fft(), a, rows.target, bounds, correlation_residual, options, work);
+  }
   if (filtered && filtered->first_residual_norm < correlation_residual) {
     // Then the accelerated projected gradient from there, with the job's stopping rules: it
     // finishes what the filter leaves (the aperture's edge, where bounds are active; on a map
     // with steep edges most of the way). A shorter stall window would save most of its
     // iterations on smooth maps but stops short on such a map (removal_fft_test).
-    fit = ProjectedGradient(a, rows.target, bounds, step, filtered->dwell_s, correlation_residual, true,
-                            options);
+    fit = ProjectedGradient(a, rows.target, bounds, step, std::move(filtered->dwell_s), correlation_residual,
+                            true, options, work);
     fit.iterations += filtered->iterations;
     fit.first_residual_norm = correlation_residual;
   } else {
-    fit = ProjectedGradient(a, rows.target, bounds, step, start, std::nullopt, false, options);
+    if (start.size() == 0) start = a.Transposed(rows.target);
+    start *= fit_scale;
+    fit =
+        ProjectedGradient(a, rows.target, bounds, step, std::move(start), std::nullopt, false, options, work);
     fit.iterations += filtered ? filtered->iterations : 0;
   }
   const double stall_reference = fit.first_residual_norm;
@@ -534,14 +612,16 @@ DwellSolution SolveDwell(const ErrorMap& target, const surfaces::Aperture& apert
       if (added_um <= options.shaping_tolerance_um) break;
       if (solution.shaping_rounds == options.max_shaping_rounds) NotSettled(path, worst, added_um, options);
       ++solution.shaping_rounds;
-      fit = ProjectedGradient(a, rows.target, bounds, step, t, stall_reference, true, options);
+      fit =
+          ProjectedGradient(a, rows.target, bounds, step, std::move(t), stall_reference, true, options, work);
       solution.iterations += fit.iterations;
       solution.converged = solution.converged && fit.converged;
       t = std::move(fit.dwell_s);
     }
   }
 
-  const Eigen::VectorXd removed = a * t;
+  Eigen::VectorXd& removed = work.residual;
+  a.Multiply(t, removed);
   solution.nonzeros = a.Nonzeros();
   solution.fft_products = a.UsesFft();
   solution.dwell_s.assign(t.data(), t.data() + t.size());
@@ -550,7 +630,8 @@ DwellSolution SolveDwell(const ErrorMap& target, const surfaces::Aperture& apert
   solution.total_time_s = t.sum();
   solution.max_acceleration_mm_s2 = MaxAcceleration(solution.speed_mm_s, bounds.chord_mm);
   solution.predicted_removal_um = Scatter(target, rows, removed);
-  solution.residual_um = Scatter(target, rows, rows.target - removed);
+  removed = rows.target - removed;  // now the residual
+  solution.residual_um = Scatter(target, rows, removed);
   solution.before = StatisticsInAperture(target, aperture);
   solution.after = StatisticsInAperture(solution.residual_um, aperture);
   return solution;

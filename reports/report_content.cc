@@ -47,7 +47,8 @@ double HeadlineValue(const Summary& s, std::string_view name) {
   return s.max_roundness_um;
 }
 
-// Limits are shown as given (at most seven significant digits, core/number_format.h), not rounded to the value's digits.
+// Limits are shown as given (at most seven significant digits, core/number_format.h), not rounded to the
+// value's digits.
 std::string LimitText(const Limit& limit, const HeadlineSpec& spec) {
   const std::string unit(spec.unit.symbol);
   if (limit.min && limit.max)

@@ -25,11 +25,21 @@ inline constexpr std::string_view kInput = "input";
 namespace input {
 inline constexpr std::string_view kPath = "path";
 inline constexpr std::string_view kSha256 = "sha256";
-inline constexpr std::string_view kFormat = "format";  // "hdf5", "csv" or "memory"
+inline constexpr std::string_view kFormat = "format";  // a name of acquisition/scan_format.h, or "memory"
 inline constexpr std::string_view kSamples = "samples";
 inline constexpr std::string_view kValidSamples = "valid_samples";
 inline constexpr std::string_view kDespikedSamples = "despiked_samples";
 inline constexpr std::string_view kStuckSamples = "stuck_samples";
+// formats.md 2.4: what the reader read. {"z": {"name": "Distance1 (mm)", "unit": "mm"}, ...}
+inline constexpr std::string_view kColumns = "columns";
+inline constexpr std::string_view kColumnName = "name";
+inline constexpr std::string_view kColumnUnit = "unit";
+// Invalid samples by marker kind: {"out_of_range_high": 12, "alarm": 3, ...}; only kinds met.
+inline constexpr std::string_view kInvalidMarkers = "invalid_markers";
+// The --scan-settings file ("" when none) and where each setting in effect came from:
+// {"spindle_rpm": "settings", "sample_period_s": "file", "radius_sign": "default", ...}.
+inline constexpr std::string_view kScanSettings = "scan_settings";
+inline constexpr std::string_view kSources = "sources";
 }  // namespace input
 
 // The scan's metadata as recorded in the scan file.

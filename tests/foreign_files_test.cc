@@ -101,7 +101,9 @@ TEST_F(ForeignFiles, Float32ReadingsKeptAsFloatAreTheSamplesOfAPlainRead) {
     if (!expected.contains("text") || std::filesystem::path(name).extension() != ".h5") continue;
     SCOPED_TRACE(name);
     const Scan plain = acquisition::ReadScan(Good(name));
-    Scan kept = acquisition::ReadScan(Good(name), {.keep_float32 = true, .while_reading = {}});
+    acquisition::ReadOptions keep;
+    keep.keep_float32 = true;
+    Scan kept = acquisition::ReadScan(Good(name), keep);
     kept_as_float += kept.holds_float() ? 1 : 0;
     EXPECT_EQ(kept.CountValid(), plain.CountValid());
     kept.WidenToDouble();

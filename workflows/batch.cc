@@ -26,8 +26,18 @@ struct Child {
   Clock::time_point start;
 };
 
+// The scan and, when the process options give one, the settings from outside it (formats.md 2.4),
+// by their SHA-256: an edited settings file makes every scan run again.
 json ScanInputs(const BatchOptions& args, const Scan& scan) {
-  return StepInputs({{"scan", scan.path}}, args.process_options);
+  std::vector<std::pair<std::string, fs::path>> files = {{"scan", scan.path}};
+  const std::vector<std::string>& options = args.process_options;
+  constexpr std::string_view kFlag = "--scan-settings";
+  for (std::size_t i = 0; i < options.size(); ++i) {
+    if (options[i] == kFlag && i + 1 < options.size()) files.emplace_back("scan_settings", options[i + 1]);
+    if (options[i].starts_with(std::string(kFlag) + "="))
+      files.emplace_back("scan_settings", options[i].substr(kFlag.size() + 1));
+  }
+  return StepInputs(files, args.process_options);
 }
 
 double SecondsSince(Clock::time_point start) {

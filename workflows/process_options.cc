@@ -111,6 +111,16 @@ std::vector<ProcessOption> MakeTable() {
        [](Options& o) -> OptionRef { return &o.no_model; }, false},
       {"--uncertainty", "type B uncertainty budget (docs/uncertainty.md); default: the simulated sensor's",
        "", [](Options& o) -> OptionRef { return &o.uncertainty_budget_path; }, false, true},
+      {"--scan-settings",
+       "JSON of the scan's settings the file lacks: spindle_rpm, feed_mm_per_min, sample_period_s, "
+       "start_y_mm, radius_sign, wheel_id, sensor, ... (formats.md 2.4)",
+       "", [](Options& o) -> OptionRef { return &o.scan_settings_path; }, false, true},
+      {"--format", "the scan's reader: hdf5, csv, sensortool, keyence-lk or columns (default: sniffed)", "",
+       [](Options& o) -> OptionRef { return &o.scan_format; }, false},
+      {"--columns",
+       "which column holds what, by header name and unit: z=NAME[:mm|um|nm],t=NAME[:s|ms|us],"
+       "angle=NAME[:deg|counts],y=NAME[:mm]",
+       "", [](Options& o) -> OptionRef { return &o.columns; }, false},
       {"--no-uncertainty", "leave the uncertainty budget and the noise-corrected figures out of summary.json",
        "", [](Options& o) -> OptionRef { return &o.no_uncertainty; }, false},
   };

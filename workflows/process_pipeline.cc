@@ -31,11 +31,11 @@ fitting::RunRecord MakeRecord(const std::string& scan_path, const ProcessPipelin
   // (docs/inputs.md).
   bool latin1_path = false;
   record.input_path = AsUtf8(scan_path, latin1_path);
-  // The readers choose by the file name (acquisition/scan_format.h); a scan that no reader made (one
+  // The reader names its format (acquisition/scan_format.h); a scan that no reader made (one
   // simulated in memory and handed over from Python) says so rather than borrow a file format.
-  const std::optional<acquisition::ScanFormat> format = acquisition::ScanFormatOfName(scan_path);
-  record.input_format = format ? std::string(acquisition::InfoOf(*format).name) : "memory";
+  record.input_format = scan.read.format.empty() ? "memory" : scan.read.format;
   record.metadata = scan.metadata;
+  record.read = scan.read;
   record.has_encoder = scan.has_encoder();
   // The parameters as the options table records them, in its order; then what the record states
   // beside the options.
@@ -207,6 +207,15 @@ void ResolveProcessPipelineOptions(ProcessPipelineOptions& options) {
   // Every bad option of both stages in one message, before the scan is read: the fit's would
   // otherwise surface only after the whole scan had been processed.
   std::vector<std::string> problems = options.binding_problems;
+  if (!options.scan_format.empty()) {
+    try {
+      (void)acquisition::ScanFormatNamed(options.scan_format, "process");
+    } catch (const Error& e) {
+      problems.push_back(std::string(e.what()).substr(std::string("process: ").size()));
+    }
+  }
+  for (std::string& problem : acquisition::ColumnsOptionProblems(options.columns))
+    problems.push_back(std::move(problem));
   for (std::string& problem : options.processing.Problems()) problems.push_back(std::move(problem));
   for (std::string& problem : options.fit.Problems()) problems.push_back(std::move(problem));
   if (!options.no_model) {
@@ -221,6 +230,9 @@ void ResolveProcessPipelineOptions(ProcessPipelineOptions& options) {
   // A bad budget is refused before the scan is read, with every problem it has (exit 2).
   if (!options.no_uncertainty && !options.uncertainty_budget_path.empty())
     options.uncertainty_budget = uncertainty::ReadBudget(options.uncertainty_budget_path);
+  // So is a bad settings file (exit 2), with every problem it has.
+  if (!options.scan_settings_path.empty())
+    options.scan_settings = acquisition::ReadScanSettings(options.scan_settings_path);
 }
 
 ProcessPipelineResult RunProcessPipeline(const std::string& scan_path, const std::filesystem::path& outdir,
@@ -237,7 +249,11 @@ ProcessPipelineResult RunProcessPipeline(const std::string& scan_path, const std
     sha256 = std::async(std::launch::async, [scan_path] { return Sha256OfFile(scan_path); });
   };
   acquisition::Scan scan =
-      acquisition::ReadScan(scan_path, {.keep_float32 = true, .while_reading = start_hash});
+      acquisition::ReadScan(scan_path, {.keep_float32 = true,
+                                        .while_reading = start_hash,
+                                        .settings = options.scan_settings ? &*options.scan_settings : nullptr,
+                                        .format = options.scan_format,
+                                        .columns = options.columns});
   clock.Stop();
   if (!sha256.valid()) start_hash();  // a reader that had nothing to overlap
   return RunOnScan(std::move(scan), scan_path, std::move(sha256), outdir, options, progress,
@@ -248,7 +264,9 @@ ProcessPipelineResult RunProcessPipeline(acquisition::Scan scan, std::string inp
                                          const std::filesystem::path& outdir, ProcessPipelineOptions options,
                                          Progress& progress) {
   ResolveProcessPipelineOptions(options);
-  // The readers validate what they read; a scan built in memory gets the same checks here.
+  // The readers merge the settings and validate what they read; a scan built in memory gets the
+  // same here.
+  acquisition::ApplyScanSettings(options.scan_settings ? &*options.scan_settings : nullptr, scan);
   acquisition::ValidateScan(scan);
   std::promise<std::string> known;
   known.set_value(std::move(input_sha256));

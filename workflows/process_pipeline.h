@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "acquisition/scan.h"
+#include "acquisition/scan_settings.h"
 #include "core/progress.h"
 #include "core/stage_clock.h"
 #include "fitting/outputs.h"
@@ -36,6 +37,16 @@ struct ProcessPipelineOptions {
   std::string uncertainty_budget_path;
   bool no_uncertainty = false;
   uncertainty::WheelUncertaintyOptions uncertainty;
+  // formats.md 2.4: the scan's settings from outside the file (`--scan-settings FILE`: spindle
+  // speed, feed, sample period, start position, radius sign, names), read and checked with the
+  // other options, before the scan; they fill what the file does not give, and a value the file
+  // gives otherwise is refused (exit 2).
+  std::string scan_settings_path;
+  // formats.md 2.4: the reader by name (`--format`: hdf5, csv, sensortool, keyence-lk, columns;
+  // empty: by the extension and a sniff of the header) and the column map of a delimited file
+  // (`--columns z=NAME[:UNIT],t=NAME[:UNIT],...`), both checked with the other options.
+  std::string scan_format;
+  std::string columns;
   // The tolerances (`--tolerances FILE`, reports/tolerances.h), read by the caller before the
   // scan: with the uncertainty, every toleranced quantity is decided by the file's rule (ISO
   // 14253-1 by default) and summary.json's "uncertainty" carries the rule and the decisions.
@@ -52,6 +63,8 @@ struct ProcessPipelineOptions {
   std::vector<std::string> binding_problems;
   // Filled by ResolveProcessPipelineOptions from uncertainty_budget_path.
   std::optional<uncertainty::BudgetFile> uncertainty_budget;
+  // Filled by ResolveProcessPipelineOptions from scan_settings_path.
+  std::optional<acquisition::ScanSettingsFile> scan_settings;
 };
 
 // Checks every option of both stages (and of the

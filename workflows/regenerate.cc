@@ -117,15 +117,24 @@ void RunRegenerate(const RegenerateOptions& args) {
   RemoveStale(outdir, {kRecordFileName, "regenerate_report.html", "regenerate_report.pdf"});
   StepStatus status;
   const fs::path summary = outdir / kWheelStep.id / schema::summary::kFileName;
-  status.wheel_ran = RunOrReuse(outdir, kWheelStep, StepInputs({{"scan", args.scan}}, json::object()),
-                                [&](const fs::path& folder) {
-                                  RunProcessStep(args.scan, folder);
-                                  const json s = ReadJsonFile(summary, kRegenerateStage);
-                                  fmt::print("mean arc radius {} (1-sigma {}), max runout {}: {}\n",
-                                             Mm(At(s, schema::summary::kMeanArcRadiusMm), 5),
-                                             Mm(At(s, schema::summary::kMeanArcRadiusSigmaMm), 5),
-                                             Um(At(s, schema::summary::kMaxRunoutUm), 2), folder.string());
-                                });
+  // The settings file is an input like the scan; the reader's choice an option (absent at the
+  // defaults, so that earlier records stay equal).
+  std::vector<std::pair<std::string, fs::path>> wheel_files = {{"scan", args.scan}};
+  if (!args.scan_settings.empty()) wheel_files.emplace_back("scan_settings", args.scan_settings);
+  json wheel_options = json::object();
+  if (!args.scan_format.empty()) wheel_options["format"] = args.scan_format;
+  if (!args.columns.empty()) wheel_options["columns"] = args.columns;
+  status.wheel_ran =
+      RunOrReuse(outdir, kWheelStep, StepInputs(wheel_files, wheel_options), [&](const fs::path& folder) {
+        RunProcessStep(
+            args.scan, folder,
+            {.scan_settings = args.scan_settings, .format = args.scan_format, .columns = args.columns});
+        const json s = ReadJsonFile(summary, kRegenerateStage);
+        fmt::print("mean arc radius {} (1-sigma {}), max runout {}: {}\n",
+                   Mm(At(s, schema::summary::kMeanArcRadiusMm), 5),
+                   Mm(At(s, schema::summary::kMeanArcRadiusSigmaMm), 5),
+                   Um(At(s, schema::summary::kMaxRunoutUm), 2), folder.string());
+      });
   if (status.wheel_ran) RemoveStale(outdir, {kToolpathStep.id, kPolishStep.id});
 
   // --wheel-profile model reads p(u) from the wheel map too.

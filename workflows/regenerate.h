@@ -11,7 +11,12 @@
 namespace arcwheel::workflows {
 
 struct RegenerateOptions {
-  std::string scan;      // raw wheel scan (.h5/.hdf5 or .csv)
+  std::string scan;  // raw wheel scan (.h5/.hdf5 or .csv)
+  // How the scan is read (formats.md 2.4, `process --scan-settings/--format/--columns`); empty: as
+  // `process` reads it by default.
+  std::string scan_settings;
+  std::string scan_format;
+  std::string columns;
   std::string job;       // toolpath job of the part (docs/grinding.md)
   std::string polish;    // polishing job; empty: no polishing step
   std::string output;    // OUTDIR

@@ -18,10 +18,15 @@ double StepSecondsSince(std::chrono::steady_clock::time_point start) {
 
 }  // namespace
 
-void RunProcessStep(const std::filesystem::path& scan, const std::filesystem::path& output) {
+void RunProcessStep(const std::filesystem::path& scan, const std::filesystem::path& output,
+                    const ProcessStepInput& input) {
   // The pipeline `arcwheel process -q SCAN -o OUTPUT` runs, with its default options.
   Progress quiet(false);
-  (void)RunProcessPipeline(scan.string(), output, {}, quiet);
+  ProcessPipelineOptions options;
+  options.scan_settings_path = input.scan_settings;
+  options.scan_format = input.format;
+  options.columns = input.columns;
+  (void)RunProcessPipeline(scan.string(), output, std::move(options), quiet);
 }
 
 ToolpathStepResult RunToolpathStep(const std::filesystem::path& job_path,

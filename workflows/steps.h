@@ -5,15 +5,25 @@
 
 #include <filesystem>
 #include <optional>
+#include <string>
 
 #include "grinding/toolpath_writer.h"
 #include "polishing/job.h"
 
 namespace arcwheel::workflows {
 
-// `arcwheel process SCAN -o OUTDIR -q`: the pipeline the command runs (workflows/process_pipeline.h),
-// its options at their defaults, so that the files are those `arcwheel process` writes.
-void RunProcessStep(const std::filesystem::path& scan, const std::filesystem::path& output);
+// How the scan is read (formats.md 2.4): `process`'s --scan-settings, --format and --columns.
+struct ProcessStepInput {
+  std::string scan_settings;
+  std::string format;
+  std::string columns;
+};
+
+// `arcwheel process SCAN -o OUTDIR -q [--scan-settings F --format N --columns C]`: the pipeline the
+// command runs (workflows/process_pipeline.h), its other options at their defaults, so that the
+// files are those `arcwheel process` writes.
+void RunProcessStep(const std::filesystem::path& scan, const std::filesystem::path& output,
+                    const ProcessStepInput& input = {});
 
 struct ToolpathStepResult {
   grinding::Job job;

@@ -9,6 +9,7 @@
 #include <utility>
 
 #include "acquisition/scan_reader.h"
+#include "acquisition/scan_settings.h"
 #include "python/src/bindings.h"
 
 namespace arcwheel::python {
@@ -89,13 +90,26 @@ void BindScan(py::module_& module) {
 
   module.def(
       "read_scan",
-      [](const std::filesystem::path& path, bool keep_float32) {
-        return RunReleased(
-            [&] { return acquisition::ReadScan(path, {.keep_float32 = keep_float32, .while_reading = {}}); });
+      [](const std::filesystem::path& path, bool keep_float32, const std::string& format,
+         const std::string& columns, const std::string& scan_settings) {
+        return RunReleased([&] {
+          std::optional<acquisition::ScanSettingsFile> settings;
+          if (!scan_settings.empty()) settings = acquisition::ReadScanSettings(scan_settings);
+          acquisition::ReadOptions options;
+          options.keep_float32 = keep_float32;
+          options.settings = settings ? &*settings : nullptr;
+          options.format = format;
+          options.columns = columns;
+          return acquisition::ReadScan(path, options);
+        });
       },
-      py::arg("path"), py::arg("keep_float32") = true,
-      "Reads a raw scan (.h5/.hdf5 or .csv/.txt, formats.md section 2). float32 readings stay "
-      "float32 unless keep_float32=False. Raises BadInputError or IoError naming the file.");
+      py::arg("path"), py::arg("keep_float32") = true, py::arg("format") = "", py::arg("columns") = "",
+      py::arg("scan_settings") = "",
+      "Reads a raw scan (.h5/.hdf5 or .csv/.txt, formats.md sections 2 and 2.4): the contract's layouts "
+      "or a sensor's own file (format: sensortool, keyence-lk, columns; default: sniffed), with the "
+      "column map `columns` ('z=NAME:UNIT,...') and the settings file `scan_settings` that supplies what "
+      "the file lacks. float32 readings stay float32 unless keep_float32=False. Raises BadInputError, "
+      "InvalidOptionError or IoError naming the file.");
 }
 
 }  // namespace arcwheel::python

@@ -82,7 +82,7 @@ struct CharacteristicsOptions {
   // Nodes (phases) re-evaluated by the bootstrap: those within this many noise sigmas of the
   // largest value, at most `max_candidates` of them. The rest cannot become the maximum.
   double candidate_sigmas = 8.0;
-  int max_candidates = 16;
+  int max_candidates = 1000;
   [[nodiscard]] std::vector<std::string> Problems() const;
 };
 

@@ -11,10 +11,11 @@
 // and the wheel's value of each, the largest over the band's nodes (or the phases).
 //
 // Type A uncertainty: the map's values carry independent noise of a known sigma, so a parametric
-// bootstrap re-evaluates the operator on the measured values plus fresh noise. A peak-to-valley of
-// noisy points is biased upwards (a filter lowers the bias, it does not remove it): the spread of
-// the replicates about the measured value estimates that bias, and the value is corrected by it;
-// the replicates' standard deviation is u. Pure, deterministic for a given seed.
+// bootstrap re-evaluates the operator on a noise-free estimate of the profiles (the uncertainty
+// stage's smoothed fits of the turns and the sections) plus fresh noise. A peak-to-valley of noisy
+// points is biased upwards (a filter lowers the bias, it does not remove it): the replicates'
+// largest value less the estimate's estimates that bias, and the value is corrected by it; the
+// replicates' standard deviation is u. Pure, deterministic for a given seed.
 
 #include <cstdint>
 #include <optional>
@@ -59,6 +60,11 @@ struct WheelForm {
   std::span<const double> rho_mm{};
   std::span<const double> y_mm{};
   double map_sigma_mm = 0.0;
+  // Each map value's own 1-sigma, mm, [n_phase * n_y] as rho_mm (the noise over the root of its
+  // cell's samples); empty, or NaN at a value: map_sigma_mm stands for it. A cell of three
+  // samples and one of four differ by 15 %: the median alone overstates the noise of the map's
+  // maxima and so their bias.
+  std::span<const double> rho_sigma_mm{};
   // The radial distance from the spindle axis of rho = 0 (the wheel's radius): a roundness
   // profile is of distances from the axis, and the association's limaçon depends on it (weakly).
   double radius_offset_mm = 0.0;
@@ -71,6 +77,17 @@ struct WheelForm {
   // Without them (section_bins = 0) the map's nodes in the band stand for them.
   int section_bins = 0;
   std::span<const double> section_residual_um{}, section_y_mm{}, section_sigma_um{};
+  // The sections' noise-free estimate (um), laid out as their points (the bins, or the map's nodes
+  // in the band without them), and the factor the points' sigmas are scaled by to the noise the
+  // sections show: the uncertainty stage's fit (WheelUncertainty::smoothed_section_um). Empty: the
+  // arc profile's bootstrap starts from the measured points, and its bias comes out far too small.
+  std::span<const double> section_smooth_um{};
+  double section_sigma_scale = 1.0;
+  // The turns' noise-free estimate (um, about rho = 0), [n_band_nodes * n_phase] row-major by the
+  // band's nodes in order: the map's harmonics fitted along the nodes (uncertainty::
+  // FitNoiseFreeRows). Empty: each turn's significant harmonics alone (SignificantHarmonics), whose
+  // noise left in the kept harmonics makes the bootstrap's bias of a maximum over the nodes small.
+  std::span<const double> turn_smooth_um{};
 };
 
 struct CharacteristicsOptions {

@@ -2,14 +2,18 @@
 
 #include <fmt/core.h>
 
+#include <algorithm>
 #include <cmath>
+#include <limits>
 #include <nlohmann/json.hpp>
+#include <span>
 
 #include "core/error.h"
 #include "fitting/wheel_fit.h"
 #include "processing/wheel_map.h"
 #include "reports/tolerances.h"
 #include "schema/summary.h"
+#include "uncertainty/noise_corrected.h"
 #include "uncertainty/wheel_uncertainty.h"
 #include "workflows/process_pipeline.h"
 
@@ -20,10 +24,13 @@ namespace key = schema::summary;
 using characteristics::Association;
 using characteristics::FormOperator;
 
-std::optional<double> CutOff(double value) { return value > 0.0 ? std::optional<double>(value) : std::nullopt; }
+std::optional<double> CutOff(double value) {
+  return value > 0.0 ? std::optional<double>(value) : std::nullopt;
+}
 
 // `op` with what the tolerance of `contract_key` names in place of the defaults.
-void ApplyNamedOperator(const ProcessPipelineOptions& options, std::string_view contract_key, FormOperator& op) {
+void ApplyNamedOperator(const ProcessPipelineOptions& options, std::string_view contract_key,
+                        FormOperator& op) {
   if (!options.tolerances) return;
   const auto found = options.tolerances->operators.find(std::string(contract_key));
   if (found == options.tolerances->operators.end()) return;
@@ -51,14 +58,16 @@ void FitCutOffToThePhases(std::string_view what, FormOperator& op, int points_pe
 }
 
 std::string OperatorProblem(std::string_view contract_key, const FormOperator& op, int points_per_turn) {
-  if (contract_key == key::kMaxRoundnessUm) return characteristics::RoundnessOperatorProblem(op, points_per_turn);
+  if (contract_key == key::kMaxRoundnessUm)
+    return characteristics::RoundnessOperatorProblem(op, points_per_turn);
   if (contract_key == key::kMaxRunoutUm) return characteristics::RunoutOperatorProblem(op, points_per_turn);
   return characteristics::ArcProfileOperatorProblem(op);
 }
 
 // The budget's type B inputs of a quantity, with the operator's type A in place of the
 // uncertainty stage's.
-uncertainty::Combined CombineWithBudget(const uncertainty::WheelUncertainty& wheel, std::string_view contract_key,
+uncertainty::Combined CombineWithBudget(const uncertainty::WheelUncertainty& wheel,
+                                        std::string_view contract_key,
                                         const characteristics::FormCharacteristic& form) {
   std::vector<uncertainty::Input> inputs;
   uncertainty::Input type_a;
@@ -77,13 +86,15 @@ uncertainty::Combined CombineWithBudget(const uncertainty::WheelUncertainty& whe
   return uncertainty::Combine(inputs, wheel.budget.combine);
 }
 
-std::optional<uncertainty::Decision> DecisionOf(const ProcessPipelineOptions& options, std::string_view contract_key,
-                                                double value, double expanded) {
+std::optional<uncertainty::Decision> DecisionOf(const ProcessPipelineOptions& options,
+                                                std::string_view contract_key, double value,
+                                                double expanded) {
   if (!options.tolerances) return std::nullopt;
   const auto found = options.tolerances->limits.find(std::string(contract_key));
   if (found == options.tolerances->limits.end()) return std::nullopt;
-  return uncertainty::Decide(value, expanded, {.min = found->second.min, .max = found->second.max},
-                             {.rule = options.tolerances->rule.value_or(uncertainty::DecisionRule::kIso14253)});
+  return uncertainty::Decide(
+      value, expanded, {.min = found->second.min, .max = found->second.max},
+      {.rule = options.tolerances->rule.value_or(uncertainty::DecisionRule::kIso14253)});
 }
 
 Characteristic FormItem(const ProcessPipelineOptions& options, const uncertainty::WheelUncertainty& wheel,
@@ -102,7 +113,8 @@ Characteristic FormItem(const ProcessPipelineOptions& options, const uncertainty
   c.operator_text = form.op.Describe();
   c.cutoff_upr = form.op.cutoff_upr;
   c.cutoff_mm = form.op.cutoff_mm;
-  c.association = form.op.association ? std::string(characteristics::AssociationName(*form.op.association)) : "";
+  c.association =
+      form.op.association ? std::string(characteristics::AssociationName(*form.op.association)) : "";
   c.parameter = form.op.parameter;
   c.where = std::move(where);
   c.decision = DecisionOf(options, contract_key, c.value, c.expanded);
@@ -111,7 +123,8 @@ Characteristic FormItem(const ProcessPipelineOptions& options, const uncertainty
 
 // A least-squares figure of the per-phase fits, as the uncertainty stage evaluates it.
 Characteristic FitItem(const ProcessPipelineOptions& options, const uncertainty::WheelUncertainty& wheel,
-                       std::string name, std::string_view contract_key, std::string label, std::string parameter) {
+                       std::string name, std::string_view contract_key, std::string label,
+                       std::string parameter) {
   Characteristic c;
   c.name = std::move(name);
   c.contract_key = contract_key;
@@ -121,7 +134,8 @@ Characteristic FitItem(const ProcessPipelineOptions& options, const uncertainty:
   c.parameter = std::move(parameter);
   c.operator_text = c.parameter + ", no filter, LS";
   const uncertainty::QuantityUncertainty* q = wheel.Find(contract_key);
-  if (q == nullptr) throw Error(ErrorCode::kInternal, "process", fmt::format("no uncertainty for {}", contract_key));
+  if (q == nullptr)
+    throw Error(ErrorCode::kInternal, "process", fmt::format("no uncertainty for {}", contract_key));
   c.unit = q->unit;
   c.value = q->value;
   c.u = q->combined.standard_uncertainty;
@@ -131,10 +145,63 @@ Characteristic FitItem(const ProcessPipelineOptions& options, const uncertainty:
   return c;
 }
 
+// The turns of the map in the band without their noise, um about rho = 0, [band nodes x phases]:
+// the uncertainty stage's fit of the map (harmonics kept over all the nodes, each fitted along
+// them) up to three times the larger turn cut-off (its Gaussian passes 0.2 % there), so that the
+// bootstrap of roundness and run-out draws about turns with little noise left in them. Empty when
+// the map has no noise or no node in the band.
+// Each map value's 1-sigma from the noise, mm: the per-sample noise over the root of the cell's
+// samples that the despiking kept; NaN where none. Over simulated scans the map's residuals
+// about its smoothed turns scatter by 1.00 of it in cells of three samples and of four alike.
+std::vector<double> ValueSigmasMm(const processing::WheelMap& map) {
+  std::vector<double> sigma(map.rho_mm.size(), std::numeric_limits<double>::quiet_NaN());
+  if (map.sample_count.size() != sigma.size() || map.despiked_count.size() != sigma.size()) return sigma;
+  for (std::size_t cell = 0; cell < sigma.size(); ++cell) {
+    const int samples = map.sample_count[cell] - map.despiked_count[cell];
+    if (samples > 0) sigma[cell] = map.noise_sigma_mm / std::sqrt(static_cast<double>(samples));
+  }
+  return sigma;
+}
+
+std::vector<double> SmoothedTurns(const processing::WheelMap& map, std::span<const double> value_sigma_mm,
+                                  double band_low_mm, double band_high_mm,
+                                  const characteristics::CharacteristicsOptions& operators, int max_degree) {
+  const std::size_t n_phase = map.n_phase(), n_y = map.n_y();
+  std::vector<std::size_t> band;
+  for (std::size_t j = 0; j < n_y; ++j)
+    if (map.y_mm[j] >= band_low_mm && map.y_mm[j] <= band_high_mm) band.push_back(j);
+  const double sigma_um = map.map_sigma_mm * 1000.0;
+  if (band.size() < 3 || !(sigma_um > 0.0) || n_phase < 8) return {};
+  std::vector<double> rows(band.size() * n_phase), sigmas(rows.size());
+  for (std::size_t i = 0; i < band.size(); ++i) {
+    for (std::size_t p = 0; p < n_phase; ++p) {
+      const std::size_t cell = p * n_y + band[i];
+      rows[i * n_phase + p] = map.rho_mm[cell] * 1000.0;
+      sigmas[i * n_phase + p] =
+          std::isfinite(value_sigma_mm[cell]) ? value_sigma_mm[cell] * 1000.0 : sigma_um;
+    }
+  }
+  const int most = static_cast<int>(n_phase - 2) / 2;
+  double cutoff_upr = 0.0;
+  for (const auto& op : {operators.roundness, operators.runout})
+    cutoff_upr = std::max(cutoff_upr, op.cutoff_upr.value_or(static_cast<double>(most)));
+  const uncertainty::NoiseCorrectedPvOptions fit{
+      .basis = uncertainty::SmoothBasis::kFourier,
+      .max_order = std::min(most, static_cast<int>(std::ceil(3.0 * cutoff_upr))),
+      .across_rows_max_degree = std::min(max_degree, static_cast<int>(band.size()) - 2)};
+  try {
+    return uncertainty::FitNoiseFreeRows(rows, sigmas, static_cast<int>(band.size()),
+                                         static_cast<int>(n_phase), fit);
+  } catch (const Error&) {
+    return {};  // no turn with half its values: each turn's own harmonics stand in
+  }
+}
+
 }  // namespace
 
 characteristics::CharacteristicsOptions CharacteristicOperators(const ProcessPipelineOptions& options,
-                                                                int points_per_turn, std::vector<std::string>* warnings) {
+                                                                int points_per_turn,
+                                                                std::vector<std::string>* warnings) {
   characteristics::CharacteristicsOptions out;
   out.roundness = {.cutoff_upr = CutOff(options.roundness_filter_upr),
                    .cutoff_mm = std::nullopt,
@@ -163,7 +230,8 @@ characteristics::CharacteristicsOptions CharacteristicOperators(const ProcessPip
                                                                     {key::kMaxArcErrorUm, &out.arc_profile}};
   for (const auto& [contract_key, op] : named) {
     if (const std::string problem = OperatorProblem(contract_key, *op, points_per_turn); !problem.empty()) {
-      const bool from_tolerance = options.tolerances && options.tolerances->operators.count(std::string(contract_key));
+      const bool from_tolerance =
+          options.tolerances && options.tolerances->operators.count(std::string(contract_key));
       problems.push_back(fmt::format("{} ({}): {}", contract_key,
                                      from_tolerance ? "the tolerance's operator" : "the options", problem));
     }
@@ -172,11 +240,13 @@ characteristics::CharacteristicsOptions CharacteristicOperators(const ProcessPip
   return out;
 }
 
-CharacteristicsResult EvaluateCharacteristics(const ProcessPipelineOptions& options, const processing::WheelMap& map,
-                                              const fitting::WheelFit& fit,
-                                              const uncertainty::WheelUncertainty& wheel, double wheel_radius_mm) {
+CharacteristicsResult EvaluateCharacteristics(const ProcessPipelineOptions& options,
+                                              const processing::WheelMap& map, const fitting::WheelFit& fit,
+                                              const uncertainty::WheelUncertainty& wheel,
+                                              double wheel_radius_mm) {
   std::vector<double> center_axial, center_radial, radius;
   std::vector<char> usable;
+  std::vector<std::string> warnings;
   for (const fitting::PhaseFit& phase : fit.phases) {
     center_axial.push_back(phase.center_axial_mm);
     center_radial.push_back(phase.center_radial_mm);
@@ -198,20 +268,31 @@ CharacteristicsResult EvaluateCharacteristics(const ProcessPipelineOptions& opti
   form.section_residual_um = fit.section_residual_um;
   form.section_y_mm = fit.section_y_mm;
   form.section_sigma_um = fit.section_sigma_um;
+  form.section_smooth_um = wheel.smoothed_section_um;
+  form.section_sigma_scale = wheel.section_sigma_scale;
+  const characteristics::CharacteristicsOptions operators =
+      CharacteristicOperators(options, static_cast<int>(map.n_phase()), &warnings);
+  const std::vector<double> value_sigma = ValueSigmasMm(map);
+  form.rho_sigma_mm = value_sigma;
+  const std::vector<double> turns = SmoothedTurns(map, value_sigma, fit.band_low_mm, fit.band_high_mm,
+                                                  operators, options.uncertainty.max_degree);
+  form.turn_smooth_um = turns;
 
   CharacteristicsResult result;
-  result.form = characteristics::EvaluateWheelCharacteristics(
-      form, CharacteristicOperators(options, static_cast<int>(map.n_phase()), &result.warnings));
+  result.warnings = std::move(warnings);
+  result.form = characteristics::EvaluateWheelCharacteristics(form, operators);
   if (options.tolerances)
     result.rule = options.tolerances->rule.value_or(uncertainty::DecisionRule::kIso14253);
   const auto& f = result.form;
-  result.items.push_back(FitItem(options, wheel, "mean_arc_radius", key::kMeanArcRadiusMm, "mean arc radius", "mean Ra"));
+  result.items.push_back(
+      FitItem(options, wheel, "mean_arc_radius", key::kMeanArcRadiusMm, "mean arc radius", "mean Ra"));
   result.items.push_back(
       FitItem(options, wheel, "arc_radius_range", key::kArcRadiusRangeMm, "arc radius range", "range of Ra"));
   result.items.push_back(FitItem(options, wheel, "center_axial_deviation", key::kCenterAxialDeviationMm,
                                  "arc centre axial deviation", "range of a"));
-  result.items.push_back(FormItem(options, wheel, "max_arc_error", key::kMaxArcErrorUm, "max arc profile error",
-                                  f.arc_profile, fmt::format("at phase {:g} deg", f.arc_profile.worst_at)));
+  result.items.push_back(FormItem(options, wheel, "max_arc_error", key::kMaxArcErrorUm,
+                                  "max arc profile error", f.arc_profile,
+                                  fmt::format("at phase {:g} deg", f.arc_profile.worst_at)));
   result.items.push_back(FormItem(options, wheel, "max_runout", key::kMaxRunoutUm, "max circular run-out",
                                   f.runout, fmt::format("at y = {:.3f} mm", f.runout.worst_at)));
   result.items.push_back(FormItem(options, wheel, "max_roundness", key::kMaxRoundnessUm, "max roundness",

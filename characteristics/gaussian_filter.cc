@@ -118,6 +118,25 @@ std::vector<double> FilterClosedProfile(std::span<const double> values, double c
   return {real.get(), real.get() + n};
 }
 
+std::vector<double> SignificantHarmonics(std::span<const double> values, double noise_sigma, double power_ratio) {
+  const std::size_t n = values.size();
+  RequireClosedProfile(n);
+  ComplexBuffer spectrum = Spectrum(values);
+  const double noise_power = static_cast<double>(n) * noise_sigma * noise_sigma;
+  const double inverse_n = 1.0 / static_cast<double>(n);
+  spectrum[0][0] *= inverse_n;
+  spectrum[0][1] = 0.0;
+  for (std::size_t k = 1; k <= n / 2; ++k) {
+    const double power = spectrum[k][0] * spectrum[k][0] + spectrum[k][1] * spectrum[k][1];
+    const double weight = power > power_ratio * noise_power ? 1.0 - noise_power / power : 0.0;
+    spectrum[k][0] *= weight * inverse_n;
+    spectrum[k][1] *= weight * inverse_n;
+  }
+  RealBuffer real = AllocateReal(n);
+  fftw_execute_dft_c2r(PlansFor(n).inverse, spectrum.get(), real.get());
+  return {real.get(), real.get() + n};
+}
+
 std::vector<double> HarmonicAmplitudes(std::span<const double> values, int max_harmonic) {
   const std::size_t n = values.size();
   RequireClosedProfile(n);

@@ -38,6 +38,13 @@ namespace arcwheel::characteristics {
 // the unit of the values; element k - 1 holds harmonic k.
 [[nodiscard]] std::vector<double> HarmonicAmplitudes(std::span<const double> values, int max_harmonic);
 
+// The closed profile's estimate without its white noise of 1-sigma `noise_sigma`: each harmonic
+// k >= 1 whose power |X_k|^2 exceeds power_ratio times the noise's (n sigma^2) kept with the
+// Wiener weight 1 - n sigma^2 / |X_k|^2, every other dropped (the noise cannot be told from it),
+// the mean kept. Throws Error{kBadInput} for n < 8.
+[[nodiscard]] std::vector<double> SignificantHarmonics(std::span<const double> values, double noise_sigma,
+                                                       double power_ratio);
+
 // The mean line of an open profile sampled every `spacing_mm`, for a cut-off wavelength
 // `cutoff_mm` (end treatment above). Throws Error{kInvalidOption, "characteristics.filter"} unless
 // spacing_mm > 0 and cutoff_mm >= 5 spacing_mm (below that the weighting function is not

@@ -37,7 +37,24 @@ struct ProcessArgs {
   std::string db;
 };
 
-void PrintHeadline(const ProcessArgs& args, const processing::ProcessedScan& p, const fitting::WheelFit& f) {
+// One line a characteristic: its value under its operator, U and, with a tolerance, the decision.
+void PrintCharacteristics(const workflows::CharacteristicsResult& c) {
+  for (const workflows::Characteristic& item : c.items) {
+    const bool mm = item.unit == "mm";
+    const std::string value = mm ? fmt::format("{:.5f} mm", Shown(item.value))
+                                 : fmt::format("{:.3f} {}", Shown(item.value), item.unit);
+    const std::string expanded = mm ? fmt::format("U = {:.5f} (k = {:.2f})", Shown(item.expanded),
+                                                  Shown(item.coverage_factor))
+                                    : fmt::format("U = {:.3f} (k = {:.2f})", Shown(item.expanded),
+                                                  Shown(item.coverage_factor));
+    fmt::print("{:<28} {:>14}  {:<24} {:<24} {}\n", item.label, value, expanded, item.operator_text,
+               item.decision ? uncertainty::DecisionName(*item.decision) : "");
+  }
+}
+
+void PrintHeadline(const ProcessArgs& args, const workflows::ProcessPipelineResult& result) {
+  const processing::ProcessedScan& p = result.processed;
+  const fitting::WheelFit& f = result.fit;
   const std::filesystem::path out(args.outdir);
   fmt::print("summary: {}\nmap:     {}\n", (out / schema::summary::kFileName).string(),
              (out / schema::wheel_map::kFileName).string());
@@ -46,18 +63,21 @@ void PrintHeadline(const ProcessArgs& args, const processing::ProcessedScan& p, 
              p.phase_source == processing::PhaseSource::kEncoder     ? "encoder"
              : p.phase_source == processing::PhaseSource::kEstimated ? "estimated from the data"
                                                                      : "nominal");
-  fmt::print("mean arc radius      {:.5f} +- {:.5f} mm (1 sigma), {} of {} phases usable\n",
-             Shown(f.mean_arc_radius_mm), Shown(f.mean_arc_radius_sigma_mm), f.usable_phases,
-             f.phases.size());
-  fmt::print("arc radius range     {:.5f} mm ({:.3f} %); real spread beyond noise {:.5f} mm\n",
-             Shown(f.arc_radius_range_mm), Shown(f.arc_radius_fluctuation_pct),
-             Shown(f.arc_radius_excess_std_mm));
-  fmt::print("arc centre axial     {:.5f} mm, deviation {:.5f} mm\n", Shown(f.mean_center_axial_mm),
-             Shown(f.center_axial_deviation_mm));
-  fmt::print("max arc error        {:.3f} um in the band [{:.3f}, {:.3f}] mm\n", Shown(f.max_arc_error_um),
+  fmt::print("{} of {} phases usable; band [{:.3f}, {:.3f}] mm\n", f.usable_phases, f.phases.size(),
              Shown(f.band_low_mm), Shown(f.band_high_mm));
-  fmt::print("max runout           {:.3f} um (wheel + spindle error motion)\n", Shown(f.max_runout_um));
-  fmt::print("max roundness        {:.3f} um\n", Shown(f.max_roundness_um));
+  if (result.characteristics) {
+    PrintCharacteristics(*result.characteristics);
+    return;
+  }
+  // Without the uncertainty there is no operator's value to show: the contract's raw figures,
+  // named as what they are.
+  fmt::print("mean arc radius      {:.5f} +- {:.5f} mm (1 sigma, least squares)\n", Shown(f.mean_arc_radius_mm),
+             Shown(f.mean_arc_radius_sigma_mm));
+  fmt::print("arc radius range     {:.5f} mm (least squares)\n", Shown(f.arc_radius_range_mm));
+  fmt::print("arc centre axial     deviation {:.5f} mm (least squares)\n", Shown(f.center_axial_deviation_mm));
+  fmt::print("max arc error        {:.3f} um (unfiltered, least squares)\n", Shown(f.max_arc_error_um));
+  fmt::print("max runout           {:.3f} um (unfiltered)\n", Shown(f.max_runout_um));
+  fmt::print("max roundness        {:.3f} um (unfiltered, least squares)\n", Shown(f.max_roundness_um));
 }
 
 void PrintModelHeadline(const fitting::WheelModel& m) {
@@ -90,7 +110,7 @@ void RunAndPrint(ProcessArgs& args) {
       workflows::RunProcessPipeline(args.scan_path, args.outdir, args.pipeline, progress);
   progress.Done();
   if (args.timings) PrintTimings(result.clock);
-  if (!args.quiet) PrintHeadline(args, result.processed, result.fit);
+  if (!args.quiet) PrintHeadline(args, result);
   if (!args.quiet && result.model) PrintModelHeadline(*result.model);
   if (!args.report_formats.empty()) {
     // The report is drawn from the files just written, exactly as `arcwheel report` would.

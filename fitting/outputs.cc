@@ -177,7 +177,7 @@ void WriteMap(const std::filesystem::path& path, const RunRecord& record,
 }  // namespace
 
 std::string SummaryJson(const RunRecord& record, const processing::ProcessedScan& processed,
-                        const WheelFit& fit, const WheelModel* model, const nlohmann::json* uncertainty) {
+                        const WheelFit& fit, const WheelModel* model, const nlohmann::json* later_stages) {
   const processing::WheelMap& map = processed.map;
   const acquisition::ScanMetadata& m = record.metadata;
   json s;
@@ -267,20 +267,22 @@ std::string SummaryJson(const RunRecord& record, const processing::ProcessedScan
   for (const auto& w : fit.warnings) warnings.push_back(w);
   s[key::kWarnings] = warnings;
   if (model != nullptr && model->fitted) s[key::kModel] = ModelJson(*model);
-  if (uncertainty != nullptr) s[key::kUncertainty] = *uncertainty;
+  if (later_stages != nullptr) {
+    for (const auto& [name, object] : later_stages->items()) s[name] = object;
+  }
   return s.dump(2) + "\n";
 }
 
 void WriteProcessOutputs(const std::filesystem::path& outdir, const RunRecord& record,
                          const processing::ProcessedScan& processed, const WheelFit& fit,
-                         const WheelModel* model, const nlohmann::json* uncertainty) {
+                         const WheelModel* model, const nlohmann::json* later_stages) {
   // A folder this call makes goes again if a write fails: nothing of a failed run stays behind.
   OutputSet outputs;
   outputs.CreateFolder(outdir);
   const auto summary_path = outputs.Stage(outdir / key::kFileName);
   const auto map_path = outputs.Stage(outdir / h5::kFileName);
   {
-    const std::string summary = SummaryJson(record, processed, fit, model, uncertainty);
+    const std::string summary = SummaryJson(record, processed, fit, model, later_stages);
     std::ofstream out(summary_path, std::ios::binary);
     out << summary;
     out.flush();

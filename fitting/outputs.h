@@ -27,16 +27,17 @@ struct RunRecord {
   std::vector<std::pair<std::string, std::string>> text_parameters;
 };
 
-// Writes OUTDIR/summary.json and OUTDIR/wheel_map.h5; creates OUTDIR if needed. `uncertainty`,
-// when given, is summary.json's "uncertainty" object (uncertainty/wheel_uncertainty.h makes it).
+// Writes OUTDIR/summary.json and OUTDIR/wheel_map.h5; creates OUTDIR if needed. `later_stages`,
+// when given, is an object whose members are summary.json's objects of the stages after the fit
+// ("uncertainty", uncertainty/wheel_uncertainty.h; "characteristics", workflows/characteristics_step.h).
 // Throws Error{kIo}; on any failure neither file is replaced.
 void WriteProcessOutputs(const std::filesystem::path& outdir, const RunRecord& record,
                          const processing::ProcessedScan& processed, const WheelFit& fit,
-                         const WheelModel* model = nullptr, const nlohmann::json* uncertainty = nullptr);
+                         const WheelModel* model = nullptr, const nlohmann::json* later_stages = nullptr);
 
 // The summary document alone (what WriteProcessOutputs writes to summary.json).
 [[nodiscard]] std::string SummaryJson(const RunRecord& record, const processing::ProcessedScan& processed,
                                       const WheelFit& fit, const WheelModel* model = nullptr,
-                                      const nlohmann::json* uncertainty = nullptr);
+                                      const nlohmann::json* later_stages = nullptr);
 
 }  // namespace arcwheel::fitting

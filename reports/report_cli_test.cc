@@ -97,20 +97,36 @@ TEST(ReportCommand, ReportsASimulatedAndProcessedScanWithTheSummaryNumbers) {
   const nlohmann::json summary = nlohmann::json::parse(ReadText(dir / "out" / "summary.json"));
   // pdftotext breaks wrapped table cells into lines: read the text with single spaces.
   const std::string text = std::regex_replace(PdfText(dir / "out" / "report.pdf"), std::regex(R"(\s+)"), " ");
-  EXPECT_THAT(text, HasSubstr(fmt::format("{:.5f} mm", summary["mean_arc_radius_mm"].get<double>())));
-  EXPECT_THAT(text, HasSubstr(fmt::format("± {:.5f} mm (σ of the mean)",
-                                          summary["mean_arc_radius_sigma_mm"].get<double>())));
-  EXPECT_THAT(
-      text, HasSubstr(fmt::format("phase-to-phase σ {:.4f} mm", summary["arc_radius_std_mm"].get<double>())));
+  const std::string html = ReadText(dir / "out" / "report.html");
+  // Page 1's rows for the characteristics read as summary.json's characteristics block has them:
+  // the value, U and k, then the operator and where the largest value is. pdftotext interleaves a
+  // wrapped cell with its neighbour's lines, so the whole cell is read in the HTML. Precision as
+  // the report documents it per unit.
+  struct Row {
+    const char* name;
+    const char* value_key;
+    const char* unit;
+    int digits;
+  };
+  for (const Row& row :
+       {Row{"mean_arc_radius", "value_mm", "mm", 5}, Row{"arc_radius_range", "value_mm", "mm", 4},
+        Row{"center_axial_deviation", "value_mm", "mm", 4}, Row{"max_arc_error", "value_um", "µm", 2},
+        Row{"max_runout", "value_um", "µm", 2}, Row{"max_roundness", "value_um", "µm", 2}}) {
+    const nlohmann::json& c = summary.at("characteristics").at(row.name);
+    const std::string value =
+        fmt::format("{:.{}f} {}", c.at(row.value_key).get<double>(), row.digits, row.unit);
+    const std::string expanded = fmt::format("U = {:.{}f} {}", c.at("U").get<double>(), row.digits, row.unit);
+    const std::string where = c.contains("where") ? ", " + c.at("where").get<std::string>() : "";
+    EXPECT_THAT(text, HasSubstr(value)) << row.name;
+    EXPECT_THAT(text, HasSubstr(expanded)) << row.name;
+    EXPECT_THAT(html, HasSubstr(fmt::format("{} (k = {:.2f}); {}{}", expanded, c.at("k").get<double>(),
+                                            c.at("operator").at("short").get<std::string>(), where)))
+        << row.name;
+  }
   // The caveat's cell wraps beside the uncertainty's, so pdftotext interleaves their lines: its
   // first words are checked.
   EXPECT_THAT(text, HasSubstr("Caveat: " + summary["runout_note"].get<std::string>().substr(0, 9)));
-  EXPECT_THAT(text, HasSubstr(fmt::format("{:.4f} mm", summary["arc_radius_range_mm"].get<double>())));
   EXPECT_THAT(text, HasSubstr(fmt::format("{:.3f} %", summary["arc_radius_fluctuation_pct"].get<double>())));
-  EXPECT_THAT(text, HasSubstr(fmt::format("{:.4f} mm", summary["center_axial_deviation_mm"].get<double>())));
-  for (const char* key : {"max_arc_error_um", "max_runout_um", "max_roundness_um"}) {
-    EXPECT_THAT(text, HasSubstr(fmt::format("{:.2f} µm", summary[key].get<double>()))) << key;
-  }
   EXPECT_THAT(text, HasSubstr(summary["input"]["sha256"].get<std::string>()));
   EXPECT_THAT(text, HasSubstr("Overall: PASS"));
   // The wheel model, which `process` fits by default, as summary.json has it.
@@ -124,8 +140,6 @@ TEST(ReportCommand, ReportsASimulatedAndProcessedScanWithTheSummaryNumbers) {
                                           model["radius_variation_chi2"].get<double>(),
                                           model["radius_variation_dof"].get<int>())));
   EXPECT_THAT(text, HasSubstr(fmt::format("{:.2f} µm", model["profile_pv_um"].get<double>())));
-  const std::string html = ReadText(dir / "out" / "report.html");
-  EXPECT_THAT(html, HasSubstr(fmt::format("{:.2f} µm", summary["max_runout_um"].get<double>())));
 }
 
 // ISO 14253-1 through the CLI: limits placed by hand around the summary's noise-corrected runout
@@ -139,8 +153,9 @@ TEST(ReportCommand, DecidesByIso14253AgainstValueAndExpandedUncertainty) {
       RunArcwheel("process '" + (dir / "scan.h5").string() + "' -o '" + (dir / "out").string() + "' -q");
   ASSERT_EQ(processed.exit_status, 0) << processed.output;
   const nlohmann::json summary = nlohmann::json::parse(ReadText(dir / "out" / "summary.json"));
-  const nlohmann::json& runout = summary["uncertainty"]["quantities"]["max_runout_um"];
-  const double value = runout["value"].get<double>();
+  // Page 1 decides the characteristic (TIR under its operator) on its own value and U.
+  const nlohmann::json& runout = summary["characteristics"]["max_runout"];
+  const double value = runout["value_um"].get<double>();
   const double u = runout["U"].get<double>();
   ASSERT_GT(u, 0.0);
   const auto overall = [&](double limit, const std::string& extra = "") {
@@ -155,7 +170,7 @@ TEST(ReportCommand, DecidesByIso14253AgainstValueAndExpandedUncertainty) {
   EXPECT_EQ(overall(value - u / 2), "overall: NOT PROVEN");
   EXPECT_EQ(overall(value + 2 * u), "overall: PASS");
   EXPECT_EQ(overall(value - 2 * u), "overall: FAIL");
-  const std::string text = PdfText(dir / "out" / "report.pdf");
+  const std::string text = std::regex_replace(PdfText(dir / "out" / "report.pdf"), std::regex(R"(\s+)"), " ");
   EXPECT_THAT(text, HasSubstr("ISO 14253-1:2017 default rule"));
   // Shared risk, named in the tolerance file: the value alone decides.
   WriteText(dir / "shared.json", R"({"decision_rule": "simple-acceptance"})");

@@ -133,6 +133,33 @@ DecisionRule RuleOf(const Summary& summary, const Tolerances& tolerances) {
   return summary.uncertainty.empty() ? DecisionRule::kSimpleAcceptance : DecisionRule::kIso14253;
 }
 
+Verdict VerdictOf(uncertainty::Decision decision) {
+  return decision == uncertainty::Decision::kConforms         ? Verdict::kPass
+         : decision == uncertainty::Decision::kDoesNotConform ? Verdict::kFail
+                                                              : Verdict::kNotProven;
+}
+
+// A characteristic as `process` evaluated it: one value under its operator, its U, and the
+// decision process made; a limit given to the report alone is decided here, on the same value and U.
+HeadlineRow CharacteristicRow(HeadlineRow row, const Summary::Characteristic& c, const HeadlineSpec& spec,
+                              const std::optional<Limit>& limit, DecisionRule rule) {
+  row.value = FormatValue(c.value, spec.unit);
+  row.uncertainty = "U = " + FormatValue(c.expanded, spec.unit) + " (k = " + FormatFixed(c.coverage_factor, 2) +
+                    "); " + c.operator_text + (c.where.empty() ? "" : ", " + c.where);
+  row.noise.clear();
+  if (!limit) {
+    row.verdict = Verdict::kNoTolerance;
+  } else if (!c.decision.empty()) {
+    row.verdict = c.decision == "conforms" ? Verdict::kPass
+                  : c.decision == "does not conform" ? Verdict::kFail
+                                                     : Verdict::kNotProven;
+  } else {
+    row.verdict = VerdictOf(
+        uncertainty::Decide(c.value, c.expanded, {.min = limit->min, .max = limit->max}, {.rule = rule}));
+  }
+  return row;
+}
+
 std::vector<HeadlineRow> HeadlineRows(const ReportInputs& inputs, const Tolerances& tolerances) {
   std::vector<HeadlineRow> rows;
   for (const HeadlineSpec& spec : kHeadline) {
@@ -145,8 +172,12 @@ std::vector<HeadlineRow> HeadlineRows(const ReportInputs& inputs, const Toleranc
     std::optional<Limit> limit;
     if (const auto it = tolerances.limits.find(row.key); it != tolerances.limits.end()) limit = it->second;
     row.tolerance = limit ? LimitText(*limit, spec) : "–";
-    const auto u = inputs.summary.uncertainty.find(row.key);
     const DecisionRule rule = RuleOf(inputs.summary, tolerances);
+    if (const auto c = inputs.summary.characteristics.find(row.key); c != inputs.summary.characteristics.end()) {
+      rows.push_back(CharacteristicRow(std::move(row), c->second, spec, limit, rule));
+      continue;
+    }
+    const auto u = inputs.summary.uncertainty.find(row.key);
     if (u != inputs.summary.uncertainty.end()) {
       // Value, U and k as the decision uses them (docs/uncertainty.md).
       const std::string expanded =

@@ -337,6 +337,49 @@ std::optional<ModelCurves> ReadModelCurves(const hdf5::File& file, std::size_t n
   return model;
 }
 
+// "characteristics" is optional (schema < 1.3, --no-uncertainty); an entry without a value_* is
+// refused naming it.
+std::map<std::string, Summary::Characteristic> ParseCharacteristics(const json& root, const JsonWhere& top) {
+  std::map<std::string, Summary::Characteristic> out;
+  const auto block = root.find(key::kCharacteristics);
+  if (block == root.end() || block->is_null()) return out;
+  if (!block->is_object()) BadSummary(top.Child(key::kCharacteristics), "is not a JSON object");
+  const auto number = [](const json& object, std::string_view field) {
+    const auto it = object.find(field);
+    return it != object.end() && it->is_number() ? it->get<double>() : std::numeric_limits<double>::quiet_NaN();
+  };
+  const auto text = [](const json& object, std::string_view field) {
+    const auto it = object.find(field);
+    return it != object.end() && it->is_string() ? it->get<std::string>() : std::string();
+  };
+  for (const auto& [name, item] : block->items()) {
+    const JsonWhere where = top.Child(key::kCharacteristics).Child(name);
+    if (!item.is_object()) BadSummary(where, "is not a JSON object");
+    std::string unit;
+    for (const char* candidate : {"um", "mm", "pct"}) {
+      if (item.contains(std::string("value_") + candidate)) unit = candidate;
+    }
+    if (unit.empty()) BadSummary(where, "has no value_um or value_mm");
+    Summary::Characteristic c;
+    c.value = number(item, "value_" + unit);
+    c.expanded = number(item, "U");
+    c.coverage_factor = number(item, "k");
+    c.where = text(item, "where");
+    c.decision = text(item, "decision");
+    c.rule = text(item, "rule");
+    if (const auto op = item.find("operator"); op != item.end() && op->is_object()) {
+      c.operator_text = text(*op, "short");
+      c.association = text(*op, "association");
+      if (const auto filter = op->find("filter"); filter != op->end() && filter->is_object()) {
+        const double cutoff = number(*filter, "cutoff_upr");
+        if (std::isfinite(cutoff)) c.cutoff_upr = cutoff;
+      }
+    }
+    out[name + "_" + unit] = c;
+  }
+  return out;
+}
+
 }  // namespace
 
 Summary ParseSummary(const std::string& text, const std::string& name) {
@@ -386,6 +429,7 @@ Summary ParseSummary(const std::string& text, const std::string& name) {
       }
     }
   }
+  summary.characteristics = ParseCharacteristics(root, top);
   return summary;
 }
 

@@ -134,6 +134,17 @@ struct Summary {
   };
   std::map<std::string, QuantityUncertainty> uncertainty;
   double coverage_probability = 0.95;
+  // "characteristics" (formats.md 3.3): per headline key (the characteristic's name and its
+  // value's unit, "max_roundness_um"), the value under its operator, U, k, the operator in short,
+  // where, and the decision process made ("" without a tolerance); empty when the file has none.
+  struct Characteristic {
+    double value = 0.0, expanded = 0.0, coverage_factor = 0.0;
+    std::string operator_text, where, decision, rule;
+    // The operator's closed-profile cut-off (UPR) and association, for the polar plot.
+    std::optional<double> cutoff_upr;
+    std::string association;
+  };
+  std::map<std::string, Characteristic> characteristics;
 };
 
 // wheel_map.h5 "/model": the wheel model's functions. Ra(c), a(c), b(c) and their 1-sigma on the

@@ -6,6 +6,7 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 
+#include "characteristics/association.h"
 #include "core/error.h"
 #include "core/json_text.h"
 
@@ -42,7 +43,44 @@ double FiniteNumber(const nlohmann::json& value, const std::string& where) {
   return value.get<double>();
 }
 
-Limit ParseLimit(const nlohmann::json& value, const std::string& where) {
+bool TakesOperator(const std::string& key) {
+  return key == schema::summary::kMaxRoundnessUm || key == schema::summary::kMaxRunoutUm ||
+         key == schema::summary::kMaxArcErrorUm;
+}
+
+// One operator key of a form tolerance; false when `name` is none.
+bool ParseOperatorKey(const std::string& key, const std::string& name, const nlohmann::json& value,
+                      const std::string& where, NamedOperator& op) {
+  const bool closed = key != schema::summary::kMaxArcErrorUm;
+  if (name != "filter_upr" && name != "filter_cutoff_mm" && name != "filter" && name != "association") return false;
+  if (!TakesOperator(key))
+    BadTolerance(ErrorCode::kBadInput, where, "names an operator, which arcwheel evaluates only for "
+                 "max_roundness_um, max_runout_um and max_arc_error_um");
+  if (name == "filter_upr" || name == "filter_cutoff_mm") {
+    if (closed != (name == "filter_upr"))
+      BadTolerance(ErrorCode::kBadInput, where, closed ? "is for an open profile: a turn's filter is 'filter_upr'"
+                                                       : "is for a closed profile: an arc's filter is 'filter_cutoff_mm'");
+    const double cutoff = FiniteNumber(value, where);
+    if (!(cutoff > 0.0)) BadTolerance(ErrorCode::kBadInput, where, "is not above 0 (found " + value.dump() + ")");
+    (name == "filter_upr" ? op.filter_upr : op.filter_cutoff_mm) = cutoff;
+  } else if (name == "filter") {
+    if (value != "none") BadTolerance(ErrorCode::kBadInput, where, "is not \"none\" (found " + value.dump() + ")");
+    op.no_filter = true;
+  } else {
+    if (key == schema::summary::kMaxRunoutUm)
+      BadTolerance(ErrorCode::kBadInput, where, "names an association, but run-out is taken about the datum axis");
+    const auto association =
+        value.is_string() ? characteristics::ParseAssociation(value.get<std::string>()) : std::nullopt;
+    if (!association)
+      BadTolerance(ErrorCode::kBadInput, where,
+                   "is not " + characteristics::AssociationNames() + " (found " + value.dump() + ")");
+    op.association = value.get<std::string>();
+  }
+  return true;
+}
+
+Limit ParseLimit(const std::string& key, const nlohmann::json& value, const std::string& where,
+                 NamedOperator& op) {
   Limit limit;
   if (value.is_number()) {
     limit.max = FiniteNumber(value, where);
@@ -55,10 +93,14 @@ Limit ParseLimit(const nlohmann::json& value, const std::string& where) {
       limit.min = FiniteNumber(bound, where + ".min");
     } else if (name == "max") {
       limit.max = FiniteNumber(bound, where + ".max");
-    } else {
-      BadTolerance(ErrorCode::kBadInput, where + "." + name, "is not 'min' or 'max'");
+    } else if (!ParseOperatorKey(key, name, bound, where + "." + name, op)) {
+      BadTolerance(ErrorCode::kBadInput, where + "." + name,
+                   TakesOperator(key) ? "is not 'min', 'max', 'filter_upr', 'filter_cutoff_mm', 'filter' or 'association'"
+                                      : "is not 'min' or 'max'");
     }
   }
+  if (op.no_filter && (op.filter_upr || op.filter_cutoff_mm))
+    BadTolerance(ErrorCode::kBadInput, where, "names both a cut-off and \"filter\": \"none\"");
   if (!limit.min && !limit.max) BadTolerance(ErrorCode::kBadInput, where, "has neither 'min' nor 'max'");
   CheckOrder(limit, ErrorCode::kBadInput, where);
   return limit;
@@ -107,7 +149,9 @@ Tolerances ParseTolerances(const std::string& text, const std::string& name) {
     }
     if (!IsHeadlineKey(key))
       BadTolerance(ErrorCode::kBadInput, where, "is not a headline quantity (" + KnownKeys() + ")");
-    tolerances.limits[key] = ParseLimit(value, where);
+    NamedOperator op;
+    tolerances.limits[key] = ParseLimit(key, value, where, op);
+    if (!op.Empty()) tolerances.operators[key] = op;
   }
   return tolerances;
 }

@@ -4,7 +4,11 @@
 // Tolerance file (JSON object), keyed by the summary.json name of the headline quantity:
 //   {"max_arc_error_um": 3.0,                                 // a number: the upper limit
 //    "mean_arc_radius_mm": {"min": 74.95, "max": 75.05},      // or an object with min and/or max
-//    "max_runout_um": {"max": 10}}
+//    "max_runout_um": {"max": 10},
+//    "max_roundness_um": {"max": 2.0, "filter_upr": 50, "association": "minimum-zone"}}
+// A form tolerance (max_roundness_um, max_runout_um, max_arc_error_um) may name its operator:
+// "filter_upr" (roundness, run-out), "filter_cutoff_mm" (arc error), "filter": "none", and
+// "association" (roundness, arc error); the decision is then made under it.
 // Keys: mean_arc_radius_mm, arc_radius_range_mm, arc_radius_fluctuation_pct,
 // center_axial_deviation_mm, max_arc_error_um, max_runout_um, max_roundness_um.
 // Command-line form of one limit: "KEY=MAX" or "KEY=MIN:MAX" (either side of ':' may be empty).
@@ -28,6 +32,19 @@
 
 namespace arcwheel::reports {
 
+// The operator a drawing names with a form tolerance (docs/characteristics.md), as the file
+// gives it; what it leaves out is process's default. Only max_roundness_um, max_runout_um and
+// max_arc_error_um take one.
+struct NamedOperator {
+  std::optional<double> filter_upr = std::nullopt;        // "filter_upr": K (closed profiles)
+  std::optional<double> filter_cutoff_mm = std::nullopt;  // "filter_cutoff_mm": L (open profiles)
+  bool no_filter = false;                                 // "filter": "none"
+  std::optional<std::string> association = std::nullopt; // "association": "minimum-zone", ...
+  [[nodiscard]] bool Empty() const {
+    return !filter_upr && !filter_cutoff_mm && !no_filter && !association;
+  }
+};
+
 struct Limit {
   std::optional<double> min = std::nullopt;
   std::optional<double> max = std::nullopt;
@@ -42,6 +59,7 @@ inline constexpr std::array<std::string_view, 7> kHeadlineKeys = {
 
 struct Tolerances {
   std::map<std::string, Limit> limits;  // by headline key; absent = no tolerance
+  std::map<std::string, NamedOperator> operators;  // by headline key, where the limit names one
   // "decision_rule" as the file names it; absent = ISO 14253-1 where uncertainties are recorded.
   std::optional<uncertainty::DecisionRule> rule = std::nullopt;
 };

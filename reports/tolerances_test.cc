@@ -89,5 +89,40 @@ TEST(AddToleranceFlag, RefusesMalformedFlagsQuotingThem) {
   }
 }
 
+TEST(ParseTolerances, ReadsTheOperatorAFormToleranceNames) {
+  const Tolerances t = ParseTolerances(R"({"max_roundness_um": {"max": 2.0, "filter_upr": 150, "association": "least-squares"},
+                                          "max_runout_um": {"max": 9, "filter": "none"},
+                                          "max_arc_error_um": {"max": 3, "filter_cutoff_mm": 2.5}})",
+                                       "t.json");
+  const NamedOperator& roundness = t.operators.at("max_roundness_um");
+  EXPECT_EQ(roundness.filter_upr, 150.0);
+  EXPECT_EQ(roundness.association, "least-squares");
+  EXPECT_EQ(t.limits.at("max_roundness_um").max, 2.0);
+  EXPECT_TRUE(t.operators.at("max_runout_um").no_filter);
+  EXPECT_EQ(t.operators.at("max_arc_error_um").filter_cutoff_mm, 2.5);
+  EXPECT_TRUE(ParseTolerances(R"({"max_roundness_um": 2})", "t.json").operators.empty());
+}
+
+TEST(ParseTolerances, RefusesAnOperatorArcwheelCannotEvaluateNamingTheKey) {
+  const std::pair<const char*, const char*> cases[] = {
+      {R"({"mean_arc_radius_mm": {"max": 55.5, "filter_upr": 50}})", "'t.json' key 'mean_arc_radius_mm'.filter_upr"},
+      {R"({"max_runout_um": {"max": 9, "association": "minimum-zone"}})", "datum axis"},
+      {R"({"max_arc_error_um": {"max": 3, "filter_upr": 50}})", "filter_cutoff_mm"},
+      {R"({"max_roundness_um": {"max": 2, "filter_cutoff_mm": 0.8}})", "filter_upr"},
+      {R"({"max_roundness_um": {"max": 2, "association": "chebyshev"}})", "minimum-zone"},
+      {R"({"max_roundness_um": {"max": 2, "filter_upr": 0}})", "not above 0"},
+      {R"({"max_roundness_um": {"max": 2, "filter": "none", "filter_upr": 50}})", "both"},
+  };
+  for (const auto& [text, expected] : cases) {
+    try {
+      (void)ParseTolerances(text, "t.json");
+      ADD_FAILURE() << "accepted " << text;
+    } catch (const Error& e) {
+      EXPECT_EQ(e.code(), ErrorCode::kBadInput) << text;
+      EXPECT_NE(std::string(e.what()).find(expected), std::string::npos) << e.what();
+    }
+  }
+}
+
 }  // namespace
 }  // namespace arcwheel::reports

@@ -199,6 +199,9 @@ inline constexpr std::string_view kWarnings = "warnings";  // array of strings
 // Measurement uncertainty per GUM and conformity decisions per ISO 14253-1
 // (uncertainty/wheel_uncertainty.h, docs/uncertainty.md); absent with --no-uncertainty.
 inline constexpr std::string_view kUncertainty = "uncertainty";
+// Each characteristic under its operator (formats.md section 3.3, workflows/characteristics_step.h);
+// absent with --no-uncertainty.
+inline constexpr std::string_view kCharacteristics = "characteristics";
 namespace uncertainty {
 inline constexpr std::string_view kCoverageProbability = "coverage_probability";
 inline constexpr std::string_view kBudgetSource = "budget_source";  // "default" or the budget file's path

@@ -106,6 +106,7 @@ TEST(Cli, ProcessTimingsListEveryStageAndSumThem) {
                                              "wheel model",
                                              "releasing the samples",
                                              "uncertainty",
+                                             "characteristics",
                                              "waiting for the SHA-256",
                                              "writing"};
   EXPECT_EQ(stages, expected) << run.output;

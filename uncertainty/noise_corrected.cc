@@ -416,6 +416,8 @@ void CheckShapes(std::span<const double> values, std::span<const double> sigmas,
 struct Rows {
   Eigen::MatrixXd y, sigma, positions, present;
   Eigen::VectorXd row_sigma;  // root mean square of each row's present sigmas
+  std::vector<int> used;      // each row's index in the caller's rows
+  int given_rows = 0;         // the caller's rows
   double values = 0.0;        // present values
   double raw_pv = 0.0;
 };
@@ -437,6 +439,7 @@ Rows FilledRows(std::span<const double> values, std::span<const double> sigmas, 
                 bool periodic) {
   std::vector<Eigen::VectorXd> y_rows, sigma_rows;
   Rows out;
+  out.given_rows = rows;
   for (int r = 0; r < rows; ++r) {
     Eigen::VectorXd row(columns), sigma_row(columns);
     double low = std::numeric_limits<double>::infinity(), high = -low;
@@ -450,6 +453,7 @@ Rows FilledRows(std::span<const double> values, std::span<const double> sigmas, 
     }
     if (!FillRow(row, periodic)) continue;
     FillRow(sigma_row, periodic);
+    out.used.push_back(r);
     y_rows.push_back(std::move(row));
     sigma_rows.push_back(std::move(sigma_row));
     out.raw_pv = std::max(out.raw_pv, high - low);
@@ -472,6 +476,7 @@ Rows PositionedRows(std::span<const double> values, std::span<const double> sigm
                     std::span<const double> positions, int rows, int columns, int functions) {
   std::vector<int> used;
   Rows out;
+  out.given_rows = rows;
   for (int r = 0; r < rows; ++r) {
     int present = 0;
     double low = std::numeric_limits<double>::infinity(), high = -low;
@@ -487,6 +492,7 @@ Rows PositionedRows(std::span<const double> values, std::span<const double> sigm
   }
   if (used.empty()) throw Error(ErrorCode::kBadInput, kStage, "no row has half its values present");
   const auto n = static_cast<Eigen::Index>(used.size());
+  out.used = used;
   out.y = out.sigma = out.present = Eigen::MatrixXd::Zero(n, columns);
   out.positions = Eigen::MatrixXd::Zero(n, columns);
   for (Eigen::Index i = 0; i < n; ++i) {
@@ -503,6 +509,38 @@ Rows PositionedRows(std::span<const double> values, std::span<const double> sigm
   return out;
 }
 
+// The rows the bootstrap draws about (the fit with its orders kept in part at full size), laid
+// out as the caller's rows: NaN where a value is missing or its row is left out.
+std::vector<double> WorldRows(const Rows& data, const Eigen::MatrixXd& fitted, SmoothBasis basis) {
+  const auto columns = data.y.cols();
+  const std::size_t total = static_cast<std::size_t>(data.given_rows) * columns;
+  std::vector<double> out(total, std::numeric_limits<double>::quiet_NaN());
+  const bool positioned = data.present.size() > 0 && basis == SmoothBasis::kLegendre;
+  for (std::size_t i = 0; i < data.used.size(); ++i) {
+    const auto r = static_cast<Eigen::Index>(i);
+    for (Eigen::Index j = 0; j < columns; ++j)
+      if (!positioned || data.present(r, j) != 0.0)
+        out[static_cast<std::size_t>(data.used[i]) * columns + j] = fitted(r, j);
+  }
+  return out;
+}
+
+// The fit of the rows, and its repetition with the sigmas scaled by the root of chi-square per
+// degree of freedom of the first (Birge ratio, into `sigma_scale`) when the noise is taken as the
+// data show it: `data`'s sigmas are scaled with it.
+Estimate FitWithDataSigmas(Rows& data, const RowBases& bases, const NoiseCorrectedPvOptions& options,
+                           Eigen::MatrixXd& kept_coefficients, double& sigma_scale) {
+  Estimate estimate = Fit(data.y, data.row_sigma, data.values, bases, options, kept_coefficients);
+  sigma_scale = 1.0;
+  if (options.sigmas_from_residuals && estimate.dof > 0.0 && estimate.chi2 > 0.0) {
+    sigma_scale = std::sqrt(estimate.chi2 / estimate.dof);
+    data.sigma *= sigma_scale;
+    data.row_sigma *= sigma_scale;
+    estimate = Fit(data.y, data.row_sigma, data.values, bases, options, kept_coefficients);
+  }
+  return estimate;
+}
+
 // The estimate and its bootstrap on rows gathered by FilledRows or PositionedRows.
 NoiseCorrectedPv Solve(Rows data, const RowBases& bases, const NoiseCorrectedPvOptions& options) {
   NoiseCorrectedPv result;
@@ -512,16 +550,9 @@ NoiseCorrectedPv Solve(Rows data, const RowBases& bases, const NoiseCorrectedPvO
   const auto n_rows = data.y.rows();
   const auto columns = data.y.cols();
   Eigen::MatrixXd kept_coefficients;
-  Estimate estimate = Fit(data.y, row_sigma, data.values, bases, options, kept_coefficients);
-  // The noise as the data show it: the sigmas scaled by the root of chi-square per degree of
-  // freedom of the fit (Birge ratio), then the fit repeated with them.
-  if (options.sigmas_from_residuals && estimate.dof > 0.0 && estimate.chi2 > 0.0) {
-    result.sigma_scale = std::sqrt(estimate.chi2 / estimate.dof);
-    sigma *= result.sigma_scale;
-    row_sigma *= result.sigma_scale;
-    estimate = Fit(data.y, row_sigma, data.values, bases, options, kept_coefficients);
-  }
+  const Estimate estimate = FitWithDataSigmas(data, bases, options, kept_coefficients, result.sigma_scale);
   result.fitted_pv = estimate.fitted_pv;
+  result.fitted_rows = WorldRows(data, estimate.fitted, options.basis);
   result.order = estimate.order;
   result.rows_used = static_cast<int>(n_rows);
   result.replicates = options.replicates;
@@ -578,6 +609,17 @@ NoiseCorrectedPv EstimateNoiseCorrectedPv(std::span<const double> values, std::s
   Rows data = FilledRows(values, sigmas, rows, columns, options.basis == SmoothBasis::kFourier);
   const RowBases bases(OrthonormalBasis(options.basis, options.max_order, columns));
   return Solve(std::move(data), bases, options);
+}
+
+std::vector<double> FitNoiseFreeRows(std::span<const double> values, std::span<const double> sigmas, int rows,
+                                     int columns, const NoiseCorrectedPvOptions& options) {
+  CheckShapes(values, sigmas, rows, columns, options);
+  Rows data = FilledRows(values, sigmas, rows, columns, options.basis == SmoothBasis::kFourier);
+  const RowBases bases(OrthonormalBasis(options.basis, options.max_order, columns));
+  Eigen::MatrixXd kept_coefficients;
+  double sigma_scale = 1.0;
+  const Estimate estimate = FitWithDataSigmas(data, bases, options, kept_coefficients, sigma_scale);
+  return WorldRows(data, estimate.fitted, options.basis);
 }
 
 NoiseCorrectedPv EstimateNoiseCorrectedPv(std::span<const double> values, std::span<const double> sigmas,

@@ -78,6 +78,11 @@ struct NoiseCorrectedPv {
   int rows_used = 0;                  // rows with enough values to fit
   int replicates = 0;
   double dof = 0.0;  // of standard_uncertainty: replicates - 1
+  // The noise-free rows the bootstrap draws about (every kept order at its full fitted size,
+  // smoothed along the rows when asked), at the values' columns (filled ones too) or positions,
+  // rows x columns row-major as the values; NaN where a positioned value is missing or its row is
+  // left out. Other operators of the same data start their own bootstrap from them.
+  std::vector<double> fitted_rows;
 };
 
 // `values` and `sigmas` hold `rows` rows of `columns` each, row-major; a NaN value is missing
@@ -102,5 +107,12 @@ struct NoiseCorrectedPv {
                                                         std::span<const double> positions, int rows,
                                                         int columns,
                                                         const NoiseCorrectedPvOptions& options = {});
+
+// The noise-free rows alone (NoiseCorrectedPv::fitted_rows of the same call), without the
+// bootstrap: for an operator other than the PV to draw its own replicates about. Throws as
+// EstimateNoiseCorrectedPv.
+[[nodiscard]] std::vector<double> FitNoiseFreeRows(std::span<const double> values,
+                                                   std::span<const double> sigmas, int rows, int columns,
+                                                   const NoiseCorrectedPvOptions& options = {});
 
 }  // namespace arcwheel::uncertainty

@@ -216,5 +216,43 @@ TEST(EstimateNoiseCorrectedPv, FillsMissingValuesAndRefusesBadShapes) {
                                           ErrorCode::kBadInput);
 }
 
+// The noise-free rows another operator bootstraps about: rows of a third harmonic whose amplitude
+// grows along the rows, plus noise. Fitted along the rows, each row keeps the noise of a few
+// coefficients: far below the noise of a value, and far below what the one row's own fit of the
+// same harmonic would keep (2 coefficients' noise, sigma sqrt(2 / 360) = 0.075 sigma). A row with
+// fewer than half its values present is left out: NaN throughout.
+TEST(FitNoiseFreeRows, RemovesTheNoiseAndMarksTheRowsLeftOut) {
+  const int rows = 40, columns = 360;
+  const double sigma = 1.0;
+  std::mt19937 rng(77);
+  std::normal_distribution<double> noise(0.0, sigma);
+  std::vector<double> values(rows * columns), truth(values.size()), sigmas(values.size(), sigma);
+  for (int r = 0; r < rows; ++r) {
+    for (int j = 0; j < columns; ++j) {
+      const auto k = static_cast<std::size_t>(r * columns + j);
+      truth[k] = 0.5 * (1.0 + 0.1 * r) * std::cos(3.0 * 2.0 * std::numbers::pi * j / columns);
+      values[k] = truth[k] + noise(rng);
+    }
+  }
+  for (int j = 0; j < 200; ++j) values[static_cast<std::size_t>(5 * columns + j)] = NAN;
+  const std::vector<double> fitted =
+      FitNoiseFreeRows(values, sigmas, rows, columns, {.max_order = 12, .across_rows_max_degree = 10});
+  ASSERT_EQ(fitted.size(), values.size());
+  double squares = 0.0;
+  int counted = 0;
+  for (int r = 0; r < rows; ++r) {
+    for (int j = 0; j < columns; ++j) {
+      const auto k = static_cast<std::size_t>(r * columns + j);
+      if (r == 5) {
+        EXPECT_TRUE(std::isnan(fitted[k])) << j;
+        continue;
+      }
+      squares += (fitted[k] - truth[k]) * (fitted[k] - truth[k]);
+      ++counted;
+    }
+  }
+  EXPECT_LT(std::sqrt(squares / counted), 0.05 * sigma);
+}
+
 }  // namespace
 }  // namespace arcwheel::uncertainty

@@ -236,6 +236,10 @@ WheelUncertainty EvaluateWheelUncertainty(const WheelObservations& o, const Budg
 
   WheelUncertainty out;
   out.budget = budget;
+  if (arc_error) {
+    out.smoothed_section_um = arc_error->fitted_rows;
+    out.section_sigma_scale = arc_error->sigma_scale;
+  }
   for (const std::string& key : BudgetQuantityKeys()) {
     QuantityUncertainty q;
     q.key = key;

@@ -87,6 +87,12 @@ struct WheelUncertainty {
   // With tolerances (DecideConformity): the rule and a decision per toleranced quantity.
   std::optional<DecisionRule> rule = std::nullopt;
   std::vector<ConformityDecision> decisions;
+  // The sections as the arc error's estimator fits them (NoiseCorrectedPv::fitted_rows): the
+  // noise-free estimate of each section's residual (um) at its points, [n_phase * columns] as the
+  // section points lie (WheelObservations::section_*, or the map's nodes in the band); empty when
+  // there is no estimate. And the factor the estimator scaled the points' sigmas by (Birge ratio).
+  std::vector<double> smoothed_section_um;
+  double section_sigma_scale = 1.0;
   // The quantity by key; nullptr if absent.
   [[nodiscard]] const QuantityUncertainty* Find(std::string_view key) const;
 };

@@ -16,6 +16,8 @@ using Options = ProcessPipelineOptions;
 constexpr std::array<std::string_view, 3> kDespikeMethods = {"median", "moving-mean", "none"};
 constexpr std::array<std::string_view, 4> kRpmSources = {"auto", "nominal", "encoder", "estimate"};
 constexpr std::array<std::string_view, 2> kFitSpans = {"band", "full"};
+constexpr std::array<std::string_view, 4> kAssociations = {"least-squares", "minimum-zone", "maximum-inscribed",
+                                                           "minimum-circumscribed"};
 // Each name's position is its enum's value.
 static_assert(static_cast<int>(processing::DespikeMethod::kMovingMean) == 1 &&
               static_cast<int>(processing::DespikeMethod::kNone) == 2);
@@ -23,6 +25,9 @@ static_assert(static_cast<int>(processing::RpmSource::kNominal) == 1 &&
               static_cast<int>(processing::RpmSource::kEncoder) == 2 &&
               static_cast<int>(processing::RpmSource::kEstimate) == 3);
 static_assert(static_cast<int>(fitting::FitSpan::kFull) == 1);
+static_assert(static_cast<int>(characteristics::Association::kMinimumZone) == 1 &&
+              static_cast<int>(characteristics::Association::kMaximumInscribed) == 2 &&
+              static_cast<int>(characteristics::Association::kMinimumCircumscribed) == 3);
 
 // An enum held as the position of its name in `names` (the enums declare their values in that order).
 template <typename Enum>
@@ -84,6 +89,17 @@ std::vector<ProcessOption> MakeTable() {
        [](Options& o) -> OptionRef { return Choice(o.processing.rpm_source, kRpmSources); }},
       {"--fit-span", "band: fit inside the band; full: the whole rim", parameter::kFitSpan,
        [](Options& o) -> OptionRef { return Choice(o.fit.fit_span, kFitSpans); }},
+      // The operators' defaults (docs/characteristics.md): summary.json's characteristics name them.
+      {"--roundness-filter-upr", "roundness: Gaussian cut-off in UPR, 0 for none (ISO 12181-2)", "",
+       [](Options& o) -> OptionRef { return &o.roundness_filter_upr; }},
+      {"--roundness-association", "roundness: minimum-zone, least-squares, maximum-inscribed or minimum-circumscribed",
+       "", [](Options& o) -> OptionRef { return Choice(o.roundness_association, kAssociations); }},
+      {"--runout-filter-upr", "circular run-out: Gaussian cut-off in UPR, 0 for none", "",
+       [](Options& o) -> OptionRef { return &o.runout_filter_upr; }},
+      {"--arc-error-filter-mm", "arc profile error: Gaussian cut-off wavelength in mm, 0 for none", "",
+       [](Options& o) -> OptionRef { return &o.arc_error_filter_mm; }},
+      {"--arc-error-association", "arc profile error: minimum-zone or least-squares", "",
+       [](Options& o) -> OptionRef { return Choice(o.arc_error_association, kAssociations); }},
       // Options that the record states otherwise (the map's steps as used, "model": on or off).
       {"--axial-step-mm", "map node spacing (default one helix pitch)", "",
        [](Options& o) -> OptionRef { return &o.processing.map.axial_step_mm; }, false},

@@ -183,6 +183,20 @@ void DecideTolerances(const reports::Tolerances& tolerances, uncertainty::WheelU
 }
 
 // Waits for the input's hash, writes the outputs and keeps the clock, for both kinds of scan.
+// The characteristics under their named operators, from the map, the fits and the budget's
+// type B inputs; their warnings join the processing's.
+void EvaluateCharacteristicsStep(const ProcessPipelineOptions& options,
+                                 const acquisition::ScanMetadata& metadata, ProcessPipelineResult& result,
+                                 StageClock& clock) {
+  clock.Start("characteristics");
+  result.characteristics = EvaluateCharacteristics(
+      options, result.processed.map, result.fit, *result.uncertainty,
+      options.processing.wheel_radius_mm > 0.0 ? options.processing.wheel_radius_mm
+                                               : metadata.wheel_diameter_mm.value_or(400.0) / 2.0);
+  for (const std::string& warning : result.characteristics->warnings)
+    result.processed.warnings.push_back(warning);
+}
+
 void FinishRun(std::future<std::string> sha256, const std::filesystem::path& outdir,
                ProcessPipelineResult& result, StageClock& clock) {
   clock.Start("waiting for the SHA-256");
@@ -190,11 +204,13 @@ void FinishRun(std::future<std::string> sha256, const std::filesystem::path& out
   ThrowIfInterrupted();
   if (!outdir.empty()) {
     clock.Start("writing");
-    const nlohmann::json uncertainty =
-        result.uncertainty ? uncertainty::WheelUncertaintyToJson(*result.uncertainty) : nlohmann::json();
+    nlohmann::json later_stages = nlohmann::json::object();
+    if (result.uncertainty)
+      later_stages[schema::summary::kUncertainty] = uncertainty::WheelUncertaintyToJson(*result.uncertainty);
+    if (result.characteristics)
+      later_stages[schema::summary::kCharacteristics] = CharacteristicsToJson(*result.characteristics);
     fitting::WriteProcessOutputs(outdir, result.record, result.processed, result.fit,
-                                 result.model ? &*result.model : nullptr,
-                                 result.uncertainty ? &uncertainty : nullptr);
+                                 result.model ? &*result.model : nullptr, &later_stages);
   }
   clock.Stop();
   result.clock = std::move(clock);
@@ -228,6 +244,7 @@ ProcessPipelineResult RunOnScan(acquisition::Scan scan, const std::string& scan_
     clock.Start("uncertainty");
     result.uncertainty = EvaluateUncertainty(options, metadata, result.processed, result.fit);
     if (options.tolerances) DecideTolerances(*options.tolerances, *result.uncertainty);
+    EvaluateCharacteristicsStep(options, metadata, result, clock);
   }
   progress.Update("writing", 0.9);
   FinishRun(std::move(sha256), outdir, result, clock);
@@ -272,6 +289,7 @@ ProcessPipelineResult RunOnProfileScan(acquisition::ProfileScan scan, const std:
     result.uncertainty =
         EvaluateUncertainty(options, result.record.metadata, processed, result.fit, &placement);
     if (options.tolerances) DecideTolerances(*options.tolerances, *result.uncertainty);
+    EvaluateCharacteristicsStep(options, result.record.metadata, result, clock);
   }
   progress.Update("writing", 0.9);
   FinishRun(std::move(sha256), outdir, result, clock);
@@ -302,6 +320,8 @@ void ResolveProcessPipelineOptions(ProcessPipelineOptions& options) {
     for (std::string& problem : options.uncertainty.Problems()) problems.push_back(std::move(problem));
   }
   ThrowIfProblems(ErrorCode::kInvalidOption, "process", problems);
+  // An operator that cannot be evaluated (an option, or a tolerance's) likewise.
+  if (!options.no_uncertainty) (void)CharacteristicOperators(options, options.processing.map.phases);
   // A bad budget is refused before the scan is read, with every problem it has (exit 2).
   if (!options.no_uncertainty && !options.uncertainty_budget_path.empty())
     options.uncertainty_budget = uncertainty::ReadBudget(options.uncertainty_budget_path);

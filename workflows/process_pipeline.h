@@ -21,6 +21,7 @@
 #include "reports/tolerances.h"
 #include "uncertainty/budget_json.h"
 #include "uncertainty/wheel_uncertainty.h"
+#include "workflows/characteristics_step.h"
 
 namespace arcwheel::workflows {
 
@@ -51,6 +52,13 @@ struct ProcessPipelineOptions {
   // scan: with the uncertainty, every toleranced quantity is decided by the file's rule (ISO
   // 14253-1 by default) and summary.json's "uncertainty" carries the rule and the decisions.
   std::optional<reports::Tolerances> tolerances;
+  // The operators of the form characteristics (docs/characteristics.md); a tolerance file's
+  // operator replaces them for its characteristic. A cut-off of 0 means no filter.
+  double roundness_filter_upr = 50.0;
+  characteristics::Association roundness_association = characteristics::Association::kMinimumZone;
+  double runout_filter_upr = 50.0;
+  double arc_error_filter_mm = 0.0;
+  characteristics::Association arc_error_association = characteristics::Association::kMinimumZone;
   // Problems met while the options were bound from text (an unknown choice, process_options.h),
   // reported by ResolveProcessPipelineOptions with every other problem.
   std::vector<std::string> binding_problems;
@@ -70,6 +78,7 @@ struct ProcessPipelineResult {
   fitting::WheelFit fit;
   std::optional<fitting::WheelModel> model;  // empty with no_model, or when the model could not be fitted
   std::optional<uncertainty::WheelUncertainty> uncertainty;  // empty with no_uncertainty
+  std::optional<CharacteristicsResult> characteristics;      // empty with no_uncertainty
   StageClock clock;  // wall time of each step (`arcwheel process --timings`)
 };
 

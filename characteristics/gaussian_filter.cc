@@ -118,7 +118,8 @@ std::vector<double> FilterClosedProfile(std::span<const double> values, double c
   return {real.get(), real.get() + n};
 }
 
-std::vector<double> SignificantHarmonics(std::span<const double> values, double noise_sigma, double power_ratio) {
+std::vector<double> SignificantHarmonics(std::span<const double> values, double noise_sigma,
+                                         double power_ratio) {
   const std::size_t n = values.size();
   RequireClosedProfile(n);
   ComplexBuffer spectrum = Spectrum(values);

@@ -40,8 +40,9 @@ struct TestWheel {
       const double c = 2.0 * kPi * i / n_phase;
       for (std::size_t j = 0; j < n_y; ++j) {
         const double scale = j == 1 ? 1.0 : 0.5;
-        rho_mm[static_cast<std::size_t>(i) * n_y + j] =
-            50.0 + eccentricity_mm * std::cos(c) + scale * amplitude_mm * std::cos(k * c) + sigma * normal(rng);
+        rho_mm[static_cast<std::size_t>(i) * n_y + j] = 50.0 + eccentricity_mm * std::cos(c) +
+                                                        scale * amplitude_mm * std::cos(k * c) +
+                                                        sigma * normal(rng);
       }
     }
     center_axial_mm.assign(static_cast<std::size_t>(n_phase), 0.0);
@@ -167,9 +168,10 @@ TEST(WheelCharacteristics, TheBiasCorrectedValueCoversTheNoiseFreeTruth) {
   }
   const double sd_r = std::sqrt(sum2_error_r / draws - std::pow(sum_error_r / draws, 2));
   const double sd_t = std::sqrt(sum2_error_t / draws - std::pow(sum_error_t / draws, 2));
-  std::printf("RONt: mean error %.4f um, sd %.4f um, mean u %.4f um, covered %d/%d; TIR: %.4f, %.4f, %.4f, %d/%d\n",
-              sum_error_r / draws, sd_r, sum_u_r / draws, covered_r, draws, sum_error_t / draws, sd_t,
-              sum_u_t / draws, covered_t, draws);
+  std::printf(
+      "RONt: mean error %.4f um, sd %.4f um, mean u %.4f um, covered %d/%d; TIR: %.4f, %.4f, %.4f, %d/%d\n",
+      sum_error_r / draws, sd_r, sum_u_r / draws, covered_r, draws, sum_error_t / draws, sd_t,
+      sum_u_t / draws, covered_t, draws);
   // The uncorrected PV would sit several sigma high; the corrected one within a third of u.
   EXPECT_LT(std::abs(sum_error_r / draws), 0.35 * sum_u_r / draws);
   EXPECT_LT(std::abs(sum_error_t / draws), 0.35 * sum_u_t / draws);

@@ -43,10 +43,9 @@ void PrintCharacteristics(const workflows::CharacteristicsResult& c) {
     const bool mm = item.unit == "mm";
     const std::string value = mm ? fmt::format("{:.5f} mm", Shown(item.value))
                                  : fmt::format("{:.3f} {}", Shown(item.value), item.unit);
-    const std::string expanded = mm ? fmt::format("U = {:.5f} (k = {:.2f})", Shown(item.expanded),
-                                                  Shown(item.coverage_factor))
-                                    : fmt::format("U = {:.3f} (k = {:.2f})", Shown(item.expanded),
-                                                  Shown(item.coverage_factor));
+    const std::string expanded =
+        mm ? fmt::format("U = {:.5f} (k = {:.2f})", Shown(item.expanded), Shown(item.coverage_factor))
+           : fmt::format("U = {:.3f} (k = {:.2f})", Shown(item.expanded), Shown(item.coverage_factor));
     fmt::print("{:<28} {:>14}  {:<24} {:<24} {}\n", item.label, value, expanded, item.operator_text,
                item.decision ? uncertainty::DecisionName(*item.decision) : "");
   }
@@ -71,10 +70,11 @@ void PrintHeadline(const ProcessArgs& args, const workflows::ProcessPipelineResu
   }
   // Without the uncertainty there is no operator's value to show: the contract's raw figures,
   // named as what they are.
-  fmt::print("mean arc radius      {:.5f} +- {:.5f} mm (1 sigma, least squares)\n", Shown(f.mean_arc_radius_mm),
-             Shown(f.mean_arc_radius_sigma_mm));
+  fmt::print("mean arc radius      {:.5f} +- {:.5f} mm (1 sigma, least squares)\n",
+             Shown(f.mean_arc_radius_mm), Shown(f.mean_arc_radius_sigma_mm));
   fmt::print("arc radius range     {:.5f} mm (least squares)\n", Shown(f.arc_radius_range_mm));
-  fmt::print("arc centre axial     deviation {:.5f} mm (least squares)\n", Shown(f.center_axial_deviation_mm));
+  fmt::print("arc centre axial     deviation {:.5f} mm (least squares)\n",
+             Shown(f.center_axial_deviation_mm));
   fmt::print("max arc error        {:.3f} um (unfiltered, least squares)\n", Shown(f.max_arc_error_um));
   fmt::print("max runout           {:.3f} um (unfiltered)\n", Shown(f.max_runout_um));
   fmt::print("max roundness        {:.3f} um (unfiltered, least squares)\n", Shown(f.max_roundness_um));

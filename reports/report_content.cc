@@ -144,13 +144,14 @@ Verdict VerdictOf(uncertainty::Decision decision) {
 HeadlineRow CharacteristicRow(HeadlineRow row, const Summary::Characteristic& c, const HeadlineSpec& spec,
                               const std::optional<Limit>& limit, DecisionRule rule) {
   row.value = FormatValue(c.value, spec.unit);
-  row.uncertainty = "U = " + FormatValue(c.expanded, spec.unit) + " (k = " + FormatFixed(c.coverage_factor, 2) +
-                    "); " + c.operator_text + (c.where.empty() ? "" : ", " + c.where);
+  row.uncertainty = "U = " + FormatValue(c.expanded, spec.unit) +
+                    " (k = " + FormatFixed(c.coverage_factor, 2) + "); " + c.operator_text +
+                    (c.where.empty() ? "" : ", " + c.where);
   row.noise.clear();
   if (!limit) {
     row.verdict = Verdict::kNoTolerance;
   } else if (!c.decision.empty()) {
-    row.verdict = c.decision == "conforms" ? Verdict::kPass
+    row.verdict = c.decision == "conforms"           ? Verdict::kPass
                   : c.decision == "does not conform" ? Verdict::kFail
                                                      : Verdict::kNotProven;
   } else {
@@ -173,7 +174,8 @@ std::vector<HeadlineRow> HeadlineRows(const ReportInputs& inputs, const Toleranc
     if (const auto it = tolerances.limits.find(row.key); it != tolerances.limits.end()) limit = it->second;
     row.tolerance = limit ? LimitText(*limit, spec) : "–";
     const DecisionRule rule = RuleOf(inputs.summary, tolerances);
-    if (const auto c = inputs.summary.characteristics.find(row.key); c != inputs.summary.characteristics.end()) {
+    if (const auto c = inputs.summary.characteristics.find(row.key);
+        c != inputs.summary.characteristics.end()) {
       rows.push_back(CharacteristicRow(std::move(row), c->second, spec, limit, rule));
       continue;
     }

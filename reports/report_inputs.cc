@@ -346,7 +346,8 @@ std::map<std::string, Summary::Characteristic> ParseCharacteristics(const json& 
   if (!block->is_object()) BadSummary(top.Child(key::kCharacteristics), "is not a JSON object");
   const auto number = [](const json& object, std::string_view field) {
     const auto it = object.find(field);
-    return it != object.end() && it->is_number() ? it->get<double>() : std::numeric_limits<double>::quiet_NaN();
+    return it != object.end() && it->is_number() ? it->get<double>()
+                                                 : std::numeric_limits<double>::quiet_NaN();
   };
   const auto text = [](const json& object, std::string_view field) {
     const auto it = object.find(field);

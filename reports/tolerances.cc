@@ -52,23 +52,29 @@ bool TakesOperator(const std::string& key) {
 bool ParseOperatorKey(const std::string& key, const std::string& name, const nlohmann::json& value,
                       const std::string& where, NamedOperator& op) {
   const bool closed = key != schema::summary::kMaxArcErrorUm;
-  if (name != "filter_upr" && name != "filter_cutoff_mm" && name != "filter" && name != "association") return false;
+  if (name != "filter_upr" && name != "filter_cutoff_mm" && name != "filter" && name != "association")
+    return false;
   if (!TakesOperator(key))
-    BadTolerance(ErrorCode::kBadInput, where, "names an operator, which arcwheel evaluates only for "
+    BadTolerance(ErrorCode::kBadInput, where,
+                 "names an operator, which arcwheel evaluates only for "
                  "max_roundness_um, max_runout_um and max_arc_error_um");
   if (name == "filter_upr" || name == "filter_cutoff_mm") {
     if (closed != (name == "filter_upr"))
-      BadTolerance(ErrorCode::kBadInput, where, closed ? "is for an open profile: a turn's filter is 'filter_upr'"
-                                                       : "is for a closed profile: an arc's filter is 'filter_cutoff_mm'");
+      BadTolerance(ErrorCode::kBadInput, where,
+                   closed ? "is for an open profile: a turn's filter is 'filter_upr'"
+                          : "is for a closed profile: an arc's filter is 'filter_cutoff_mm'");
     const double cutoff = FiniteNumber(value, where);
-    if (!(cutoff > 0.0)) BadTolerance(ErrorCode::kBadInput, where, "is not above 0 (found " + value.dump() + ")");
+    if (!(cutoff > 0.0))
+      BadTolerance(ErrorCode::kBadInput, where, "is not above 0 (found " + value.dump() + ")");
     (name == "filter_upr" ? op.filter_upr : op.filter_cutoff_mm) = cutoff;
   } else if (name == "filter") {
-    if (value != "none") BadTolerance(ErrorCode::kBadInput, where, "is not \"none\" (found " + value.dump() + ")");
+    if (value != "none")
+      BadTolerance(ErrorCode::kBadInput, where, "is not \"none\" (found " + value.dump() + ")");
     op.no_filter = true;
   } else {
     if (key == schema::summary::kMaxRunoutUm)
-      BadTolerance(ErrorCode::kBadInput, where, "names an association, but run-out is taken about the datum axis");
+      BadTolerance(ErrorCode::kBadInput, where,
+                   "names an association, but run-out is taken about the datum axis");
     const auto association =
         value.is_string() ? characteristics::ParseAssociation(value.get<std::string>()) : std::nullopt;
     if (!association)
@@ -95,8 +101,9 @@ Limit ParseLimit(const std::string& key, const nlohmann::json& value, const std:
       limit.max = FiniteNumber(bound, where + ".max");
     } else if (!ParseOperatorKey(key, name, bound, where + "." + name, op)) {
       BadTolerance(ErrorCode::kBadInput, where + "." + name,
-                   TakesOperator(key) ? "is not 'min', 'max', 'filter_upr', 'filter_cutoff_mm', 'filter' or 'association'"
-                                      : "is not 'min' or 'max'");
+                   TakesOperator(key)
+                       ? "is not 'min', 'max', 'filter_upr', 'filter_cutoff_mm', 'filter' or 'association'"
+                       : "is not 'min' or 'max'");
     }
   }
   if (op.no_filter && (op.filter_upr || op.filter_cutoff_mm))

@@ -39,10 +39,8 @@ struct NamedOperator {
   std::optional<double> filter_upr = std::nullopt;        // "filter_upr": K (closed profiles)
   std::optional<double> filter_cutoff_mm = std::nullopt;  // "filter_cutoff_mm": L (open profiles)
   bool no_filter = false;                                 // "filter": "none"
-  std::optional<std::string> association = std::nullopt; // "association": "minimum-zone", ...
-  [[nodiscard]] bool Empty() const {
-    return !filter_upr && !filter_cutoff_mm && !no_filter && !association;
-  }
+  std::optional<std::string> association = std::nullopt;  // "association": "minimum-zone", ...
+  [[nodiscard]] bool Empty() const { return !filter_upr && !filter_cutoff_mm && !no_filter && !association; }
 };
 
 struct Limit {
@@ -58,7 +56,7 @@ inline constexpr std::array<std::string_view, 7> kHeadlineKeys = {
     schema::summary::kMaxRoundnessUm};
 
 struct Tolerances {
-  std::map<std::string, Limit> limits;  // by headline key; absent = no tolerance
+  std::map<std::string, Limit> limits;             // by headline key; absent = no tolerance
   std::map<std::string, NamedOperator> operators;  // by headline key, where the limit names one
   // "decision_rule" as the file names it; absent = ISO 14253-1 where uncertainties are recorded.
   std::optional<uncertainty::DecisionRule> rule = std::nullopt;

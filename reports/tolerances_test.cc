@@ -90,10 +90,11 @@ TEST(AddToleranceFlag, RefusesMalformedFlagsQuotingThem) {
 }
 
 TEST(ParseTolerances, ReadsTheOperatorAFormToleranceNames) {
-  const Tolerances t = ParseTolerances(R"({"max_roundness_um": {"max": 2.0, "filter_upr": 150, "association": "least-squares"},
+  const Tolerances t =
+      ParseTolerances(R"({"max_roundness_um": {"max": 2.0, "filter_upr": 150, "association": "least-squares"},
                                           "max_runout_um": {"max": 9, "filter": "none"},
                                           "max_arc_error_um": {"max": 3, "filter_cutoff_mm": 2.5}})",
-                                       "t.json");
+                      "t.json");
   const NamedOperator& roundness = t.operators.at("max_roundness_um");
   EXPECT_EQ(roundness.filter_upr, 150.0);
   EXPECT_EQ(roundness.association, "least-squares");
@@ -105,7 +106,8 @@ TEST(ParseTolerances, ReadsTheOperatorAFormToleranceNames) {
 
 TEST(ParseTolerances, RefusesAnOperatorArcwheelCannotEvaluateNamingTheKey) {
   const std::pair<const char*, const char*> cases[] = {
-      {R"({"mean_arc_radius_mm": {"max": 55.5, "filter_upr": 50}})", "'t.json' key 'mean_arc_radius_mm'.filter_upr"},
+      {R"({"mean_arc_radius_mm": {"max": 55.5, "filter_upr": 50}})",
+       "'t.json' key 'mean_arc_radius_mm'.filter_upr"},
       {R"({"max_runout_um": {"max": 9, "association": "minimum-zone"}})", "datum axis"},
       {R"({"max_arc_error_um": {"max": 3, "filter_upr": 50}})", "filter_cutoff_mm"},
       {R"({"max_roundness_um": {"max": 2, "filter_cutoff_mm": 0.8}})", "filter_upr"},

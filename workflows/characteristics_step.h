@@ -53,7 +53,7 @@ struct CharacteristicsResult {
   std::vector<Characteristic> items;  // in report order
   std::optional<uncertainty::DecisionRule> rule;
   characteristics::WheelCharacteristics form;  // the operators' details (worst section, per node)
-  std::vector<std::string> warnings;            // summary.json's warnings, e.g. a cut-off lowered
+  std::vector<std::string> warnings;           // summary.json's warnings, e.g. a cut-off lowered
 };
 
 // The operators `process` evaluates: its options' defaults, each replaced by what a tolerance
@@ -61,9 +61,8 @@ struct CharacteristicsResult {
 // (the tolerance's key named), with `points_per_turn` the map's phases.
 // A cut-off of the options that the phases cannot carry is lowered to ISO 12181-2's next, with a
 // line in `warnings`.
-[[nodiscard]] characteristics::CharacteristicsOptions CharacteristicOperators(const ProcessPipelineOptions& options,
-                                                                              int points_per_turn,
-                                                                              std::vector<std::string>* warnings = nullptr);
+[[nodiscard]] characteristics::CharacteristicsOptions CharacteristicOperators(
+    const ProcessPipelineOptions& options, int points_per_turn, std::vector<std::string>* warnings = nullptr);
 
 [[nodiscard]] CharacteristicsResult EvaluateCharacteristics(const ProcessPipelineOptions& options,
                                                             const processing::WheelMap& map,

@@ -16,8 +16,8 @@ using Options = ProcessPipelineOptions;
 constexpr std::array<std::string_view, 3> kDespikeMethods = {"median", "moving-mean", "none"};
 constexpr std::array<std::string_view, 4> kRpmSources = {"auto", "nominal", "encoder", "estimate"};
 constexpr std::array<std::string_view, 2> kFitSpans = {"band", "full"};
-constexpr std::array<std::string_view, 4> kAssociations = {"least-squares", "minimum-zone", "maximum-inscribed",
-                                                           "minimum-circumscribed"};
+constexpr std::array<std::string_view, 4> kAssociations = {"least-squares", "minimum-zone",
+                                                           "maximum-inscribed", "minimum-circumscribed"};
 // Each name's position is its enum's value.
 static_assert(static_cast<int>(processing::DespikeMethod::kMovingMean) == 1 &&
               static_cast<int>(processing::DespikeMethod::kNone) == 2);
@@ -92,8 +92,9 @@ std::vector<ProcessOption> MakeTable() {
       // The operators' defaults (docs/characteristics.md): summary.json's characteristics name them.
       {"--roundness-filter-upr", "roundness: Gaussian cut-off in UPR, 0 for none (ISO 12181-2)", "",
        [](Options& o) -> OptionRef { return &o.roundness_filter_upr; }},
-      {"--roundness-association", "roundness: minimum-zone, least-squares, maximum-inscribed or minimum-circumscribed",
-       "", [](Options& o) -> OptionRef { return Choice(o.roundness_association, kAssociations); }},
+      {"--roundness-association",
+       "roundness: minimum-zone, least-squares, maximum-inscribed or minimum-circumscribed", "",
+       [](Options& o) -> OptionRef { return Choice(o.roundness_association, kAssociations); }},
       {"--runout-filter-upr", "circular run-out: Gaussian cut-off in UPR, 0 for none", "",
        [](Options& o) -> OptionRef { return &o.runout_filter_upr; }},
       {"--arc-error-filter-mm", "arc profile error: Gaussian cut-off wavelength in mm, 0 for none", "",

@@ -9,6 +9,7 @@
 #include <memory>
 #include <numbers>
 
+#include "core/check.h"
 #include "core/error.h"
 #include "core/fftw_planner.h"
 
@@ -88,6 +89,15 @@ void RequireClosedProfile(std::size_t n) {
                 fmt::format("a closed profile needs at least 8 points, got {}", n));
 }
 
+void RequireClosedProfileCutOff(std::size_t n, double cutoff_upr) {
+  RequireClosedProfile(n);
+  if (!(cutoff_upr > 0) || !(cutoff_upr <= 0.5 * static_cast<double>(n))) {
+    throw Error(ErrorCode::kInvalidOption, kStage,
+                fmt::format("cut-off {} UPR violates 0 < cut-off <= {} (half the {} points of the profile)",
+                            cutoff_upr, 0.5 * static_cast<double>(n), n));
+  }
+}
+
 }  // namespace
 
 double GaussianAlpha() { return std::sqrt(std::numbers::ln2 / std::numbers::pi); }
@@ -97,25 +107,51 @@ double GaussianTransmission(double k, double cutoff) {
   return std::exp(-std::numbers::pi * ratio * ratio);
 }
 
-std::vector<double> FilterClosedProfile(std::span<const double> values, double cutoff_upr) {
-  const std::size_t n = values.size();
-  RequireClosedProfile(n);
-  if (!(cutoff_upr > 0) || !(cutoff_upr <= 0.5 * static_cast<double>(n))) {
-    throw Error(ErrorCode::kInvalidOption, kStage,
-                fmt::format("cut-off {} UPR violates 0 < cut-off <= {} (half the {} points of the profile)",
-                            cutoff_upr, 0.5 * static_cast<double>(n), n));
-  }
-  ComplexBuffer spectrum = Spectrum(values);
+struct ClosedProfileFilter::State {
+  std::size_t n = 0;
+  Plans plans;
+  std::vector<double> gain;  // the transmission of harmonics 0 .. n / 2, times 1 / n
+  RealBuffer real;
+  ComplexBuffer spectrum;
+};
+
+ClosedProfileFilter::ClosedProfileFilter(std::size_t n, double cutoff_upr)
+    : state_(std::make_unique<State>()) {
+  RequireClosedProfileCutOff(n, cutoff_upr);
+  State& s = *state_;
+  s.n = n;
+  s.plans = PlansFor(n);
   // The inverse transform is unnormalised: 1 / n folded into the transmission.
   const double inverse_n = 1.0 / static_cast<double>(n);
-  for (std::size_t k = 0; k <= n / 2; ++k) {
-    const double gain = GaussianTransmission(static_cast<double>(k), cutoff_upr) * inverse_n;
-    spectrum[k][0] *= gain;
-    spectrum[k][1] *= gain;
+  s.gain.resize(n / 2 + 1);
+  for (std::size_t k = 0; k <= n / 2; ++k)
+    s.gain[k] = GaussianTransmission(static_cast<double>(k), cutoff_upr) * inverse_n;
+  s.real = AllocateReal(n);
+  s.spectrum = AllocateComplex(n / 2 + 1);
+}
+
+ClosedProfileFilter::~ClosedProfileFilter() = default;
+ClosedProfileFilter::ClosedProfileFilter(ClosedProfileFilter&&) noexcept = default;
+ClosedProfileFilter& ClosedProfileFilter::operator=(ClosedProfileFilter&&) noexcept = default;
+
+void ClosedProfileFilter::Apply(std::span<const double> values, std::span<double> filtered) {
+  State& s = *state_;
+  ARCWHEEL_CHECK(values.size() == s.n && filtered.size() == s.n)
+      << values.size() << " and " << filtered.size() << " values for a filter of " << s.n;
+  std::copy(values.begin(), values.end(), s.real.get());
+  fftw_execute_dft_r2c(s.plans.forward, s.real.get(), s.spectrum.get());
+  for (std::size_t k = 0; k <= s.n / 2; ++k) {
+    s.spectrum[k][0] *= s.gain[k];
+    s.spectrum[k][1] *= s.gain[k];
   }
-  RealBuffer real = AllocateReal(n);
-  fftw_execute_dft_c2r(PlansFor(n).inverse, spectrum.get(), real.get());
-  return {real.get(), real.get() + n};
+  fftw_execute_dft_c2r(s.plans.inverse, s.spectrum.get(), s.real.get());
+  std::copy(s.real.get(), s.real.get() + s.n, filtered.begin());
+}
+
+std::vector<double> FilterClosedProfile(std::span<const double> values, double cutoff_upr) {
+  std::vector<double> filtered(values.size());
+  ClosedProfileFilter(values.size(), cutoff_upr).Apply(values, filtered);
+  return filtered;
 }
 
 std::vector<double> SignificantHarmonics(std::span<const double> values, double noise_sigma,

@@ -93,6 +93,26 @@ TEST(ClosedGaussianFilter, EqualsThePeriodisedWeightingFunctionInTheSpaceDomain)
   }
 }
 
+TEST(ClosedGaussianFilter, KeptForManyProfilesFiltersEachAsTheTransmissionSays) {
+  // One filter object, profiles of several harmonics in turn, some filtered in place: each comes
+  // out with its harmonic scaled by the closed-form transmission and its mean kept.
+  ClosedProfileFilter filter(360, 50.0);
+  for (const double k : {1.0, 15.0, 50.0, 120.0}) {
+    std::vector<double> values = Harmonic(360, k, 2.0, 0.3 * k, 7.0);
+    std::vector<double> out(values.size());
+    filter.Apply(values, out);
+    EXPECT_NEAR(AmplitudeOf(out, static_cast<int>(k)), 2.0 * Expected(k, 50.0), 1e-12) << k;
+    double mean = 0.0;
+    for (const double v : out) mean += v / 360.0;
+    EXPECT_NEAR(mean, 7.0, 1e-12) << k;
+    filter.Apply(values, values);
+    for (std::size_t i = 0; i < values.size(); ++i) ASSERT_EQ(values[i], out[i]) << k << " " << i;
+  }
+  std::vector<double> wrong(100);
+  EXPECT_THROW(filter.Apply(wrong, wrong), Error);
+  EXPECT_THROW(ClosedProfileFilter(360, 181.0), Error);
+}
+
 TEST(ClosedGaussianFilter, RefusesACutOffOfZeroOrAboveHalfThePoints) {
   const std::vector<double> profile = Harmonic(100, 3, 1.0, 0.0, 5.0);
   EXPECT_EQ(

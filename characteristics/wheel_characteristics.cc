@@ -22,9 +22,22 @@ namespace {
 constexpr std::string_view kStage = "characteristics.wheel";
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
-// One evaluation of an operator on one node's points; NaN where it cannot be evaluated.
-using NodeOperator = double (*)(const FormOperator& op, std::span<const double> values,
-                                std::span<const double> coordinate, std::span<const double> extra);
+// The cosines and sines of a turn's phases, for all the turns.
+struct UnitCircle {
+  std::vector<double> cos, sin;
+};
+
+// The points of one node: values (with their 1-sigma, in the values' unit), the coordinate the
+// operator needs and its extra constants.
+struct Node {
+  std::vector<double> values, sigma, coordinate, extra;
+  std::vector<double> truth_estimate;  // the values with the noise's share taken out (the bootstrap's base)
+  const UnitCircle* unit = nullptr;    // a turn's: its phases' cosines and sines
+};
+
+// One evaluation of an operator on one node's points; NaN where it cannot be evaluated. A closed
+// profile's filter (op.cutoff_upr) is applied before (LargestWithBootstrap), not by the operator.
+using NodeOperator = double (*)(const FormOperator& op, std::span<const double> values, const Node& node);
 
 std::vector<double> PhaseGridDeg(std::size_t n_phase) {
   std::vector<double> phase(n_phase);
@@ -33,18 +46,40 @@ std::vector<double> PhaseGridDeg(std::size_t n_phase) {
   return phase;
 }
 
+// As EvaluateRoundness turns the phases into directions, so that its points are the same.
+UnitCircle UnitCircleOf(std::span<const double> phase_deg) {
+  UnitCircle unit;
+  for (const double phase : phase_deg) {
+    const double angle_rad = phase * std::numbers::pi / 180.0;
+    unit.cos.push_back(std::cos(angle_rad));
+    unit.sin.push_back(std::sin(angle_rad));
+  }
+  return unit;
+}
+
 bool AllFinite(std::span<const double> values) {
   return std::all_of(values.begin(), values.end(), [](double v) { return std::isfinite(v); });
 }
 
-// RONt (um) of one turn of radii about the spindle axis.
-double Roundness(const FormOperator& op, std::span<const double> radius_mm, std::span<const double> phase_deg,
-                 std::span<const double>) {
+// RONt (um) of one turn of (filtered) radii about the spindle axis, as EvaluateRoundness takes it.
+double Roundness(const FormOperator& op, std::span<const double> radius_mm, const Node& node) {
   if (!AllFinite(radius_mm)) return kNaN;
-  const RoundnessResult result = EvaluateRoundness(
-      phase_deg, radius_mm,
-      {.filter_cutoff_upr = op.cutoff_upr, .association = *op.association, .max_harmonic_upr = 1});
-  return result.ront_um;
+  const std::size_t n = radius_mm.size();
+  std::vector<double> x(n), y(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    x[i] = radius_mm[i] * node.unit->cos[i];
+    y[i] = radius_mm[i] * node.unit->sin[i];
+  }
+  const AssociatedCircle circle = AssociateCircle(x, y, {.association = *op.association});
+  if (!circle.IsCertified()) return kNaN;
+  double highest = -std::numeric_limits<double>::infinity(), lowest = -highest;
+  for (std::size_t i = 0; i < n; ++i) {
+    const double deviation =
+        std::hypot(x[i] - circle.center_x_mm, y[i] - circle.center_y_mm) - circle.radius_mm;
+    highest = std::max(highest, deviation);
+    lowest = std::min(lowest, deviation);
+  }
+  return (highest - lowest) * 1000.0;
 }
 
 // An upper bound of Roundness at a filter and a pass over the points: a minimum zone's width is at
@@ -52,29 +87,24 @@ double Roundness(const FormOperator& op, std::span<const double> radius_mm, std:
 // reference centre (extra = {x, y}, mm), near the replicate's own, bounds it closely, else the
 // turn's first harmonic (the least-squares centre to first order). +inf where it bounds nothing
 // (another association's RONt is not the least over the centres).
-double RoundnessBound(const FormOperator& op, std::span<const double> radius_mm,
-                      std::span<const double> phase_deg, std::span<const double> extra) {
+double RoundnessBound(const FormOperator& op, std::span<const double> radius_mm, const Node& node) {
   if (op.association != Association::kMinimumZone || !AllFinite(radius_mm))
     return std::numeric_limits<double>::infinity();
-  std::vector<double> turn(radius_mm.begin(), radius_mm.end());
-  if (op.cutoff_upr) turn = FilterClosedProfile(turn, *op.cutoff_upr);
-  const double to_rad = std::numbers::pi / 180.0;
-  std::vector<double> x(turn.size()), y(turn.size());
-  for (std::size_t i = 0; i < turn.size(); ++i) {
-    x[i] = turn[i] * std::cos(phase_deg[i] * to_rad);
-    y[i] = turn[i] * std::sin(phase_deg[i] * to_rad);
-  }
+  const std::size_t n = radius_mm.size();
+  const std::vector<double>& cos = node.unit->cos;
+  const std::vector<double>& sin = node.unit->sin;
   double cx = 0.0, cy = 0.0;
-  if (extra.size() == 2) {
-    cx = extra[0], cy = extra[1];
+  if (node.extra.size() == 2) {
+    cx = node.extra[0], cy = node.extra[1];
   } else {
-    for (std::size_t i = 0; i < turn.size(); ++i) cx += x[i], cy += y[i];
-    cx *= 2.0 / static_cast<double>(turn.size());
-    cy *= 2.0 / static_cast<double>(turn.size());
+    for (std::size_t i = 0; i < n; ++i) cx += radius_mm[i] * cos[i], cy += radius_mm[i] * sin[i];
+    cx *= 2.0 / static_cast<double>(n);
+    cy *= 2.0 / static_cast<double>(n);
   }
   double low = std::numeric_limits<double>::infinity(), high = -low;
-  for (std::size_t i = 0; i < turn.size(); ++i) {
-    const double d = std::hypot(x[i] - cx, y[i] - cy);
+  for (std::size_t i = 0; i < n; ++i) {
+    const double dx = radius_mm[i] * cos[i] - cx, dy = radius_mm[i] * sin[i] - cy;
+    const double d = std::sqrt(dx * dx + dy * dy);
     low = std::min(low, d);
     high = std::max(high, d);
   }
@@ -83,20 +113,18 @@ double RoundnessBound(const FormOperator& op, std::span<const double> radius_mm,
 }
 
 // Total indicator reading (um) of one turn about the spindle axis.
-double Runout(const FormOperator& op, std::span<const double> radius_mm, std::span<const double>,
-              std::span<const double>) {
+double Runout(const FormOperator&, std::span<const double> radius_mm, const Node&) {
   if (!AllFinite(radius_mm)) return kNaN;
-  std::vector<double> turn(radius_mm.begin(), radius_mm.end());
-  if (op.cutoff_upr) turn = FilterClosedProfile(turn, *op.cutoff_upr);
-  const auto [low, high] = std::minmax_element(turn.begin(), turn.end());
+  const auto [low, high] = std::minmax_element(radius_mm.begin(), radius_mm.end());
   return (*high - *low) * 1000.0;
 }
 
 // Peak-to-valley (um) of one section about its associated arc. `residual_um` are the points'
 // distances from the phase's least-squares arc minus its radius, at axial offsets `dy_mm` from
 // its centre; extra = {radius_mm, spacing_mm}.
-double ArcProfile(const FormOperator& op, std::span<const double> residual_um, std::span<const double> dy_mm,
-                  std::span<const double> extra) {
+double ArcProfile(const FormOperator& op, std::span<const double> residual_um, const Node& node) {
+  const std::vector<double>& dy_mm = node.coordinate;
+  const std::vector<double>& extra = node.extra;
   std::vector<double> r(residual_um.begin(), residual_um.end());
   if (r.size() < 4) return kNaN;
   if (op.cutoff_mm) r = FilterOpenProfile(r, extra[1], *op.cutoff_mm);
@@ -123,8 +151,8 @@ double ArcProfile(const FormOperator& op, std::span<const double> residual_um, s
 // the points' range about any one centre, the least-squares arc's among them, where a point's
 // distance is the radius plus its residual. +inf where it bounds nothing (a least-squares
 // association's PV is not the least over the centres).
-double ArcProfileBound(const FormOperator& op, std::span<const double> residual_um, std::span<const double>,
-                       std::span<const double> extra) {
+double ArcProfileBound(const FormOperator& op, std::span<const double> residual_um, const Node& node) {
+  const std::vector<double>& extra = node.extra;
   if (residual_um.size() < 4 || op.association != Association::kMinimumZone)
     return std::numeric_limits<double>::infinity();
   std::vector<double> r(residual_um.begin(), residual_um.end());
@@ -134,11 +162,34 @@ double ArcProfileBound(const FormOperator& op, std::span<const double> residual_
   return (*high - *low) * (1.0 + 1e-9) + 1e-9;
 }
 
-// The points of one node: values (with their 1-sigma, in the values' unit), the coordinate the
-// operator needs and its extra constants.
-struct Node {
-  std::vector<double> values, sigma, coordinate, extra;
-  std::vector<double> truth_estimate;  // the values with the noise's share taken out (the bootstrap's base)
+// A closed profile's filter (an operator's UPR cut-off; none without one), made once a length:
+// a bootstrap filters each candidate turn of each replicate.
+class TurnFilter {
+ public:
+  explicit TurnFilter(std::optional<double> cutoff_upr) : cutoff_upr_(cutoff_upr) {}
+
+  // `values` filtered in place; empty or non-finite values are left as they are.
+  void Apply(std::vector<double>& values) {
+    if (!cutoff_upr_ || values.empty() || !AllFinite(values)) return;
+    if (!filter_ || size_ != values.size()) {
+      filter_.emplace(values.size(), *cutoff_upr_);
+      size_ = values.size();
+    }
+    filter_->Apply(values, values);
+  }
+
+ private:
+  std::optional<double> cutoff_upr_;
+  std::optional<ClosedProfileFilter> filter_;
+  std::size_t size_ = 0;
+};
+
+// What one bootstrap worker keeps from replicate to replicate.
+struct Workspace {
+  explicit Workspace(std::optional<double> cutoff_upr) : filter(cutoff_upr) {}
+  TurnFilter filter;
+  std::vector<std::vector<double>> noisy;
+  std::vector<std::pair<double, std::size_t>> order;
 };
 
 // The largest value over the candidates of one bootstrap replicate `b`: each candidate's estimate
@@ -148,21 +199,23 @@ struct Node {
 // 20 us a section, from about a tenth of 360). NaN when none can be evaluated.
 double ReplicateLargest(const FormOperator& op, NodeOperator evaluate, NodeOperator bound,
                         const std::vector<Node>& nodes, const std::vector<std::size_t>& candidates,
-                        std::uint64_t seed, int b) {
+                        std::uint64_t seed, int b, Workspace& workspace) {
   std::seed_seq seeds{seed, seed >> 32, static_cast<std::uint64_t>(b)};
   std::mt19937_64 rng(seeds);
   // Boost's ziggurat: a replicate draws a deviate a point (29 000 of them for a turn's map, as
   // many for the sections), and the standard library's polar method took a third of the step.
   boost::random::normal_distribution<double> normal(0.0, 1.0);
-  std::vector<std::vector<double>> noisy(candidates.size());
-  std::vector<std::pair<double, std::size_t>> order(candidates.size());
+  std::vector<std::vector<double>>& noisy = workspace.noisy;
+  std::vector<std::pair<double, std::size_t>>& order = workspace.order;
+  noisy.resize(candidates.size());
+  order.resize(candidates.size());
   for (std::size_t c = 0; c < candidates.size(); ++c) {
     const Node& node = nodes[candidates[c]];
     noisy[c].resize(node.values.size());
     for (std::size_t i = 0; i < noisy[c].size(); ++i)
       noisy[c][i] = node.truth_estimate[i] + node.sigma[i] * normal(rng);
-    const double limit =
-        bound ? bound(op, noisy[c], node.coordinate, node.extra) : std::numeric_limits<double>::infinity();
+    workspace.filter.Apply(noisy[c]);
+    const double limit = bound ? bound(op, noisy[c], node) : std::numeric_limits<double>::infinity();
     order[c] = {std::isnan(limit) ? std::numeric_limits<double>::infinity() : limit, c};
   }
   std::sort(order.begin(), order.end(), [](const auto& x, const auto& y) { return x.first > y.first; });
@@ -170,7 +223,7 @@ double ReplicateLargest(const FormOperator& op, NodeOperator evaluate, NodeOpera
   for (const auto& [limit, c] : order) {
     if (limit < top) break;  // no candidate left can exceed the largest value
     const Node& node = nodes[candidates[c]];
-    const double value = evaluate(op, noisy[c], node.coordinate, node.extra);
+    const double value = evaluate(op, noisy[c], node);
     if (std::isfinite(value)) top = std::max(top, value);
   }
   return std::isfinite(top) ? top : kNaN;
@@ -184,10 +237,17 @@ FormCharacteristic LargestWithBootstrap(const FormOperator& op, NodeOperator eva
                                         std::uint64_t seed) {
   FormCharacteristic out;
   out.op = op;
+  // A closed profile's filter is applied here, once for the bound and the operator alike.
+  FormOperator unfiltered = op;
+  unfiltered.cutoff_upr = std::nullopt;
+  TurnFilter filter(op.cutoff_upr);
+  const auto evaluate_filtered = [&](std::vector<double> values, const Node& node) {
+    filter.Apply(values);
+    return evaluate(unfiltered, values, node);
+  };
   out.per_node_um.assign(nodes.size(), kNaN);
   for (std::size_t j = 0; j < nodes.size(); ++j) {
-    if (!nodes[j].values.empty())
-      out.per_node_um[j] = evaluate(op, nodes[j].values, nodes[j].coordinate, nodes[j].extra);
+    if (!nodes[j].values.empty()) out.per_node_um[j] = evaluate_filtered(nodes[j].values, nodes[j]);
     if (std::isfinite(out.per_node_um[j]) &&
         (out.worst_index < 0 ||
          out.per_node_um[j] > out.per_node_um[static_cast<std::size_t>(out.worst_index)]))
@@ -220,7 +280,7 @@ FormCharacteristic LargestWithBootstrap(const FormOperator& op, NodeOperator eva
   std::vector<double> base(candidates.size(), kNaN);
   for (std::size_t c = 0; c < candidates.size(); ++c) {
     const Node& node = nodes[candidates[c]];
-    base[c] = evaluate(op, node.truth_estimate, node.coordinate, node.extra);
+    base[c] = evaluate_filtered(node.truth_estimate, node);
   }
   const double base_max = *std::max_element(base.begin(), base.end(), [](double x, double y) {
     return !std::isfinite(x) || (std::isfinite(y) && y > x);
@@ -229,9 +289,10 @@ FormCharacteristic LargestWithBootstrap(const FormOperator& op, NodeOperator eva
   // does not depend on how the two workers share them.
   std::vector<double> largest(static_cast<std::size_t>(options.replicates), kNaN);
   RunOnWorkers(2, [&](int worker) {
+    Workspace workspace(op.cutoff_upr);
     for (int b = worker; b < options.replicates; b += 2)
       largest[static_cast<std::size_t>(b)] =
-          ReplicateLargest(op, evaluate, bound, nodes, candidates, seed, b);
+          ReplicateLargest(unfiltered, evaluate, bound, nodes, candidates, seed, b, workspace);
   });
   std::vector<double> replicate_max;
   std::copy_if(largest.begin(), largest.end(), std::back_inserter(replicate_max),
@@ -312,7 +373,8 @@ std::vector<double> EstimateCentre(const FormOperator& roundness, const std::vec
 
 // The turns of the map at the band's nodes.
 std::vector<Node> TurnNodes(const WheelForm& form, const FormOperator& roundness, std::size_t n_phase,
-                            const std::vector<double>& phase_deg, std::vector<double>& at) {
+                            const std::vector<double>& phase_deg, const UnitCircle& unit,
+                            std::vector<double>& at) {
   const std::size_t n_y = form.y_mm.size();
   std::vector<Node> nodes;
   for (std::size_t j = 0; j < n_y; ++j) {
@@ -325,6 +387,7 @@ std::vector<Node> TurnNodes(const WheelForm& form, const FormOperator& roundness
     node.sigma.resize(n_phase);
     for (std::size_t i = 0; i < n_phase; ++i) node.sigma[i] = ValueSigmaMm(form, i * n_y + j);
     node.coordinate = phase_deg;
+    node.unit = &unit;
     if (!AllFinite(node.values)) node.values.clear();
     if (!node.values.empty()) {
       node.truth_estimate = TurnEstimate(form, node.values, nodes.size());
@@ -505,7 +568,8 @@ WheelCharacteristics EvaluateWheelCharacteristics(const WheelForm& form,
 
   const std::vector<double> phase_deg = PhaseGridDeg(n_phase);
   std::vector<double> node_y;
-  const std::vector<Node> turns = TurnNodes(form, options.roundness, n_phase, phase_deg, node_y);
+  const UnitCircle unit = UnitCircleOf(phase_deg);
+  const std::vector<Node> turns = TurnNodes(form, options.roundness, n_phase, phase_deg, unit, node_y);
   const std::uint64_t seed = MixedSeed(options.seed, form.rho_mm);
   const double map_sigma_um = form.map_sigma_mm * 1000.0;
 

@@ -184,66 +184,105 @@ class TurnFilter {
   std::size_t size_ = 0;
 };
 
-// What one bootstrap worker keeps from replicate to replicate.
+// One characteristic the bootstrap takes over a set of nodes: its operator, the operator's
+// evaluation on a node's (filtered) points and an upper bound of it (nullptr: none).
+struct Measure {
+  FormOperator op;
+  NodeOperator evaluate = nullptr;
+  NodeOperator bound = nullptr;
+};
+
+// A measure prepared for the bootstrap: its operator without the closed profile's filter, which
+// is applied before the bound and the operator see the points (once for the measures that share
+// a cut-off), its candidates, and the result so far.
+struct Prepared {
+  FormOperator unfiltered;
+  std::size_t filter_group = 0;         // measures of one cut-off share their filtered turns
+  std::vector<std::size_t> candidates;  // node indices, largest measured value first
+  FormCharacteristic out;
+  double base_max = kNaN;  // the largest value on the noise-free estimates
+};
+
+// What one bootstrap worker keeps from replicate to replicate: a node's noisy points, filtered
+// once for each cut-off, and each measure's order of its candidates.
 struct Workspace {
-  explicit Workspace(std::optional<double> cutoff_upr) : filter(cutoff_upr) {}
-  TurnFilter filter;
-  std::vector<std::vector<double>> noisy;
+  std::vector<TurnFilter> filters;                         // one per filter group
+  std::vector<std::vector<double>> noisy;                  // per node
+  std::vector<std::vector<std::vector<double>>> filtered;  // per filter group, per node
+  std::vector<std::vector<char>> filtered_ready;           // per filter group, per node
   std::vector<std::pair<double, std::size_t>> order;
 };
 
-// The largest value over the candidates of one bootstrap replicate `b`: each candidate's estimate
-// plus fresh noise. With a `bound` (an upper bound of `evaluate`, cheap), the candidates are
-// evaluated in order of their bounds, down to the first whose bound is below the largest value so
-// far: the same largest value, from a few of the candidates (the arc profile's minimum zone, some
-// 20 us a section, from about a tenth of 360). NaN when none can be evaluated.
-double ReplicateLargest(const FormOperator& op, NodeOperator evaluate, NodeOperator bound,
-                        const std::vector<Node>& nodes, const std::vector<std::size_t>& candidates,
-                        std::uint64_t seed, int b, Workspace& workspace) {
-  std::seed_seq seeds{seed, seed >> 32, static_cast<std::uint64_t>(b)};
-  std::mt19937_64 rng(seeds);
-  // Boost's ziggurat: a replicate draws a deviate a point (29 000 of them for a turn's map, as
-  // many for the sections), and the standard library's polar method took a third of the step.
-  boost::random::normal_distribution<double> normal(0.0, 1.0);
-  std::vector<std::vector<double>>& noisy = workspace.noisy;
+// The largest value over measure `m`'s candidates of one replicate: each candidate in order of its
+// bound, down to the first whose bound is below the largest value so far. With a cheap bound, the
+// same largest value from a few of the candidates (the arc profile's minimum zone, some 20 us a
+// section, from about a tenth of 360). NaN when none can be evaluated.
+double ReplicateLargest(const Measure& measure, const Prepared& prepared, const std::vector<Node>& nodes,
+                        Workspace& workspace) {
+  const std::size_t g = prepared.filter_group;
   std::vector<std::pair<double, std::size_t>>& order = workspace.order;
-  noisy.resize(candidates.size());
-  order.resize(candidates.size());
-  for (std::size_t c = 0; c < candidates.size(); ++c) {
-    const Node& node = nodes[candidates[c]];
-    noisy[c].resize(node.values.size());
-    for (std::size_t i = 0; i < noisy[c].size(); ++i)
-      noisy[c][i] = node.truth_estimate[i] + node.sigma[i] * normal(rng);
-    workspace.filter.Apply(noisy[c]);
-    const double limit = bound ? bound(op, noisy[c], node) : std::numeric_limits<double>::infinity();
-    order[c] = {std::isnan(limit) ? std::numeric_limits<double>::infinity() : limit, c};
+  order.clear();
+  for (const std::size_t j : prepared.candidates) {
+    std::vector<double>& points = workspace.filtered[g][j];
+    if (!workspace.filtered_ready[g][j]) {
+      points = workspace.noisy[j];
+      workspace.filters[g].Apply(points);
+      workspace.filtered_ready[g][j] = 1;
+    }
+    const double limit = measure.bound ? measure.bound(prepared.unfiltered, points, nodes[j])
+                                       : std::numeric_limits<double>::infinity();
+    order.emplace_back(std::isnan(limit) ? std::numeric_limits<double>::infinity() : limit, j);
   }
   std::sort(order.begin(), order.end(), [](const auto& x, const auto& y) { return x.first > y.first; });
   double top = -std::numeric_limits<double>::infinity();
-  for (const auto& [limit, c] : order) {
+  for (const auto& [limit, j] : order) {
     if (limit < top) break;  // no candidate left can exceed the largest value
-    const Node& node = nodes[candidates[c]];
-    const double value = evaluate(op, noisy[c], node);
+    const double value = measure.evaluate(prepared.unfiltered, workspace.filtered[g][j], nodes[j]);
     if (std::isfinite(value)) top = std::max(top, value);
   }
   return std::isfinite(top) ? top : kNaN;
 }
 
-// The largest of the nodes' values and its bootstrap (header). `noise_scale` converts a sigma
-// into the value's unit (um) to choose the candidates.
-FormCharacteristic LargestWithBootstrap(const FormOperator& op, NodeOperator evaluate, NodeOperator bound,
-                                        const std::vector<Node>& nodes, std::span<const double> at,
-                                        const CharacteristicsOptions& options, double noise_um,
-                                        std::uint64_t seed) {
-  FormCharacteristic out;
-  out.op = op;
-  // A closed profile's filter is applied here, once for the bound and the operator alike.
-  FormOperator unfiltered = op;
-  unfiltered.cutoff_upr = std::nullopt;
-  TurnFilter filter(op.cutoff_upr);
+// Replicate `b`: fresh noise about each drawn node's estimate, from a stream of the replicate's own
+// (the seed and its number), so that the result does not depend on how the workers share them;
+// then each measure's largest value. The measures of one set of nodes see the same noise: a
+// replicate is one simulated scan.
+void RunReplicate(std::span<const Measure> measures, std::span<const Prepared> prepared,
+                  const std::vector<Node>& nodes, const std::vector<std::size_t>& drawn, std::uint64_t seed,
+                  int b, Workspace& workspace, std::vector<std::vector<double>>& largest) {
+  std::seed_seq seeds{seed, seed >> 32, static_cast<std::uint64_t>(b)};
+  std::mt19937_64 rng(seeds);
+  // Boost's ziggurat: a replicate draws a deviate a point (some 10^5 of them for a turn's map),
+  // and the standard library's polar method took a third of the step.
+  boost::random::normal_distribution<double> normal(0.0, 1.0);
+  for (const std::size_t j : drawn) {
+    const Node& node = nodes[j];
+    std::vector<double>& noisy = workspace.noisy[j];
+    noisy.resize(node.values.size());
+    for (std::size_t i = 0; i < noisy.size(); ++i)
+      noisy[i] = node.truth_estimate[i] + node.sigma[i] * normal(rng);
+  }
+  for (std::vector<char>& ready : workspace.filtered_ready) std::fill(ready.begin(), ready.end(), 0);
+  for (std::size_t m = 0; m < measures.size(); ++m) {
+    if (prepared[m].candidates.empty()) continue;
+    largest[m][static_cast<std::size_t>(b)] = ReplicateLargest(measures[m], prepared[m], nodes, workspace);
+  }
+}
+
+// A measure's value at every node, its largest, and the candidates that can become the largest.
+// `noise_um` (a sigma in the value's unit) sets how far below the largest a candidate may be.
+Prepared Prepare(const Measure& measure, std::size_t filter_group, const std::vector<Node>& nodes,
+                 std::span<const double> at, const CharacteristicsOptions& options, double noise_um) {
+  Prepared p;
+  p.filter_group = filter_group;
+  p.unfiltered = measure.op;
+  p.unfiltered.cutoff_upr = std::nullopt;
+  FormCharacteristic& out = p.out;
+  out.op = measure.op;
+  TurnFilter filter(measure.op.cutoff_upr);
   const auto evaluate_filtered = [&](std::vector<double> values, const Node& node) {
     filter.Apply(values);
-    return evaluate(unfiltered, values, node);
+    return measure.evaluate(p.unfiltered, values, node);
   };
   out.per_node_um.assign(nodes.size(), kNaN);
   for (std::size_t j = 0; j < nodes.size(); ++j) {
@@ -255,21 +294,20 @@ FormCharacteristic LargestWithBootstrap(const FormOperator& op, NodeOperator eva
   }
   if (out.worst_index < 0) {
     out.measured_um = out.value_um = out.u_um = kNaN;
-    return out;
+    return p;
   }
   out.measured_um = out.per_node_um[static_cast<std::size_t>(out.worst_index)];
   out.worst_at = at[static_cast<std::size_t>(out.worst_index)];
 
-  std::vector<std::size_t> candidates;
   for (std::size_t j = 0; j < nodes.size(); ++j) {
     if (std::isfinite(out.per_node_um[j]) &&
         out.per_node_um[j] >= out.measured_um - options.candidate_sigmas * noise_um)
-      candidates.push_back(j);
+      p.candidates.push_back(j);
   }
-  std::sort(candidates.begin(), candidates.end(),
+  std::sort(p.candidates.begin(), p.candidates.end(),
             [&](std::size_t a, std::size_t b) { return out.per_node_um[a] > out.per_node_um[b]; });
-  if (candidates.size() > static_cast<std::size_t>(options.max_candidates))
-    candidates.resize(static_cast<std::size_t>(options.max_candidates));
+  if (p.candidates.size() > static_cast<std::size_t>(options.max_candidates))
+    p.candidates.resize(static_cast<std::size_t>(options.max_candidates));
 
   // The bootstrap simulates the noise about the best estimate of the noise-free profile (a
   // node's `truth_estimate`: the smoothed fit of the turns or the sections, below), not about the
@@ -277,38 +315,72 @@ FormCharacteristic LargestWithBootstrap(const FormOperator& op, NodeOperator eva
   // f(estimate) is the bias, their spread u. The estimate must hold little noise itself: noise
   // left in it raises f(estimate) and the replicates' maximum less than the measured one (a
   // section's own points as the estimate made the arc profile's bias 0.78 um short).
-  std::vector<double> base(candidates.size(), kNaN);
-  for (std::size_t c = 0; c < candidates.size(); ++c) {
-    const Node& node = nodes[candidates[c]];
-    base[c] = evaluate_filtered(node.truth_estimate, node);
+  for (const std::size_t j : p.candidates) {
+    const double base = evaluate_filtered(nodes[j].truth_estimate, nodes[j]);
+    if (std::isfinite(base) && !(base <= p.base_max)) p.base_max = base;
   }
-  const double base_max = *std::max_element(base.begin(), base.end(), [](double x, double y) {
-    return !std::isfinite(x) || (std::isfinite(y) && y > x);
-  });
-  // Each replicate draws from a stream of its own (the seed and its number), so that the result
-  // does not depend on how the two workers share them.
-  std::vector<double> largest(static_cast<std::size_t>(options.replicates), kNaN);
-  RunOnWorkers(2, [&](int worker) {
-    Workspace workspace(op.cutoff_upr);
-    for (int b = worker; b < options.replicates; b += 2)
-      largest[static_cast<std::size_t>(b)] =
-          ReplicateLargest(unfiltered, evaluate, bound, nodes, candidates, seed, b, workspace);
-  });
+  return p;
+}
+
+// The replicates' largest values made into the measure's bias, value and u.
+void Conclude(const std::vector<double>& largest, Prepared& p) {
+  FormCharacteristic& out = p.out;
   std::vector<double> replicate_max;
   std::copy_if(largest.begin(), largest.end(), std::back_inserter(replicate_max),
                [](double v) { return std::isfinite(v); });
   out.replicates = static_cast<int>(replicate_max.size());
-  if (out.replicates < 2 || !std::isfinite(base_max)) {
+  if (out.replicates < 2 || !std::isfinite(p.base_max)) {
     out.value_um = out.measured_um;
     out.u_um = kNaN;
-    return out;
+    return;
   }
   const double mean = std::accumulate(replicate_max.begin(), replicate_max.end(), 0.0) / out.replicates;
   double sum2 = 0.0;
   for (const double v : replicate_max) sum2 += (v - mean) * (v - mean);
   out.u_um = std::sqrt(sum2 / (out.replicates - 1));
-  out.bias_um = mean - base_max;
+  out.bias_um = mean - p.base_max;
   out.value_um = std::max(0.0, out.measured_um - out.bias_um);
+}
+
+// The largest of the nodes' values of each measure and its bootstrap (header). `noise_um`
+// converts a sigma into the values' unit (um) to choose the candidates.
+std::vector<FormCharacteristic> LargestWithBootstrap(std::span<const Measure> measures,
+                                                     const std::vector<Node>& nodes,
+                                                     std::span<const double> at,
+                                                     const CharacteristicsOptions& options, double noise_um,
+                                                     std::uint64_t seed) {
+  std::vector<std::optional<double>> cutoffs;  // of the filter groups
+  std::vector<Prepared> prepared;
+  std::vector<char> is_drawn(nodes.size(), 0);
+  for (const Measure& measure : measures) {
+    const auto found = std::find(cutoffs.begin(), cutoffs.end(), measure.op.cutoff_upr);
+    const std::size_t group = static_cast<std::size_t>(found - cutoffs.begin());
+    if (found == cutoffs.end()) cutoffs.push_back(measure.op.cutoff_upr);
+    prepared.push_back(Prepare(measure, group, nodes, at, options, noise_um));
+    for (const std::size_t j : prepared.back().candidates) is_drawn[j] = 1;
+  }
+  std::vector<std::size_t> drawn;
+  for (std::size_t j = 0; j < nodes.size(); ++j)
+    if (is_drawn[j]) drawn.push_back(j);
+
+  std::vector<std::vector<double>> largest(
+      measures.size(), std::vector<double>(static_cast<std::size_t>(options.replicates), kNaN));
+  if (!drawn.empty()) {
+    RunOnWorkers(2, [&](int worker) {
+      Workspace workspace;
+      for (const std::optional<double>& cutoff : cutoffs) workspace.filters.emplace_back(cutoff);
+      workspace.noisy.resize(nodes.size());
+      workspace.filtered.assign(cutoffs.size(), std::vector<std::vector<double>>(nodes.size()));
+      workspace.filtered_ready.assign(cutoffs.size(), std::vector<char>(nodes.size(), 0));
+      for (int b = worker; b < options.replicates; b += 2)
+        RunReplicate(measures, prepared, nodes, drawn, seed, b, workspace, largest);
+    });
+  }
+  std::vector<FormCharacteristic> out;
+  for (std::size_t m = 0; m < measures.size(); ++m) {
+    if (!prepared[m].candidates.empty()) Conclude(largest[m], prepared[m]);
+    out.push_back(std::move(prepared[m].out));
+  }
   return out;
 }
 
@@ -574,13 +646,17 @@ WheelCharacteristics EvaluateWheelCharacteristics(const WheelForm& form,
   const double map_sigma_um = form.map_sigma_mm * 1000.0;
 
   WheelCharacteristics out;
-  out.roundness = LargestWithBootstrap(options.roundness, Roundness, RoundnessBound, turns, node_y, options,
-                                       map_sigma_um, seed);
-  out.runout =
-      LargestWithBootstrap(options.runout, Runout, nullptr, turns, node_y, options, map_sigma_um, seed + 1);
+  // Roundness and run-out are taken on the same turns: one replicate's noise serves both.
+  const Measure turn_measures[] = {{options.roundness, Roundness, RoundnessBound},
+                                   {options.runout, Runout, nullptr}};
+  std::vector<FormCharacteristic> of_turns =
+      LargestWithBootstrap(turn_measures, turns, node_y, options, map_sigma_um, seed);
+  out.roundness = std::move(of_turns[0]);
+  out.runout = std::move(of_turns[1]);
   const std::vector<Node> sections = SectionNodes(form, n_phase, options.arc_profile);
-  out.arc_profile = LargestWithBootstrap(options.arc_profile, ArcProfile, ArcProfileBound, sections,
-                                         phase_deg, options, map_sigma_um, seed + 2);
+  const Measure arc_measure[] = {{options.arc_profile, ArcProfile, ArcProfileBound}};
+  out.arc_profile =
+      std::move(LargestWithBootstrap(arc_measure, sections, phase_deg, options, map_sigma_um, seed + 2)[0]);
   out.worst_roundness_section = WorstRoundnessSection(out.roundness, turns, node_y);
   return out;
 }

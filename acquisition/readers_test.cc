@@ -1,6 +1,7 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <limits>
@@ -104,6 +105,51 @@ TEST(Hdf5Reader, ComparesTheInvalidValueInTheFilesOwnType) {
   const Scan scan = ReadHdf5Scan(dir / "scan.h5");
   EXPECT_TRUE(std::isnan(scan.z_mm[3]));
   EXPECT_EQ(scan.CountValid(), 399u);
+}
+
+// Kept float32 readings are marked block by block as they are read: every block, the last one
+// short, gets the same marks as a reading read whole (the sentinel compared as float, the range
+// limits, an infinity), and no other reading changes.
+TEST(Hdf5Reader, MarksKeptFloat32ReadingsInEveryBlockAsTheyAreRead) {
+  TempDir dir;
+  const std::size_t n = 3 * 65536 + 123;
+  std::vector<float> z(n);
+  for (std::size_t i = 0; i < n; ++i) z[i] = 0.5f + static_cast<float>(i % 1000) / 1024.0f;
+  std::vector<std::size_t> invalid;
+  for (const std::size_t block_start :
+       {std::size_t{0}, std::size_t{65536}, std::size_t{131072}, std::size_t{196608}}) {
+    const std::size_t i = block_start + 7;
+    z[i] = 0.1f;      // the sentinel
+    z[i + 1] = 4.0f;  // above range_max_mm
+    z[i + 2] = std::numeric_limits<float>::infinity();
+    invalid.insert(invalid.end(), {i, i + 1, i + 2});
+  }
+  z[n - 1] = -5.0f;  // below range_min_mm, the last reading of the short block
+  invalid.push_back(n - 1);
+  {
+    auto file = hdf5::File::Create(dir / "scan.h5");
+    file.CreateGroup("/scan");
+    file.WriteFloats("/scan/z", z, {n});
+    file.WriteAttribute("/scan", "spindle_rpm", 500.0);
+    file.WriteAttribute("/scan", "feed_mm_per_min", 100.0);
+    file.WriteAttribute("/scan", "sample_period_s", 0.001);
+    file.WriteAttribute("/scan", "invalid_value", 0.1);
+    file.WriteAttribute("/scan", "range_min_mm", -3.0);
+    file.WriteAttribute("/scan", "range_max_mm", 3.0);
+  }
+  ReadOptions options;
+  options.keep_float32 = true;
+  const Scan scan = ReadHdf5Scan(dir / "scan.h5", options);
+  ASSERT_TRUE(scan.holds_float());
+  ASSERT_EQ(scan.z_float_mm.size(), n);
+  for (std::size_t i = 0; i < n; ++i) {
+    if (std::find(invalid.begin(), invalid.end(), i) != invalid.end()) {
+      EXPECT_TRUE(std::isnan(scan.z_float_mm[i])) << i;
+    } else {
+      ASSERT_EQ(scan.z_float_mm[i], z[i]) << i;
+    }
+  }
+  EXPECT_EQ(scan.CountValid(), n - invalid.size());
 }
 
 TEST(Hdf5Reader, KeepsFloat32ReadingsInTheChildsPagesAndCopiesThemAsValues) {

@@ -18,6 +18,7 @@
 #include "core/check.h"
 #include "core/error.h"
 #include "core/hdf5.h"
+#include "core/text_lines.h"
 
 namespace arcwheel::acquisition {
 namespace {
@@ -43,30 +44,6 @@ bool ParseDouble(std::string_view cell, double& value) {
   const auto [end, error] = std::from_chars(cell.data(), cell.data() + cell.size(), value);
   return !cell.empty() && error == std::errc() && end == cell.data() + cell.size() && std::isfinite(value);
 }
-
-// Walks a text buffer line by line (CRLF or LF), counting lines from 1.
-class Lines {
- public:
-  explicit Lines(std::string_view text) : text_(text) {
-    if (text_.starts_with("\xEF\xBB\xBF")) text_.remove_prefix(3);
-  }
-  bool Next(std::string_view& line) {
-    if (position_ >= text_.size()) return false;
-    const std::size_t end = text_.find('\n', position_);
-    const std::size_t stop = end == std::string_view::npos ? text_.size() : end;
-    line = text_.substr(position_, stop - position_);
-    if (!line.empty() && line.back() == '\r') line.remove_suffix(1);
-    position_ = end == std::string_view::npos ? text_.size() : end + 1;
-    ++number_;
-    return true;
-  }
-  [[nodiscard]] std::size_t number() const { return number_; }
-
- private:
-  std::string_view text_;
-  std::size_t position_ = 0;
-  std::size_t number_ = 0;
-};
 
 // Calls f(index, cell) for each cell of a separated line.
 template <typename F>
@@ -298,7 +275,7 @@ class ProfileTextParser {
   }
 
   std::string text_;
-  Lines lines_;
+  TextLines lines_;
   std::string stage_;
   ProfileScan scan_;
   int trigger_mode_ = 0;

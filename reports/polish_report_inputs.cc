@@ -16,6 +16,7 @@
 #include "core/error.h"
 #include "core/json_text.h"
 #include "core/sha256.h"
+#include "core/text_lines.h"
 #include "schema/polish_outputs.h"
 
 namespace arcwheel::reports {
@@ -32,27 +33,6 @@ constexpr double kMaxGridNodes = 1e7;
 [[noreturn]] void BadLine(const std::string& source, std::size_t line, const std::string& what) {
   Bad(fmt::format("'{}' line {}: {}", source, line, what));
 }
-
-// One line of a CSV text with its 1-based line number; "\r\n" endings are accepted.
-class Lines {
- public:
-  explicit Lines(std::string_view text) : text_(text) {}
-  bool Next(std::string_view& line) {
-    if (position_ >= text_.size()) return false;
-    const std::size_t end = std::min(text_.find('\n', position_), text_.size());
-    line = text_.substr(position_, end - position_);
-    if (!line.empty() && line.back() == '\r') line.remove_suffix(1);
-    position_ = end + 1;
-    ++number_;
-    return true;
-  }
-  [[nodiscard]] std::size_t number() const { return number_; }
-
- private:
-  std::string_view text_;
-  std::size_t position_ = 0;
-  std::size_t number_ = 0;
-};
 
 std::vector<std::string_view> SplitCells(std::string_view line) {
   std::vector<std::string_view> cells;
@@ -96,7 +76,7 @@ std::vector<std::size_t> Columns(std::string_view header, std::span<const std::s
 template <typename Row, typename Comment>
 void ReadCsv(std::string_view text, const std::string& source, std::span<const std::string_view> required,
              const Row& row, const Comment& comment) {
-  Lines lines(text);
+  TextLines lines(text);
   std::string_view line;
   std::vector<std::size_t> columns;
   std::size_t width = 0;

@@ -97,11 +97,6 @@ SentinelComparison ComparisonOf(const ZLayout& layout) {
   return layout.is_float32 ? SentinelComparison::kAsFloat : SentinelComparison::kAsDouble;
 }
 
-// Whether ReadColumns marks the invalid readings itself (float32 readings kept as float32).
-bool MarkedOnReading(const ZLayout& layout, const ReadOptions& options) {
-  return layout.is_float32 && options.keep_float32;
-}
-
 // The optional columns, as formats.md 2.1 names them.
 constexpr std::pair<const char*, std::vector<double> Scan::*> kColumns[] = {
     {"/scan/t", &Scan::t_s}, {"/scan/angle", &Scan::angle_deg}, {"/scan/y", &Scan::y_mm}};
@@ -112,12 +107,8 @@ void ReadColumns(const hdf5::File& file, const ScanMetadata& metadata, const Rea
                  Allocator&& allocate) {
   const ZLayout layout = ReadZLayout(file);
   const std::string z = "/scan/z";
-  if (MarkedOnReading(layout, options)) {
-    // Each block of readings marked as it arrives, while it is in cache: at 1e8 samples a pass
-    // of its own over the 400 MB, after the read, cost 0.5 s.
-    file.ReadInto(z, allocate(z, file.NumericCount(z, sizeof(float)), float{}), [&](std::span<float> block) {
-      MarkInvalidReadings(block, metadata, ComparisonOf(layout));
-    });
+  if (layout.is_float32 && options.keep_float32) {
+    file.ReadInto(z, allocate(z, file.NumericCount(z, sizeof(float)), float{}));
   } else {
     const std::span<double> values = allocate(z, file.NumericCount(z, sizeof(double)), double{});
     file.ReadInto(z, values);
@@ -160,11 +151,10 @@ std::vector<double>& DoubleColumnOf(Scan& scan, const std::string& name) {
   throw Error(ErrorCode::kInternal, kStage, "no scan column for " + name);
 }
 
-// Invalid markers (unless ReadColumns marked them), then formats.md 2.3.
+// Invalid markers, then formats.md 2.3.
 Scan Finish(Scan scan, const hdf5::File& file, const ReadOptions& options) {
   scan.read.format = "hdf5";
-  const ZLayout layout = ReadZLayout(file);
-  if (!MarkedOnReading(layout, options)) ApplyInvalidMarkers(scan, ComparisonOf(layout));
+  ApplyInvalidMarkers(scan, ComparisonOf(ReadZLayout(file)));
   FinishScan(scan, options);
   return scan;
 }

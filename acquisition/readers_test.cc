@@ -107,10 +107,10 @@ TEST(Hdf5Reader, ComparesTheInvalidValueInTheFilesOwnType) {
   EXPECT_EQ(scan.CountValid(), 399u);
 }
 
-// Kept float32 readings are marked block by block as they are read: every block, the last one
-// short, gets the same marks as a reading read whole (the sentinel compared as float, the range
-// limits, an infinity), and no other reading changes.
-TEST(Hdf5Reader, MarksKeptFloat32ReadingsInEveryBlockAsTheyAreRead) {
+// Kept float32 readings of a scan larger than a few blocks get their marks wherever they lie, the
+// last reading included (the sentinel compared as float, the range limits, an infinity), and no
+// other reading changes.
+TEST(Hdf5Reader, MarksKeptFloat32ReadingsWhereverTheyLie) {
   TempDir dir;
   const std::size_t n = 3 * 65536 + 123;
   std::vector<float> z(n);

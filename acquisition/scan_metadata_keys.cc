@@ -123,33 +123,23 @@ void MarkInvalid(std::span<T> readings, double low, double high, IsSentinel is_s
 
 }  // namespace
 
-namespace {
-
-template <typename T>
-void MarkInvalidAs(std::span<T> readings, const ScanMetadata& m, SentinelComparison comparison) {
+void ApplyInvalidMarkers(Scan& scan, SentinelComparison comparison) {
+  const ScanMetadata& m = scan.metadata;
   const double low = m.range_min_mm.value_or(-std::numeric_limits<double>::infinity());
   const double high = m.range_max_mm.value_or(std::numeric_limits<double>::infinity());
   const bool has_sentinel = m.invalid_value.has_value() && comparison != SentinelComparison::kDone;
   const double sentinel = m.invalid_value.value_or(0.0);
-  if (!has_sentinel) {
-    MarkInvalid(readings, low, high, [](auto) { return false; });
-  } else if (comparison == SentinelComparison::kAsFloat) {
-    const float sentinel_float = static_cast<float>(sentinel);
-    MarkInvalid(readings, low, high, [=](auto z) { return static_cast<float>(z) == sentinel_float; });
-  } else {
-    MarkInvalid(readings, low, high, [=](auto z) { return static_cast<double>(z) == sentinel; });
-  }
-}
-
-}  // namespace
-
-void ApplyInvalidMarkers(Scan& scan, SentinelComparison comparison) {
-  VisitReadings(scan, [&](auto& column) { MarkInvalidAs(std::span(column), scan.metadata, comparison); });
-}
-
-void MarkInvalidReadings(std::span<float> readings, const ScanMetadata& metadata,
-                         SentinelComparison comparison) {
-  MarkInvalidAs(readings, metadata, comparison);
+  VisitReadings(scan, [&](auto& column) {
+    const std::span readings(column);
+    if (!has_sentinel) {
+      MarkInvalid(readings, low, high, [](auto) { return false; });
+    } else if (comparison == SentinelComparison::kAsFloat) {
+      const float sentinel_float = static_cast<float>(sentinel);
+      MarkInvalid(readings, low, high, [=](auto z) { return static_cast<float>(z) == sentinel_float; });
+    } else {
+      MarkInvalid(readings, low, high, [=](auto z) { return static_cast<double>(z) == sentinel; });
+    }
+  });
 }
 
 void FinishScan(Scan& scan, const ReadOptions& options) {

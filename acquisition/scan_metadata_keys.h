@@ -3,7 +3,6 @@
 
 #include <filesystem>
 #include <set>
-#include <span>
 #include <string>
 #include <string_view>
 
@@ -51,9 +50,6 @@ enum class SentinelComparison {
 // Marks as NaN every z equal to metadata.invalid_value (see SentinelComparison), not finite, or
 // outside the range limits.
 void ApplyInvalidMarkers(Scan& scan, SentinelComparison comparison);
-// The same marks on a block of float32 readings, for a reader that marks them as they arrive.
-void MarkInvalidReadings(std::span<float> readings, const ScanMetadata& metadata,
-                         SentinelComparison comparison);
 
 // The readers' last step: merges the settings from outside the file (options.settings,
 // scan_settings.h), then ValidateScan.

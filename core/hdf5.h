@@ -159,11 +159,6 @@ class File {
   // Reads a numeric dataset into `values`, which must hold NumericCount values (converted by HDF5).
   void ReadInto(const std::string& dataset, std::span<double> values) const;
   void ReadInto(const std::string& dataset, std::span<float> values) const;
-  // The same for a one-dimensional float dataset, calling `each_block` on each block of `values`
-  // as soon as it is read, while it is still in the processor's cache (a stored contiguous
-  // dataset is read in blocks of 256 KiB; a chunked one, whose chunks a block could cut, at once).
-  void ReadInto(const std::string& dataset, std::span<float> values,
-                const std::function<void(std::span<float>)>& each_block) const;
   void WriteDoubles(const std::string& dataset, const std::vector<double>& values,
                     const std::vector<hsize_t>& shape);
   void WriteFloats(const std::string& dataset, const std::vector<float>& values,

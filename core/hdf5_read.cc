@@ -122,34 +122,6 @@ void File::ReadInto(const std::string& dataset, std::span<float> values) const {
   ReadIntoSpan(handle_.id(), OpenDataset(dataset), H5T_NATIVE_FLOAT, values, Where(dataset));
 }
 
-void File::ReadInto(const std::string& dataset, std::span<float> values,
-                    const std::function<void(std::span<float>)>& each_block) const {
-  const Handle data = OpenDataset(dataset);
-  const std::string where = Where(dataset);
-  if (hdf5::NumericCount(handle_.id(), data, sizeof(float), where) != values.size())
-    throw Error(ErrorCode::kInternal, kStage, "buffer does not match the size of " + where);
-  const Handle creation(H5Dget_create_plist(data.id()), H5Pclose);
-  const Handle file_space(H5Dget_space(data.id()), H5Sclose);
-  const bool contiguous = creation.valid() && H5Pget_layout(creation.id()) == H5D_CONTIGUOUS;
-  if (!contiguous || H5Sget_simple_extent_ndims(file_space.id()) != 1) {
-    ReadNumericInto(data, H5T_NATIVE_FLOAT, values.data(), values.size(), where);
-    if (!values.empty()) each_block(values);
-    return;
-  }
-  constexpr std::size_t kBlock = 64 * 1024;  // values: 256 KiB, within a core's L2 cache
-  for (std::size_t start = 0; start < values.size(); start += kBlock) {
-    const hsize_t offset = start, count = std::min(kBlock, values.size() - start);
-    const Handle memory_space(H5Screate_simple(1, &count, nullptr), H5Sclose);
-    if (H5Sselect_hyperslab(file_space.id(), H5S_SELECT_SET, &offset, nullptr, &count, nullptr) < 0 ||
-        H5Dread(data.id(), H5T_NATIVE_FLOAT, memory_space.id(), file_space.id(), H5P_DEFAULT,
-                values.data() + start) < 0)
-      throw Error(
-          ErrorCode::kBadInput, kStage,
-          "cannot read " + where + " from value " + std::to_string(start) + " (file truncated or damaged?)");
-    each_block(values.subspan(start, count));
-  }
-}
-
 std::vector<double> File::ReadDoubles(const std::string& dataset) const {
   return ReadNumeric<double>(handle_.id(), OpenDataset(dataset), H5T_NATIVE_DOUBLE, Where(dataset));
 }

@@ -123,6 +123,20 @@ TEST(ReportCommand, ReportsASimulatedAndProcessedScanWithTheSummaryNumbers) {
                                             c.at("operator").at("short").get<std::string>(), where)))
         << row.name;
   }
+  // Where the largest value is, as a number too: the node's y in the band (the text rounds it),
+  // the phase of the worst section; the report draws the worst roundness section at that node.
+  for (const char* name : {"max_runout", "max_roundness"}) {
+    const nlohmann::json& c = summary.at("characteristics").at(name);
+    const double y = c.at("at_y_mm").get<double>();
+    EXPECT_EQ(c.at("where").get<std::string>(), fmt::format("at y = {:.3f} mm", y)) << name;
+    EXPECT_GE(y, summary.at("band_mm").at(0).get<double>()) << name;
+    EXPECT_LE(y, summary.at("band_mm").at(1).get<double>()) << name;
+  }
+  const double arc_phase = summary.at("characteristics").at("max_arc_error").at("at_phase_deg").get<double>();
+  EXPECT_TRUE(arc_phase >= 0.0 && arc_phase < 360.0) << arc_phase;
+  EXPECT_THAT(text, HasSubstr(fmt::format(
+                        "Worst roundness section, y = {:.3f} mm",
+                        summary.at("characteristics").at("max_roundness").at("at_y_mm").get<double>())));
   // The caveat's cell wraps beside the uncertainty's, so pdftotext interleaves their lines: its
   // first words are checked.
   EXPECT_THAT(text, HasSubstr("Caveat: " + summary["runout_note"].get<std::string>().substr(0, 9)));

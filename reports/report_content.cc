@@ -6,7 +6,11 @@
 #include <cmath>
 #include <ctime>
 #include <limits>
+#include <numbers>
 
+#include "characteristics/gaussian_filter.h"
+#include "characteristics/roundness.h"
+#include "core/error.h"
 #include "core/number_format.h"
 #include "core/version.h"
 #include "reports/report_inputs.h"
@@ -527,6 +531,102 @@ std::vector<ReportFigure> SectionFigures(const ReportInputs& inputs) {
        residuals, 0.42}};
 }
 
+// The worst roundness section as `process`'s operator saw it (docs/characteristics.md): the
+// map's turn at the node the characteristic names, filtered and associated again, its deviations
+// from the reference circle drawn magnified about a base circle, with the zone's two circles; and
+// the unfiltered turn's harmonic spectrum with the filter's cut-off. Empty without the
+// characteristic, its node or a complete turn there.
+std::vector<ReportFigure> RoundnessFigures(const ReportInputs& inputs) {
+  const auto found = inputs.summary.characteristics.find(std::string(key::kMaxRoundnessUm));
+  if (found == inputs.summary.characteristics.end() || !found->second.at_y_mm) return {};
+  const Summary::Characteristic& c = found->second;
+  const std::optional<characteristics::Association> association =
+      characteristics::ParseAssociation(c.association);
+  const WheelMapData& map = inputs.map;
+  if (!association || map.n_phase() < 8 || map.n_y() == 0) return {};
+  std::size_t node = 0;
+  for (std::size_t j = 1; j < map.n_y(); ++j)
+    if (std::abs(map.y_mm[j] - *c.at_y_mm) < std::abs(map.y_mm[node] - *c.at_y_mm)) node = j;
+  // The radii about the spindle axis: the map's rho about the nominal radius (the deviations,
+  // not the radius, make the plot: a wrong nominal moves them by (e / R)^2 of themselves).
+  const json& scan = inputs.summary.scan;
+  const double diameter_mm = scan.contains("wheel_diameter_mm") && scan["wheel_diameter_mm"].is_number()
+                                 ? scan["wheel_diameter_mm"].get<double>()
+                                 : 400.0;
+  const double radius_mm = diameter_mm > 0.0 ? diameter_mm / 2.0 : 200.0;
+  std::vector<double> turn(map.n_phase());
+  for (std::size_t i = 0; i < map.n_phase(); ++i) turn[i] = radius_mm + map.rho_mm[i * map.n_y() + node];
+  if (!std::all_of(turn.begin(), turn.end(), [](double r) { return std::isfinite(r); })) return {};
+  characteristics::RoundnessResult result;
+  std::vector<double> filtered = turn;
+  try {
+    result = characteristics::EvaluateRoundness(
+        map.phase_deg, turn, {.filter_cutoff_upr = c.cutoff_upr, .association = *association});
+    if (c.cutoff_upr) filtered = characteristics::FilterClosedProfile(turn, *c.cutoff_upr);
+  } catch (const Error&) {
+    return {};  // the map's phases are not a closed profile the operator takes
+  }
+  const characteristics::AssociatedCircle& ref = result.reference;
+  // Deviations (um) from the reference circle, in the direction seen from its centre.
+  const double base_um = 2.0 * std::max(result.ront_um, 1e-3);
+  plot::PathMap polar;
+  polar.title = fmt::format("Worst roundness section, y = {} mm: {} (magnified, base circle {} µm)",
+                            FormatFixed(map.y_mm[node], 3), c.operator_text, FormatFixed(base_um, 2));
+  polar.x = FreeAxis("x (µm, magnified)");
+  polar.y = FreeAxis("y (µm, magnified)");
+  polar.colour_bar_label = "deviation from the reference circle (µm)";
+  for (std::size_t i = 0; i <= filtered.size(); ++i) {
+    const std::size_t k = i % filtered.size();
+    const double a = map.phase_deg[k] * std::numbers::pi / 180.0;
+    const double x = filtered[k] * std::cos(a) - ref.center_x_mm,
+                 y = filtered[k] * std::sin(a) - ref.center_y_mm;
+    const double deviation_um = (std::hypot(x, y) - ref.radius_mm) * 1000.0;
+    const double direction = std::atan2(y, x), shown = base_um + deviation_um;
+    polar.x_points.push_back(shown * std::cos(direction));
+    polar.y_points.push_back(shown * std::sin(direction));
+    polar.values.push_back(deviation_um);
+  }
+  const auto circle = [&](double deviation_um, const std::string& label, plot::Rgb colour) {
+    plot::Series series{label, {}, {}, {}, {}, colour, false, true};
+    for (int k = 0; k <= 360; ++k) {
+      const double a = k * std::numbers::pi / 180.0;
+      series.x.push_back((base_um + deviation_um) * std::cos(a));
+      series.y.push_back((base_um + deviation_um) * std::sin(a));
+    }
+    return series;
+  };
+  polar.overlays = {circle(0.0, "reference circle", plot::SeriesColour(0)),
+                    circle(-result.ronv_um, "inner", plot::SeriesColour(1)),
+                    circle(result.ronp_um, "outer", plot::SeriesColour(1))};
+  std::vector<double> upr, amplitude;
+  for (std::size_t k = 0; k < result.harmonic_amplitude_um.size(); ++k) {
+    upr.push_back(static_cast<double>(k + 1));
+    amplitude.push_back(result.harmonic_amplitude_um[k]);
+  }
+  plot::LinePlot spectrum{
+      fmt::format("Harmonic spectrum of the worst roundness section, y = {} mm (unfiltered)",
+                  FormatFixed(map.y_mm[node], 3)),
+      FreeAxis("undulations per revolution (UPR)"),
+      FreeAxis("amplitude (µm)"),
+      {{"amplitude", upr, amplitude, {}, {}, plot::SeriesColour(2), true}},
+      {}};
+  if (c.cutoff_upr) {
+    spectrum.x_marks = {*c.cutoff_upr};
+    spectrum.x_marks_label = fmt::format("filter cut-off {} UPR", ShowSignificant(*c.cutoff_upr));
+  }
+  return {{fmt::format(
+               "The map's turn at the node of the largest roundness, filtered and associated as the "
+               "characteristic's operator says ({}); its RONt here {} µm before the noise's bias is taken "
+               "off. Distances from the centre: a base circle of {} µm plus each point's deviation from "
+               "the reference circle, so the form shows, not the radius. Dashed: the reference circle "
+               "and the zone's inner and outer circles.",
+               c.operator_text, FormatFixed(result.ront_um, 3), FormatFixed(base_um, 2)),
+           polar, 1.0},
+          {"Amplitude of each harmonic of the same turn before the filter (1 UPR is the eccentricity); the "
+           "Gaussian filter passes half the amplitude at its cut-off.",
+           spectrum, 0.42}};
+}
+
 ReportFigure ProfileErrorPlot(const ModelCurves& model) {
   plot::LinePlot plot{"Profile error p(u) common to all phases (shaded: ± 1σ)",
                       FreeAxis("distance from the arc centre u = y − a(c) (mm)"),
@@ -756,6 +856,7 @@ ReportContent ComposeReport(const ReportInputs& inputs, const Tolerances& tolera
   content.figures.push_back(ArcErrorPlot(s.phases));
   content.figures.push_back(RunoutPlot(s));
   for (ReportFigure& figure : SectionFigures(inputs)) content.figures.push_back(std::move(figure));
+  for (ReportFigure& figure : RoundnessFigures(inputs)) content.figures.push_back(std::move(figure));
   content.figures.push_back(CoverageMap(inputs));
   if (!s.processing.empty()) Flatten(s.processing, "", content.processing);
   // The warnings are texts of summary.json, which keeps every digit; the report shows seven.

@@ -368,6 +368,7 @@ std::map<std::string, Summary::Characteristic> ParseCharacteristics(const json& 
     c.where = text(item, "where");
     c.decision = text(item, "decision");
     c.rule = text(item, "rule");
+    if (const double at = number(item, "at_y_mm"); std::isfinite(at)) c.at_y_mm = at;
     if (const auto op = item.find("operator"); op != item.end() && op->is_object()) {
       c.operator_text = text(*op, "short");
       c.association = text(*op, "association");

@@ -140,9 +140,11 @@ struct Summary {
   struct Characteristic {
     double value = 0.0, expanded = 0.0, coverage_factor = 0.0;
     std::string operator_text, where, decision, rule;
-    // The operator's closed-profile cut-off (UPR) and association, for the polar plot.
+    // The operator's closed-profile cut-off (UPR) and association, and the axial node of the
+    // largest value ("at_y_mm"), for the polar plot of the worst section.
     std::optional<double> cutoff_upr;
     std::string association;
+    std::optional<double> at_y_mm;
   };
   std::map<std::string, Characteristic> characteristics;
 };

@@ -1,9 +1,11 @@
 #include "reports/report.h"
 
 #include <cairo.h>
+#include <fmt/format.h>
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
@@ -254,6 +256,50 @@ TEST(ComposeReport, DrawsTheProfileErrorAndTheResidualMapOfTheModel) {
       }
     }
   }
+}
+
+// The worst roundness section is drawn from the map's turn at the node the characteristic names,
+// filtered and associated as its operator says. A turn of three lobes of amplitude a: the 50 UPR
+// Gaussian passes a 2^-(3/50)^2 of them, and the minimum zone of r = R + a' cos 3c is 2 a' wide
+// (its six extremes alternate on two circles about the axis).
+TEST(ComposeReport, DrawsTheWorstRoundnessSectionAsItsOperatorSeesIt) {
+  TempDir dir;
+  WriteFixture(dir.path(), {.n_phase = 360, .n_y = 41});
+  ReportInputs inputs = ReadReportInputs(dir.path());
+  const std::size_t node = 17, n_y = inputs.map.n_y();
+  const double lobes_um = 1.234;
+  for (std::size_t i = 0; i < 360; ++i)
+    inputs.map.rho_mm[i * n_y + node] =
+        lobes_um / 1000.0 * std::cos(3.0 * static_cast<double>(i) * M_PI / 180.0);
+  Summary::Characteristic roundness;
+  roundness.value = 2.0;
+  roundness.operator_text = "RONt, 50 UPR, MZ";
+  roundness.cutoff_upr = 50.0;
+  roundness.association = "minimum-zone";
+  roundness.at_y_mm = inputs.map.y_mm[node] + 0.01;  // the nearest node is the one
+  inputs.summary.characteristics["max_roundness_um"] = roundness;
+  const ReportContent content = ComposeReport(inputs, {});
+  const plot::PathMap* polar = nullptr;
+  std::string caption;
+  for (const ReportFigure& figure : content.figures) {
+    if (const auto* path = std::get_if<plot::PathMap>(&figure.figure);
+        path != nullptr && path->title.starts_with("Worst roundness section")) {
+      polar = path;
+      caption = figure.caption;
+    }
+  }
+  ASSERT_NE(polar, nullptr);
+  const double passed_um = lobes_um * std::pow(2.0, -(3.0 / 50.0) * (3.0 / 50.0));
+  EXPECT_THAT(caption, HasSubstr(fmt::format("its RONt here {:.3f} µm", 2.0 * passed_um)));
+  const auto [low, high] = std::minmax_element(polar->values.begin(), polar->values.end());
+  EXPECT_NEAR(*high, passed_um, 1e-6);
+  EXPECT_NEAR(*low, -passed_um, 1e-6);
+  EXPECT_THAT(polar->title, HasSubstr(fmt::format("y = {:.3f} mm", inputs.map.y_mm[node])));
+  const plot::Series& spectrum = SeriesLabelled(
+      LinePlotTitled(content, "Harmonic spectrum of the worst roundness section"), "amplitude");
+  ASSERT_GE(spectrum.y.size(), 3u);
+  EXPECT_NEAR(spectrum.y[2], lobes_um, 1e-6) << "3 UPR, before the filter";
+  EXPECT_NEAR(spectrum.y[1], 0.0, 1e-6);
 }
 
 TEST(ComposeReport, SaysInOneLineWhyASummaryHasNoModel) {

@@ -99,7 +99,8 @@ std::optional<uncertainty::Decision> DecisionOf(const ProcessPipelineOptions& op
 
 Characteristic FormItem(const ProcessPipelineOptions& options, const uncertainty::WheelUncertainty& wheel,
                         std::string name, std::string_view contract_key, std::string label,
-                        const characteristics::FormCharacteristic& form, std::string where) {
+                        const characteristics::FormCharacteristic& form, std::string where,
+                        std::string at_key) {
   Characteristic c;
   c.name = std::move(name);
   c.contract_key = contract_key;
@@ -117,6 +118,10 @@ Characteristic FormItem(const ProcessPipelineOptions& options, const uncertainty
       form.op.association ? std::string(characteristics::AssociationName(*form.op.association)) : "";
   c.parameter = form.op.parameter;
   c.where = std::move(where);
+  if (form.worst_index >= 0) {
+    c.at_key = std::move(at_key);
+    c.at = form.worst_at;
+  }
   c.decision = DecisionOf(options, contract_key, c.value, c.expanded);
   return c;
 }
@@ -292,11 +297,12 @@ CharacteristicsResult EvaluateCharacteristics(const ProcessPipelineOptions& opti
                                  "arc centre axial deviation", "range of a"));
   result.items.push_back(FormItem(options, wheel, "max_arc_error", key::kMaxArcErrorUm,
                                   "max arc profile error", f.arc_profile,
-                                  fmt::format("at phase {:g} deg", f.arc_profile.worst_at)));
+                                  fmt::format("at phase {:g} deg", f.arc_profile.worst_at), "at_phase_deg"));
   result.items.push_back(FormItem(options, wheel, "max_runout", key::kMaxRunoutUm, "max circular run-out",
-                                  f.runout, fmt::format("at y = {:.3f} mm", f.runout.worst_at)));
+                                  f.runout, fmt::format("at y = {:.3f} mm", f.runout.worst_at), "at_y_mm"));
   result.items.push_back(FormItem(options, wheel, "max_roundness", key::kMaxRoundnessUm, "max roundness",
-                                  f.roundness, fmt::format("at y = {:.3f} mm", f.roundness.worst_at)));
+                                  f.roundness, fmt::format("at y = {:.3f} mm", f.roundness.worst_at),
+                                  "at_y_mm"));
   return result;
 }
 
@@ -315,6 +321,7 @@ nlohmann::json CharacteristicsToJson(const CharacteristicsResult& result) {
                            {"U", number(c.expanded)},
                            {"k", number(c.coverage_factor)}};
     if (!c.where.empty()) item["where"] = c.where;
+    if (!c.at_key.empty()) item[c.at_key] = number(c.at);
     if (c.decision) {
       item["decision"] = uncertainty::DecisionName(*c.decision);
       item["rule"] = uncertainty::DecisionRuleName(*result.rule);

@@ -46,6 +46,9 @@ struct Characteristic {
   std::string association;  // "" for run-out (the datum axis)
   std::string parameter;
   std::string where;  // "at y = 1.234 mm", "at phase 12 deg"
+  // The same as a number under its key, for a reader: "at_y_mm" or "at_phase_deg" ("" for none).
+  std::string at_key;
+  double at = 0.0;
   std::optional<uncertainty::Decision> decision;
 };
 

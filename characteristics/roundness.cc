@@ -71,6 +71,27 @@ AngleSpacing CheckAngleSpacing(std::span<const double> angle_deg) {
   return spacing;
 }
 
+RoundnessParameters ParametersAbout(const AssociatedCircle& reference, std::span<const double> x_mm,
+                                    std::span<const double> y_mm) {
+  double highest = -std::numeric_limits<double>::infinity();
+  double lowest = std::numeric_limits<double>::infinity();
+  double sum_squares = 0.0;
+  for (std::size_t i = 0; i < x_mm.size(); ++i) {
+    const double deviation =
+        std::hypot(x_mm[i] - reference.center_x_mm, y_mm[i] - reference.center_y_mm) - reference.radius_mm;
+    highest = std::max(highest, deviation);
+    lowest = std::min(lowest, deviation);
+    sum_squares += deviation * deviation;
+  }
+  RoundnessParameters out;
+  // Rounding may put a support point a few 1e-13 mm on the wrong side of its own circle.
+  out.ronp_um = std::max(highest, 0.0) * kMmToUm;
+  out.ronv_um = std::max(-lowest, 0.0) * kMmToUm;
+  out.ront_um = (highest - lowest) * kMmToUm;
+  out.ronq_um = std::sqrt(sum_squares / static_cast<double>(x_mm.size())) * kMmToUm;
+  return out;
+}
+
 RoundnessResult EvaluateRoundness(std::span<const double> angle_deg, std::span<const double> radius_mm,
                                   const RoundnessOptions& options) {
   ThrowIfProblems(ErrorCode::kInvalidOption, kStage, options.Problems());
@@ -117,22 +138,12 @@ RoundnessResult EvaluateRoundness(std::span<const double> angle_deg, std::span<c
                 fmt::format("no {} reference circle: {}", AssociationName(options.association),
                             result.reference.message));
   }
-  double highest = -std::numeric_limits<double>::infinity();
-  double lowest = std::numeric_limits<double>::infinity();
-  double sum_squares = 0.0;
-  for (std::size_t i = 0; i < n; ++i) {
-    const double deviation =
-        std::hypot(x[i] - result.reference.center_x_mm, y[i] - result.reference.center_y_mm) -
-        result.reference.radius_mm;
-    highest = std::max(highest, deviation);
-    lowest = std::min(lowest, deviation);
-    sum_squares += deviation * deviation;
-  }
-  // Rounding may put a support point a few 1e-13 mm on the wrong side of its own circle.
-  result.ronp_um = std::max(highest, 0.0) * kMmToUm;
-  result.ronv_um = std::max(-lowest, 0.0) * kMmToUm;
-  result.ront_um = (highest - lowest) * kMmToUm;
-  result.ronq_um = std::sqrt(sum_squares / static_cast<double>(n)) * kMmToUm;
+  const RoundnessParameters parameters = ParametersAbout(result.reference, x, y);
+  result.ront_um = parameters.ront_um;
+  result.ronp_um = parameters.ronp_um;
+  result.ronv_um = parameters.ronv_um;
+  result.ronq_um = parameters.ronq_um;
+  result.filtered_radius_mm = filtered;
   const int max_harmonic = std::min(static_cast<int>(n / 2) - 1, options.max_harmonic_upr);
   result.harmonic_amplitude_um = HarmonicAmplitudes(radius_mm, max_harmonic);
   for (double& amplitude : result.harmonic_amplitude_um) amplitude *= kMmToUm;

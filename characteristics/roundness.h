@@ -51,7 +51,18 @@ struct RoundnessResult {
   // Amplitude of harmonic k of the unfiltered radial function at element k - 1, k = 1 ..
   // min(n / 2 - 1, max_harmonic_upr), um (k = 1 holds the eccentricity).
   std::vector<double> harmonic_amplitude_um;
+  std::vector<double> filtered_radius_mm;  // the profile the reference was associated to
 };
+
+// ISO 12181-1's parameters of points (x, y, mm) about their reference circle, um.
+struct RoundnessParameters {
+  double ront_um = 0.0;
+  double ronp_um = 0.0;
+  double ronv_um = 0.0;
+  double ronq_um = 0.0;
+};
+[[nodiscard]] RoundnessParameters ParametersAbout(const AssociatedCircle& reference,
+                                                  std::span<const double> x_mm, std::span<const double> y_mm);
 
 // Whether the angles of a closed profile are equally spaced over one turn (any start, either
 // direction): every step within 1 % of 360 / n deg and the steps adding up to one turn.

@@ -72,14 +72,7 @@ double Roundness(const FormOperator& op, std::span<const double> radius_mm, cons
   }
   const AssociatedCircle circle = AssociateCircle(x, y, {.association = *op.association});
   if (!circle.IsCertified()) return kNaN;
-  double highest = -std::numeric_limits<double>::infinity(), lowest = -highest;
-  for (std::size_t i = 0; i < n; ++i) {
-    const double deviation =
-        std::hypot(x[i] - circle.center_x_mm, y[i] - circle.center_y_mm) - circle.radius_mm;
-    highest = std::max(highest, deviation);
-    lowest = std::min(lowest, deviation);
-  }
-  return (highest - lowest) * 1000.0;
+  return ParametersAbout(circle, x, y).ront_um;
 }
 
 // An upper bound of Roundness at a filter and a pass over the points: a minimum zone's width is at
@@ -542,19 +535,27 @@ RoundnessSection WorstRoundnessSection(const FormCharacteristic& roundness, cons
   RoundnessSection section;
   if (roundness.worst_index < 0) return section;
   const Node& node = turns[static_cast<std::size_t>(roundness.worst_index)];
-  section.y_mm = at[static_cast<std::size_t>(roundness.worst_index)];
-  section.phase_deg = node.coordinate;
-  const RoundnessResult result = EvaluateRoundness(
-      node.coordinate, node.values,
-      {.filter_cutoff_upr = roundness.op.cutoff_upr, .association = *roundness.op.association});
-  section.filtered_radius_mm =
-      roundness.op.cutoff_upr ? FilterClosedProfile(node.values, *roundness.op.cutoff_upr) : node.values;
-  section.reference = result.reference;
-  section.harmonic_amplitude_um = result.harmonic_amplitude_um;
-  return section;
+  return RoundnessSectionOf(node.coordinate, node.values, roundness.op,
+                            at[static_cast<std::size_t>(roundness.worst_index)]);
 }
 
 }  // namespace
+
+RoundnessSection RoundnessSectionOf(std::span<const double> phase_deg, std::span<const double> radius_mm,
+                                    const FormOperator& op, double y_mm) {
+  RoundnessResult result = EvaluateRoundness(
+      phase_deg, radius_mm, {.filter_cutoff_upr = op.cutoff_upr, .association = *op.association});
+  RoundnessSection section;
+  section.y_mm = y_mm;
+  section.phase_deg.assign(phase_deg.begin(), phase_deg.end());
+  section.filtered_radius_mm = std::move(result.filtered_radius_mm);
+  section.reference = result.reference;
+  section.ront_um = result.ront_um;
+  section.ronp_um = result.ronp_um;
+  section.ronv_um = result.ronv_um;
+  section.harmonic_amplitude_um = std::move(result.harmonic_amplitude_um);
+  return section;
+}
 
 std::string FormOperator::Describe() const {
   std::string filter = "no filter";

@@ -124,8 +124,15 @@ struct RoundnessSection {
   std::vector<double> phase_deg;
   std::vector<double> filtered_radius_mm;  // the filtered turn about the spindle axis
   AssociatedCircle reference;
-  std::vector<double> harmonic_amplitude_um;  // of the unfiltered turn, element k - 1 = k UPR
+  double ront_um = 0.0, ronp_um = 0.0, ronv_um = 0.0;  // of the filtered turn about the reference
+  std::vector<double> harmonic_amplitude_um;           // of the unfiltered turn, element k - 1 = k UPR
 };
+
+// One turn (radii about the spindle axis, mm, at equally spaced phases) at axial position y_mm as
+// the roundness operator `op` (its filter and association) sees it. Throws as EvaluateRoundness.
+[[nodiscard]] RoundnessSection RoundnessSectionOf(std::span<const double> phase_deg,
+                                                  std::span<const double> radius_mm, const FormOperator& op,
+                                                  double y_mm);
 
 struct WheelCharacteristics {
   FormCharacteristic roundness, runout, arc_profile;

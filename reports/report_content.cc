@@ -8,8 +8,7 @@
 #include <limits>
 #include <numbers>
 
-#include "characteristics/gaussian_filter.h"
-#include "characteristics/roundness.h"
+#include "characteristics/wheel_characteristics.h"
 #include "core/error.h"
 #include "core/number_format.h"
 #include "core/version.h"
@@ -557,18 +556,21 @@ std::vector<ReportFigure> RoundnessFigures(const ReportInputs& inputs) {
   std::vector<double> turn(map.n_phase());
   for (std::size_t i = 0; i < map.n_phase(); ++i) turn[i] = radius_mm + map.rho_mm[i * map.n_y() + node];
   if (!std::all_of(turn.begin(), turn.end(), [](double r) { return std::isfinite(r); })) return {};
-  characteristics::RoundnessResult result;
-  std::vector<double> filtered = turn;
+  characteristics::RoundnessSection section;
   try {
-    result = characteristics::EvaluateRoundness(
-        map.phase_deg, turn, {.filter_cutoff_upr = c.cutoff_upr, .association = *association});
-    if (c.cutoff_upr) filtered = characteristics::FilterClosedProfile(turn, *c.cutoff_upr);
+    section = characteristics::RoundnessSectionOf(map.phase_deg, turn,
+                                                  {.cutoff_upr = c.cutoff_upr,
+                                                   .cutoff_mm = std::nullopt,
+                                                   .association = *association,
+                                                   .parameter = "RONt"},
+                                                  map.y_mm[node]);
   } catch (const Error&) {
     return {};  // the map's phases are not a closed profile the operator takes
   }
-  const characteristics::AssociatedCircle& ref = result.reference;
+  const std::vector<double>& filtered = section.filtered_radius_mm;
+  const characteristics::AssociatedCircle& ref = section.reference;
   // Deviations (um) from the reference circle, in the direction seen from its centre.
-  const double base_um = 2.0 * std::max(result.ront_um, 1e-3);
+  const double base_um = 2.0 * std::max(section.ront_um, 1e-3);
   plot::PathMap polar;
   polar.title = fmt::format("Worst roundness section, y = {} mm: {} (magnified, base circle {} µm)",
                             FormatFixed(map.y_mm[node], 3), c.operator_text, FormatFixed(base_um, 2));
@@ -596,12 +598,12 @@ std::vector<ReportFigure> RoundnessFigures(const ReportInputs& inputs) {
     return series;
   };
   polar.overlays = {circle(0.0, "reference circle", plot::SeriesColour(0)),
-                    circle(-result.ronv_um, "inner", plot::SeriesColour(1)),
-                    circle(result.ronp_um, "outer", plot::SeriesColour(1))};
+                    circle(-section.ronv_um, "inner", plot::SeriesColour(1)),
+                    circle(section.ronp_um, "outer", plot::SeriesColour(1))};
   std::vector<double> upr, amplitude;
-  for (std::size_t k = 0; k < result.harmonic_amplitude_um.size(); ++k) {
+  for (std::size_t k = 0; k < section.harmonic_amplitude_um.size(); ++k) {
     upr.push_back(static_cast<double>(k + 1));
-    amplitude.push_back(result.harmonic_amplitude_um[k]);
+    amplitude.push_back(section.harmonic_amplitude_um[k]);
   }
   plot::LinePlot spectrum{
       fmt::format("Harmonic spectrum of the worst roundness section, y = {} mm (unfiltered)",
@@ -620,7 +622,7 @@ std::vector<ReportFigure> RoundnessFigures(const ReportInputs& inputs) {
                "off. Distances from the centre: a base circle of {} µm plus each point's deviation from "
                "the reference circle, so the form shows, not the radius. Dashed: the reference circle "
                "and the zone's inner and outer circles.",
-               c.operator_text, FormatFixed(result.ront_um, 3), FormatFixed(base_um, 2)),
+               c.operator_text, FormatFixed(section.ront_um, 3), FormatFixed(base_um, 2)),
            polar, 1.0},
           {"Amplitude of each harmonic of the same turn before the filter (1 UPR is the eccentricity); the "
            "Gaussian filter passes half the amplitude at its cut-off.",

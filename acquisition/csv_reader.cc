@@ -15,13 +15,13 @@
 #include "acquisition/scan_metadata_keys.h"
 #include "acquisition/scan_reader.h"
 #include "core/error.h"
+#include "core/nan.h"
 #include "core/text_encoding.h"
 
 namespace arcwheel::acquisition {
 namespace {
 
-constexpr const char* kStage = "acquisition.csv";
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+constexpr const char* kCsvReaderStage = "acquisition.csv";
 
 enum class Column { kZ, kT, kAngle, kY, kIndex };
 
@@ -42,7 +42,7 @@ class CsvParser {
 
  private:
   [[noreturn]] void Refuse(const std::string& problem) const {
-    throw Error(ErrorCode::kBadInput, kStage,
+    throw Error(ErrorCode::kBadInput, kCsvReaderStage,
                 "'" + path_ + "' line " + std::to_string(line_number_) + ": " + problem);
   }
 
@@ -312,10 +312,10 @@ class CsvParser {
 
 std::string ReadWholeFile(const std::filesystem::path& path) {
   std::ifstream in(path, std::ios::binary);
-  if (!in) throw Error(ErrorCode::kIo, kStage, "cannot open '" + path.string() + "'");
+  if (!in) throw Error(ErrorCode::kIo, kCsvReaderStage, "cannot open '" + path.string() + "'");
   std::ostringstream buffer;
   buffer << in.rdbuf();
-  if (in.bad()) throw Error(ErrorCode::kIo, kStage, "cannot read '" + path.string() + "'");
+  if (in.bad()) throw Error(ErrorCode::kIo, kCsvReaderStage, "cannot read '" + path.string() + "'");
   return std::move(buffer).str();
 }
 

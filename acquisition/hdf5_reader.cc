@@ -18,12 +18,12 @@
 namespace arcwheel::acquisition {
 namespace {
 
-constexpr const char* kStage = "acquisition.hdf5";
+constexpr const char* kHdf5ReaderStage = "acquisition.hdf5";
 
 void CheckOneDimensional(const hdf5::File& file, const std::string& name) {
   const std::vector<hsize_t> shape = file.Shape(name);
   if (shape.size() != 1) {
-    throw Error(ErrorCode::kBadInput, kStage,
+    throw Error(ErrorCode::kBadInput, kHdf5ReaderStage,
                 "'" + file.path().string() + "' dataset " + name + " must be one-dimensional, has rank " +
                     std::to_string(shape.size()));
   }
@@ -38,7 +38,8 @@ void ReadAttributes(const hdf5::File& file, ScanMetadata& metadata) {
       return step();
     } catch (const Error& error) {
       if (error.code() != ErrorCode::kBadInput) throw;
-      throw Error(ErrorCode::kBadInput, kStage, "'" + file.path().string() + "' /scan: " + error.what());
+      throw Error(ErrorCode::kBadInput, kHdf5ReaderStage,
+                  "'" + file.path().string() + "' /scan: " + error.what());
     }
   };
   for (const std::string& attribute : file.AttributeNames("/scan")) {
@@ -75,7 +76,7 @@ ZLayout ReadZLayout(const hdf5::File& file) {
   layout.is_float = false;
   const std::optional<double> scale = file.ReadAttributeDouble(name, "scale_factor");
   if (!scale) {
-    throw Error(ErrorCode::kBadInput, kStage,
+    throw Error(ErrorCode::kBadInput, kHdf5ReaderStage,
                 "'" + file.path().string() +
                     "' dataset /scan/z stores integers (sensor counts?), not millimetres: "
                     "give their scale as attribute scale_factor (mm per count, and add_offset in mm if any) "
@@ -86,7 +87,7 @@ ZLayout ReadZLayout(const hdf5::File& file) {
   layout.offset = file.ReadAttributeDouble(name, "add_offset").value_or(0.0);
   if (!std::isfinite(layout.scale) || layout.scale == 0.0 || !std::isfinite(layout.offset)) {
     throw Error(
-        ErrorCode::kBadInput, kStage,
+        ErrorCode::kBadInput, kHdf5ReaderStage,
         "'" + file.path().string() + "' /scan/z: scale_factor must be finite and not 0, add_offset finite");
   }
   return layout;
@@ -131,13 +132,13 @@ void ReadColumns(const hdf5::File& file, const ScanMetadata& metadata, const Rea
 Scan ReadHeader(const hdf5::File& file) {
   const std::filesystem::path& path = file.path();
   if (!file.HasObject("/scan")) {
-    throw Error(ErrorCode::kBadInput, kStage, "'" + path.string() + "' has no group /scan");
+    throw Error(ErrorCode::kBadInput, kHdf5ReaderStage, "'" + path.string() + "' has no group /scan");
   }
   Scan scan;
   scan.path = path.string();
   ReadAttributes(file, scan.metadata);
   if (!file.HasObject("/scan/z")) {
-    throw Error(ErrorCode::kBadInput, kStage, "'" + path.string() + "' has no dataset /scan/z");
+    throw Error(ErrorCode::kBadInput, kHdf5ReaderStage, "'" + path.string() + "' has no dataset /scan/z");
   }
   return scan;
 }
@@ -148,7 +149,7 @@ std::vector<double>& DoubleColumnOf(Scan& scan, const std::string& name) {
   for (const auto& [column, member] : kColumns) {
     if (name == column) return scan.*member;
   }
-  throw Error(ErrorCode::kInternal, kStage, "no scan column for " + name);
+  throw Error(ErrorCode::kInternal, kHdf5ReaderStage, "no scan column for " + name);
 }
 
 // Invalid markers, then formats.md 2.3.

@@ -18,12 +18,12 @@
 #include "core/check.h"
 #include "core/error.h"
 #include "core/hdf5.h"
+#include "core/nan.h"
 #include "core/text_lines.h"
 
 namespace arcwheel::acquisition {
 namespace {
 
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 // Gocator time stamps count 1/1.024 us.
 constexpr double kGocatorTicksPerSecond = 1.024e6;
 // Keyence LJ values are integers of 0.01 um; these and below mark invalid points.

@@ -15,7 +15,7 @@
 namespace arcwheel::acquisition {
 namespace {
 
-constexpr const char* kStage = "acquisition.write";
+constexpr const char* kProfileWriterStage = "acquisition.write";
 constexpr double kUnitsPerMm = 1e5;  // 0.01 um, Keyence LJ's integer unit
 constexpr long long kLjInvalid = -2147483648LL;
 
@@ -147,7 +147,7 @@ void WriteProfileScan(const ProfileScan& scan, ScanFormat format, const std::fil
     case ScanFormat::kKeyenceLj:
       return WriteFileAtomically(path, KeyenceLjText(scan));
     default:
-      throw Error(ErrorCode::kInvalidOption, kStage,
+      throw Error(ErrorCode::kInvalidOption, kProfileWriterStage,
                   fmt::format("no profile writer of the {} layout (gocator, keyence-lj or profile-hdf5)",
                               InfoOf(format).name));
   }

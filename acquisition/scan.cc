@@ -9,10 +9,10 @@
 namespace arcwheel::acquisition {
 namespace {
 
-constexpr const char* kStage = "acquisition.validate";
+constexpr const char* kScanStage = "acquisition.validate";
 
 [[noreturn]] void Refuse(const Scan& scan, const std::string& problem) {
-  throw Error(ErrorCode::kBadInput, kStage, "'" + scan.path + "': " + problem);
+  throw Error(ErrorCode::kBadInput, kScanStage, "'" + scan.path + "': " + problem);
 }
 
 std::string Number(double value) {

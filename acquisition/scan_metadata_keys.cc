@@ -14,7 +14,7 @@
 namespace arcwheel::acquisition {
 namespace {
 
-constexpr const char* kStage = "acquisition";
+constexpr const char* kScanMetadataKeysStage = "acquisition";
 
 double ParseValue(const std::string& key, std::string_view text) {
   const std::string_view written = text;
@@ -25,7 +25,7 @@ double ParseValue(const std::string& key, std::string_view text) {
   const auto [end, error] = std::from_chars(text.data(), text.data() + text.size(), number);
   if (text.empty() || error != std::errc() || end != text.data() + text.size()) {
     bool latin1 = false;
-    throw Error(ErrorCode::kBadInput, kStage,
+    throw Error(ErrorCode::kBadInput, kScanMetadataKeysStage,
                 "metadata '" + key + "' is not a number: '" + AsUtf8(written, latin1) + "'");
   }
   return number;
@@ -47,7 +47,7 @@ std::string MetadataSetter::Claim(std::string_view key) {
     return {};
   }
   if (!claimed_.insert(name).second) {
-    throw Error(ErrorCode::kBadInput, kStage,
+    throw Error(ErrorCode::kBadInput, kScanMetadataKeysStage,
                 "metadata '" + name + "' is given twice (keys match case-insensitively)");
   }
   metadata_.file_keys.push_back(name);
@@ -81,7 +81,7 @@ void MetadataSetter::SetNumber(const std::string& name, double value) {
   else if (name == "wheel_width_mm")
     m.wheel_width_mm = value;
   else
-    throw Error(ErrorCode::kInternal, kStage, "metadata '" + name + "' is not numeric");
+    throw Error(ErrorCode::kInternal, kScanMetadataKeysStage, "metadata '" + name + "' is not numeric");
 }
 
 void MetadataSetter::SetText(const std::string& name, std::string_view value) {
@@ -99,7 +99,7 @@ void MetadataSetter::SetText(const std::string& name, std::string_view value) {
   else if (name == "timestamp")
     m.timestamp = std::move(text);
   else
-    throw Error(ErrorCode::kInternal, kStage, "metadata '" + name + "' is not text");
+    throw Error(ErrorCode::kInternal, kScanMetadataKeysStage, "metadata '" + name + "' is not text");
 }
 
 namespace {

@@ -15,7 +15,7 @@
 namespace arcwheel::acquisition {
 namespace {
 
-constexpr const char* kStage = "acquisition.settings";
+constexpr const char* kScanSettingsStage = "acquisition.settings";
 // Beside formats.md 2.1's keys: the encoder's counts per turn, for an angle column in counts.
 constexpr const char* kEncoderCountsPerRev = "encoder_counts_per_rev";
 // A line-profile sensor's calibrated placement (profile_scan.h, ProfilePlacement).
@@ -90,11 +90,12 @@ ScanSettingsFile ParseScanSettings(std::string_view text, const std::string& nam
   try {
     document = nlohmann::json::parse(text);
   } catch (const nlohmann::json::exception& e) {
-    throw Error(ErrorCode::kInvalidOption, kStage, fmt::format("'{}' is not JSON: {}", name, e.what()));
+    throw Error(ErrorCode::kInvalidOption, kScanSettingsStage,
+                fmt::format("'{}' is not JSON: {}", name, e.what()));
   }
   if (!document.is_object()) {
     throw Error(
-        ErrorCode::kInvalidOption, kStage,
+        ErrorCode::kInvalidOption, kScanSettingsStage,
         fmt::format("'{}' must hold one JSON object of settings, got {}", name, document.type_name()));
   }
   std::vector<std::string> problems;
@@ -119,14 +120,14 @@ ScanSettingsFile ParseScanSettings(std::string_view text, const std::string& nam
   if (!problems.empty()) {
     std::string joined;
     for (const std::string& problem : problems) joined += (joined.empty() ? "" : "; ") + problem;
-    throw Error(ErrorCode::kInvalidOption, kStage, fmt::format("'{}': {}", name, joined));
+    throw Error(ErrorCode::kInvalidOption, kScanSettingsStage, fmt::format("'{}': {}", name, joined));
   }
   return settings;
 }
 
 ScanSettingsFile ReadScanSettings(const std::filesystem::path& path) {
   std::ifstream in(path, std::ios::binary);
-  if (!in) throw Error(ErrorCode::kIo, kStage, fmt::format("cannot open '{}'", path.string()));
+  if (!in) throw Error(ErrorCode::kIo, kScanSettingsStage, fmt::format("cannot open '{}'", path.string()));
   std::ostringstream buffer;
   buffer << in.rdbuf();
   return ParseScanSettings(buffer.str(), path.string());
@@ -149,7 +150,7 @@ void ApplyScanSettings(const ScanSettingsFile* settings, Scan& scan) {
       if (from_file(key)) {
         const double in_file = NumberOf(m, key).value_or(value);
         if (!SameNumber(in_file, value)) {
-          throw Error(ErrorCode::kInvalidOption, kStage,
+          throw Error(ErrorCode::kInvalidOption, kScanSettingsStage,
                       fmt::format("{} contradicts the scan: '{}' gives {} = {}, '{}' gives {} = {}", key,
                                   settings->path, key, Shown(value), scan.path, key, Shown(in_file)));
         }
@@ -162,7 +163,7 @@ void ApplyScanSettings(const ScanSettingsFile* settings, Scan& scan) {
       if (from_file(key)) {
         const std::string& in_file = TextOf(m, key);
         if (in_file != value) {
-          throw Error(ErrorCode::kInvalidOption, kStage,
+          throw Error(ErrorCode::kInvalidOption, kScanSettingsStage,
                       fmt::format("{} contradicts the scan: '{}' gives {} = '{}', '{}' gives {} = '{}'", key,
                                   settings->path, key, value, scan.path, key, in_file));
         }

@@ -26,12 +26,11 @@
 #include "acquisition/scan_settings.h"
 #include "core/check.h"
 #include "core/error.h"
+#include "core/nan.h"
 #include "core/text_encoding.h"
 
 namespace arcwheel::acquisition {
 namespace {
-
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 enum class Quantity { kZ, kT, kAngle, kY };
 constexpr std::array<const char*, 4> kQuantityNames = {"z", "t", "angle", "y"};

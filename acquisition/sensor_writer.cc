@@ -14,7 +14,7 @@
 namespace arcwheel::acquisition {
 namespace {
 
-constexpr const char* kStage = "acquisition.write";
+constexpr const char* kSensorWriterStage = "acquisition.write";
 
 // The first and last valid sample: outside them the sensor sees no rim.
 std::pair<std::size_t, std::size_t> ValidSpan(const Scan& scan) {
@@ -35,7 +35,7 @@ std::string WithComma(std::string text) {
 
 double PeriodOf(const Scan& scan) {
   if (scan.metadata.sample_period_s) return *scan.metadata.sample_period_s;
-  throw Error(ErrorCode::kInvalidOption, kStage, "the scan has no sample period to write");
+  throw Error(ErrorCode::kInvalidOption, kSensorWriterStage, "the scan has no sample period to write");
 }
 
 std::string SensorToolText(const Scan& scan) {
@@ -102,7 +102,7 @@ void WriteSensorScan(const Scan& scan, ScanFormat format, const std::filesystem:
   } else if (format == ScanFormat::kKeyenceLk) {
     text = KeyenceLkText(scan);
   } else {
-    throw Error(ErrorCode::kInvalidOption, kStage,
+    throw Error(ErrorCode::kInvalidOption, kSensorWriterStage,
                 fmt::format("no writer of the {} layout (sensortool or keyence-lk)", InfoOf(format).name));
   }
   WriteFileAtomically(path.string(), text);

@@ -6,12 +6,12 @@
 #include <random>
 
 #include "core/error.h"
+#include "core/nan.h"
 
 namespace arcwheel::acquisition {
 namespace {
 
 constexpr double kDegToRad = std::numbers::pi / 180.0;
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 double SumHarmonics(const std::vector<Harmonic>& harmonics, double phase_deg) {
   double sum = 0.0;

@@ -17,7 +17,7 @@
 namespace arcwheel::characteristics {
 namespace {
 
-constexpr std::string_view kStage = "characteristics.association";
+constexpr std::string_view kAssociationStage = "characteristics.association";
 
 struct NamedAssociation {
   Association association;
@@ -561,7 +561,7 @@ std::string CircleDataProblem(std::span<const double> x_mm, std::span<const doub
 
 AssociatedCircle AssociateCircle(std::span<const double> x_mm, std::span<const double> y_mm,
                                  const AssociationOptions& options) {
-  ThrowIfProblems(ErrorCode::kInvalidOption, kStage, options.Problems());
+  ThrowIfProblems(ErrorCode::kInvalidOption, kAssociationStage, options.Problems());
   AssociatedCircle result;
   result.association = options.association;
   result.n = static_cast<int>(x_mm.size());

@@ -16,7 +16,7 @@
 namespace arcwheel::characteristics {
 namespace {
 
-constexpr std::string_view kStage = "characteristics.filter";
+constexpr std::string_view kGaussianFilterStage = "characteristics.filter";
 
 struct FftwFree {
   void operator()(void* memory) const { fftw_free(memory); }
@@ -85,14 +85,14 @@ ComplexBuffer Spectrum(std::span<const double> values) {
 
 void RequireClosedProfile(std::size_t n) {
   if (n < 8)
-    throw Error(ErrorCode::kBadInput, kStage,
+    throw Error(ErrorCode::kBadInput, kGaussianFilterStage,
                 fmt::format("a closed profile needs at least 8 points, got {}", n));
 }
 
 void RequireClosedProfileCutOff(std::size_t n, double cutoff_upr) {
   RequireClosedProfile(n);
   if (!(cutoff_upr > 0) || !(cutoff_upr <= 0.5 * static_cast<double>(n))) {
-    throw Error(ErrorCode::kInvalidOption, kStage,
+    throw Error(ErrorCode::kInvalidOption, kGaussianFilterStage,
                 fmt::format("cut-off {} UPR violates 0 < cut-off <= {} (half the {} points of the profile)",
                             cutoff_upr, 0.5 * static_cast<double>(n), n));
   }
@@ -190,13 +190,13 @@ std::vector<double> HarmonicAmplitudes(std::span<const double> values, int max_h
 std::vector<double> FilterOpenProfile(std::span<const double> values, double spacing_mm, double cutoff_mm) {
   if (!(spacing_mm > 0) || !std::isfinite(spacing_mm) || !(cutoff_mm >= 5.0 * spacing_mm) ||
       !std::isfinite(cutoff_mm)) {
-    throw Error(ErrorCode::kInvalidOption, kStage,
+    throw Error(ErrorCode::kInvalidOption, kGaussianFilterStage,
                 fmt::format("cut-off {} mm with spacing {} mm violates spacing > 0 and cut-off >= 5 spacings",
                             cutoff_mm, spacing_mm));
   }
   const std::size_t n = values.size();
   if (n < 2)
-    throw Error(ErrorCode::kBadInput, kStage,
+    throw Error(ErrorCode::kBadInput, kGaussianFilterStage,
                 fmt::format("an open profile needs at least 2 points, got {}", n));
   // The weighting function over |x| <= lambda_c, where it has fallen to exp(-pi / alpha^2) = 7e-7.
   const auto half_width = static_cast<std::ptrdiff_t>(std::floor(cutoff_mm / spacing_mm));

@@ -13,7 +13,7 @@
 namespace arcwheel::characteristics {
 namespace {
 
-constexpr std::string_view kStage = "characteristics.roundness";
+constexpr std::string_view kRoundnessStage = "characteristics.roundness";
 constexpr double kMmToUm = 1000.0;
 // Relative departure of a step from 360 / n that is still "equally spaced": a hundredth of a step
 // moves a sample of an eccentric profile by 1e-4 rad times the eccentricity.
@@ -94,30 +94,30 @@ RoundnessParameters ParametersAbout(const AssociatedCircle& reference, std::span
 
 RoundnessResult EvaluateRoundness(std::span<const double> angle_deg, std::span<const double> radius_mm,
                                   const RoundnessOptions& options) {
-  ThrowIfProblems(ErrorCode::kInvalidOption, kStage, options.Problems());
+  ThrowIfProblems(ErrorCode::kInvalidOption, kRoundnessStage, options.Problems());
   ARCWHEEL_CHECK(angle_deg.size() == radius_mm.size())
       << angle_deg.size() << " angles, " << radius_mm.size() << " radii";
   const std::size_t n = radius_mm.size();
   if (n < 8)
-    throw Error(ErrorCode::kBadInput, kStage,
+    throw Error(ErrorCode::kBadInput, kRoundnessStage,
                 fmt::format("a closed profile needs at least 8 points, got {}", n));
   for (std::size_t i = 0; i < n; ++i) {
     if (!(radius_mm[i] > 0) || !std::isfinite(radius_mm[i]) || !std::isfinite(angle_deg[i])) {
-      throw Error(ErrorCode::kBadInput, kStage,
+      throw Error(ErrorCode::kBadInput, kRoundnessStage,
                   fmt::format("point {}: radius {} mm at {} deg", i, radius_mm[i], angle_deg[i]));
     }
   }
   const AngleSpacing spacing = CheckAngleSpacing(angle_deg);
   if (!spacing.equally_spaced) {
     throw Error(
-        ErrorCode::kBadInput, kStage,
+        ErrorCode::kBadInput, kRoundnessStage,
         fmt::format("the angles are not equally spaced over one turn: the largest gap, {} deg from point {} "
                     "to the next, is not {} deg (360 / {} points); they turn {} deg",
                     spacing.largest_gap_deg, spacing.largest_gap_index, spacing.expected_step_deg, n,
                     spacing.turn_deg));
   }
   if (options.filter_cutoff_upr && *options.filter_cutoff_upr > 0.5 * static_cast<double>(n)) {
-    throw Error(ErrorCode::kInvalidOption, kStage,
+    throw Error(ErrorCode::kInvalidOption, kRoundnessStage,
                 fmt::format("cut-off {} UPR is above half the {} points of the profile ({} UPR)",
                             *options.filter_cutoff_upr, n, 0.5 * static_cast<double>(n)));
   }
@@ -134,7 +134,7 @@ RoundnessResult EvaluateRoundness(std::span<const double> angle_deg, std::span<c
   result.op = {.filter_cutoff_upr = options.filter_cutoff_upr, .association = options.association};
   result.reference = AssociateCircle(x, y, {.association = options.association});
   if (!result.reference.IsCertified()) {
-    throw Error(ErrorCode::kFitFailed, kStage,
+    throw Error(ErrorCode::kFitFailed, kRoundnessStage,
                 fmt::format("no {} reference circle: {}", AssociationName(options.association),
                             result.reference.message));
   }

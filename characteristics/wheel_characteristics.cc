@@ -14,13 +14,13 @@
 #include "characteristics/gaussian_filter.h"
 #include "characteristics/roundness.h"
 #include "core/error.h"
+#include "core/nan.h"
 #include "core/parallel.h"
 
 namespace arcwheel::characteristics {
 namespace {
 
-constexpr std::string_view kStage = "characteristics.wheel";
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+constexpr std::string_view kWheelCharacteristicsStage = "characteristics.wheel";
 
 // The cosines and sines of a turn's phases, for all the turns.
 struct UnitCircle {
@@ -392,13 +392,14 @@ void CheckSizes(const WheelForm& form, std::size_t n_phase, std::size_t n_y) {
   if (n_y == 0 || form.rho_mm.size() != n_phase * n_y || n_phase < 8 ||
       form.arc_radius_mm.size() != n_phase || form.center_axial_mm.size() != n_phase ||
       form.center_radial_mm.size() != n_phase || form.usable.size() != n_phase)
-    throw Error(ErrorCode::kBadInput, kStage,
+    throw Error(ErrorCode::kBadInput, kWheelCharacteristicsStage,
                 fmt::format("the map ({} values, {} nodes) and the {} phase fits do not match",
                             form.rho_mm.size(), n_y, form.arc_radius_mm.size()));
   const std::size_t cells = n_phase * static_cast<std::size_t>(std::max(form.section_bins, 0));
   if (form.section_residual_um.size() != cells || form.section_y_mm.size() != cells ||
       form.section_sigma_um.size() != cells)
-    throw Error(ErrorCode::kBadInput, kStage, "the sections' arrays do not match their bins");
+    throw Error(ErrorCode::kBadInput, kWheelCharacteristicsStage,
+                "the sections' arrays do not match their bins");
 }
 
 // The 1-sigma of the map's value `cell` (WheelForm::rho_sigma_mm).
@@ -462,7 +463,7 @@ std::vector<Node> TurnNodes(const WheelForm& form, const FormOperator& roundness
     at.push_back(y);
   }
   if (nodes.empty())
-    throw Error(ErrorCode::kBadInput, kStage,
+    throw Error(ErrorCode::kBadInput, kWheelCharacteristicsStage,
                 fmt::format("no axial node of the map lies in the band [{:g}, {:g}] mm", form.band_low_mm,
                             form.band_high_mm));
   return nodes;
@@ -636,7 +637,7 @@ WheelCharacteristics EvaluateWheelCharacteristics(const WheelForm& form,
     problems.push_back("roundness: " + p);
   if (const std::string p = RunoutOperatorProblem(options.runout, per_turn); !p.empty())
     problems.push_back("circular run-out: " + p);
-  ThrowIfProblems(ErrorCode::kInvalidOption, kStage, problems);
+  ThrowIfProblems(ErrorCode::kInvalidOption, kWheelCharacteristicsStage, problems);
   CheckSizes(form, n_phase, form.y_mm.size());
 
   const std::vector<double> phase_deg = PhaseGridDeg(n_phase);

@@ -26,7 +26,7 @@
 namespace arcwheel::hdf5 {
 namespace {
 
-constexpr const char* kStage = "hdf5";
+constexpr const char* kHdf5ChildStage = "hdf5";
 
 bool g_in_child = false;
 
@@ -122,18 +122,18 @@ bool RunInChildProcess(const std::filesystem::path& path, const std::function<vo
   ThrowIfInterrupted();
   const std::string name = fmt::format("'{}'", path.string());
   if (!status) {
-    throw Error(ErrorCode::kBadInput, kStage,
+    throw Error(ErrorCode::kBadInput, kHdf5ChildStage,
                 fmt::format("{}: libhdf5 had not finished reading it after {:g} s (a damaged file?)", name,
                             timeout_s));
   }
   if (WIFSIGNALED(*status)) {
     const int signal = WTERMSIG(*status);
-    throw Error(ErrorCode::kBadInput, kStage,
+    throw Error(ErrorCode::kBadInput, kHdf5ChildStage,
                 name + ": reading it crashed libhdf5 (signal " + std::to_string(signal) + ", " +
                     strsignal(signal) + "); the file is damaged");
   }
   if (!WIFEXITED(*status) || WEXITSTATUS(*status) != 0) {
-    throw Error(ErrorCode::kBadInput, kStage,
+    throw Error(ErrorCode::kBadInput, kHdf5ChildStage,
                 name + ": reading it crashed libhdf5 (exit status " +
                     std::to_string(WIFEXITED(*status) ? WEXITSTATUS(*status) : -1) +
                     "); the file is damaged");
@@ -151,7 +151,7 @@ constexpr std::size_t kCopyChunk = 1u << 20;
 std::size_t RoundUpToPage(std::size_t bytes) { return (bytes + kPage - 1) / kPage * kPage; }
 
 [[noreturn]] void ThrowSystemError(const std::string& what) {
-  throw Error(ErrorCode::kIo, kStage, what + ": " + std::strerror(errno));
+  throw Error(ErrorCode::kIo, kHdf5ChildStage, what + ": " + std::strerror(errno));
 }
 
 // `length` bytes of `fd` from `offset` into `data`; Error{kIo} when they are not all there.
@@ -181,7 +181,7 @@ SharedArrays::~SharedArrays() {
 
 void* SharedArrays::Allocate(const std::string& name, std::size_t count, std::size_t value_bytes) {
   if (directory_.arrays == kMaxArrays || name.size() >= sizeof(Entry::name)) {
-    throw Error(ErrorCode::kInternal, kStage,
+    throw Error(ErrorCode::kInternal, kHdf5ChildStage,
                 "too many shared arrays, or the name '" + name + "' is too long");
   }
   Entry& entry = directory_.entries[directory_.arrays++];

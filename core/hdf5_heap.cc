@@ -23,7 +23,7 @@
 namespace arcwheel::hdf5 {
 namespace {
 
-constexpr const char* kStage = "hdf5";
+constexpr const char* kHdf5HeapStage = "hdf5";
 
 // A soft conversion from a variable-length type to an opaque one of the same size: the stored
 // reference bytes stay as they are, and the library follows nothing. (The same size matters: a
@@ -55,7 +55,7 @@ void RegisterKeepStoredReference() {
                        KeepStoredReference) >= 0;
   }();
   if (!registered)
-    throw Error(ErrorCode::kInternal, kStage, "cannot register the stored-reference conversion");
+    throw Error(ErrorCode::kInternal, kHdf5HeapStage, "cannot register the stored-reference conversion");
 }
 
 // Little-endian unsigned field; UINT64_MAX when it does not fit 64 bits.
@@ -156,14 +156,15 @@ void File::CheckHeapReferences(hid_t object, hid_t stored_type, const std::strin
   const Handle creation(H5Fget_create_plist(handle_.id()), H5Pclose);
   if (!creation.valid() || H5Pget_sizes(creation.id(), &address_size, &length_size) < 0 ||
       address_size == 0 || address_size > 16 || length_size == 0 || length_size > 16) {
-    throw Error(ErrorCode::kBadInput, kStage,
+    throw Error(ErrorCode::kBadInput, kHdf5HeapStage,
                 "'" + path_.string() + "' declares invalid address or length sizes");
   }
   const bool dataset = H5Iget_type(object) == H5I_DATASET;
   const Handle space(dataset ? H5Dget_space(object) : H5Aget_space(object), H5Sclose);
   const hssize_t elements = H5Sget_simple_extent_npoints(space.id());
   if (elements < 1 || elements > (1 << 16)) {
-    throw Error(ErrorCode::kBadInput, kStage, what + " holds " + std::to_string(elements) + " elements");
+    throw Error(ErrorCode::kBadInput, kHdf5HeapStage,
+                what + " holds " + std::to_string(elements) + " elements");
   }
   // As stored: 4 bytes of length, the address of a collection, 4 bytes of object index.
   const size_t stored_bytes = 4 + address_size + 4;
@@ -181,7 +182,7 @@ void File::CheckHeapReferences(hid_t object, hid_t stored_type, const std::strin
                    : H5Aread(object, memory_type.id(), stored.data());
   };
   if (!memory_type.valid() || read() < 0) {
-    throw Error(ErrorCode::kBadInput, kStage, "cannot read the stored references of " + what);
+    throw Error(ErrorCode::kBadInput, kHdf5HeapStage, "cannot read the stored references of " + what);
   }
   const size_t element_bytes = StoredElementBytes(stored_type);
   for (hssize_t e = 0; e < elements; ++e) {
@@ -199,7 +200,7 @@ void File::CheckHeapReferences(hid_t object, hid_t stored_type, const std::strin
                                         ? UINT64_MAX
                                         : reference.length * element_bytes;
     if (const auto problem = ReferenceProblem(collection, reference, expected_bytes, length_size)) {
-      throw Error(ErrorCode::kBadInput, kStage, what + " " + *problem + " (damaged?)");
+      throw Error(ErrorCode::kBadInput, kHdf5HeapStage, what + " " + *problem + " (damaged?)");
     }
   }
 }

@@ -7,6 +7,13 @@
 
 namespace arcwheel {
 
+// `text` without its leading and trailing blanks (spaces, tabs, a stray carriage return).
+inline std::string_view TrimBlanks(std::string_view text) {
+  const std::size_t first = text.find_first_not_of(" \t\r");
+  if (first == std::string_view::npos) return {};
+  return text.substr(first, text.find_last_not_of(" \t\r") - first + 1);
+}
+
 // The lines of `text` in order, LF or CRLF endings taken off, counted from 1; a UTF-8 byte order
 // mark (as spreadsheets and Windows tools write) is skipped.
 class TextLines {

@@ -14,13 +14,13 @@
 #include "core/check.h"
 #include "core/error.h"
 #include "core/interrupt.h"
+#include "core/nan.h"
 #include "core/parallel.h"
 
 namespace arcwheel::fitting {
 namespace {
 
-constexpr const char* kStage = "fitting";
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+constexpr const char* kSampleFitStage = "fitting";
 constexpr int kWorkers = 2;
 // Gauss-Newton passes over the runs after the Kasa start; the last one also gathers the
 // residuals and the map. The first is without the slope correction; each later one takes its
@@ -480,7 +480,7 @@ double MeanCenterAxial(const std::vector<Circle>& circles, const std::vector<Nod
     ++usable;
   }
   if (usable == 0) {
-    throw Error(ErrorCode::kFitFailed, kStage, "no phase gave a usable arc fit (" + why + ")");
+    throw Error(ErrorCode::kFitFailed, kSampleFitStage, "no phase gave a usable arc fit (" + why + ")");
   }
   return sum / usable;
 }
@@ -548,7 +548,7 @@ void Summarise(const std::vector<Circle>& circles, const std::vector<NodeSums>& 
     out.phases.push_back(fit);
   }
   if (usable == 0) {
-    throw Error(ErrorCode::kFitFailed, kStage,
+    throw Error(ErrorCode::kFitFailed, kSampleFitStage,
                 "no phase gave a usable arc fit (phase 0: " + out.phases.front().flag + ")");
   }
   SummariseUsablePhases(out);
@@ -667,7 +667,7 @@ void SetSections(const CellSums& cells, double sigma_mm, WheelFit& out) {
 template <typename T>
 WheelFit FitToSamples(std::span<const T> rho, const processing::HelixGeometry& geometry,
                       processing::WheelMap& map, const WheelFitOptions& options) {
-  ThrowIfProblems(ErrorCode::kInvalidOption, kStage, options.Problems());
+  ThrowIfProblems(ErrorCode::kInvalidOption, kSampleFitStage, options.Problems());
   ARCWHEEL_CHECK(geometry.size() == rho.size())
       << geometry.size() << " positions for " << rho.size() << " samples";
   ARCWHEEL_CHECK(map.n_phase() >= 4 && map.n_y() >= 2) << map.n_phase() << " x " << map.n_y() << " map";
@@ -746,7 +746,7 @@ WheelFit FitToSamples(std::span<const T> rho, const processing::HelixGeometry& g
   out.band_low_mm = full ? y_low : std::max(used_center - half, y_low);
   out.band_high_mm = full ? y_high : std::min(used_center + half, y_high);
   if (!(out.band_high_mm > out.band_low_mm)) {
-    throw Error(ErrorCode::kBadInput, kStage,
+    throw Error(ErrorCode::kBadInput, kSampleFitStage,
                 fmt::format("the band {:.4g} +- {:.4g} mm lies outside the scanned span [{:.4g}, {:.4g}] mm",
                             used_center, half, y_low, y_high));
   }

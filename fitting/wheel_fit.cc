@@ -16,14 +16,14 @@
 #include "core/error.h"
 #include "core/free_memory.h"
 #include "core/interrupt.h"
+#include "core/nan.h"
 #include "core/parallel.h"
 #include "fitting/circle_fit.h"
 
 namespace arcwheel::fitting {
 namespace {
 
-constexpr const char* kStage = "fitting";
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+constexpr const char* kWheelFitStage = "fitting";
 
 // What the means and their sigmas need of one phase's fit. Of the circle's sensitivities only
 // the two rows the sigmas of the means propagate are kept (8 MB at 1e8 samples instead of 17).
@@ -197,7 +197,8 @@ double MeanCenterAxialOfUsable(const std::vector<PhaseSolution>& solutions) {
   }
   if (usable == 0) {
     const std::string why = !solutions.empty() ? solutions[0].fit.flag : "no phases";
-    throw Error(ErrorCode::kFitFailed, kStage, "no phase gave a usable arc fit (phase 0: " + why + ")");
+    throw Error(ErrorCode::kFitFailed, kWheelFitStage,
+                "no phase gave a usable arc fit (phase 0: " + why + ")");
   }
   return sum_a / usable;
 }
@@ -238,7 +239,7 @@ void SetBand(const processing::WheelMap& map, const CenteredFits& fits, const Wh
   out.band_low_mm = std::max(fits.used_center_mm - half, y_min);
   out.band_high_mm = std::min(fits.used_center_mm + half, y_max);
   if (!(out.band_high_mm > out.band_low_mm)) {
-    throw Error(ErrorCode::kBadInput, kStage,
+    throw Error(ErrorCode::kBadInput, kWheelFitStage,
                 fmt::format("the band {:.4g} +- {:.4g} mm lies outside the scanned span [{:.4g}, {:.4g}] mm",
                             fits.mean_center_mm, half, y_min, y_max));
   }
@@ -344,7 +345,7 @@ std::vector<std::string> WheelFitOptions::Problems() const {
 }
 
 WheelFit FitWheel(const processing::WheelMap& map, const WheelFitOptions& options) {
-  ThrowIfProblems(ErrorCode::kInvalidOption, kStage, options.Problems());
+  ThrowIfProblems(ErrorCode::kInvalidOption, kWheelFitStage, options.Problems());
   WheelFit out;
   {
     const CenteredFits fits = FitPhasesInCenteredBand(map, options);

@@ -8,14 +8,13 @@
 #include <vector>
 
 #include "core/check.h"
+#include "core/nan.h"
 #include "core/parallel.h"
 #include "fitting/wheel_model_impl.h"
 #include "processing/helix_geometry.h"
 
 namespace arcwheel::fitting::internal {
 namespace {
-
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 std::size_t RunStart(std::size_t run, std::size_t stride) {
   // splitmix64's finaliser: a fixed, well-spread place in each run.

@@ -8,31 +8,26 @@
 #include <sstream>
 
 #include "core/error.h"
+#include "core/text_lines.h"
 
 namespace arcwheel::frames {
 namespace {
-
-std::string Trim(std::string_view text) {
-  const auto first = text.find_first_not_of(" \t\r");
-  if (first == std::string_view::npos) return {};
-  const auto last = text.find_last_not_of(" \t\r");
-  return std::string(text.substr(first, last - first + 1));
-}
 
 std::vector<std::string> SplitCells(const std::string& line) {
   std::vector<std::string> cells;
   std::stringstream stream(line);
   std::string cell;
-  while (std::getline(stream, cell, ',')) cells.push_back(Trim(cell));
+  while (std::getline(stream, cell, ',')) cells.push_back(std::string(TrimBlanks(cell)));
   if (!line.empty() && line.back() == ',') cells.emplace_back();
   return cells;
 }
 
 void ReadNote(const std::string& line, CsvTable& table) {
-  const std::string body = Trim(std::string_view(line).substr(1));
+  const std::string body(TrimBlanks(std::string_view(line).substr(1)));
   const auto colon = body.find(':');
   if (colon == std::string::npos) return;
-  table.notes[Trim(std::string_view(body).substr(0, colon))] = Trim(std::string_view(body).substr(colon + 1));
+  table.notes[std::string(TrimBlanks(std::string_view(body).substr(0, colon)))] =
+      std::string(TrimBlanks(std::string_view(body).substr(colon + 1)));
 }
 
 }  // namespace
@@ -73,7 +68,7 @@ CsvTable ReadCsvTable(const std::filesystem::path& path, std::string_view stage)
   int line_number = 0;
   while (std::getline(file, line)) {
     ++line_number;
-    const std::string trimmed = Trim(line);
+    const std::string trimmed(TrimBlanks(line));
     if (trimmed.empty()) continue;
     if (trimmed.front() == '#') {
       ReadNote(trimmed, table);

@@ -15,13 +15,13 @@ namespace arcwheel::frames {
 namespace {
 
 constexpr const char* kRecordStage = "frames.force_record";
-constexpr const char* kStage = "frames.headcenter";
+constexpr const char* kForceCentreStage = "frames.headcenter";
 
-struct Channel {
+struct RecordChannel {
   const char* name;
   std::vector<double> ForceRecord::*values;
 };
-constexpr std::array<Channel, 7> kChannels = {{
+constexpr std::array<RecordChannel, 7> kRecordChannels = {{
     {"t_s", &ForceRecord::t_s},
     {"Fx_N", &ForceRecord::fx_N},
     {"Fy_N", &ForceRecord::fy_N},
@@ -37,7 +37,7 @@ void ValidateForceRecord(const ForceRecord& record) {
   const size_t n = record.t_s.size();
   if (n == 0)
     throw Error(ErrorCode::kBadInput, kRecordStage, fmt::format("'{}' has no samples", record.source));
-  for (const Channel& channel : kChannels) {
+  for (const RecordChannel& channel : kRecordChannels) {
     const std::vector<double>& values = record.*channel.values;
     if (values.size() != n) {
       throw Error(ErrorCode::kBadInput, kRecordStage,
@@ -103,7 +103,7 @@ std::vector<std::string> ContactSolveOptions::Problems() const {
 }
 
 ContactCentre SolveContactCentre(const ForceRecord& tared, const ContactSolveOptions& options) {
-  ThrowIfProblems(ErrorCode::kInvalidOption, kStage, options.Problems());
+  ThrowIfProblems(ErrorCode::kInvalidOption, kForceCentreStage, options.Problems());
   ValidateForceRecord(tared);
   const size_t n = tared.size();
   const double z0 = options.platform_height_mm;
@@ -119,7 +119,7 @@ ContactCentre SolveContactCentre(const ForceRecord& tared, const ContactSolveOpt
     if (normal[i] >= result.normal_force_threshold_N && normal[i] > 0.0) used.push_back(i);
   }
   if (used.size() < 3) {
-    throw Error(ErrorCode::kFitFailed, kStage,
+    throw Error(ErrorCode::kFitFailed, kForceCentreStage,
                 fmt::format("'{}': only {} of {} samples carry a normal force of at least {:.4g} N",
                             tared.source, used.size(), n, result.normal_force_threshold_N));
   }
@@ -156,7 +156,7 @@ ContactCentre SolveContactCentre(const ForceRecord& tared, const ContactSolveOpt
 }
 
 MoveTables TabulateMoves(std::span<const MoveSample> samples) {
-  if (samples.empty()) throw Error(ErrorCode::kBadInput, kStage, "no records to tabulate");
+  if (samples.empty()) throw Error(ErrorCode::kBadInput, kForceCentreStage, "no records to tabulate");
   constexpr double kSamePositionMm = 1e-6;
   MoveTables tables;
   std::vector<std::vector<Eigen::Vector2d>> groups;
@@ -201,7 +201,7 @@ MoveTables TabulateMoves(std::span<const MoveSample> samples) {
 namespace {
 
 ForceRecord SimulateRecord(const ForceSimulation& s, bool loaded, std::mt19937& rng) {
-  ThrowIfProblems(ErrorCode::kInvalidOption, kStage, s.Problems());
+  ThrowIfProblems(ErrorCode::kInvalidOption, kForceCentreStage, s.Problems());
   const auto n = static_cast<size_t>(std::llround(s.duration_s * s.sample_rate_hz));
   const double omega = 2.0 * std::numbers::pi * s.pad_rpm / 60.0;
   const Eigen::Vector3d p(s.centre_mm.x(), s.centre_mm.y(), s.platform_height_mm);

@@ -15,7 +15,7 @@
 namespace arcwheel::frames {
 namespace {
 
-constexpr const char* kStage = "frames.force_record";
+constexpr const char* kForceRecordIoStage = "frames.force_record";
 
 enum class Kind { kTime, kForce, kMoment };
 
@@ -75,7 +75,7 @@ Located Locate(const Channel& channel, const std::vector<std::string>& names, co
       unit = channel.kind == Kind::kTime && note_unit.empty() ? "s" : note_unit;
       if (unit.empty()) {
         throw Error(
-            ErrorCode::kBadInput, kStage,
+            ErrorCode::kBadInput, kForceRecordIoStage,
             fmt::format("{}: column '{}' has no unit: name it {}_<unit> or give the {} note ({})", where,
                         name, base, channel.kind == Kind::kForce ? "force_unit" : "moment_unit",
                         AcceptedUnits(channel.kind)));
@@ -88,20 +88,20 @@ Located Locate(const Channel& channel, const std::vector<std::string>& names, co
     const auto factor = UnitFactor(channel.kind, unit);
     if (!factor) {
       throw Error(
-          ErrorCode::kBadInput, kStage,
+          ErrorCode::kBadInput, kForceRecordIoStage,
           fmt::format("{}: unit '{}' of '{}' is not {}", where, unit, name, AcceptedUnits(channel.kind)));
     }
     found.push_back({name, *factor});
   }
   if (found.empty()) {
-    throw Error(ErrorCode::kBadInput, kStage,
+    throw Error(ErrorCode::kBadInput, kForceRecordIoStage,
                 fmt::format("{}: no '{}' channel (expected e.g. {}_{})", where, channel.base, channel.base,
                             channel.kind == Kind::kTime    ? "s"
                             : channel.kind == Kind::kForce ? "N"
                                                            : "Nmm"));
   }
   if (found.size() > 1) {
-    throw Error(ErrorCode::kBadInput, kStage,
+    throw Error(ErrorCode::kBadInput, kForceRecordIoStage,
                 fmt::format("{}: channel '{}' appears twice ('{}' and '{}')", where, channel.base,
                             found[0].name, found[1].name));
   }
@@ -125,14 +125,14 @@ std::optional<double> PlatformHeight(const std::map<std::string, std::string>& n
   const std::string& text = note->second;
   const auto [end, error] = std::from_chars(text.data(), text.data() + text.size(), value);
   if (error != std::errc() || end != text.data() + text.size() || !std::isfinite(value)) {
-    throw Error(ErrorCode::kBadInput, kStage,
+    throw Error(ErrorCode::kBadInput, kForceRecordIoStage,
                 fmt::format("{}: platform_height_mm '{}' is not a number", where, text));
   }
   return value;
 }
 
 ForceRecordFile ReadCsv(const std::filesystem::path& path, const ForceRecordReadOptions& options) {
-  const CsvTable table = ReadCsvTable(path, kStage);
+  const CsvTable table = ReadCsvTable(path, kForceRecordIoStage);
   const std::string where = fmt::format("'{}'", path.string());
   ForceRecordFile file;
   file.record.source = path.string();
@@ -143,12 +143,12 @@ ForceRecordFile ReadCsv(const std::filesystem::path& path, const ForceRecordRead
     std::vector<double>& values = file.record.*channel.values;
     values.reserve(table.cells.size());
     for (size_t row = 0; row < table.cells.size(); ++row)
-      values.push_back(located.factor * table.Number(row, column, kStage));
+      values.push_back(located.factor * table.Number(row, column, kForceRecordIoStage));
   }
   // Name time faults by file line rather than sample index.
   for (size_t row = 1; row < table.cells.size(); ++row) {
     if (!(file.record.t_s[row] > file.record.t_s[row - 1])) {
-      throw Error(ErrorCode::kBadInput, kStage,
+      throw Error(ErrorCode::kBadInput, kForceRecordIoStage,
                   fmt::format("{} line {}: t_s {} does not increase (previous {})", where,
                               table.line_numbers[row], file.record.t_s[row], file.record.t_s[row - 1]));
     }
@@ -185,7 +185,7 @@ ForceRecordFile ReadHdf5(const std::filesystem::path& path, const ForceRecordRea
     const Located located = Locate(channel, names, note_unit, where);
     const std::string dataset = "/" + located.name;
     if (h5.Shape(dataset).size() != 1) {
-      throw Error(ErrorCode::kBadInput, kStage,
+      throw Error(ErrorCode::kBadInput, kForceRecordIoStage,
                   fmt::format("{}: dataset {} is not one-dimensional", where, dataset));
     }
     std::vector<double> values = h5.ReadDoubles(dataset);
@@ -210,7 +210,7 @@ std::vector<std::string> ForceRecordReadOptions::Problems() const {
 }
 
 ForceRecordFile ReadForceRecord(const std::filesystem::path& path, const ForceRecordReadOptions& options) {
-  ThrowIfProblems(ErrorCode::kInvalidOption, kStage, options.Problems());
+  ThrowIfProblems(ErrorCode::kInvalidOption, kForceRecordIoStage, options.Problems());
   const std::string extension = path.extension().string();
   if (extension == ".h5" || extension == ".hdf5") return ReadHdf5(path, options);
   return ReadCsv(path, options);

@@ -10,11 +10,12 @@
 #include <set>
 
 #include "core/error.h"
+#include "core/text_lines.h"
 
 namespace arcwheel::frames {
 namespace {
 
-constexpr const char* kStage = "frames.program_transform";
+constexpr const char* kProgramTransformStage = "frames.program_transform";
 
 struct Line {
   std::string_view body;    // without the line ending
@@ -37,18 +38,13 @@ std::vector<Line> SplitLines(std::string_view text) {
   return lines;
 }
 
-std::string Trim(std::string_view text) {
-  const auto first = text.find_first_not_of(" \t");
-  if (first == std::string_view::npos) return {};
-  return std::string(text.substr(first, text.find_last_not_of(" \t") - first + 1));
-}
-
 [[noreturn]] void Refuse(const std::string& source, size_t line_index, const std::string& detail) {
-  throw Error(ErrorCode::kBadInput, kStage, fmt::format("'{}' line {}: {}", source, line_index + 1, detail));
+  throw Error(ErrorCode::kBadInput, kProgramTransformStage,
+              fmt::format("'{}' line {}: {}", source, line_index + 1, detail));
 }
 
 std::optional<double> ParseNumber(std::string_view text) {
-  const std::string trimmed = Trim(text);
+  const std::string trimmed(TrimBlanks(text));
   const char* begin = trimmed.data();
   if (!trimmed.empty() && trimmed.front() == '+') ++begin;
   double value = 0.0;
@@ -93,7 +89,7 @@ std::vector<Triple> FindTriples(const std::vector<std::string>& header, const st
     int found = 0;
     for (int k = 0; k < 3; ++k) {
       for (size_t c = 0; c < header.size(); ++c) {
-        if (Trim(header[c]) == names[k]) {
+        if (TrimBlanks(header[c]) == names[k]) {
           triple.columns[k] = c;
           ++found;
         }
@@ -118,7 +114,7 @@ ProgramTransformResult TransformToolpathCsv(std::string_view text, const Transfo
   const auto lines = SplitLines(text);
   for (size_t index = 0; index < lines.size(); ++index) {
     const Line& line = lines[index];
-    const std::string trimmed = Trim(line.body);
+    const std::string trimmed(TrimBlanks(line.body));
     if (trimmed.empty() || trimmed.front() == '#' || header.empty()) {
       if (!trimmed.empty() && trimmed.front() != '#') {
         header = SplitRaw(line.body);
@@ -138,8 +134,8 @@ ProgramTransformResult TransformToolpathCsv(std::string_view text, const Transfo
         const auto value = ParseNumber(cells[triple.columns[k]]);
         if (!value) {
           Refuse(source, index,
-                 fmt::format("column '{}': '{}' is not a finite number", Trim(header[triple.columns[k]]),
-                             cells[triple.columns[k]]));
+                 fmt::format("column '{}': '{}' is not a finite number",
+                             TrimBlanks(header[triple.columns[k]]), cells[triple.columns[k]]));
         }
         v(k) = *value;
       }
@@ -154,7 +150,7 @@ ProgramTransformResult TransformToolpathCsv(std::string_view text, const Transfo
     result.text.append(rewritten).append(line.ending);
   }
   if (header.empty())
-    throw Error(ErrorCode::kBadInput, kStage, fmt::format("'{}' has no header row", source));
+    throw Error(ErrorCode::kBadInput, kProgramTransformStage, fmt::format("'{}' has no header row", source));
   return result;
 }
 
@@ -413,7 +409,7 @@ ProgramTransformResult TransformMachineProgram(std::string_view text, bool gcode
     result.text.append(rewritten).append(line.ending);
   }
   if (!gcode && result.points_transformed == 0) {
-    throw Error(ErrorCode::kBadInput, kStage,
+    throw Error(ErrorCode::kBadInput, kProgramTransformStage,
                 fmt::format("'{}' has no X/Y/Z move between OPEN PROG and CLOSE", source));
   }
   return result;
@@ -430,7 +426,7 @@ ProgramKind ParseProgramKind(std::string_view name) {
   if (name == "csv") return ProgramKind::kToolpathCsv;
   if (name == "gcode") return ProgramKind::kGcode;
   if (name == "pmac") return ProgramKind::kPmac;
-  throw Error(ErrorCode::kInvalidOption, kStage,
+  throw Error(ErrorCode::kInvalidOption, kProgramTransformStage,
               fmt::format("unknown file format '{}' (expected csv, gcode or pmac)", name));
 }
 
@@ -452,7 +448,7 @@ ProgramKind DetectProgramKind(const std::filesystem::path& path, std::string_vie
 ProgramTransformResult TransformProgram(std::string_view text, ProgramKind kind, const Transform& transform,
                                         const std::string& source_name,
                                         const ProgramTransformOptions& options) {
-  ThrowIfProblems(ErrorCode::kInvalidOption, kStage, options.Problems());
+  ThrowIfProblems(ErrorCode::kInvalidOption, kProgramTransformStage, options.Problems());
   switch (kind) {
     case ProgramKind::kToolpathCsv:
       return TransformToolpathCsv(text, transform, source_name);

@@ -14,7 +14,7 @@
 namespace arcwheel::frames {
 namespace {
 
-constexpr const char* kStage = "frames.three_point";
+constexpr const char* kThreePointFrameStage = "frames.three_point";
 
 std::string Point(const Eigen::Vector3d& p) { return fmt::format("({}, {}, {})", p.x(), p.y(), p.z()); }
 
@@ -54,28 +54,28 @@ Transform WorkpieceFrame::WorkpieceFromMachine() const { return MachineFromWorkp
 
 WorkpieceFrame ThreePointFrame(const Eigen::Vector3d& p1_mm, const Eigen::Vector3d& p2_mm,
                                const Eigen::Vector3d& p3_mm, const ThreePointFrameOptions& options) {
-  ThrowIfProblems(ErrorCode::kInvalidOption, kStage, options.Problems());
+  ThrowIfProblems(ErrorCode::kInvalidOption, kThreePointFrameStage, options.Problems());
   if (!p1_mm.allFinite() || !p2_mm.allFinite() || !p3_mm.allFinite()) {
-    throw Error(ErrorCode::kBadInput, kStage, "a probed point has a non-finite coordinate");
+    throw Error(ErrorCode::kBadInput, kThreePointFrameStage, "a probed point has a non-finite coordinate");
   }
   const Eigen::Vector3d along_x = p2_mm - p1_mm;
   const Eigen::Vector3d in_plane = p3_mm - p1_mm;
   if (along_x.norm() < options.min_separation_mm) {
     throw Error(
-        ErrorCode::kBadInput, kStage,
+        ErrorCode::kBadInput, kThreePointFrameStage,
         fmt::format("the origin P1 {} and the +X point P2 {} coincide ({:.3g} mm apart, minimum {} mm)",
                     Point(p1_mm), Point(p2_mm), along_x.norm(), options.min_separation_mm));
   }
   if (in_plane.norm() < options.min_separation_mm) {
     throw Error(
-        ErrorCode::kBadInput, kStage,
+        ErrorCode::kBadInput, kThreePointFrameStage,
         fmt::format("the origin P1 {} and the XY-plane point P3 {} coincide ({:.3g} mm apart, minimum {} mm)",
                     Point(p1_mm), Point(p3_mm), in_plane.norm(), options.min_separation_mm));
   }
   const Eigen::Vector3d i = along_x.normalized();
   const double angle_deg = std::atan2(i.cross(in_plane).norm(), i.dot(in_plane)) * 180.0 / std::numbers::pi;
   if (std::min(angle_deg, 180.0 - angle_deg) < options.min_angle_deg) {
-    throw Error(ErrorCode::kBadInput, kStage,
+    throw Error(ErrorCode::kBadInput, kThreePointFrameStage,
                 fmt::format("P1 {}, P2 {} and P3 {} are collinear (angle {:.3g} deg at P1, minimum {} deg)",
                             Point(p1_mm), Point(p2_mm), Point(p3_mm), angle_deg, options.min_angle_deg));
   }

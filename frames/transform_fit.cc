@@ -12,7 +12,7 @@
 namespace arcwheel::frames {
 namespace {
 
-constexpr const char* kStage = "frames.transform_fit";
+constexpr const char* kTransformFitStage = "frames.transform_fit";
 constexpr int kMinimumPairs = 3;
 
 Eigen::MatrixXd Coordinates(std::span<const PointPair> pairs, int dimension, bool source) {
@@ -27,12 +27,13 @@ Eigen::MatrixXd Coordinates(std::span<const PointPair> pairs, int dimension, boo
 void CheckInputs(std::span<const PointPair> pairs, TransformModel model) {
   if (pairs.size() < kMinimumPairs) {
     throw Error(
-        ErrorCode::kBadInput, kStage,
+        ErrorCode::kBadInput, kTransformFitStage,
         fmt::format("{} point pairs; {} needs at least {}", pairs.size(), ModelName(model), kMinimumPairs));
   }
   for (size_t i = 0; i < pairs.size(); ++i) {
     if (!pairs[i].source_mm.allFinite() || !pairs[i].target_mm.allFinite()) {
-      throw Error(ErrorCode::kBadInput, kStage, fmt::format("pair {} has a non-finite coordinate", i + 1));
+      throw Error(ErrorCode::kBadInput, kTransformFitStage,
+                  fmt::format("pair {} has a non-finite coordinate", i + 1));
     }
   }
 }
@@ -55,7 +56,7 @@ double GeometryRatio(const Eigen::VectorXd& singular_values, int rank, double co
 void RefuseDegenerate(double ratio, double limit, TransformModel model, const char* what) {
   if (ratio > limit) return;
   const char* shape = RequiredRank(model) == 1 ? "coincident" : "coincident or collinear";
-  throw Error(ErrorCode::kBadInput, kStage,
+  throw Error(ErrorCode::kBadInput, kTransformFitStage,
               fmt::format("the {} are {} (singular-value ratio {:.3g} <= {:.3g}): {} is not determined", what,
                           shape, ratio, limit, ModelName(model)));
 }
@@ -112,7 +113,7 @@ Transform FitUmeyama(const Centred& c, TransformModel model, double degenerate_r
     const double source_variance = c.source.squaredNorm() / n;
     scale = svd.singularValues().dot(signs) / source_variance;
     if (!(scale > 0.0)) {
-      throw Error(ErrorCode::kFitFailed, kStage,
+      throw Error(ErrorCode::kFitFailed, kTransformFitStage,
                   fmt::format("the fitted scale {:.6g} is not positive", scale));
     }
   }
@@ -336,7 +337,7 @@ Transform FitTransformExact(std::span<const PointPair> pairs, TransformModel mod
 
 TransformFit FitTransform(std::span<const PointPair> pairs, TransformModel model,
                           const TransformFitOptions& options) {
-  ThrowIfProblems(ErrorCode::kInvalidOption, kStage, options.Problems());
+  ThrowIfProblems(ErrorCode::kInvalidOption, kTransformFitStage, options.Problems());
   TransformFit fit;
   fit.used.assign(pairs.size(), true);
   fit.transform = FitTransformExact(pairs, model, options.degenerate_ratio);

@@ -12,7 +12,7 @@
 namespace arcwheel::frames {
 namespace {
 
-constexpr const char* kStage = "frames.transform_json";
+constexpr const char* kTransformJsonStage = "frames.transform_json";
 constexpr double kDegPerRad = 180.0 / std::numbers::pi;
 
 nlohmann::json Vector(const Eigen::VectorXd& v) {
@@ -58,7 +58,8 @@ nlohmann::json TransformKeys(const Transform& t) {
 }
 
 [[noreturn]] void Malformed(const std::string& source, const std::string& key, const std::string& detail) {
-  throw Error(ErrorCode::kBadInput, kStage, fmt::format("'{}': key '{}' {}", source, key, detail));
+  throw Error(ErrorCode::kBadInput, kTransformJsonStage,
+              fmt::format("'{}': key '{}' {}", source, key, detail));
 }
 
 double Number(const nlohmann::json& value, const std::string& source, const std::string& key) {
@@ -133,7 +134,7 @@ nlohmann::json TransformFitToJson(const TransformFit& fit) {
 
 Transform TransformFromJson(const nlohmann::json& json, const std::string& source) {
   if (!json.is_object())
-    throw Error(ErrorCode::kBadInput, kStage, fmt::format("'{}' is not a JSON object", source));
+    throw Error(ErrorCode::kBadInput, kTransformJsonStage, fmt::format("'{}' is not a JSON object", source));
   const nlohmann::json& root =
       json.contains("transform") && !json.contains("model") ? json.at("transform") : json;
   if (!root.contains("model") || !root.at("model").is_string()) Malformed(source, "model", "is missing");

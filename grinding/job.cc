@@ -20,7 +20,7 @@ namespace arcwheel::grinding {
 
 namespace {
 
-constexpr const char* kStage = "grinding.job";
+constexpr const char* kJobStage = "grinding.job";
 
 // Peak resident memory of `arcwheel toolpath` per item, measured on the trial part (docs/grinding.md
 // "Sizes"): a control point of a row in flight, with its CSV, G-code and PMAC text (360 B); a
@@ -289,11 +289,11 @@ Job ParseJob(const std::string& text, const std::filesystem::path& source,
              const std::optional<std::filesystem::path>& wheel_summary_override, double max_wheel_change_mm,
              WheelProfileSource wheel_profile) {
   if (!(max_wheel_change_mm > 0.0)) {
-    throw Error(ErrorCode::kInvalidOption, kStage,
+    throw Error(ErrorCode::kInvalidOption, kJobStage,
                 fmt::format("--max-wheel-change-mm = {} violates > 0", max_wheel_change_mm));
   }
-  const nlohmann::json document = ParseJsonText(text, source.string(), kStage);
-  JsonSection root(document, {.file = source.string(), .stage = kStage, .docs_page = "docs/grinding.md"});
+  const nlohmann::json document = ParseJsonText(text, source.string(), kJobStage);
+  JsonSection root(document, {.file = source.string(), .stage = kJobStage, .docs_page = "docs/grinding.md"});
   Job job;
   job.source = source;
   job.name = root.OptionalString("name").value_or(source.stem().string());
@@ -343,7 +343,7 @@ Job ReadJob(const std::filesystem::path& path,
             const std::optional<std::filesystem::path>& wheel_summary_override, double max_wheel_change_mm,
             WheelProfileSource wheel_profile) {
   std::ifstream in(path);
-  if (!in) throw Error(ErrorCode::kIo, kStage, fmt::format("cannot open job file '{}'", path.string()));
+  if (!in) throw Error(ErrorCode::kIo, kJobStage, fmt::format("cannot open job file '{}'", path.string()));
   std::ostringstream text;
   text << in.rdbuf();
   return ParseJob(text.str(), path, wheel_summary_override, max_wheel_change_mm, wheel_profile);

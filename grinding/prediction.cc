@@ -22,7 +22,7 @@ using surfaces::SurfacePoint;
 
 namespace {
 
-constexpr const char* kStage = "grinding.prediction";
+constexpr const char* kPredictionStage = "grinding.prediction";
 constexpr int kRunoutTableSize = 4096;
 // Samples of the wheel-centre offset per turn of the wheel in the ripple's minimum search.
 constexpr double kSamplesPerTurn = 256.0;
@@ -82,7 +82,7 @@ class NodePredictor {
     double n2 = 1.0;
     for (int iteration = 0; iteration < 8; ++iteration) {
       if (!surface_.InDomain(contact.x(), contact.y())) {
-        throw Error(ErrorCode::kBadInput, kStage,
+        throw Error(ErrorCode::kBadInput, kPredictionStage,
                     fmt::format("contact ({:.6f}, {:.6f}) mm grinding map node ({:.6f}, {:.6f}) mm "
                                 "lies off the surface's domain",
                                 contact.x(), contact.y(), x, y));
@@ -255,7 +255,7 @@ double ProfilePrintUm(const Surface& surface, const Wheel& wheel, const Predicti
 
 FormPrediction PredictFormError(const Surface& surface, const Aperture& aperture, const Wheel& wheel,
                                 const PredictionOptions& options) {
-  ThrowIfProblems(ErrorCode::kInvalidOption, kStage, options.Problems());
+  ThrowIfProblems(ErrorCode::kInvalidOption, kPredictionStage, options.Problems());
   FormPrediction p;
   const size_t nx = static_cast<size_t>(options.nodes_x), ny = static_cast<size_t>(options.nodes_y);
   for (int i = 0; i < options.nodes_x; ++i) {

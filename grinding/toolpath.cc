@@ -21,7 +21,7 @@ using surfaces::SurfacePoint;
 
 namespace {
 
-constexpr const char* kStage = "grinding.toolpath";
+constexpr const char* kToolpathStage = "grinding.toolpath";
 constexpr double kNewtonTolerance_mm = 1e-11;
 constexpr int kNewtonMaxIterations = 40;
 // Rounding noise of the clearance curvature is ~1e-15 / mm; anything below this is a real cut.
@@ -82,7 +82,7 @@ Eq5 SolveEq5(const Surface& surface, const Wheel& wheel, bool fix_contact_x, dou
     xy -= jacobian.inverse() * residual;
   }
   throw Error(
-      ErrorCode::kBadInput, kStage,
+      ErrorCode::kBadInput, kToolpathStage,
       fmt::format("cannot place the wheel at {} = {:.6f} mm, wheel-centre Y = {:.6f} mm: "
                   "eq. 5 has no solution there (last contact tried ({:.6f}, {:.6f}) mm); "
                   "the wheel cannot follow the surface at that point",
@@ -241,7 +241,7 @@ class RowBuilder {
     stats.max_row_deviation_mm = std::max(stats.max_row_deviation_mm, std::abs(c.y() - context.yw));
     const double u = p.contact_mm.y() - c.y();
     if (!wheel_.Reaches(u)) {
-      throw Error(ErrorCode::kBadInput, kStage,
+      throw Error(ErrorCode::kBadInput, kToolpathStage,
                   fmt::format("row {} point {}: contact ({:.6f}, {:.6f}) mm lies {:.4f} mm from the "
                               "arc centre along the wheel axis, beyond the wheel's usable arc "
                               "(half width {} mm{}); the surface is too steep across the feed",
@@ -251,7 +251,7 @@ class RowBuilder {
     const double clearance = SmallestEigenvalue(ClearanceHessianOf(e, wheel_));
     stats.min_local_clearance_per_mm = std::min(stats.min_local_clearance_per_mm, clearance);
     if (clearance < kLocalClearanceTolerance_per_mm) {
-      throw Error(ErrorCode::kBadInput, kStage,
+      throw Error(ErrorCode::kBadInput, kToolpathStage,
                   fmt::format("row {} point {}: the wheel (Ra = {} mm, total radius {} mm) cannot "
                               "reach the curvature at contact ({:.6f}, {:.6f}) mm: the concave "
                               "surface is more curved than the wheel there (clearance curvature "
@@ -268,7 +268,7 @@ class RowBuilder {
     stats.min_gouge_gap_mm = std::min(stats.min_gouge_gap_mm, probe.min_gap_mm);
     if (probe.min_gap_mm < -options_.gouge_tolerance_mm) {
       const Eigen::Vector3d& c = p.wheel_centre_mm;
-      throw Error(ErrorCode::kBadInput, kStage,
+      throw Error(ErrorCode::kBadInput, kToolpathStage,
                   fmt::format("row {} point {}: gouge: with the wheel centre at ({:.6f}, {:.6f}, "
                               "{:.6f}) mm for contact ({:.6f}, {:.6f}) mm the wheel cuts {:.3f} um "
                               "below the surface at ({:.6f}, {:.6f}) mm",
@@ -405,8 +405,8 @@ std::vector<std::string> ToolpathOptions::Problems() const {
 
 ToolpathSummary GenerateToolpath(const Surface& surface, const Aperture& aperture, const Wheel& wheel,
                                  const ToolpathOptions& options, const RowSink& sink) {
-  ThrowIfProblems(ErrorCode::kInvalidOption, kStage, options.Problems());
-  ThrowIfProblems(ErrorCode::kBadInput, kStage, wheel.Problems());
+  ThrowIfProblems(ErrorCode::kInvalidOption, kToolpathStage, options.Problems());
+  ThrowIfProblems(ErrorCode::kBadInput, kToolpathStage, wheel.Problems());
   const std::vector<double> rows = PlanRows(surface, aperture, wheel, options.step_over_mm);
   const RowBuilder builder(surface, aperture, wheel, options, static_cast<int>(rows.size()));
   const int threads = WorkerCount(options.threads);

@@ -21,13 +21,13 @@
 namespace arcwheel::grinding {
 namespace {
 
-constexpr const char* kStage = "grinding.output";
+constexpr const char* kToolpathWriterStage = "grinding.output";
 enum Stream { kCsv = 0, kGcode = 1, kPmac = 2 };
 
 std::ofstream OpenStaged(const std::filesystem::path& path) {
   std::ofstream out(path, std::ios::binary | std::ios::trunc);
   if (!out) {
-    throw Error(ErrorCode::kIo, kStage,
+    throw Error(ErrorCode::kIo, kToolpathWriterStage,
                 fmt::format("cannot create '{}': {}", path.string(), std::strerror(errno)));
   }
   return out;
@@ -36,7 +36,7 @@ std::ofstream OpenStaged(const std::filesystem::path& path) {
 void CloseChecked(std::ofstream& out, const std::filesystem::path& final_path) {
   out.flush();
   if (!out) {
-    throw Error(ErrorCode::kIo, kStage,
+    throw Error(ErrorCode::kIo, kToolpathWriterStage,
                 fmt::format("cannot write '{}' (disk full?): {}", final_path.string(), std::strerror(errno)));
   }
   out.close();

@@ -17,7 +17,7 @@
 namespace arcwheel::grinding {
 namespace {
 
-constexpr const char* kStage = "grinding.wheel";
+constexpr const char* kWheelStage = "grinding.wheel";
 using nlohmann::json;
 namespace key = schema::summary;
 
@@ -27,7 +27,7 @@ std::string Dotted(std::string_view object, std::string_view name) {
 }
 
 [[noreturn]] void Bad(const std::filesystem::path& path, std::string_view key, const std::string& what) {
-  throw Error(ErrorCode::kBadInput, kStage, fmt::format("'{}': key '{}' {}", path.string(), key, what));
+  throw Error(ErrorCode::kBadInput, kWheelStage, fmt::format("'{}': key '{}' {}", path.string(), key, what));
 }
 
 double RequiredNumber(const json& object, const std::filesystem::path& path, std::string_view key) {
@@ -81,7 +81,7 @@ void CheckSchemaVersion(const json& root, const std::filesystem::path& path) {
     version = it->get<std::string>();
   }
   schema::CheckVersion(version, key::kVersion, path.string(), fmt::format("key '{}'", key::kSchemaVersion),
-                       kStage);
+                       kWheelStage);
 }
 
 }  // namespace
@@ -136,7 +136,7 @@ std::vector<std::string> Wheel::Problems() const {
 }
 
 WheelSummary ReadWheelSummary(const std::filesystem::path& path) {
-  const json root = ReadJsonFile(path, kStage);
+  const json root = ReadJsonFile(path, kWheelStage);
   if (!root.is_object()) Bad(path, "(root)", "must be a JSON object");
   CheckSchemaVersion(root, path);
   WheelSummary s;

@@ -18,15 +18,17 @@
 namespace arcwheel::polishing {
 namespace {
 
-constexpr const char* kStage = "polishing.dwell";
+constexpr const char* kDwellStage = "polishing.dwell";
 // How far the least-dwell removal may exceed the target before the speeds count as unreachable.
 constexpr double kOvershootToleranceUm = 1e-3;
 
-[[noreturn]] void Invalid(const std::string& what) { throw Error(ErrorCode::kInvalidOption, kStage, what); }
+[[noreturn]] void Invalid(const std::string& what) {
+  throw Error(ErrorCode::kInvalidOption, kDwellStage, what);
+}
 
 void CheckOptions(const RemovalFunction& removal, const DwellOptions& o, std::size_t points) {
   removal.Check();
-  ThrowIfProblems(ErrorCode::kInvalidOption, kStage, o.Problems());
+  ThrowIfProblems(ErrorCode::kInvalidOption, kDwellStage, o.Problems());
   if (!o.least_dwell_s.empty() && o.least_dwell_s.size() != points) {
     Invalid(fmt::format("least_dwell_s has {} values for {} path points", o.least_dwell_s.size(), points));
   }
@@ -60,7 +62,7 @@ Rows ApertureRows(const ErrorMap& target, const surfaces::Aperture& aperture) {
     }
   }
   if (rows.node.empty()) {
-    throw Error(ErrorCode::kBadInput, kStage,
+    throw Error(ErrorCode::kBadInput, kDwellStage,
                 fmt::format("empty aperture: no target node lies inside {}", aperture.Describe()));
   }
   rows.target.resize(static_cast<Eigen::Index>(rows.node.size()));
@@ -214,7 +216,7 @@ void CheckReachable(const Removal& a, const Rows& rows, const ErrorMap& map, con
   const double most = excess.maxCoeff(&worst);
   if (most <= kOvershootToleranceUm) return;
   const int node = rows.node[static_cast<std::size_t>(worst)];
-  throw Error(ErrorCode::kBadInput, kStage,
+  throw Error(ErrorCode::kBadInput, kDwellStage,
               fmt::format("unreachable speeds: at max_speed_mm_s = {} the path already removes {:.4f} um "
                           "at ({:.3f}, {:.3f}) mm where the target is {:.4f} um; add a uniform layer of "
                           "at least {:.4f} um (removal_target.uniform_layer_um) or raise the maximum speed",
@@ -240,7 +242,7 @@ void AddLeastDwell(Bounds& b, std::span<const Eigen::Vector2d> path, const Dwell
                              const DwellOptions& o) {
   const auto k = static_cast<std::size_t>(worst);
   throw Error(
-      ErrorCode::kBadInput, kStage,
+      ErrorCode::kBadInput, kDwellStage,
       fmt::format(
           "unreachable speeds: after {} shaping rounds the speeds still exceed max_acceleration_mm_s2 "
           "= {}: slowing down into path point {} ({:.3f}, {:.3f}) mm adds {:.3g} um of removal "
@@ -475,7 +477,7 @@ ErrorMap Scatter(const ErrorMap& like, const Rows& rows, const Eigen::VectorXd& 
 }  // namespace
 
 std::vector<Eigen::Vector2d> SpiralPath(const surfaces::Aperture& aperture, const RasterOptions& o) {
-  ThrowIfProblems(ErrorCode::kInvalidOption, kStage, o.Problems());
+  ThrowIfProblems(ErrorCode::kInvalidOption, kDwellStage, o.Problems());
   const bool circle = aperture.shape == surfaces::Aperture::Shape::kCircle;
   const double radius =
       circle ? aperture.HalfY() + o.extension_mm
@@ -508,7 +510,7 @@ std::vector<Eigen::Vector2d> SpiralPath(const surfaces::Aperture& aperture, cons
 }
 
 std::vector<Eigen::Vector2d> RasterPath(const surfaces::Aperture& aperture, const RasterOptions& o) {
-  ThrowIfProblems(ErrorCode::kInvalidOption, kStage, o.Problems());
+  ThrowIfProblems(ErrorCode::kInvalidOption, kDwellStage, o.Problems());
   const bool circle = aperture.shape == surfaces::Aperture::Shape::kCircle;
   const double half_y = aperture.HalfY() + o.extension_mm;
   const int lines = static_cast<int>(std::ceil(2.0 * half_y / o.line_spacing_mm - 1e-9)) + 1;

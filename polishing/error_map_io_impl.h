@@ -2,13 +2,13 @@
 // What the error-map readers' sources (polishing/error_map_*.cc) share: the stage id, the failures
 // they throw and the memory budget's test of a grid. Not installed.
 
-#include <limits>
 #include <string>
+
+#include "core/nan.h"
 
 namespace arcwheel::polishing::internal {
 
 inline constexpr const char* kStage = "polishing.map";
-inline constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 // An error map marks a node without data with NaN; an infinity is a damaged value, never "no data".
 inline constexpr const char* kInfinityIsDamage =
     "is not finite: a map marks no data with nan, and an infinity is a damaged value (docs/polishing.md)";

@@ -18,7 +18,7 @@ namespace arcwheel::polishing {
 namespace {
 
 // Largest grid read (8e8 bytes of doubles).
-constexpr double kMaxNodes = 1e8;
+constexpr double kMaxGridNodes = 1e8;
 
 [[noreturn]] void LineFail(std::string_view stage, const std::filesystem::path& path, std::size_t line,
                            const std::string& what) {
@@ -95,7 +95,7 @@ CsvGrid ReadCsvGrid(const std::filesystem::path& path, std::string_view value_co
   grid.dy_mm = ys.size() > 1 ? MedianGap(ys) : 1.0;
   const double nx = std::round((*xs.rbegin() - grid.x0_mm) / grid.dx_mm) + 1.0;
   const double ny = std::round((*ys.rbegin() - grid.y0_mm) / grid.dy_mm) + 1.0;
-  if (!(nx * ny <= kMaxNodes)) LineFail(stage, path, grid.last_line, "the grid would exceed 1e8 nodes");
+  if (!(nx * ny <= kMaxGridNodes)) LineFail(stage, path, grid.last_line, "the grid would exceed 1e8 nodes");
   // A measured map fills most of its grid; a few rows spanning a vast grid are not a grid at all.
   if (nx * ny > 64.0 * static_cast<double>(rows.size()) + 4096.0) {
     LineFail(

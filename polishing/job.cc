@@ -27,7 +27,7 @@ namespace arcwheel::polishing {
 namespace {
 
 using nlohmann::json;
-constexpr const char* kStage = "polishing.job";
+constexpr const char* kJobStage = "polishing.job";
 
 AbbQuaternion ReadQuaternion(JsonSection& s, const std::string& key) {
   const std::vector<double> q = s.Numbers(key, {1.0, 0.0, 0.0, 0.0});
@@ -213,7 +213,7 @@ void ReadRobot(JsonSection& s, const std::filesystem::path& job_path, PolishJob&
     const std::filesystem::path resolved = file.is_absolute() ? file : job_path.parent_path() / file;
     std::ifstream in(resolved, std::ios::binary);
     if (!in)
-      throw Error(ErrorCode::kIo, kStage, fmt::format("cannot open robot.urdf '{}'", resolved.string()));
+      throw Error(ErrorCode::kIo, kJobStage, fmt::format("cannot open robot.urdf '{}'", resolved.string()));
     std::ostringstream text;
     text << in.rdbuf();
     job.robot.urdf_override = text.str();
@@ -245,10 +245,10 @@ void ReadRobot(JsonSection& s, const std::filesystem::path& job_path, PolishJob&
 
 PolishJob ReadPolishJob(const std::filesystem::path& path,
                         const std::optional<std::filesystem::path>& error_map_override) {
-  const json document = ReadJsonFile(path, kStage);
+  const json document = ReadJsonFile(path, kJobStage);
   PolishJob job;
   job.source = path;
-  JsonSection s(document, {.file = path.string(), .stage = kStage, .docs_page = "docs/polishing.md"});
+  JsonSection s(document, {.file = path.string(), .stage = kJobStage, .docs_page = "docs/polishing.md"});
   std::vector<std::string> problems;  // every range problem, reported together at the end
   job.name = s.String("name", path.stem().string());
   s.Section("surface", true, [&](JsonSection& c) {
@@ -348,7 +348,7 @@ void CheckOnSurface(const PolishJob& job, std::span<const Eigen::Vector2d> path)
       if (!std::isfinite(m.At(i, j)) || !job.aperture.Contains(m.grid.X(i), m.grid.Y(j))) continue;
       if (!job.surface->InDomain(m.grid.X(i), m.grid.Y(j))) {
         throw Error(
-            ErrorCode::kBadInput, kStage,
+            ErrorCode::kBadInput, kJobStage,
             fmt::format("map off the surface: '{}' node ({}, {}) mm lies outside {}",
                         job.error_map_file.string(), m.grid.X(i), m.grid.Y(j), job.surface->Describe()));
       }
@@ -356,7 +356,7 @@ void CheckOnSurface(const PolishJob& job, std::span<const Eigen::Vector2d> path)
   }
   for (std::size_t k = 0; k < path.size(); ++k) {
     if (!job.surface->InDomain(path[k].x(), path[k].y())) {
-      throw Error(ErrorCode::kBadInput, kStage,
+      throw Error(ErrorCode::kBadInput, kJobStage,
                   fmt::format("'{}': path point {} ({}, {}) mm (aperture grown by path.extension_mm = {}) "
                               "is off the surface {}",
                               job.source.string(), k, path[k].x(), path[k].y(), job.path.extension_mm,
@@ -481,7 +481,7 @@ std::string RobotJointsCsv(const RobotPath& robot) {
 
 WorkObjectProposal ProposeWorkObject(const PolishJob& job) {
   if (!job.robot_kinematics) {
-    throw Error(ErrorCode::kInvalidOption, kStage,
+    throw Error(ErrorCode::kInvalidOption, kJobStage,
                 fmt::format("'{}': --place-workobject needs a robot: the job has no \"robot\" section "
                             "(docs/polishing.md, \"Robot\")",
                             job.source.string()));
@@ -599,7 +599,7 @@ PolishRunReport RunPolishJob(const PolishJob& job, const std::filesystem::path& 
     std::ofstream out(temporary, std::ios::binary);
     out << text;
     out.close();
-    if (!out) throw Error(ErrorCode::kIo, kStage, fmt::format("cannot write '{}'", temporary.string()));
+    if (!out) throw Error(ErrorCode::kIo, kJobStage, fmt::format("cannot write '{}'", temporary.string()));
   };
   write(schema::polish::kPathFileName, PolishingPathCsv(points, comments));
   write("polish.mod", RapidModule(points, job.tool, job.work_object, "ArcwheelPolish", program_comments,

@@ -10,7 +10,7 @@
 namespace arcwheel::polishing {
 namespace {
 
-constexpr const char* kStage = "polishing.precession";
+constexpr const char* kPrecessionStage = "polishing.precession";
 
 Eigen::Vector3d UpwardNormal(const surfaces::SurfacePoint& p) {
   return Eigen::Vector3d(-p.fx, -p.fy, 1.0).normalized();
@@ -36,13 +36,13 @@ std::vector<std::string> PrecessionOptions::Problems() const {
 std::vector<PrecessionSample> PrecessionTrajectory(const surfaces::Surface& surface,
                                                    std::span<const Eigen::Vector2d> path_xy_mm,
                                                    const PrecessionOptions& options) {
-  ThrowIfProblems(ErrorCode::kInvalidOption, kStage, options.Problems());
+  ThrowIfProblems(ErrorCode::kInvalidOption, kPrecessionStage, options.Problems());
   // Cumulative length of the polyline in the part's (x, y) plane lifted onto the surface.
   std::vector<double> length_mm{0.0};
   for (std::size_t i = 0; i < path_xy_mm.size(); ++i) {
     const Eigen::Vector2d& p = path_xy_mm[i];
     if (!surface.InDomain(p.x(), p.y())) {
-      throw Error(ErrorCode::kBadInput, kStage,
+      throw Error(ErrorCode::kBadInput, kPrecessionStage,
                   fmt::format("path point {} ({}, {}) mm is off the surface", i, p.x(), p.y()));
     }
     if (i == 0) continue;
@@ -52,7 +52,7 @@ std::vector<PrecessionSample> PrecessionTrajectory(const surfaces::Surface& surf
     length_mm.push_back(length_mm.back() + (b - a).norm());
   }
   if (path_xy_mm.size() < 2 || !(length_mm.back() > 0.0)) {
-    throw Error(ErrorCode::kInvalidOption, kStage, "the path needs two or more distinct points");
+    throw Error(ErrorCode::kInvalidOption, kPrecessionStage, "the path needs two or more distinct points");
   }
   const double theta_rad = options.tilt_deg * std::numbers::pi / 180.0;
   const double w2_rad_per_s = options.precession_rate_rpm * 2.0 * std::numbers::pi / 60.0;

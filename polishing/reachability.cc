@@ -15,7 +15,7 @@
 namespace arcwheel::polishing {
 namespace {
 
-constexpr const char* kStage = "polishing.robot";
+constexpr const char* kReachabilityStage = "polishing.robot";
 constexpr double kDegPerRad = 180.0 / std::numbers::pi;
 constexpr double kTwoPi = 2.0 * std::numbers::pi;
 
@@ -236,14 +236,14 @@ RobotPath SolveRobotPath(const RobotKinematics& kinematics, const RobotMargins& 
   // A joint too fast is not cured by another configuration: named as it is.
   if (each_alone && !furthest->speed) {
     throw Error(
-        ErrorCode::kBadInput, kStage,
+        ErrorCode::kBadInput, kReachabilityStage,
         fmt::format("'{}': the path needs a configuration change: no one arm configuration of {} runs "
                     "every target; the one that gets furthest (cfx {}) stops at {}: {}{}",
                     job_name, robot, furthest_cfx, Describe(furthest->target, target_mm), furthest->why,
                     alone_cfx ? fmt::format("; that target alone needs cfx {}", *alone_cfx) : ""));
   }
   throw Error(
-      ErrorCode::kBadInput, kStage,
+      ErrorCode::kBadInput, kReachabilityStage,
       fmt::format("'{}': {} cannot run the path: {}: {} (in the arm configuration that gets furthest, "
                   "cfx {}; the others stop there or earlier)",
                   job_name, robot, Describe(furthest->target, target_mm), furthest->why, furthest_cfx));
@@ -311,7 +311,7 @@ WorkObjectProposal ProposeWorkObjectOrigin(const RobotKinematics& kinematics, co
   WorkObject placed = work_object;
   placed.origin_mm = proposal.origin_mm;
   if (!std::isfinite(best_score)) {
-    throw Error(ErrorCode::kBadInput, kStage,
+    throw Error(ErrorCode::kBadInput, kReachabilityStage,
                 fmt::format("'{}': no work-object origin within reach of {} lets it run the path with this "
                             "orientation (tried {} origins)",
                             job_name, kinematics.model().name, proposal.candidates));

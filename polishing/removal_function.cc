@@ -19,10 +19,12 @@
 namespace arcwheel::polishing {
 namespace {
 
-constexpr const char* kStage = "polishing.removal";
-constexpr double kMaxNodes = 1e7;
+constexpr const char* kRemovalFunctionStage = "polishing.removal";
+constexpr double kMaxKernelNodes = 1e7;
 
-[[noreturn]] void Bad(const std::string& what) { throw Error(ErrorCode::kBadInput, kStage, what); }
+[[noreturn]] void Bad(const std::string& what) {
+  throw Error(ErrorCode::kBadInput, kRemovalFunctionStage, what);
+}
 
 double FwhmFromSigma(double sigma_mm) { return 2.0 * std::sqrt(2.0 * std::numbers::ln2) * sigma_mm; }
 
@@ -50,7 +52,8 @@ void TabulatedRemovalFunction::Check() const {
   }
   if (!std::isfinite(x0_mm) || !std::isfinite(y0_mm))
     Bad(fmt::format("{}: the grid origin must be finite", where));
-  if (static_cast<double>(nx) * ny > kMaxNodes) Bad(fmt::format("{}: more than {} nodes", where, kMaxNodes));
+  if (static_cast<double>(nx) * ny > kMaxKernelNodes)
+    Bad(fmt::format("{}: more than {} nodes", where, kMaxKernelNodes));
   if (rate_um_per_s.size() != static_cast<std::size_t>(nx) * ny) {
     Bad(fmt::format("{}: {} rates for a {} x {} grid", where, rate_um_per_s.size(), nx, ny));
   }
@@ -120,7 +123,7 @@ TabulatedRemovalFunction ReadRemovalFunction(const std::filesystem::path& path) 
 }
 
 TabulatedRemovalFunction ReadRemovalFunctionCsv(const std::filesystem::path& path) {
-  CsvGrid grid = ReadCsvGrid(path, "rate_um_per_s", kStage);
+  CsvGrid grid = ReadCsvGrid(path, "rate_um_per_s", kRemovalFunctionStage);
   for (std::size_t k = 0; k < grid.values.size(); ++k) {
     const double rate = grid.values[k];
     if (grid.lines[k] != 0 && (!std::isfinite(rate) || rate < 0.0)) {
@@ -160,8 +163,8 @@ TabulatedRemovalFunction ReadRemovalFunctionHdf5(const std::filesystem::path& pa
   if (!file.HasObject(dataset)) fail("is missing");
   const std::vector<hsize_t> shape = file.Shape(dataset);
   if (shape.size() != 2) fail(fmt::format("has rank {}; it must be [ny][nx]", shape.size()));
-  if (static_cast<double>(shape[0]) * static_cast<double>(shape[1]) > kMaxNodes)
-    fail(fmt::format("has more than {} nodes", kMaxNodes));
+  if (static_cast<double>(shape[0]) * static_cast<double>(shape[1]) > kMaxKernelNodes)
+    fail(fmt::format("has more than {} nodes", kMaxKernelNodes));
   TabulatedRemovalFunction t;
   t.source = path.string();
   t.ny = static_cast<int>(shape[0]);

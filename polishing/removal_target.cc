@@ -11,12 +11,12 @@
 namespace arcwheel::polishing {
 namespace {
 
-constexpr const char* kStage = "polishing.target";
+constexpr const char* kRemovalTargetStage = "polishing.target";
 
 void CheckGrid(const ErrorMap& map) {
   if (map.grid.nx < 1 || map.grid.ny < 1 || !(map.grid.dx_mm > 0.0) || !(map.grid.dy_mm > 0.0) ||
       map.error_um.size() != static_cast<std::size_t>(map.grid.nx) * map.grid.ny) {
-    throw Error(ErrorCode::kInvalidOption, kStage,
+    throw Error(ErrorCode::kInvalidOption, kRemovalTargetStage,
                 fmt::format("error map grid {} x {} nodes, spacing {} x {} mm with {} values is "
                             "malformed",
                             map.grid.nx, map.grid.ny, map.grid.dx_mm, map.grid.dy_mm, map.error_um.size()));
@@ -54,7 +54,7 @@ ErrorMap RemovalTarget(const ErrorMap& error, const surfaces::Aperture& aperture
                        const RemovalTargetOptions& options) {
   CheckGrid(error);
   if (!(options.uniform_layer_um >= 0.0) || !std::isfinite(options.uniform_layer_um)) {
-    throw Error(ErrorCode::kInvalidOption, kStage,
+    throw Error(ErrorCode::kInvalidOption, kRemovalTargetStage,
                 fmt::format("uniform_layer_um = {} violates >= 0", options.uniform_layer_um));
   }
   double minimum = std::numeric_limits<double>::infinity();
@@ -67,7 +67,7 @@ ErrorMap RemovalTarget(const ErrorMap& error, const surfaces::Aperture& aperture
   }
   if (!std::isfinite(minimum)) {
     throw Error(
-        ErrorCode::kBadInput, kStage,
+        ErrorCode::kBadInput, kRemovalTargetStage,
         fmt::format("empty aperture: no error-map node with data lies inside {}", aperture.Describe()));
   }
   ErrorMap target = error;
@@ -84,7 +84,7 @@ ErrorMap RemovalTarget(const ErrorMap& error, const surfaces::Aperture& aperture
 
 double PolynomialProfileSagMm(std::span<const double> c, double y_mm) {
   if (c.size() < 2 || c[0] != 0.0 || !(c[1] > 0.0)) {
-    throw Error(ErrorCode::kBadInput, kStage,
+    throw Error(ErrorCode::kBadInput, kRemovalTargetStage,
                 "the profile y^2 = sum c_i x^i needs c_0 = 0 and c_1 > 0 (a vertex at the origin)");
   }
   const double y2 = y_mm * y_mm;
@@ -110,7 +110,7 @@ double PolynomialProfileSagMm(std::span<const double> c, double y_mm) {
       return x;
     }
   }
-  throw Error(ErrorCode::kBadInput, kStage,
+  throw Error(ErrorCode::kBadInput, kRemovalTargetStage,
               fmt::format("the profile has no sag through the vertex at radius {} mm", y_mm));
 }
 

@@ -19,7 +19,7 @@
 namespace arcwheel::polishing {
 namespace {
 
-constexpr const char* kStage = "polishing.robot";
+constexpr const char* kRobotKinematicsStage = "polishing.robot";
 constexpr double kPi = std::numbers::pi;
 
 double Wrap(double angle_rad) {
@@ -39,7 +39,7 @@ const Eigen::Matrix3d& LinkToTool0() {
 }
 
 [[noreturn]] void Refuse(const std::string& source, const std::string& what) {
-  throw Error(ErrorCode::kBadInput, kStage, fmt::format("URDF '{}' {}", source, what));
+  throw Error(ErrorCode::kBadInput, kRobotKinematicsStage, fmt::format("URDF '{}' {}", source, what));
 }
 
 }  // namespace

@@ -14,7 +14,7 @@
 namespace arcwheel::polishing {
 namespace {
 
-constexpr const char* kStage = "polishing.robot";
+constexpr const char* kTimeScalingStage = "polishing.robot";
 // A lengthened segment takes this much more than the joint's bare time, so that the check of the
 // slowed path, which divides the same numbers the other way, never finds it a rounding too fast.
 constexpr double kTimeRoundingMargin = 1e-9;
@@ -101,7 +101,7 @@ TimeScaling SlowDownToJointSpeeds(std::vector<PolishingPoint>& points, const Rob
     const SlowedSegment& worst = MostAt(scaling.slowed, points, removal, scaling.added.max_at_mm);
     const Eigen::Vector3d& p = points[worst.target].position_mm;
     throw Error(
-        ErrorCode::kBadInput, kStage,
+        ErrorCode::kBadInput, kTimeScalingStage,
         fmt::format("'{}': path target {} ({:.3f}, {:.3f}, {:.3f}) mm in the work object: joint {} too fast "
                     "for the dwell's speed; slowed from {:.4g} s to {:.4g} s it adds, with the other {} "
                     "slowed segments, {:.3f} nm of removal at ({:.3f}, {:.3f}) mm, more than "

@@ -19,7 +19,7 @@
 namespace arcwheel::processing {
 namespace {
 
-constexpr const char* kStage = "processing";
+constexpr const char* kProcessScanStage = "processing";
 
 // rho = radius_sign * z, in place (exact in float and double); invalid samples stay NaN.
 template <typename T>
@@ -66,9 +66,9 @@ std::size_t StuckRunSamples(std::optional<double> samples_per_turn, double stuck
 }
 
 void CheckOptions(const acquisition::Scan& scan, const ProcessOptions& options) {
-  ThrowIfProblems(ErrorCode::kInvalidOption, kStage, options.Problems());
+  ThrowIfProblems(ErrorCode::kInvalidOption, kProcessScanStage, options.Problems());
   if (options.rpm_source == RpmSource::kEncoder && !scan.has_encoder()) {
-    throw Error(ErrorCode::kInvalidOption, kStage,
+    throw Error(ErrorCode::kInvalidOption, kProcessScanStage,
                 "'" + scan.path + "' has no angle column for --rpm-source encoder");
   }
 }
@@ -85,7 +85,7 @@ void CheckSamplesPerTurn(const acquisition::Scan& scan, std::optional<double> sa
   const std::string settings = scan.has_encoder()
                                    ? std::string("by its angle column")
                                    : fmt::format("at spindle_rpm {:g}", *scan.metadata.spindle_rpm);
-  throw Error(ErrorCode::kBadInput, kStage,
+  throw Error(ErrorCode::kBadInput, kProcessScanStage,
               fmt::format("'{}': {:.3g} samples a turn {} over {:.4g} turns; a helical scan needs at least "
                           "{:g} a turn to resolve the wheel's phase (is spindle_rpm in rev/min and "
                           "sample_period_s in seconds?)",
@@ -111,7 +111,7 @@ void DropStuckSensorRuns(const acquisition::Scan& scan, std::span<T> rho, std::s
   out.valid_samples = out.stuck.valid;
   if (out.stuck.dropped > 0 && out.stuck.dropped == out.valid_samples) {
     throw Error(
-        ErrorCode::kBadInput, kStage,
+        ErrorCode::kBadInput, kProcessScanStage,
         fmt::format("'{}': every reading lies in a run of equal values (longest {} samples): the sensor is "
                     "stuck or saturated",
                     scan.path, out.stuck.longest_run));
@@ -145,7 +145,7 @@ void CorrectBeamOffsetIfAsked(const acquisition::Scan& scan, std::span<double> r
   double radius = options.wheel_radius_mm;
   if (radius <= 0 && scan.metadata.wheel_diameter_mm) radius = *scan.metadata.wheel_diameter_mm / 2.0;
   if (radius <= 0) {
-    throw Error(ErrorCode::kInvalidOption, kStage,
+    throw Error(ErrorCode::kInvalidOption, kProcessScanStage,
                 "the beam-offset correction needs the wheel radius: give --wheel-radius-mm or a "
                 "wheel_diameter_mm attribute");
   }
@@ -157,7 +157,7 @@ template <typename T>
 void ChooseSpeedWithoutEncoder(const acquisition::Scan& scan, std::span<const T> rho,
                                const ProcessOptions& options, ProcessedScan& out) {
   if (!scan.metadata.spindle_rpm) {
-    throw Error(ErrorCode::kBadInput, kStage, "'" + scan.path + "' lacks spindle_rpm");
+    throw Error(ErrorCode::kBadInput, kProcessScanStage, "'" + scan.path + "' lacks spindle_rpm");
   }
   out.rpm_used = *scan.metadata.spindle_rpm;
   out.phase_source = PhaseSource::kNominal;

@@ -10,13 +10,13 @@
 #include <vector>
 
 #include "core/error.h"
+#include "core/nan.h"
 #include "processing/helix_geometry.h"
 
 namespace arcwheel::processing {
 namespace {
 
-constexpr const char* kStage = "processing.profile";
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+constexpr const char* kProfileSectionsStage = "processing.profile";
 constexpr double kDefaultAxialStepMm = 0.1;
 
 // Sums of each (phase node, column) cell over the frames nearest the node.
@@ -112,7 +112,7 @@ void LayOutMap(const acquisition::ProfileScan& scan, const MapOptions& options, 
     high = std::min(high, section.y_mm.back());
   }
   if (!(high > low)) {
-    throw Error(ErrorCode::kBadInput, kStage,
+    throw Error(ErrorCode::kBadInput, kProfileSectionsStage,
                 fmt::format("'{}': the phases' sections share no axial span", scan.path));
   }
   const double step = options.axial_step_mm > 0 ? options.axial_step_mm : kDefaultAxialStepMm;
@@ -142,7 +142,7 @@ void LayOutMap(const acquisition::ProfileScan& scan, const MapOptions& options, 
 }  // namespace
 
 ProfileSectionsResult BuildProfileSections(const acquisition::ProfileScan& scan, const MapOptions& options) {
-  ThrowIfProblems(ErrorCode::kInvalidOption, kStage, options.Problems());
+  ThrowIfProblems(ErrorCode::kInvalidOption, kProfileSectionsStage, options.Problems());
   const CellSums sums = SumFrames(scan, options.phases);
   ProfileSectionsResult out;
   out.point_spread_mm = PooledSpread(sums);
@@ -154,7 +154,7 @@ ProfileSectionsResult BuildProfileSections(const acquisition::ProfileScan& scan,
     const auto node = static_cast<std::size_t>(j);
     if (sums.frames[node] == 0) {
       throw Error(
-          ErrorCode::kBadInput, kStage,
+          ErrorCode::kBadInput, kProfileSectionsStage,
           fmt::format("'{}': no frame lies nearest the phase node {} deg ({} frames for {} phases; scan more "
                       "frames a turn or give fewer --phases)",
                       scan.path, j * step, scan.frames(), options.phases));

@@ -11,13 +11,12 @@
 #include "core/error.h"
 #include "core/free_memory.h"
 #include "core/interrupt.h"
+#include "core/nan.h"
 #include "core/parallel.h"
 #include "processing/cubic_interpolation.h"
 
 namespace arcwheel::processing {
 namespace {
-
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 double ChooseKnotStep(const MapOptions& options, const HelixGeometry& geometry, std::size_t valid_samples) {
   if (options.knot_step_deg > 0) return options.knot_step_deg;

@@ -8,6 +8,7 @@
 
 #include "core/atomic_file.h"
 #include "core/error.h"
+#include "core/nan.h"
 #include "reports/html_page.h"
 #include "reports/pdf_flow.h"
 #include "reports/statistics.h"
@@ -17,8 +18,7 @@ namespace arcwheel::reports {
 namespace {
 
 namespace key = schema::summary;
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
-constexpr const char* kStage = "reports.compare";
+constexpr const char* kCompareStage = "reports.compare";
 
 std::string WheelId(const Summary& s) {
   const auto it = s.scan.find(key::scan::kWheelId);
@@ -94,7 +94,7 @@ MapDifference Difference(const WheelMapData& before, const WheelMapData& after, 
   const double low = std::max(before.y_mm.front(), after.y_mm.front());
   const double high = std::min(before.y_mm.back(), after.y_mm.back());
   if (!(high > low)) {
-    throw Error(ErrorCode::kBadInput, kStage,
+    throw Error(ErrorCode::kBadInput, kCompareStage,
                 fmt::format("{}: the two maps share no axial range (before {} … {} mm, after {} … {} mm)",
                             where, FormatFixed(before.y_mm.front(), 3), FormatFixed(before.y_mm.back(), 3),
                             FormatFixed(after.y_mm.front(), 3), FormatFixed(after.y_mm.back(), 3)));
@@ -259,7 +259,7 @@ double InterpolateRho_mm(const WheelMapData& source, double phase_deg, double y_
 Comparison CompareScans(const ReportInputs& before, const ReportInputs& after) {
   const std::string before_id = WheelId(before.summary), after_id = WheelId(after.summary);
   if (!before_id.empty() && !after_id.empty() && before_id != after_id) {
-    throw Error(ErrorCode::kBadInput, kStage,
+    throw Error(ErrorCode::kBadInput, kCompareStage,
                 fmt::format("'{}' key 'scan.wheel_id' = '{}' but '{}' has '{}': not the same wheel",
                             before.summary_path.string(), before_id, after.summary_path.string(), after_id));
   }

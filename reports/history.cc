@@ -12,6 +12,7 @@
 
 #include "core/atomic_file.h"
 #include "core/error.h"
+#include "core/nan.h"
 #include "reports/html_page.h"
 #include "reports/pdf_flow.h"
 #include "schema/summary.h"
@@ -20,8 +21,7 @@ namespace arcwheel::reports {
 namespace {
 
 namespace key = schema::summary;
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
-constexpr const char* kStage = "reports.history";
+constexpr const char* kHistoryStage = "reports.history";
 constexpr double kSecondsPerHour = 3600.0;
 
 std::string ScanString(const Summary& s, std::string_view name) {
@@ -250,7 +250,7 @@ double ParseTimestamp_s(const std::string& text, const std::string& where) {
   std::smatch m;
   const std::string trimmed = Trim(text);
   if (!std::regex_match(trimmed, m, kIso)) {
-    throw Error(ErrorCode::kBadInput, kStage,
+    throw Error(ErrorCode::kBadInput, kHistoryStage,
                 where + " '" + text + "' is not an ISO 8601 date and time (e.g. 2026-03-01T08:30:00Z)");
   }
   std::tm t{};
@@ -261,7 +261,7 @@ double ParseTimestamp_s(const std::string& text, const std::string& where) {
   t.tm_min = std::stoi(m[5]);
   t.tm_sec = m[6].matched ? std::stoi(m[6]) : 0;
   if (t.tm_mon > 11 || t.tm_mday < 1 || t.tm_mday > 31 || t.tm_hour > 23 || t.tm_min > 59 || t.tm_sec > 60)
-    throw Error(ErrorCode::kBadInput, kStage, where + " '" + text + "' is not a valid date and time");
+    throw Error(ErrorCode::kBadInput, kHistoryStage, where + " '" + text + "' is not a valid date and time");
   double seconds = static_cast<double>(timegm(&t));
   if (m[7].matched) seconds += std::stod(m[7]);
   if (m[8].matched && m[8] != "Z") {
@@ -289,7 +289,8 @@ std::vector<double> ParseDressingsCsv(const std::string& text, const std::string
     times.push_back(ParseTimestamp_s(cell, fmt::format("'{}' line {}:", name, number)));
     if (timestamps != nullptr) timestamps->push_back(cell);
   }
-  if (times.empty()) throw Error(ErrorCode::kBadInput, kStage, "'" + name + "' holds no dressing date");
+  if (times.empty())
+    throw Error(ErrorCode::kBadInput, kHistoryStage, "'" + name + "' holds no dressing date");
   return times;
 }
 
@@ -383,12 +384,12 @@ History BuildHistory(const std::vector<std::filesystem::path>& folders,
     scan.summary = ReadSummary(path);
     scan.timestamp = ScanString(scan.summary, key::scan::kTimestamp);
     if (scan.timestamp.empty())
-      throw Error(ErrorCode::kBadInput, kStage,
+      throw Error(ErrorCode::kBadInput, kHistoryStage,
                   "'" + path.string() + "' key 'scan.timestamp' is missing or empty");
     scan.time_s = ParseTimestamp_s(scan.timestamp, "'" + path.string() + "' key 'scan.timestamp'");
     const std::string id = ScanString(scan.summary, key::scan::kWheelId);
     if (!scans.empty() && id != wheel_id) {
-      throw Error(ErrorCode::kBadInput, kStage,
+      throw Error(ErrorCode::kBadInput, kHistoryStage,
                   fmt::format("'{}' is of wheel '{}' but '{}' of wheel '{}': a history holds one wheel",
                               (scans.front().folder / key::kFileName).string(), wheel_id, path.string(), id));
     }
@@ -409,7 +410,7 @@ History AssembleHistory(const std::string& wheel_id, std::vector<HistoryScan> sc
   for (std::size_t i = 1; i < h.scans.size(); ++i) {
     if (h.scans[i].time_s == h.scans[i - 1].time_s) {
       throw Error(
-          ErrorCode::kBadInput, kStage,
+          ErrorCode::kBadInput, kHistoryStage,
           fmt::format("'{}' and '{}' have the same scan timestamp '{}'", h.scans[i - 1].folder.string(),
                       h.scans[i].folder.string(), h.scans[i].timestamp));
     }

@@ -15,6 +15,7 @@
 
 #include "core/error.h"
 #include "core/json_text.h"
+#include "core/nan.h"
 #include "core/sha256.h"
 #include "core/text_lines.h"
 #include "schema/polish_outputs.h"
@@ -23,12 +24,13 @@ namespace arcwheel::reports {
 namespace {
 
 using nlohmann::json;
-constexpr const char* kStage = "reports.polish";
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+constexpr const char* kPolishReportInputsStage = "reports.polish";
 // A residual map is an aperture's nodes; a grid larger than this is a broken file, not a map.
 constexpr double kMaxGridNodes = 1e7;
 
-[[noreturn]] void Bad(const std::string& what) { throw Error(ErrorCode::kBadInput, kStage, what); }
+[[noreturn]] void Bad(const std::string& what) {
+  throw Error(ErrorCode::kBadInput, kPolishReportInputsStage, what);
+}
 
 [[noreturn]] void BadLine(const std::string& source, std::size_t line, const std::string& what) {
   Bad(fmt::format("'{}' line {}: {}", source, line, what));
@@ -237,14 +239,15 @@ void CheckPolishSummaryVersion(const JsonReader& r) {
   const std::string name(schema::polish::summary::kSchemaVersion);
   const std::optional<std::string> version =
       r.Find(name) == nullptr ? std::nullopt : std::optional<std::string>(r.String(name));
-  schema::CheckVersion(version, schema::polish::kVersion, r.source(), fmt::format("key '{}'", name), kStage);
+  schema::CheckVersion(version, schema::polish::kVersion, r.source(), fmt::format("key '{}'", name),
+                       kPolishReportInputsStage);
 }
 
 std::string ReadWhole(const std::filesystem::path& path) {
   std::ifstream in(path, std::ios::binary);
   if (!in) {
     const std::string why = std::filesystem::exists(path) ? "cannot be read" : "does not exist";
-    throw Error(ErrorCode::kIo, kStage,
+    throw Error(ErrorCode::kIo, kPolishReportInputsStage,
                 fmt::format("'{}' {} (is this a folder written by `arcwheel polish`?)", path.string(), why));
   }
   std::ostringstream text;
@@ -360,7 +363,7 @@ RobotJointsTable ParseRobotJointsCsv(std::string_view text, const std::string& s
 }
 
 PolishSummary ParsePolishSummary(const std::string& text, const std::string& source_name) {
-  const json root = ParseJsonText(text, source_name, kStage);
+  const json root = ParseJsonText(text, source_name, kPolishReportInputsStage);
   if (!root.is_object()) Bad(fmt::format("'{}' is not a JSON object", source_name));
   const JsonReader r(root, source_name);
   namespace key = schema::polish::summary;

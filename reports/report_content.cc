@@ -10,6 +10,7 @@
 
 #include "characteristics/wheel_characteristics.h"
 #include "core/error.h"
+#include "core/nan.h"
 #include "core/number_format.h"
 #include "core/version.h"
 #include "reports/report_inputs.h"
@@ -21,7 +22,6 @@ namespace {
 
 using nlohmann::json;
 namespace key = schema::summary;
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 struct HeadlineSpec {
   std::string_view key;

@@ -22,7 +22,7 @@ std::string VerdictBadge(Verdict verdict) {
   return "<span class=\"verdict " + VerdictClass(verdict) + "\">" + VerdictText(verdict) + "</span>";
 }
 
-std::string DecisionLine(const ReportContent& content) {
+std::string VerdictReasons(const ReportContent& content) {
   if (content.overall == Verdict::kFail) {
     std::string html = "<p class=\"failing\"><strong>Failing:</strong></p>\n<ul class=\"failing\">\n";
     for (const std::string& row : content.failing) html += "<li>" + Escape(row) + "</li>\n";
@@ -47,7 +47,7 @@ std::string Cell(const std::string& css_class, const std::string& label, const s
 std::string DecisionBlock(const ReportContent& content) {
   std::string html = "<section class=\"decision\" id=\"decision\">\n";
   html += "<div class=\"banner " + VerdictClass(content.overall) +
-          "\">Overall: " + VerdictText(content.overall) + "</div>\n" + DecisionLine(content);
+          "\">Overall: " + VerdictText(content.overall) + "</div>\n" + VerdictReasons(content);
   html +=
       "<table class=\"headline\">\n<thead><tr><th>Quantity</th><th>Value</th><th>Uncertainty (meaning)</th>"
       "<th>Noise alone (part of the PV)</th><th>Limit</th><th>Result</th></tr></thead>\n<tbody>\n";

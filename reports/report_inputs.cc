@@ -10,6 +10,7 @@
 #include "core/error.h"
 #include "core/hdf5.h"
 #include "core/json_text.h"
+#include "core/nan.h"
 #include "schema/summary.h"
 #include "schema/wheel_map.h"
 
@@ -21,7 +22,6 @@ namespace key = schema::summary;
 namespace h5 = schema::wheel_map;
 constexpr const char* kSummaryStage = "reports.summary";
 constexpr const char* kMapStage = "reports.wheel_map";
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 // Locates a value in summary.json for error messages: "'OUTDIR/summary.json' key 'phases.y_mm'".
 struct JsonWhere {

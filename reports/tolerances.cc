@@ -13,7 +13,7 @@
 namespace arcwheel::reports {
 namespace {
 
-constexpr const char* kStage = "reports.tolerances";
+constexpr const char* kTolerancesStage = "reports.tolerances";
 
 bool IsHeadlineKey(const std::string& key) {
   return std::find(kHeadlineKeys.begin(), kHeadlineKeys.end(), key) != kHeadlineKeys.end();
@@ -26,7 +26,7 @@ std::string KnownKeys() {
 }
 
 [[noreturn]] void BadTolerance(ErrorCode code, const std::string& where, const std::string& problem) {
-  throw Error(code, kStage, where + " " + problem);
+  throw Error(code, kTolerancesStage, where + " " + problem);
 }
 
 void CheckOrder(const Limit& limit, ErrorCode code, const std::string& where) {
@@ -140,8 +140,9 @@ Verdict Judge(double value, const std::optional<Limit>& limit) {
 }
 
 Tolerances ParseTolerances(const std::string& text, const std::string& name) {
-  const nlohmann::json root = ParseJsonText(text, name, kStage);
-  if (!root.is_object()) throw Error(ErrorCode::kBadInput, kStage, "'" + name + "' is not a JSON object");
+  const nlohmann::json root = ParseJsonText(text, name, kTolerancesStage);
+  if (!root.is_object())
+    throw Error(ErrorCode::kBadInput, kTolerancesStage, "'" + name + "' is not a JSON object");
   Tolerances tolerances;
   for (const auto& [key, value] : root.items()) {
     const std::string where = "'" + name + "' key '" + key + "'";
@@ -165,7 +166,7 @@ Tolerances ParseTolerances(const std::string& text, const std::string& name) {
 
 Tolerances ReadTolerances(const std::filesystem::path& path) {
   std::ifstream stream(path, std::ios::binary);
-  if (!stream) throw Error(ErrorCode::kIo, kStage, "cannot open '" + path.string() + "'");
+  if (!stream) throw Error(ErrorCode::kIo, kTolerancesStage, "cannot open '" + path.string() + "'");
   std::ostringstream contents;
   contents << stream.rdbuf();
   return ParseTolerances(contents.str(), path.string());

@@ -12,7 +12,7 @@
 namespace arcwheel::store::internal {
 namespace {
 
-constexpr const char* kStage = "store";
+constexpr const char* kPostgresDatabaseStage = "store";
 // Any fixed number: the key of the advisory lock that serialises arcwheel's writers of a store.
 constexpr const char* kWriterLock = "SELECT pg_advisory_xact_lock(727302)";
 
@@ -41,7 +41,7 @@ class PostgresDatabase final : public Database {
     if (PQstatus(connection_) != CONNECTION_OK) {
       const std::string reason = Trimmed(PQerrorMessage(connection_));
       PQfinish(connection_);
-      throw Error(ErrorCode::kIo, kStage,
+      throw Error(ErrorCode::kIo, kPostgresDatabaseStage,
                   fmt::format("cannot reach the results store '{}': {}", name_, reason));
     }
     // Notices (a table that exists already) are not the user's business.
@@ -77,7 +77,8 @@ class PostgresDatabase final : public Database {
       PQclear(result);
       const std::string connection_reason =
           PQstatus(connection_) != CONNECTION_OK ? " (the connection was lost)" : "";
-      throw Error(ErrorCode::kIo, kStage, fmt::format("'{}': {}{}", name_, reason, connection_reason));
+      throw Error(ErrorCode::kIo, kPostgresDatabaseStage,
+                  fmt::format("'{}': {}{}", name_, reason, connection_reason));
     }
     std::vector<Row> rows;
     for (int r = 0; r < PQntuples(result); ++r) {

@@ -6,6 +6,7 @@
 #include <limits>
 
 #include "core/error.h"
+#include "core/nan.h"
 #include "schema/summary.h"
 
 namespace arcwheel::store {
@@ -14,21 +15,20 @@ namespace {
 namespace s = schema::store;
 namespace k = schema::summary;
 using nlohmann::json;
-constexpr const char* kStage = "store";
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+constexpr const char* kQueriesStage = "store";
 
-double Value(const StoredRun& run, std::string_view characteristic) {
+double CharacteristicValue(const StoredRun& run, std::string_view characteristic) {
   const StoredNumber* number = run.Number(std::string(characteristic));
   return number != nullptr ? number->value : kNaN;
 }
 
 std::vector<StoredRun> Scans(Store& store, const std::string& wheel_id,
                              const std::optional<double>& since_s) {
-  if (wheel_id.empty()) throw Error(ErrorCode::kInvalidOption, kStage, "--wheel needs a wheel id");
+  if (wheel_id.empty()) throw Error(ErrorCode::kInvalidOption, kQueriesStage, "--wheel needs a wheel id");
   std::vector<StoredRun> runs =
       store.Runs({.wheel_id = wheel_id, .command = std::string(s::runs::kProcess), .since_s = since_s});
   if (runs.empty()) {
-    throw Error(ErrorCode::kBadInput, kStage,
+    throw Error(ErrorCode::kBadInput, kQueriesStage,
                 fmt::format("'{}' holds no scan of wheel '{}'{}", store.Name(), wheel_id,
                             since_s ? " since the given date" : ""));
   }
@@ -113,11 +113,11 @@ reports::History HistoryFromStore(Store& store, const std::string& wheel_id,
     const StoredNumber* radius = run.Number(std::string(k::kMeanArcRadiusMm));
     summary.mean_arc_radius_mm = radius != nullptr ? radius->value : kNaN;
     summary.mean_arc_radius_sigma_mm = radius != nullptr && radius->sigma ? *radius->sigma : kNaN;
-    summary.arc_radius_range_mm = Value(run, k::kArcRadiusRangeMm);
-    summary.center_axial_deviation_mm = Value(run, k::kCenterAxialDeviationMm);
-    summary.max_arc_error_um = Value(run, k::kMaxArcErrorUm);
-    summary.max_runout_um = Value(run, k::kMaxRunoutUm);
-    summary.max_roundness_um = Value(run, k::kMaxRoundnessUm);
+    summary.arc_radius_range_mm = CharacteristicValue(run, k::kArcRadiusRangeMm);
+    summary.center_axial_deviation_mm = CharacteristicValue(run, k::kCenterAxialDeviationMm);
+    summary.max_arc_error_um = CharacteristicValue(run, k::kMaxArcErrorUm);
+    summary.max_runout_um = CharacteristicValue(run, k::kMaxRunoutUm);
+    summary.max_roundness_um = CharacteristicValue(run, k::kMaxRoundnessUm);
     summary.scan = {{std::string(k::scan::kWheelId), run.wheel_id},
                     {std::string(k::scan::kTimestamp), run.scan_timestamp}};
     scans.push_back(std::move(scan));
@@ -129,7 +129,7 @@ std::pair<std::filesystem::path, std::filesystem::path> ComparisonFolders(
     Store& store, const std::string& wheel_id, const std::optional<double>& since_s) {
   const std::vector<StoredRun> runs = Scans(store, wheel_id, since_s);
   if (runs.size() < 2) {
-    throw Error(ErrorCode::kBadInput, kStage,
+    throw Error(ErrorCode::kBadInput, kQueriesStage,
                 fmt::format("'{}' holds {} scan of wheel '{}'{}: a comparison needs two", store.Name(),
                             runs.size(), wheel_id, since_s ? " since the given date" : ""));
   }

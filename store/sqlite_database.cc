@@ -15,7 +15,7 @@
 namespace arcwheel::store::internal {
 namespace {
 
-constexpr const char* kStage = "store";
+constexpr const char* kSqliteDatabaseStage = "store";
 // How long a writer waits for another one before the run fails: longer than any transaction of
 // ours takes, so that only a stuck store reaches it.
 constexpr int kBusyTimeoutMs = 60000;
@@ -31,7 +31,8 @@ class Statement {
   Statement(sqlite3* db, const std::string& sql, const std::string& name) {
     const std::string text = SqliteParameters(sql);
     if (sqlite3_prepare_v2(db, text.c_str(), -1, &statement_, nullptr) != SQLITE_OK) {
-      throw Error(ErrorCode::kIo, kStage, fmt::format("'{}': {} in: {}", name, sqlite3_errmsg(db), sql));
+      throw Error(ErrorCode::kIo, kSqliteDatabaseStage,
+                  fmt::format("'{}': {} in: {}", name, sqlite3_errmsg(db), sql));
     }
   }
   ~Statement() { sqlite3_finalize(statement_); }
@@ -90,7 +91,7 @@ class SqliteDatabase final : public Database {
     if (status != SQLITE_OK) {
       const std::string reason = db_ != nullptr ? sqlite3_errmsg(db_) : sqlite3_errstr(status);
       sqlite3_close(db_);
-      throw Error(ErrorCode::kIo, kStage,
+      throw Error(ErrorCode::kIo, kSqliteDatabaseStage,
                   fmt::format("cannot open the results store '{}': {}", path, reason));
     }
     sqlite3_busy_timeout(db_, kBusyTimeoutMs);
@@ -101,7 +102,8 @@ class SqliteDatabase final : public Database {
     } catch (const Error&) {
       const std::string reason = sqlite3_errmsg(db_);
       sqlite3_close(db_);
-      throw Error(ErrorCode::kIo, kStage, fmt::format("cannot use the results store '{}': {}", path, reason));
+      throw Error(ErrorCode::kIo, kSqliteDatabaseStage,
+                  fmt::format("cannot use the results store '{}': {}", path, reason));
     }
   }
   ~SqliteDatabase() override { sqlite3_close(db_); }
@@ -127,7 +129,8 @@ class SqliteDatabase final : public Database {
       } else if (status == SQLITE_DONE) {
         return rows;
       } else {
-        throw Error(ErrorCode::kIo, kStage, fmt::format("'{}': {}", name_, sqlite3_errmsg(db_)));
+        throw Error(ErrorCode::kIo, kSqliteDatabaseStage,
+                    fmt::format("'{}': {}", name_, sqlite3_errmsg(db_)));
       }
     }
   }

@@ -20,7 +20,7 @@ namespace {
 namespace s = schema::store;
 using internal::Database;
 using internal::Value;
-constexpr const char* kStage = "store";
+constexpr const char* kStoreStage = "store";
 
 bool IsPostgresUrl(const std::string& location) {
   return location.rfind("postgresql://", 0) == 0 || location.rfind("postgres://", 0) == 0;
@@ -89,7 +89,7 @@ int VersionOf(Database& db) {
   const auto rows =
       db.Query(fmt::format("SELECT {} FROM {}", s::schema_version::kVersion, s::kSchemaVersionTable));
   if (rows.size() != 1 || !internal::AsInteger(rows[0][0])) {
-    throw Error(ErrorCode::kBadInput, kStage,
+    throw Error(ErrorCode::kBadInput, kStoreStage,
                 fmt::format("'{}': table '{}' does not hold one version", db.Name(), s::kSchemaVersionTable));
   }
   return static_cast<int>(*internal::AsInteger(rows[0][0]));
@@ -124,7 +124,7 @@ double ParseSince_s(const std::string& text, const std::string& option) {
   try {
     return reports::ParseTimestamp_s(date_time, option);
   } catch (const Error&) {
-    throw Error(ErrorCode::kInvalidOption, kStage,
+    throw Error(ErrorCode::kInvalidOption, kStoreStage,
                 fmt::format("{} '{}' is not a date (YYYY-MM-DD) or an ISO 8601 date and time", option, text));
   }
 }
@@ -136,7 +136,7 @@ Store::~Store() = default;
 
 Store Store::Open(const std::string& location) {
   if (location.empty())
-    throw Error(ErrorCode::kInvalidOption, kStage, "no store given (--db or ARCWHEEL_DB)");
+    throw Error(ErrorCode::kInvalidOption, kStoreStage, "no store given (--db or ARCWHEEL_DB)");
   return Store(IsPostgresUrl(location) ? internal::OpenPostgres(location) : internal::OpenSqlite(location));
 }
 
@@ -155,19 +155,19 @@ void Store::RequireVersion(int version) {
   const int found = Version();
   if (found == version) return;
   if (found < version) {
-    throw Error(ErrorCode::kBadInput, kStage,
+    throw Error(ErrorCode::kBadInput, kStoreStage,
                 fmt::format("'{}' is at schema version {}, this arcwheel writes version {}: run `arcwheel db "
                             "migrate --db {}` first",
                             Name(), found, version, Name()));
   }
-  throw Error(ErrorCode::kBadInput, kStage,
+  throw Error(ErrorCode::kBadInput, kStoreStage,
               fmt::format("'{}' is at schema version {}, newer than this arcwheel's {}: use a newer arcwheel",
                           Name(), found, version));
 }
 
 void Store::Init(int version) {
   if (version < 1 || version > s::kLatestVersion) {
-    throw Error(ErrorCode::kInvalidOption, kStage,
+    throw Error(ErrorCode::kInvalidOption, kStoreStage,
                 fmt::format("schema version {} violates 1 .. {}", version, s::kLatestVersion));
   }
   database_->WriteTransaction([&] {
@@ -175,7 +175,7 @@ void Store::Init(int version) {
     const int found = VersionOf(*database_);
     if (found == version) return;
     if (found != 0) {
-      throw Error(ErrorCode::kBadInput, kStage,
+      throw Error(ErrorCode::kBadInput, kStoreStage,
                   fmt::format("'{}' holds schema version {} already (`arcwheel db migrate` updates it)",
                               Name(), found));
     }
@@ -190,7 +190,7 @@ std::pair<int, int> Store::Migrate() {
   database_->WriteTransaction([&] {
     const int found = VersionOf(*database_);
     if (found == 0)
-      throw Error(ErrorCode::kBadInput, kStage,
+      throw Error(ErrorCode::kBadInput, kStoreStage,
                   fmt::format("'{}' holds no store: run `arcwheel db init`", Name()));
     if (found > s::kLatestVersion) RequireVersion(s::kLatestVersion);
     for (int v = found; v < s::kLatestVersion; ++v) kMigrations[static_cast<size_t>(v - 1)](*database_);
@@ -217,7 +217,7 @@ void Store::Record(std::vector<StoredRun>& runs) {
           {run.command, run.via, run.wheel_id, run.scan_timestamp, Optional(run.scan_time_s), run.recorded_at,
            run.arcwheel_version, run.output_folder, run.options, run.host});
       if (id.size() != 1 || !internal::AsInteger(id[0][0])) {
-        throw Error(ErrorCode::kIo, kStage, fmt::format("'{}': no id for the recorded run", Name()));
+        throw Error(ErrorCode::kIo, kStoreStage, fmt::format("'{}': no id for the recorded run", Name()));
       }
       run.id = *internal::AsInteger(id[0][0]);
       for (const StoredInput& input : run.inputs) {

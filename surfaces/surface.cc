@@ -11,7 +11,7 @@
 namespace arcwheel::surfaces {
 namespace {
 
-constexpr const char* kStage = "grinding.surface";
+constexpr const char* kSurfaceStage = "grinding.surface";
 constexpr int kMaxEvenTerms = 9;  // A4 .. A20
 
 // Slopes of the clamped cubic spline through equally spaced values; the end slopes are those of
@@ -56,11 +56,11 @@ HermiteBasis Hermite(double t) {
 EvenAsphere::EvenAsphere(const EvenAsphereParameters& parameters) : parameters_(parameters) {
   if (!(parameters.vertex_radius_mm > 0.0) || !std::isfinite(parameters.vertex_radius_mm)) {
     throw Error(
-        ErrorCode::kBadInput, kStage,
+        ErrorCode::kBadInput, kSurfaceStage,
         fmt::format("vertex_radius_mm = {} must be a finite number > 0", parameters.vertex_radius_mm));
   }
   if (parameters.even_coefficients.size() > kMaxEvenTerms) {
-    throw Error(ErrorCode::kBadInput, kStage,
+    throw Error(ErrorCode::kBadInput, kSurfaceStage,
                 fmt::format("{} even coefficients given; at most {} (A4 .. A20)",
                             parameters.even_coefficients.size(), kMaxEvenTerms));
   }
@@ -68,7 +68,7 @@ EvenAsphere::EvenAsphere(const EvenAsphereParameters& parameters) : parameters_(
   sign_ = parameters.concave ? 1.0 : -1.0;
   sag_at_origin_mm_ = 0.0;
   if (!InDomain(0.0, 0.0)) {
-    throw Error(ErrorCode::kBadInput, kStage,
+    throw Error(ErrorCode::kBadInput, kSurfaceStage,
                 fmt::format("off-axis origin ({}, {}) mm lies outside the asphere's domain",
                             parameters.off_axis_x_mm, parameters.off_axis_y_mm));
   }
@@ -137,7 +137,7 @@ std::string EvenAsphere::Describe() const {
 XyPolynomial::XyPolynomial(std::vector<XyPolynomialTerm> terms) : terms_(std::move(terms)) {
   for (const XyPolynomialTerm& t : terms_) {
     if (t.x_power < 0 || t.y_power < 0 || t.x_power > 20 || t.y_power > 20) {
-      throw Error(ErrorCode::kBadInput, kStage,
+      throw Error(ErrorCode::kBadInput, kSurfaceStage,
                   fmt::format("term x^{} y^{}: powers must be within 0 .. 20", t.x_power, t.y_power));
     }
     max_x_power_ = std::max(max_x_power_, t.x_power);
@@ -176,22 +176,22 @@ std::string XyPolynomial::Describe() const {
 // ---------------------------------------------------------------------------------------------
 HeightGrid::HeightGrid(HeightGridParameters parameters) : p_(std::move(parameters)) {
   if (p_.grid.nx < 4 || p_.grid.ny < 4) {
-    throw Error(ErrorCode::kBadInput, kStage,
+    throw Error(ErrorCode::kBadInput, kSurfaceStage,
                 fmt::format("height grid of {} x {} nodes: at least 4 x 4 needed", p_.grid.nx, p_.grid.ny));
   }
   if (!(p_.grid.dx_mm > 0.0) || !(p_.grid.dy_mm > 0.0)) {
-    throw Error(ErrorCode::kBadInput, kStage,
+    throw Error(ErrorCode::kBadInput, kSurfaceStage,
                 fmt::format("height grid spacing ({}, {}) mm must be > 0", p_.grid.dx_mm, p_.grid.dy_mm));
   }
   const size_t nx = static_cast<size_t>(p_.grid.nx), ny = static_cast<size_t>(p_.grid.ny);
   if (p_.heights_mm.size() != nx * ny) {
-    throw Error(ErrorCode::kBadInput, kStage,
+    throw Error(ErrorCode::kBadInput, kSurfaceStage,
                 fmt::format("height grid holds {} heights, {} x {} = {} expected", p_.heights_mm.size(), nx,
                             ny, nx * ny));
   }
   for (size_t k = 0; k < p_.heights_mm.size(); ++k) {
     if (!std::isfinite(p_.heights_mm[k])) {
-      throw Error(ErrorCode::kBadInput, kStage,
+      throw Error(ErrorCode::kBadInput, kSurfaceStage,
                   fmt::format("height at node (i = {}, j = {}) is not finite", k % nx, k / nx));
     }
   }
@@ -289,7 +289,7 @@ void CheckApertureInDomain(const Surface& surface, const Aperture& aperture, dou
       const double x = -hx + 2.0 * hx * i / kSamples, y = -hy + 2.0 * hy * j / kSamples;
       if (aperture.shape == Aperture::Shape::kCircle && std::hypot(x / hx, y / hy) > 1.0) continue;
       if (!surface.InDomain(x, y)) {
-        throw Error(ErrorCode::kBadInput, kStage,
+        throw Error(ErrorCode::kBadInput, kSurfaceStage,
                     fmt::format("point ({:.3f}, {:.3f}) mm of the {} (with {} / {} mm lead and "
                                 "reach margins) lies outside the surface's domain ({})",
                                 x, y, aperture.Describe(), margin_x_mm, margin_y_mm, surface.Describe()));

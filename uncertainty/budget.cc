@@ -14,7 +14,7 @@
 namespace arcwheel::uncertainty {
 namespace {
 
-constexpr const char* kStage = "uncertainty.budget";
+constexpr const char* kBudgetStage = "uncertainty.budget";
 
 std::string Violation(const std::string& name, double value, const std::string& rule) {
   return name + " = " + ShowSignificant(value) + " violates " + rule;
@@ -70,7 +70,7 @@ double StandardUncertainty(const Input& input) {
 Input TypeAFromReadings(std::string name, std::string unit, std::span<const double> readings,
                         double sensitivity) {
   if (readings.size() < 2) {
-    throw Error(ErrorCode::kBadInput, kStage,
+    throw Error(ErrorCode::kBadInput, kBudgetStage,
                 "input '" + name + "' has " + std::to_string(readings.size()) + " readings, needs >= 2");
   }
   const double n = static_cast<double>(readings.size());
@@ -143,7 +143,7 @@ Combined Combine(std::span<const Input> inputs, const CombineOptions& options) {
   }
   const std::vector<std::string> own = options.Problems();
   problems.insert(problems.end(), own.begin(), own.end());
-  ThrowIfProblems(ErrorCode::kInvalidOption, kStage, problems);
+  ThrowIfProblems(ErrorCode::kInvalidOption, kBudgetStage, problems);
 
   Combined combined;
   combined.coverage_probability = options.coverage_probability;

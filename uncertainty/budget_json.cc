@@ -17,7 +17,7 @@
 namespace arcwheel::uncertainty {
 namespace {
 
-constexpr const char* kStage = "uncertainty.budget";
+constexpr const char* kBudgetJsonStage = "uncertainty.budget";
 namespace s = schema::summary;
 
 struct UnitInfo {
@@ -301,14 +301,14 @@ std::vector<Input> ResolveInputs(const std::vector<BudgetInput>& inputs, double 
 BudgetFile ParseBudget(std::string_view text, const std::string& name) {
   nlohmann::json root;
   try {
-    root = ParseJsonText(text, name, kStage);
+    root = ParseJsonText(text, name, kBudgetJsonStage);
   } catch (const Error& error) {
     // A budget is an option file: whatever is wrong with it exits 2, as its other problems do.
-    throw Error(ErrorCode::kInvalidOption, kStage,
+    throw Error(ErrorCode::kInvalidOption, kBudgetJsonStage,
                 std::string(error.what()).substr(error.stage().size() + 2));
   }
   if (!root.is_object())
-    throw Error(ErrorCode::kInvalidOption, kStage, "'" + name + "' is not a JSON object");
+    throw Error(ErrorCode::kInvalidOption, kBudgetJsonStage, "'" + name + "' is not a JSON object");
   std::vector<std::string> problems;
   Reader reader(problems);
   BudgetFile budget;
@@ -357,14 +357,14 @@ BudgetFile ParseBudget(std::string_view text, const std::string& name) {
     }
   }
   if (!problems.empty()) {
-    throw Error(ErrorCode::kInvalidOption, kStage, "'" + name + "': " + JoinProblems(problems));
+    throw Error(ErrorCode::kInvalidOption, kBudgetJsonStage, "'" + name + "': " + JoinProblems(problems));
   }
   return budget;
 }
 
 BudgetFile ReadBudget(const std::filesystem::path& path) {
   std::ifstream stream(path, std::ios::binary);
-  if (!stream) throw Error(ErrorCode::kIo, kStage, "cannot open '" + path.string() + "'");
+  if (!stream) throw Error(ErrorCode::kIo, kBudgetJsonStage, "cannot open '" + path.string() + "'");
   std::ostringstream contents;
   contents << stream.rdbuf();
   return ParseBudget(contents.str(), path.string());

@@ -9,7 +9,7 @@
 namespace arcwheel::uncertainty {
 namespace {
 
-constexpr const char* kStage = "uncertainty.budget";
+constexpr const char* kDefaultBudgetStage = "uncertainty.budget";
 namespace s = schema::summary;
 
 void Require(std::vector<std::string>& problems, bool ok, const std::string& name, double value,
@@ -68,7 +68,7 @@ BudgetFile DefaultBudget(const WheelGeometry& geometry, const SensorBudgetOption
   std::vector<std::string> problems = geometry.Problems();
   const std::vector<std::string> own = options.Problems();
   problems.insert(problems.end(), own.begin(), own.end());
-  ThrowIfProblems(ErrorCode::kInvalidOption, kStage, problems);
+  ThrowIfProblems(ErrorCode::kInvalidOption, kDefaultBudgetStage, problems);
 
   const double ra = geometry.arc_radius_mm;
   const double sagitta_mm = BandSagittaMm(geometry);

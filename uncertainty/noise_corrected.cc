@@ -15,7 +15,7 @@
 namespace arcwheel::uncertainty {
 namespace {
 
-constexpr const char* kStage = "uncertainty.pv";
+constexpr const char* kNoiseCorrectedStage = "uncertainty.pv";
 
 int Functions(SmoothBasis basis, int order) {
   return basis == SmoothBasis::kFourier ? 1 + 2 * order : order + 1;
@@ -398,15 +398,15 @@ namespace {
 
 void CheckShapes(std::span<const double> values, std::span<const double> sigmas, int rows, int columns,
                  const NoiseCorrectedPvOptions& options) {
-  ThrowIfProblems(ErrorCode::kInvalidOption, kStage, options.Problems());
+  ThrowIfProblems(ErrorCode::kInvalidOption, kNoiseCorrectedStage, options.Problems());
   if (rows <= 0 || columns <= 0 || values.size() != static_cast<std::size_t>(rows) * columns ||
       sigmas.size() != values.size()) {
-    throw Error(ErrorCode::kBadInput, kStage,
+    throw Error(ErrorCode::kBadInput, kNoiseCorrectedStage,
                 std::to_string(values.size()) + " values and " + std::to_string(sigmas.size()) +
                     " sigmas for " + std::to_string(rows) + " x " + std::to_string(columns));
   }
   if (Functions(options.basis, options.max_order) >= columns) {
-    throw Error(ErrorCode::kInvalidOption, kStage,
+    throw Error(ErrorCode::kInvalidOption, kNoiseCorrectedStage,
                 "NoiseCorrectedPvOptions::max_order = " + std::to_string(options.max_order) + " violates < " +
                     std::to_string(columns) + " functions for a row of " + std::to_string(columns));
   }
@@ -458,7 +458,8 @@ Rows FilledRows(std::span<const double> values, std::span<const double> sigmas, 
     sigma_rows.push_back(std::move(sigma_row));
     out.raw_pv = std::max(out.raw_pv, high - low);
   }
-  if (y_rows.empty()) throw Error(ErrorCode::kBadInput, kStage, "no row has half its values present");
+  if (y_rows.empty())
+    throw Error(ErrorCode::kBadInput, kNoiseCorrectedStage, "no row has half its values present");
   const auto n = static_cast<Eigen::Index>(y_rows.size());
   out.y.resize(n, columns);
   out.sigma.resize(n, columns);
@@ -490,7 +491,8 @@ Rows PositionedRows(std::span<const double> values, std::span<const double> sigm
     used.push_back(r);
     out.raw_pv = std::max(out.raw_pv, high - low);
   }
-  if (used.empty()) throw Error(ErrorCode::kBadInput, kStage, "no row has half its values present");
+  if (used.empty())
+    throw Error(ErrorCode::kBadInput, kNoiseCorrectedStage, "no row has half its values present");
   const auto n = static_cast<Eigen::Index>(used.size());
   out.used = used;
   out.y = out.sigma = out.present = Eigen::MatrixXd::Zero(n, columns);
@@ -627,7 +629,7 @@ NoiseCorrectedPv EstimateNoiseCorrectedPv(std::span<const double> values, std::s
                                           const NoiseCorrectedPvOptions& options) {
   CheckShapes(values, sigmas, rows, columns, options);
   if (options.basis != SmoothBasis::kLegendre || positions.size() != values.size()) {
-    throw Error(ErrorCode::kBadInput, kStage,
+    throw Error(ErrorCode::kBadInput, kNoiseCorrectedStage,
                 std::to_string(positions.size()) + " positions for " + std::to_string(values.size()) +
                     " values (a Legendre basis needs one a value)");
   }

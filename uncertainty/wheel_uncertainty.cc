@@ -7,16 +7,16 @@
 #include <nlohmann/json.hpp>
 
 #include "core/error.h"
+#include "core/nan.h"
 #include "core/number_format.h"
 #include "schema/summary.h"
 
 namespace arcwheel::uncertainty {
 namespace {
 
-constexpr const char* kStage = "uncertainty.wheel";
+constexpr const char* kWheelUncertaintyStage = "uncertainty.wheel";
 namespace s = schema::summary;
 namespace su = schema::summary::uncertainty;
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 Input TypeA(std::string source, std::string unit, double sigma, double dof) {
   return Input{.name = "data",
@@ -106,7 +106,7 @@ SectionPoints SectionPointsOf(const WheelObservations& o) {
   if (o.section_bins > 0) {
     const auto n = n_phase * static_cast<std::size_t>(o.section_bins);
     if (o.section_residual_um.size() != n || o.section_y_mm.size() != n || o.section_sigma_um.size() != n) {
-      throw Error(ErrorCode::kBadInput, kStage,
+      throw Error(ErrorCode::kBadInput, kWheelUncertaintyStage,
                   std::to_string(o.section_residual_um.size()) + " section points for " +
                       std::to_string(n_phase) + " phases of " + std::to_string(o.section_bins) + " bins");
     }
@@ -175,7 +175,7 @@ std::optional<NoiseCorrectedPv> EstimateArcError(const WheelObservations& o,
 
 WheelUncertainty EvaluateWheelUncertainty(const WheelObservations& o, const BudgetFile& budget,
                                           const WheelUncertaintyOptions& given) {
-  ThrowIfProblems(ErrorCode::kInvalidOption, kStage, given.Problems());
+  ThrowIfProblems(ErrorCode::kInvalidOption, kWheelUncertaintyStage, given.Problems());
   WheelUncertaintyOptions options = given;
   options.seed = BootstrapSeed(o, given.seed);
   const std::size_t n_phase = o.arc_radius_mm.size();
@@ -183,7 +183,7 @@ WheelUncertainty EvaluateWheelUncertainty(const WheelObservations& o, const Budg
   if (o.arc_radius_sigma_mm.size() != n_phase || o.center_axial_mm.size() != n_phase ||
       o.center_axial_sigma_mm.size() != n_phase || o.center_radial_mm.size() != n_phase ||
       o.usable.size() != n_phase || o.rho_mm.size() != n_phase * n_y || n_phase < 8) {
-    throw Error(ErrorCode::kBadInput, kStage,
+    throw Error(ErrorCode::kBadInput, kWheelUncertaintyStage,
                 "per-phase arrays and the map do not match (" + std::to_string(n_phase) + " phases, " +
                     std::to_string(n_y) + " axial nodes, " + std::to_string(o.rho_mm.size()) +
                     " map values)");
@@ -300,7 +300,8 @@ void DecideConformity(WheelUncertainty& uncertainty,
   for (const auto& [key, specification] : specifications) {
     const QuantityUncertainty* q = uncertainty.Find(key);
     if (q == nullptr)
-      throw Error(ErrorCode::kBadInput, kStage, "no uncertainty is evaluated for '" + key + "'");
+      throw Error(ErrorCode::kBadInput, kWheelUncertaintyStage,
+                  "no uncertainty is evaluated for '" + key + "'");
   }
   // In the budget's order (the report's), not the map's.
   for (const QuantityUncertainty& q : uncertainty.quantities) {

@@ -12,6 +12,7 @@
 #include <utility>
 #include <vector>
 
+#include "core/dense.h"
 #include "core/error.h"
 
 namespace arcwheel::fitting {
@@ -65,9 +66,9 @@ bool AlgebraicCircle(const std::vector<double>& x, const std::vector<double>& y,
     design(i, 2) = w[k];
     rhs(i) = -w[k] * (x[k] * x[k] + y[k] * y[k]);
   }
-  const Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(design);
-  if (qr.rank() < 3) return false;
-  const Eigen::Vector3d p = qr.solve(rhs);
+  Eigen::Index rank = 0;
+  const Eigen::Vector3d p = dense::ColPivQrSolve(design, rhs, &rank);
+  if (rank < 3) return false;
   guess[0] = -p(0) / 2.0;
   guess[1] = -p(1) / 2.0;
   const double r2 = guess[0] * guess[0] + guess[1] * guess[1] - p(2);

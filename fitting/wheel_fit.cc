@@ -13,6 +13,7 @@
 #include <utility>
 
 #include "core/check.h"
+#include "core/dense.h"
 #include "core/error.h"
 #include "core/free_memory.h"
 #include "core/interrupt.h"
@@ -166,7 +167,7 @@ double Roundness(const std::vector<PhaseHarmonic>& phase, const std::vector<doub
     design(i, 2) = phase[static_cast<std::size_t>(i)].sin;
     values(i) = rho[static_cast<std::size_t>(i)];
   }
-  const Eigen::VectorXd residual = values - design * design.colPivHouseholderQr().solve(values);
+  const Eigen::VectorXd residual = values - design * dense::ColPivQrSolve(design, values);
   return residual.maxCoeff() - residual.minCoeff();
 }
 

@@ -6,6 +6,8 @@
 #include <utility>
 #include <vector>
 
+#include "core/dense.h"
+
 namespace arcwheel::fitting::internal {
 
 Layout MakeLayout(const Knots& knots, double half_width_mm, double knot_step_mm) {
@@ -45,8 +47,8 @@ MatrixXd ProfileNullSpace(const ProfileBasis& basis, double half_width_mm) {
       }
     }
   }
-  Eigen::JacobiSVD<MatrixXd> svd(constraints, Eigen::ComputeFullV);
-  return svd.matrixV().rightCols(basis.size() - 3);
+  const MatrixXd v = dense::JacobiSvd(constraints, Eigen::ComputeFullV).v;
+  return v.rightCols(basis.size() - 3);
 }
 
 namespace {
@@ -64,7 +66,7 @@ MatrixXd Refinement(int fine, int coarse) {
   // The exact matrix is banded (a coarse function spans few fine ones), its entries 1 / ratio^3
   // (2.4e-4 for 4 knots in 64) or more; the solve leaves up to 1e-15 elsewhere, which would fill
   // the whole block for Project's products.
-  MatrixXd refinement = fine_basis.colPivHouseholderQr().solve(coarse_basis);
+  MatrixXd refinement = dense::ColPivQrSolve(fine_basis, coarse_basis);
   refinement = refinement.unaryExpr([](double v) { return std::abs(v) < 1e-12 ? 0.0 : v; });
   return known[{fine, coarse}] = refinement;
 }

@@ -9,6 +9,7 @@
 #include <map>
 #include <vector>
 
+#include "core/dense.h"
 #include "fitting/wheel_model_impl.h"
 
 namespace arcwheel::fitting::internal {
@@ -29,11 +30,11 @@ Variation WaldTestOfConstancy(const VectorXd& r, const MatrixXd& c) {
   const Eigen::Index k = r.size();
   const MatrixXd centre = MatrixXd::Identity(k, k) - MatrixXd::Constant(k, k, 1.0 / static_cast<double>(k));
   const VectorXd deviation = centre * r;
-  Eigen::SelfAdjointEigenSolver<MatrixXd> eigen(centre * c * centre);
+  const dense::SymmetricEigen eigen = dense::SymmetricEigenDecomposition(centre * c * centre);
   Variation v;
   for (Eigen::Index i = 1; i < k; ++i) {  // eigenvalue 0 (the constant direction) comes first
-    const double projection = eigen.eigenvectors().col(i).dot(deviation);
-    const double variance = eigen.eigenvalues()[i];
+    const double projection = eigen.vectors.col(i).dot(deviation);
+    const double variance = eigen.values[i];
     // Noise-free data leave no variance: any deviation is then infinitely significant.
     v.chi2 += variance > 0.0 ? projection * projection / variance
                              : (projection != 0.0 ? std::numeric_limits<double>::infinity() : 0.0);

@@ -9,6 +9,7 @@
 #include <utility>
 #include <vector>
 
+#include "core/dense.h"
 #include "core/error.h"
 #include "core/interrupt.h"
 #include "fitting/wheel_model_impl.h"
@@ -56,11 +57,7 @@ MatrixXd Project(const MatrixXd& h, const MatrixXd& t) {
 
 // H^-1 b for a normal matrix: by Cholesky, or by LDL^T where rounding leaves H not quite
 // positive definite.
-VectorXd SolveNormal(const MatrixXd& h, const VectorXd& b) {
-  const Eigen::LLT<MatrixXd> llt(h);
-  if (llt.info() == Eigen::Success) return llt.solve(b);
-  return h.ldlt().solve(b);
-}
+VectorXd SolveNormal(const MatrixXd& h, const VectorXd& b) { return dense::SemidefiniteSolve(h, b); }
 
 }  // namespace
 

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <limits>
 
+#include "core/dense.h"
 #include "core/error.h"
 
 namespace arcwheel::frames {
@@ -40,7 +41,7 @@ void CheckInputs(std::span<const PointPair> pairs, TransformModel model) {
 
 // Singular values of the centred point set, largest first.
 Eigen::VectorXd SpreadSingularValues(const Eigen::MatrixXd& centred) {
-  return Eigen::JacobiSVD<Eigen::MatrixXd>(centred).singularValues();
+  return dense::JacobiSvd(centred).singular_values;
 }
 
 // How many independent directions the model needs the source points to span.
@@ -100,18 +101,18 @@ Transform FitUmeyama(const Centred& c, TransformModel model, double degenerate_r
   const auto n = static_cast<double>(c.source.cols());
   const auto d = c.source.rows();
   const Eigen::MatrixXd cross = c.target * c.source.transpose() / n;
-  const Eigen::JacobiSVD<Eigen::MatrixXd> svd(cross, Eigen::ComputeFullU | Eigen::ComputeFullV);
+  const dense::Svd svd = dense::JacobiSvd(cross, Eigen::ComputeFullU | Eigen::ComputeFullV);
   // The cross-covariance is quadratic in lengths: its square-rooted ratio compares with the spread ratio.
-  RefuseDegenerate(std::sqrt(GeometryRatio(svd.singularValues(), RequiredRank(model),
-                                           coordinate_scale * coordinate_scale)),
-                   degenerate_ratio, model, "target points (against the source points)");
+  RefuseDegenerate(
+      std::sqrt(GeometryRatio(svd.singular_values, RequiredRank(model), coordinate_scale * coordinate_scale)),
+      degenerate_ratio, model, "target points (against the source points)");
   Eigen::VectorXd signs = Eigen::VectorXd::Ones(d);
-  if (svd.matrixU().determinant() * svd.matrixV().determinant() < 0.0) signs(d - 1) = -1.0;
-  const Eigen::MatrixXd rotation = svd.matrixU() * signs.asDiagonal() * svd.matrixV().transpose();
+  if (svd.u.determinant() * svd.v.determinant() < 0.0) signs(d - 1) = -1.0;
+  const Eigen::MatrixXd rotation = svd.u * signs.asDiagonal() * svd.v.transpose();
   double scale = 1.0;
   if (model == TransformModel::kSimilarity3d) {
     const double source_variance = c.source.squaredNorm() / n;
-    scale = svd.singularValues().dot(signs) / source_variance;
+    scale = svd.singular_values.dot(signs) / source_variance;
     if (!(scale > 0.0)) {
       throw Error(ErrorCode::kFitFailed, kTransformFitStage,
                   fmt::format("the fitted scale {:.6g} is not positive", scale));
@@ -130,7 +131,7 @@ Transform FitAffine2d(std::span<const PointPair> pairs) {
     design.row(i) << pairs[i].source_mm.x(), pairs[i].source_mm.y(), 1.0;
     targets.row(i) = pairs[i].target_mm.head<2>().transpose();
   }
-  const Eigen::MatrixXd solution = design.colPivHouseholderQr().solve(targets);  // 3 x 2
+  const Eigen::MatrixXd solution = dense::ColPivQrSolve(design, targets);  // 3 x 2
   const Eigen::Matrix2d matrix = solution.topRows<2>().transpose();
   return Embed(TransformModel::kAffine2d, matrix, 1.0, solution.row(2).transpose());
 }
@@ -308,7 +309,8 @@ void FillStatistics(std::span<const PointPair> pairs, TransformFit& fit) {
   fit.sigma_mm = std::sqrt(variance);
   const Eigen::MatrixXd jacobian = Jacobian(used, fit.transform);
   const Eigen::MatrixXd information = jacobian.transpose() * jacobian;
-  const Eigen::MatrixXd internal = variance * information.ldlt().solve(Eigen::MatrixXd::Identity(p, p));
+  const Eigen::MatrixXd internal =
+      variance * dense::LdltSolve(information, Eigen::MatrixXd(Eigen::MatrixXd::Identity(p, p)));
   const Eigen::MatrixXd g = ReportingJacobian(fit.transform);
   fit.covariance = g * internal * g.transpose();
 }

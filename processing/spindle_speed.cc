@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "core/check.h"
+#include "core/dense.h"
 #include "core/error.h"
 #include "core/parallel.h"
 #include "processing/helix_geometry.h"
@@ -197,9 +198,9 @@ TurnHarmonics FitWindow(const PhaseBins& bins, const std::vector<std::size_t>& c
     values(r) = bins.sum[cell] / bins.count[cell];
   }
   const Eigen::MatrixXd normal = design.transpose() * design;
-  const Eigen::LDLT<Eigen::MatrixXd> solver(normal);
-  const Eigen::VectorXd p = solver.solve(design.transpose() * values);
-  const Eigen::MatrixXd inverse = solver.solve(Eigen::MatrixXd::Identity(parameters, parameters));
+  const Eigen::VectorXd p = dense::LdltSolve(normal, Eigen::VectorXd(design.transpose() * values));
+  const Eigen::MatrixXd inverse =
+      dense::LdltSolve(normal, Eigen::MatrixXd(Eigen::MatrixXd::Identity(parameters, parameters)));
   const double rss = (design * p - values).squaredNorm();
   TurnHarmonics turn;
   turn.turn = static_cast<double>(first) + 0.5 * kTurnsPerWindow;

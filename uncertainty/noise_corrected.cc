@@ -8,6 +8,7 @@
 #include <numbers>
 #include <random>
 
+#include "core/dense.h"
 #include "core/error.h"
 #include "core/number_format.h"
 #include "core/parallel.h"
@@ -63,8 +64,7 @@ Eigen::VectorXd EvenPositions(SmoothBasis basis, int columns) {
 // QR), so that the fit of each order is the first Functions(order) coefficients of one projection.
 Eigen::MatrixXd OrthonormalBasis(SmoothBasis basis, int max_order, int columns) {
   const Eigen::MatrixXd design = Design(basis, max_order, EvenPositions(basis, columns), columns);
-  const Eigen::HouseholderQR<Eigen::MatrixXd> qr(design);
-  return qr.householderQ() * Eigen::MatrixXd::Identity(columns, design.cols());
+  return dense::HouseholderThinQ(design);
 }
 
 // Points over [-1, 1] at which a positioned row's PV is taken: the fitted function over the
@@ -99,7 +99,7 @@ class RowBases {
       Eigen::MatrixXd e = design(positions.row(i).transpose()) * scale.asDiagonal();
       for (Eigen::Index j = 0; j < columns; ++j)
         if (present(i, j) == 0.0) e.row(j).setZero();
-      fit_.emplace_back((e.transpose() * e).ldlt().solve(e.transpose()));
+      fit_.emplace_back(dense::LdltSolve(e.transpose() * e, Eigen::MatrixXd(e.transpose())));
       eval_.push_back(std::move(e));
     }
     grid_ = design(EvenPositions(SmoothBasis::kLegendre, kPvGridPoints)) * scale.asDiagonal();

@@ -15,12 +15,11 @@
 namespace arcwheel::characteristics {
 namespace {
 
-constexpr double kPi = std::numbers::pi;
-
 std::vector<double> Harmonic(int n, double k, double amplitude, double phase, double mean = 0.0) {
   std::vector<double> values(static_cast<std::size_t>(n));
   for (int i = 0; i < n; ++i)
-    values[static_cast<std::size_t>(i)] = mean + amplitude * std::cos(2 * kPi * k * i / n + phase);
+    values[static_cast<std::size_t>(i)] =
+        mean + amplitude * std::cos(2 * std::numbers::pi * k * i / n + phase);
   return values;
 }
 
@@ -29,8 +28,8 @@ double AmplitudeOf(const std::vector<double>& values, int k) {
   const auto n = static_cast<double>(values.size());
   double c = 0.0, s = 0.0;
   for (std::size_t j = 0; j < values.size(); ++j) {
-    c += values[j] * std::cos(2 * kPi * k * static_cast<double>(j) / n);
-    s += values[j] * std::sin(2 * kPi * k * static_cast<double>(j) / n);
+    c += values[j] * std::cos(2 * std::numbers::pi * k * static_cast<double>(j) / n);
+    s += values[j] * std::sin(2 * std::numbers::pi * k * static_cast<double>(j) / n);
   }
   return 2.0 * std::hypot(c, s) / n;
 }
@@ -69,18 +68,19 @@ TEST(ClosedGaussianFilter, EqualsThePeriodisedWeightingFunctionInTheSpaceDomain)
   const double cutoff = 50.0;
   std::vector<double> profile(n);
   for (int i = 0; i < n; ++i) {
-    const double t = 2 * kPi * i / n;
+    const double t = 2 * std::numbers::pi * i / n;
     profile[static_cast<std::size_t>(i)] = 10.0 + 0.01 * std::cos(3 * t) + 0.004 * std::sin(40 * t + 1.0) +
                                            0.002 * std::cos(97 * t) + (i % 7 == 0 ? 0.003 : 0.0);
   }
-  const double alpha = std::sqrt(std::log(2.0) / kPi);
-  const double width = alpha * 2 * kPi / cutoff;
-  const double step = 2 * kPi / n;
+  const double alpha = std::sqrt(std::log(2.0) / std::numbers::pi);
+  const double width = alpha * 2 * std::numbers::pi / cutoff;
+  const double step = 2 * std::numbers::pi / n;
   std::vector<double> kernel(n, 0.0);
   for (int j = 0; j < n; ++j) {
     for (int period = -2; period <= 2; ++period) {
       const double x = (j + period * n) * step;
-      kernel[static_cast<std::size_t>(j)] += std::exp(-kPi * (x / width) * (x / width)) / width * step;
+      kernel[static_cast<std::size_t>(j)] +=
+          std::exp(-std::numbers::pi * (x / width) * (x / width)) / width * step;
     }
   }
   const std::vector<double> mean_line = FilterClosedProfile(profile, cutoff);
@@ -131,7 +131,7 @@ TEST(HarmonicAmplitudes, GiveTheAmplitudeOfEachHarmonic) {
   const int n = 64;
   std::vector<double> profile(n);
   for (int i = 0; i < n; ++i) {
-    const double t = 2 * kPi * i / n;
+    const double t = 2 * std::numbers::pi * i / n;
     profile[static_cast<std::size_t>(i)] =
         7.0 + 3.0 * std::cos(2 * t) + 4.0 * std::sin(2 * t) + 0.5 * std::sin(31 * t);
   }
@@ -153,7 +153,7 @@ TEST(OpenGaussianFilter, PassesHalfTheAmplitudeAtTheCutOffWavelength) {
     const double wavelength = cutoff_mm * wavelength_factor;
     std::vector<double> profile(n);
     for (int i = 0; i < n; ++i)
-      profile[static_cast<std::size_t>(i)] = std::sin(2 * kPi * i * spacing_mm / wavelength);
+      profile[static_cast<std::size_t>(i)] = std::sin(2 * std::numbers::pi * i * spacing_mm / wavelength);
     const std::vector<double> mean_line = FilterOpenProfile(profile, spacing_mm, cutoff_mm);
     double peak = 0.0;
     for (int i = 200; i < n - 200; ++i)

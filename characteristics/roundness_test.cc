@@ -14,8 +14,6 @@
 namespace arcwheel::characteristics {
 namespace {
 
-constexpr double kPi = std::numbers::pi;
-
 struct Profile {
   std::vector<double> angle_deg, radius_mm;
 };
@@ -27,7 +25,7 @@ Profile LobedEccentricCircle(int n, double start_deg, double direction) {
   Profile profile;
   for (int i = 0; i < n; ++i) {
     const double angle_deg = start_deg + direction * 360.0 * i / n;
-    const double t = angle_deg * kPi / 180.0;
+    const double t = angle_deg * std::numbers::pi / 180.0;
     const double s = std::sin(t - theta0);
     const double circle = eccentricity * std::cos(t - theta0) +
                           std::sqrt(radius * radius - eccentricity * eccentricity * s * s);
@@ -79,7 +77,7 @@ TEST(Roundness, LobesAtTheCutOffKeepHalfTheirHeight) {
     Profile profile;
     for (int i = 0; i < 3600; ++i) {
       profile.angle_deg.push_back(0.1 * i);
-      profile.radius_mm.push_back(30.0 + 4e-3 * std::cos(cutoff * 0.1 * i * kPi / 180.0));
+      profile.radius_mm.push_back(30.0 + 4e-3 * std::cos(cutoff * 0.1 * i * std::numbers::pi / 180.0));
     }
     const RoundnessResult result =
         EvaluateRoundness(profile.angle_deg, profile.radius_mm,

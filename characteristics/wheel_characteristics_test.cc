@@ -13,12 +13,10 @@
 namespace arcwheel::characteristics {
 namespace {
 
-constexpr double kPi = std::numbers::pi;
-
 // The ISO 16610-21 transmission, written out here from the standard's formula.
-double Transmission(double k, double cutoff) {
-  const double alpha = std::sqrt(std::log(2.0) / kPi);
-  return std::exp(-kPi * (alpha * k / cutoff) * (alpha * k / cutoff));
+double ClosedFormTransmission(double k, double cutoff) {
+  const double alpha = std::sqrt(std::log(2.0) / std::numbers::pi);
+  return std::exp(-std::numbers::pi * (alpha * k / cutoff) * (alpha * k / cutoff));
 }
 
 // A map of n_phase x 3 axial nodes: rho = 50 mm + e cos(c) + a_k cos(k c) at node 1 (the worst),
@@ -37,7 +35,7 @@ struct TestWheel {
     const std::size_t n_y = y_mm.size();
     rho_mm.resize(static_cast<std::size_t>(n_phase) * n_y);
     for (int i = 0; i < n_phase; ++i) {
-      const double c = 2.0 * kPi * i / n_phase;
+      const double c = 2.0 * std::numbers::pi * i / n_phase;
       for (std::size_t j = 0; j < n_y; ++j) {
         const double scale = j == 1 ? 1.0 : 0.5;
         rho_mm[static_cast<std::size_t>(i) * n_y + j] = 50.0 + eccentricity_mm * std::cos(c) +
@@ -70,7 +68,7 @@ TEST(WheelCharacteristics, RoundnessIsTwiceTheFilteredHarmonicAtTheWorstNode) {
   const TestWheel wheel(0.0, 30, 0.002, 0.0);
   const WheelCharacteristics result = EvaluateWheelCharacteristics(wheel.Form(), {});
   // A single harmonic k >= 2 about the axis: the minimum zone is centred there and is 2 a T(k).
-  EXPECT_NEAR(result.roundness.measured_um, 2.0 * 2.0 * Transmission(30, 50), 1e-6);
+  EXPECT_NEAR(result.roundness.measured_um, 2.0 * 2.0 * ClosedFormTransmission(30, 50), 1e-6);
   EXPECT_EQ(result.roundness.worst_index, 1);
   EXPECT_DOUBLE_EQ(result.roundness.worst_at, 0.0);
   EXPECT_EQ(result.roundness.op.Describe(), "RONt, 50 UPR, MZ");
@@ -85,8 +83,9 @@ TEST(WheelCharacteristics, RunoutIsTheFilteredTurnsTotalIndicatorReading) {
   const WheelCharacteristics result = EvaluateWheelCharacteristics(wheel.Form(), {});
   double low = 1e9, high = -1e9;
   for (int i = 0; i < 360; ++i) {
-    const double c = 2.0 * kPi * i / 360.0;
-    const double r = e * Transmission(1, 50) * std::cos(c) + a * Transmission(30, 50) * std::cos(30 * c);
+    const double c = 2.0 * std::numbers::pi * i / 360.0;
+    const double r = e * ClosedFormTransmission(1, 50) * std::cos(c) +
+                     a * ClosedFormTransmission(30, 50) * std::cos(30 * c);
     low = std::min(low, r);
     high = std::max(high, r);
   }
@@ -100,8 +99,8 @@ TEST(WheelCharacteristics, A150UprCutOffPassesMoreOfA100UprLobing) {
   const double at_50 = EvaluateWheelCharacteristics(wheel.Form(), options).roundness.measured_um;
   options.roundness.cutoff_upr = 150.0;
   const double at_150 = EvaluateWheelCharacteristics(wheel.Form(), options).roundness.measured_um;
-  EXPECT_NEAR(at_50, 2.0 * 1.0 * Transmission(100, 50), 1e-6);
-  EXPECT_NEAR(at_150, 2.0 * 1.0 * Transmission(100, 150), 1e-6);
+  EXPECT_NEAR(at_50, 2.0 * 1.0 * ClosedFormTransmission(100, 50), 1e-6);
+  EXPECT_NEAR(at_150, 2.0 * 1.0 * ClosedFormTransmission(100, 150), 1e-6);
 }
 
 TEST(WheelCharacteristics, ArcProfileUnderMinimumZoneIsTwiceAnAlternatingForm) {
@@ -117,7 +116,7 @@ TEST(WheelCharacteristics, ArcProfileUnderMinimumZoneIsTwiceAnAlternatingForm) {
   for (std::size_t p = 0; p < 360; ++p) {
     for (std::size_t j = 0; j < n_y; ++j) {
       const double u = wheel.y_mm[j];
-      const double r = 20.0 + a_mm * std::cos(2.0 * kPi * u);
+      const double r = 20.0 + a_mm * std::cos(2.0 * std::numbers::pi * u);
       wheel.rho_mm[p * n_y + j] = 30.0 + std::sqrt(r * r - u * u);
     }
   }

@@ -8,9 +8,13 @@ include(GNUInstallDirs)
 # arcwheel_install_library(NAME n HEADERS ...): installs arcwheel_<n> as arcwheel::<n> of the
 #   arcwheel CMake package (cmake/ArcwheelPackage.cmake), and its public headers, the ones listed,
 #   under include/arcwheel/<n>/, where `#include "<n>/x.h"` finds them as in the source tree.
-# arcwheel_add_test(NAME n SRCS ... DEPS ... [SHARDS k] [COST s]): a GoogleTest binary registered with
-#   CTest as <folder>/<n>, or with SHARDS as <folder>/<n>/<i> for i < k, each running every k-th
-#   test (GoogleTest's sharding), so that CTest runs a long binary on both cores. COST (about the
+# arcwheel_add_test(NAME n SRCS ... DEPS ... [SHARDS k] [COST s]): the GoogleTest file SRCS[0] (with
+#   its helper sources) in the folder's test binary <folder>_tests, which compiles the folder's test
+#   files in unity batches of 8 (GoogleTest, Eigen and nlohmann-json parsed once a batch: a
+#   file-local name must be unique in the folder's tests). Registered with CTest as <folder>/<n>,
+#   running the tests that file defines (core/testing/main.cc), or with SHARDS as <folder>/<n>/<i>
+#   for i < k, each running every k-th of them (GoogleTest's sharding), so that CTest runs a long
+#   file on both cores. COST (about the
 #   seconds it takes under the sanitizers) makes CTest start the long tests first on a clean
 #   checkout, which has no timings of earlier runs: started last, they ran one after the other.
 # arcwheel_add_benchmark(NAME n SRCS ... DEPS ...): a Google Benchmark binary.
@@ -77,11 +81,25 @@ function(arcwheel_add_test)
     set(ARG_COST 1)
   endif()
   get_filename_component(_folder ${CMAKE_CURRENT_SOURCE_DIR} NAME)
-  set(_target ${_folder}_${ARG_NAME})
-  add_executable(${_target} ${ARG_SRCS})
-  target_link_libraries(${_target} PRIVATE ${ARG_DEPS} arcwheel::testing GTest::gtest GTest::gmock)
-  target_compile_options(${_target} PRIVATE ${ARCWHEEL_WARNINGS} ${ARCWHEEL_TEST_OPTIMIZATION})
-  set(_environment "ARCWHEEL_SOURCE_DIR=${PROJECT_SOURCE_DIR};ARCWHEEL_BINARY=$<TARGET_FILE:arcwheel>")
+  set(_target ${_folder}_tests)
+  if(NOT TARGET ${_target})
+    add_executable(${_target})
+    target_link_libraries(${_target} PRIVATE arcwheel::testing GTest::gtest GTest::gmock)
+    target_compile_options(${_target} PRIVATE ${ARCWHEEL_WARNINGS} ${ARCWHEEL_TEST_OPTIMIZATION}
+                           $<$<CXX_COMPILER_ID:GNU>:-Wno-subobject-linkage>)
+    set_target_properties(${_target} PROPERTIES UNITY_BUILD ON UNITY_BUILD_BATCH_SIZE 8)
+  endif()
+  # A helper source shared by several test files (reports/report_fixture.cc) is compiled once.
+  get_target_property(_sources ${_target} SOURCES)
+  foreach(_source IN LISTS ARG_SRCS)
+    if(NOT _source IN_LIST _sources)
+      target_sources(${_target} PRIVATE ${_source})
+    endif()
+  endforeach()
+  target_link_libraries(${_target} PRIVATE ${ARG_DEPS})
+  list(GET ARG_SRCS 0 _test_source)
+  set(_environment "ARCWHEEL_SOURCE_DIR=${PROJECT_SOURCE_DIR};ARCWHEEL_BINARY=$<TARGET_FILE:arcwheel>"
+                   "ARCWHEEL_TEST_SOURCE=${_folder}/${_test_source}")
   if(NOT ARG_SHARDS)
     add_test(NAME ${_folder}/${ARG_NAME} COMMAND ${_target} WORKING_DIRECTORY ${PROJECT_SOURCE_DIR})
     set_tests_properties(${_folder}/${ARG_NAME} PROPERTIES ENVIRONMENT "${_environment}" COST ${ARG_COST})

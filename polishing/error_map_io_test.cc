@@ -20,13 +20,12 @@
 #include <vector>
 
 #include "core/error.h"
+#include "core/nan.h"
 #include "core/testing/testing.h"
 #include "polishing/job.h"
 
 namespace arcwheel::polishing {
 namespace {
-
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 using arcwheel::testing::ErrorMessageOf;
 using arcwheel::testing::WriteText;
@@ -845,7 +844,7 @@ TEST(ReadScatteredCsv, RefusesTooFewCollinearOrCoincidentPointsNamingTheFile) {
 // ------------------------------------------------------------------------------------------------
 // The job's error_map section.
 
-std::string Job(const std::string& error_map) {
+std::string ErrorMapJob(const std::string& error_map) {
   return R"({"surface": {"vertex_radius_mm": 400.0, "form": "convex"},
              "aperture": {"diameter_mm": 20.0},
              "removal_function": {"peak_rate_um_per_s": 1.5, "fwhm_mm": 5.0},
@@ -855,7 +854,7 @@ std::string Job(const std::string& error_map) {
 }
 
 PolishJob ReadJob(const arcwheel::testing::TempDir& dir, const std::string& error_map) {
-  std::ofstream(dir / "job.json") << Job(error_map);
+  std::ofstream(dir / "job.json") << ErrorMapJob(error_map);
   return ReadPolishJob(dir / "job.json");
 }
 

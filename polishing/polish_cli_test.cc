@@ -52,7 +52,7 @@ std::string Job(const std::string& extra_machine = "", const std::string& extra_
 }
 
 // Runs `arcwheel polish` on dir/job.json into dir/out.
-testing::CommandResult PolishJobIn(const TempDir& dir) {
+arcwheel::testing::CommandResult PolishJobIn(const TempDir& dir) {
   return RunArcwheel(fmt::format("polish {} -o {}", (dir / "job.json").string(), (dir / "out").string()));
 }
 

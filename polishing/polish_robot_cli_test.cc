@@ -26,7 +26,7 @@ using arcwheel::testing::SourceDir;
 using arcwheel::testing::TempDir;
 using arcwheel::testing::WriteText;
 
-constexpr double kDeg = std::numbers::pi / 180.0;
+using testing::kDeg;
 
 std::string ReadText(const std::filesystem::path& path) {
   std::stringstream text;
@@ -42,19 +42,6 @@ nlohmann::json ExampleJob() {
   return job;
 }
 
-arcwheel::testing::CommandResult Polish(const TempDir& dir, const nlohmann::json& job,
-                                        const std::string& flags = "") {
-  WriteText(dir / "job.json", job.dump(2));
-  return RunArcwheel(
-      fmt::format("polish {} -o {} {}", (dir / "job.json").string(), (dir / "out").string(), flags));
-}
-
-const RobotKinematics& Irb4600() {
-  static const RobotKinematics k(*FindRobotModel("ABB IRB 4600-40/2.55"),
-                                 std::string(FindRobotModel("ABB IRB 4600-40/2.55")->urdf), "built in");
-  return k;
-}
-
 Eigen::Isometry3d Pose(const Eigen::Vector3d& p, const Eigen::Vector4d& q_wxyz) {
   Eigen::Isometry3d t = Eigen::Isometry3d::Identity();
   t.linear() = Eigen::Quaterniond(q_wxyz[0], q_wxyz[1], q_wxyz[2], q_wxyz[3]).normalized().toRotationMatrix();
@@ -65,7 +52,7 @@ Eigen::Isometry3d Pose(const Eigen::Vector3d& p, const Eigen::Vector4d& q_wxyz) 
 TEST(PolishRobot, TheShippedExampleRunsAndEveryJointSolutionReproducesItsTargetThroughKdl) {
   TempDir dir;
   const nlohmann::json job = ExampleJob();
-  const auto result = Polish(dir, job);
+  const auto result = testing::PolishJob(dir, job);
   ASSERT_EQ(result.exit_status, 0) << result.output;
   // The frames as the job gives them: the work object in the world (the robot's base at the world
   // origin), the TCP in the flange.
@@ -91,7 +78,7 @@ TEST(PolishRobot, TheShippedExampleRunsAndEveryJointSolutionReproducesItsTargetT
         world_from_work * Pose({p[0], p[1], p[2]}, {p[3], p[4], p[5], p[6]});
     JointAngles q{};
     for (std::size_t i = 0; i < 6; ++i) q[i] = joints[k][i + 1] * kDeg;
-    const Eigen::Isometry3d reached = Irb4600().ForwardKdl(q) * flange_from_tcp;
+    const Eigen::Isometry3d reached = testing::Irb4600Kinematics().ForwardKdl(q) * flange_from_tcp;
     // 1e-6 mm and 1e-9 rad (the CSVs hold shortest round-trip doubles; the joints' degrees cost
     // about 1e-13 rad).
     EXPECT_LT((reached.translation() - tcp_in_base.translation()).norm(), 1e-6) << "target " << k + 1;
@@ -109,7 +96,7 @@ TEST(PolishRobot, TheShippedExampleRunsAndEveryJointSolutionReproducesItsTargetT
 
 TEST(PolishRobot, PolishModsConfdataIsTheConfigurationOfTheJointsAtEveryTarget) {
   TempDir dir;
-  const auto result = Polish(dir, ExampleJob());
+  const auto result = testing::PolishJob(dir, ExampleJob());
   ASSERT_EQ(result.exit_status, 0) << result.output;
   const std::string rapid = ReadText(dir / "out" / "polish.mod");
   EXPECT_NE(rapid.find("ConfL \\On;"), std::string::npos);
@@ -142,7 +129,7 @@ TEST(PolishRobot, TheShippedExampleMovedFiveMetresAwayIsRefusedNamingReach) {
   TempDir dir;
   nlohmann::json job = ExampleJob();
   job["workobject"]["origin_mm"][0] = job["workobject"]["origin_mm"][0].get<double>() + 5000.0;
-  const auto result = Polish(dir, job);
+  const auto result = testing::PolishJob(dir, job);
   EXPECT_EQ(result.exit_status, 3) << result.output;
   EXPECT_NE(result.output.find("path target 1 "), std::string::npos) << result.output;
   EXPECT_NE(result.output.find("out of reach"), std::string::npos) << result.output;
@@ -157,7 +144,7 @@ TEST(PolishRobot, RefusesABadRobotSectionNamingEveryProblem) {
                   {"base", {{"origin_mm", {0, 0, 0}}, {"quaternion", {1, 0.2, 0, 0}}}},
                   {"min_wrist_margin_deg", 95},
                   {"max_joint_speed_ratio", 0}};
-  auto result = Polish(dir, job);
+  auto result = testing::PolishJob(dir, job);
   EXPECT_EQ(result.exit_status, 3) << result.output;
   for (const char* problem :
        {"robot.model = 'ABB IRB 9999' is not a robot arcwheel knows (known: ABB IRB 4600-40/2.55)",
@@ -169,7 +156,7 @@ TEST(PolishRobot, RefusesABadRobotSectionNamingEveryProblem) {
   job["robot"] = {{"model", "ABB IRB 4600-40/2.55"},
                   {"urdf", (dir / "broken.urdf").string()},
                   {"base", {{"matrix", {1, 0, 0, 0, 0, 2, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1}}}}};
-  result = Polish(dir, job);
+  result = testing::PolishJob(dir, job);
   EXPECT_EQ(result.exit_status, 3) << result.output;
   EXPECT_NE(result.output.find("broken.urdf' does not parse"), std::string::npos) << result.output;
   EXPECT_NE(result.output.find("robot.base.matrix is not a rigid transform"), std::string::npos)
@@ -181,7 +168,7 @@ TEST(PolishRobot, PlaceWorkobjectProposesAnOriginWhereTheJobThenRuns) {
   TempDir dir;
   nlohmann::json job = ExampleJob();
   job["workobject"]["origin_mm"] = {4000.0, 0.0, 450.0};  // out of reach
-  const auto proposal = Polish(dir, job, "--place-workobject");
+  const auto proposal = testing::PolishJob(dir, job, "--place-workobject");
   ASSERT_EQ(proposal.exit_status, 0) << proposal.output;
   EXPECT_FALSE(std::filesystem::exists(dir / "out")) << "the proposal writes nothing";
   const std::regex origin(R"("origin_mm": \[([-0-9.]+), ([-0-9.]+), ([-0-9.]+)\])");
@@ -189,7 +176,7 @@ TEST(PolishRobot, PlaceWorkobjectProposesAnOriginWhereTheJobThenRuns) {
   ASSERT_TRUE(std::regex_search(proposal.output, m, origin)) << proposal.output;
   EXPECT_NE(proposal.output.find("wrist singularity"), std::string::npos) << proposal.output;
   job["workobject"]["origin_mm"] = {std::stod(m[1]), std::stod(m[2]), std::stod(m[3])};
-  const auto run = Polish(dir, job);
+  const auto run = testing::PolishJob(dir, job);
   ASSERT_EQ(run.exit_status, 0) << run.output;
   const nlohmann::json summary = nlohmann::json::parse(ReadText(dir / "out" / "polish_summary.json"));
   EXPECT_GE(summary["robot"]["wrist_margin_deg"].get<double>(), 10.0);

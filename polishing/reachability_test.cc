@@ -9,17 +9,12 @@
 
 #include "core/error.h"
 #include "polishing/robot_model.h"
+#include "polishing/testing.h"
 
 namespace arcwheel::polishing {
 namespace {
 
-constexpr double kDeg = std::numbers::pi / 180.0;
-
-const RobotKinematics& Kinematics() {
-  static const RobotKinematics k(*FindRobotModel("ABB IRB 4600-40/2.55"),
-                                 std::string(FindRobotModel("ABB IRB 4600-40/2.55")->urdf), "built in");
-  return k;
-}
+using testing::kDeg;
 
 // Flange poses along a straight line in joint space from `a` to `b` (deg), through KDL: targets a
 // robot reaches by construction, whatever the closed form says.
@@ -28,7 +23,7 @@ std::vector<Eigen::Isometry3d> JointLine(const JointAngles& a_deg, const JointAn
   for (int k = 0; k < n; ++k) {
     JointAngles q{};
     for (std::size_t i = 0; i < 6; ++i) q[i] = (a_deg[i] + (b_deg[i] - a_deg[i]) * k / (n - 1)) * kDeg;
-    poses.push_back(Kinematics().ForwardKdl(q));
+    poses.push_back(testing::Irb4600Kinematics().ForwardKdl(q));
   }
   return poses;
 }
@@ -37,7 +32,7 @@ std::string RefusalOf(std::span<const Eigen::Isometry3d> poses, double segment_s
                       const RobotMargins& margins = {}) {
   const std::vector<double> times(poses.size(), segment_s);
   try {
-    (void)SolveRobotPath(Kinematics(), margins, poses, times, "job.json");
+    (void)SolveRobotPath(testing::Irb4600Kinematics(), margins, poses, times, "job.json");
   } catch (const Error& e) {
     EXPECT_EQ(e.code(), ErrorCode::kBadInput);
     return e.what();
@@ -48,10 +43,10 @@ std::string RefusalOf(std::span<const Eigen::Isometry3d> poses, double segment_s
 TEST(SolveRobotPath, SolvesAReachablePathInOneConfigurationWithItsMargins) {
   const auto poses = JointLine({-20, 10, -5, 30, 40, -60}, {25, 30, 10, -30, 70, 60}, 40);
   const std::vector<double> times(poses.size(), 1.0);
-  const RobotPath path = SolveRobotPath(Kinematics(), {}, poses, times, "job.json");
+  const RobotPath path = SolveRobotPath(testing::Irb4600Kinematics(), {}, poses, times, "job.json");
   ASSERT_EQ(path.joints_rad.size(), poses.size());
   for (std::size_t k = 0; k < poses.size(); ++k) {
-    const Eigen::Isometry3d back = Kinematics().ForwardKdl(path.joints_rad[k]);
+    const Eigen::Isometry3d back = testing::Irb4600Kinematics().ForwardKdl(path.joints_rad[k]);
     EXPECT_LT((back.translation() - poses[k].translation()).norm(), 1e-6) << k;
     EXPECT_LT(Eigen::AngleAxisd(back.linear().transpose() * poses[k].linear()).angle(), 1e-9) << k;
     EXPECT_EQ(path.confdata[k][3], path.branch.Cfx());

@@ -33,7 +33,7 @@ std::string Csv(const TabulatedRemovalFunction& t) {
   return out;
 }
 
-std::string CsvError(const std::string& text) {
+std::string KernelCsvError(const std::string& text) {
   arcwheel::testing::TempDir dir;
   std::ofstream(dir / "footprint.csv") << text;
   return arcwheel::testing::ErrorMessageOf([&dir] { (void)ReadRemovalFunction(dir / "footprint.csv"); });
@@ -112,26 +112,27 @@ TEST(ReadRemovalFunction, ReadsTheCsvAndHdf5FormsToTheSameTable) {
 
 TEST(ReadRemovalFunction, NamesTheFileAndLineOfAMalformedCsv) {
   const std::string head = "x_mm,y_mm,rate_um_per_s\n";
-  EXPECT_NE(CsvError("x,y,r\n").find("footprint.csv' line 1: header 'x,y,r'"), std::string::npos);
-  EXPECT_NE(CsvError(head + "0,0,1\n1,0,-0.5\n0,1,1\n1,1,1\n")
+  EXPECT_NE(KernelCsvError("x,y,r\n").find("footprint.csv' line 1: header 'x,y,r'"), std::string::npos);
+  EXPECT_NE(KernelCsvError(head + "0,0,1\n1,0,-0.5\n0,1,1\n1,1,1\n")
                 .find("line 3: rate_um_per_s = -0.5 must be finite and >= 0"),
             std::string::npos);
-  EXPECT_NE(CsvError(head + "0,0,1\n1,0,nan\n0,1,1\n1,1,1\n").find("line 3: rate_um_per_s = nan"),
+  EXPECT_NE(KernelCsvError(head + "0,0,1\n1,0,nan\n0,1,1\n1,1,1\n").find("line 3: rate_um_per_s = nan"),
             std::string::npos);
-  EXPECT_NE(CsvError(head + "0,0,1\n1,0,abc\n").find("line 3: 'abc' is not a number"), std::string::npos);
+  EXPECT_NE(KernelCsvError(head + "0,0,1\n1,0,abc\n").find("line 3: 'abc' is not a number"),
+            std::string::npos);
   std::string grid = head;
   for (int j = 0; j < 2; ++j) {
     for (int i = 0; i < 5; ++i) grid += fmt::format("{},{},1\n", i, j);
   }
-  EXPECT_NE(CsvError(grid + "1.4,1,1\n").find("line 12: (1.4, 1) mm is not on the regular grid"),
+  EXPECT_NE(KernelCsvError(grid + "1.4,1,1\n").find("line 12: (1.4, 1) mm is not on the regular grid"),
             std::string::npos);
-  EXPECT_NE(CsvError(head + "0,0,1\n1,0,1\n0,1,1\n0,1,1\n").find("line 5: (0, 1) mm appears twice"),
+  EXPECT_NE(KernelCsvError(head + "0,0,1\n1,0,1\n0,1,1\n0,1,1\n").find("line 5: (0, 1) mm appears twice"),
             std::string::npos);
-  EXPECT_NE(
-      CsvError(head + "0,0,1\n1,0,1\n0,1,1\n").find("node (1, 1) mm of the 2 x 2 footprint grid is missing"),
-      std::string::npos);
-  EXPECT_NE(CsvError(head + "0,0,0\n1,0,0\n0,1,0\n1,1,0\n").find("removes nothing"), std::string::npos);
-  EXPECT_NE(CsvError(head + "0,0,1\n1,0,1\n").find("needs 2 x 2 or more"), std::string::npos);
+  EXPECT_NE(KernelCsvError(head + "0,0,1\n1,0,1\n0,1,1\n")
+                .find("node (1, 1) mm of the 2 x 2 footprint grid is missing"),
+            std::string::npos);
+  EXPECT_NE(KernelCsvError(head + "0,0,0\n1,0,0\n0,1,0\n1,1,0\n").find("removes nothing"), std::string::npos);
+  EXPECT_NE(KernelCsvError(head + "0,0,1\n1,0,1\n").find("needs 2 x 2 or more"), std::string::npos);
 }
 
 TEST(ReadRemovalFunction, NamesTheDatasetOfAMalformedHdf5Table) {

@@ -9,11 +9,12 @@
 
 #include "core/error.h"
 #include "polishing/robot_model.h"
+#include "polishing/testing.h"
 
 namespace arcwheel::polishing {
 namespace {
 
-constexpr double kDeg = std::numbers::pi / 180.0;
+using testing::kDeg;
 
 const RobotModel& Irb4600() {
   const RobotModel* model = FindRobotModel("ABB IRB 4600-40/2.55");

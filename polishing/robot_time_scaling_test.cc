@@ -42,11 +42,6 @@ nlohmann::json Example(const std::string& name) {
   return job;
 }
 
-arcwheel::testing::CommandResult Polish(const TempDir& dir, const nlohmann::json& job) {
-  WriteText(dir / "job.json", job.dump(2));
-  return RunArcwheel(fmt::format("polish {} -o {}", (dir / "job.json").string(), (dir / "out").string()));
-}
-
 std::vector<std::vector<double>> Rows(const std::filesystem::path& file, const std::string& header) {
   std::string found;
   auto rows = testing::ParseCsvRows(ReadText(file), found);
@@ -73,12 +68,6 @@ std::vector<RapidTarget> RapidTargets(const std::string& rapid) {
   return out;
 }
 
-const RobotKinematics& Irb4600() {
-  static const RobotKinematics k(*FindRobotModel("ABB IRB 4600-40/2.55"),
-                                 std::string(FindRobotModel("ABB IRB 4600-40/2.55")->urdf), "built in");
-  return k;
-}
-
 // Each segment's time from the written path: its TCP chord / its speed.
 std::vector<double> ChordTimesS(const std::vector<std::vector<double>>& path) {
   std::vector<double> t(path.size(), 0.0);
@@ -97,7 +86,8 @@ double LargestJointSpeedRatio(const std::vector<std::vector<double>>& joints,
   for (std::size_t k = 1; k < joints.size(); ++k) {
     for (std::size_t i = 0; i < 6; ++i) {
       const double turned_rad = std::abs(joints[k][i + 1] - joints[k - 1][i + 1]) / kDegPerRad;
-      largest = std::max(largest, turned_rad / time_s[k] / Irb4600().limits()[i].max_speed_rad_s);
+      largest = std::max(largest,
+                         turned_rad / time_s[k] / testing::Irb4600Kinematics().limits()[i].max_speed_rad_s);
     }
   }
   return largest;
@@ -107,7 +97,7 @@ double LargestJointSpeedRatio(const std::vector<std::vector<double>>& joints,
 void ExpectWithinLimits(const std::vector<std::vector<double>>& joints) {
   for (std::size_t k = 0; k < joints.size(); ++k) {
     for (std::size_t i = 0; i < 6; ++i) {
-      const JointLimit& l = Irb4600().limits()[i];
+      const JointLimit& l = testing::Irb4600Kinematics().limits()[i];
       EXPECT_GE(joints[k][i + 1], l.lower_rad * kDegPerRad + 5.0) << "target " << k + 1 << " joint " << i + 1;
       EXPECT_LE(joints[k][i + 1], l.upper_rad * kDegPerRad - 5.0) << "target " << k + 1 << " joint " << i + 1;
     }
@@ -123,7 +113,7 @@ TEST(PolishPrecession,
   EXPECT_EQ(job["precession"]["tilt_deg"], 20);
   EXPECT_EQ(job["precession"]["precession_rate_rpm"], 5);
   EXPECT_EQ(job["precession"]["bonnet_radius_mm"], 40);
-  const auto result = Polish(dir, job);
+  const auto result = testing::PolishJob(dir, job);
   ASSERT_EQ(result.exit_status, 0) << result.output;
 
   const std::vector<RapidTarget> rapid = RapidTargets(ReadText(dir / "out" / "polish.mod"));
@@ -194,11 +184,11 @@ constexpr double kSlowJointSpeedRatio = 0.03;
 TEST(PolishTimeScaling, SegmentsTooFastForAJointAreSlowedAndTheReportedRemovalIsTheWrittenPathsRemoval) {
   TempDir fast_dir, slow_dir;
   const nlohmann::json fast_job = Example("disc_job.json");
-  ASSERT_EQ(Polish(fast_dir, fast_job).exit_status, 0);
+  ASSERT_EQ(testing::PolishJob(fast_dir, fast_job).exit_status, 0);
   nlohmann::json job = fast_job;
   job["robot"]["max_joint_speed_ratio"] = kSlowJointSpeedRatio;
   job["robot"]["max_added_residual_nm"] = 1e6;
-  const auto result = Polish(slow_dir, job);
+  const auto result = testing::PolishJob(slow_dir, job);
   ASSERT_EQ(result.exit_status, 0) << result.output;
 
   const auto fast_path = Rows(fast_dir / "out" / "polishing_path.csv", kPathHeader);
@@ -225,8 +215,8 @@ TEST(PolishTimeScaling, SegmentsTooFastForAJointAreSlowedAndTheReportedRemovalIs
     EXPECT_GT(time_s[k], fast_time_s[k]);
     const auto i = s["joint"].get<std::size_t>();
     const double turned_rad = std::abs(joints[k][i] - joints[k - 1][i]) / kDegPerRad;
-    EXPECT_NEAR(turned_rad / time_s[k] / Irb4600().limits()[i - 1].max_speed_rad_s, kSlowJointSpeedRatio,
-                1e-6);
+    EXPECT_NEAR(turned_rad / time_s[k] / testing::Irb4600Kinematics().limits()[i - 1].max_speed_rad_s,
+                kSlowJointSpeedRatio, 1e-6);
   }
   double added_time_s = 0.0;
   for (std::size_t k = 0; k < path.size(); ++k) {
@@ -264,7 +254,7 @@ TEST(PolishTimeScaling, SegmentsTooFastForAJointAreSlowedAndTheReportedRemovalIs
   // With a tolerance below that, refused naming a slowed target, and nothing written.
   TempDir tight_dir;
   job["robot"]["max_added_residual_nm"] = 0.5 * most_added_nm;
-  const auto refused = Polish(tight_dir, job);
+  const auto refused = testing::PolishJob(tight_dir, job);
   EXPECT_EQ(refused.exit_status, 3) << refused.output;
   EXPECT_NE(refused.output.find("robot.max_added_residual_nm"), std::string::npos) << refused.output;
   std::smatch m;

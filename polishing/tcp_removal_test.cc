@@ -43,7 +43,7 @@ double GaussianRateUmPerS(double dx_mm, double dy_mm) {
 }
 
 // Astigmatism, a bump and a tilt on a 1 mm grid over 56 x 56 mm, in micrometres.
-void WriteMap(const std::filesystem::path& path) {
+void WriteTcpErrorMap(const std::filesystem::path& path) {
   std::ofstream out(path);
   out << "x_mm,y_mm,error_um\n";
   for (int j = -28; j <= 28; ++j) {
@@ -63,7 +63,7 @@ struct Written {
 };
 
 Written RunJob(const TempDir& dir, const std::string& surface, const std::string& extra) {
-  WriteMap(dir / "map.csv");
+  WriteTcpErrorMap(dir / "map.csv");
   std::ofstream(dir / "job.json") << fmt::format(R"({{
   "surface": {},
   "aperture": {{"diameter_mm": 40.0}},

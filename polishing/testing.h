@@ -1,14 +1,38 @@
 #pragma once
 // Helpers shared by polishing's tests.
 
+#include <fmt/core.h>
+
 #include <cmath>
+#include <nlohmann/json.hpp>
+#include <numbers>
 #include <sstream>
 #include <string>
 #include <vector>
 
+#include "core/testing/testing.h"
 #include "polishing/removal_function.h"
+#include "polishing/robot_kinematics.h"
+#include "polishing/robot_model.h"
 
 namespace arcwheel::polishing::testing {
+
+inline constexpr double kDeg = std::numbers::pi / 180.0;  // radians in a degree
+
+// The built-in ABB IRB 4600-40/2.55 with its own URDF.
+inline const RobotKinematics& Irb4600Kinematics() {
+  static const RobotKinematics k(*FindRobotModel("ABB IRB 4600-40/2.55"),
+                                 std::string(FindRobotModel("ABB IRB 4600-40/2.55")->urdf), "built in");
+  return k;
+}
+
+// Writes `job` to dir/job.json and runs `arcwheel polish` on it into dir/out, with `flags`.
+inline arcwheel::testing::CommandResult PolishJob(const arcwheel::testing::TempDir& dir,
+                                                  const nlohmann::json& job, const std::string& flags = "") {
+  arcwheel::testing::WriteText(dir / "job.json", job.dump(2));
+  return arcwheel::testing::RunArcwheel(
+      fmt::format("polish {} -o {} {}", (dir / "job.json").string(), (dir / "out").string(), flags));
+}
 
 // An axis-aligned elliptic Gaussian of known parameters (peak rate, centre cx, cy and sigmas sx, sy
 // in mm) sampled on an nx x ny grid of tool offsets from (x0, y0) in steps of h mm.

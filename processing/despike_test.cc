@@ -18,10 +18,10 @@
 #include <utility>
 #include <vector>
 
+#include "core/nan.h"
+
 namespace arcwheel::processing {
 namespace {
-
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 double SortedMedian(std::vector<double> values) {
   if (values.empty()) return kNaN;

@@ -11,12 +11,11 @@
 #include <vector>
 
 #include "acquisition/scan.h"
+#include "core/nan.h"
 #include "processing/helix_geometry.h"
 
 namespace arcwheel::processing {
 namespace {
-
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 // A scan without encoder, time or axial columns: sample i lies at phase start + 6 rpm dt i.
 acquisition::Scan ScanOfReadings(std::vector<double> z_mm, double rpm, double sample_period_s,

@@ -10,6 +10,7 @@
 #include <span>
 #include <vector>
 
+#include "core/nan.h"
 #include "processing/banded_spd.h"
 #include "processing/cubic_interpolation.h"
 #include "processing/despike.h"
@@ -18,8 +19,6 @@
 
 namespace arcwheel::processing {
 namespace {
-
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 // Fills `banded` with a random diagonally dominant matrix of bandwidth 3 and returns the same
 // matrix dense, for checks against Eigen's dense inverse.

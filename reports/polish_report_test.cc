@@ -211,7 +211,7 @@ TEST(PolishReport, PhoneShowsTheWholeBeforeAfterTable) {
   EXPECT_LE(right, viewport) << layout;
 }
 
-TEST(ReportCommand, MakesThePolishReportForAPolishFolder) {
+TEST(PolishReportCommand, MakesThePolishReportForAPolishFolder) {
   TempDir dir;
   Polish(dir / "out");
   EXPECT_THAT(ListFolder(dir / "out"), Not(HasSubstr("polish_report")));
@@ -223,7 +223,7 @@ TEST(ReportCommand, MakesThePolishReportForAPolishFolder) {
             "csv\nresidual_map.csv\nresidual_map.h5\nrobot_joints.csv\n");
 }
 
-TEST(ReportCommand, RefusesACorruptResidualLineNamingFileAndLineAndKeepsTheEarlierReport) {
+TEST(PolishReportCommand, RefusesACorruptResidualLineNamingFileAndLineAndKeepsTheEarlierReport) {
   TempDir dir;
   Polish(dir / "out", "--report pdf,html");
   const std::string pdf_before = ReadText(dir / "out" / "polish_report.pdf");
@@ -248,7 +248,7 @@ TEST(ReportCommand, RefusesACorruptResidualLineNamingFileAndLineAndKeepsTheEarli
   EXPECT_EQ(ReadText(dir / "out" / "polish_report.html"), html_before);
 }
 
-TEST(ReportCommand, RefusesASummaryMissingAKeyAndWritesNothing) {
+TEST(PolishReportCommand, RefusesASummaryMissingAKeyAndWritesNothing) {
   TempDir dir;
   Polish(dir / "out");
   nlohmann::json summary = nlohmann::json::parse(ReadText(dir / "out" / "polish_summary.json"));
@@ -261,7 +261,7 @@ TEST(ReportCommand, RefusesASummaryMissingAKeyAndWritesNothing) {
   EXPECT_EQ(ListFolder(dir / "out"), listing);
 }
 
-TEST(ReportCommand, RefusesWheelTolerancesForAPolishFolder) {
+TEST(PolishReportCommand, RefusesWheelTolerancesForAPolishFolder) {
   TempDir dir;
   Polish(dir / "out");
   const std::string listing = ListFolder(dir / "out");

@@ -31,6 +31,8 @@ export UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
 # And the 300 paper-wheel scans of tests/all_sample_accuracy_test (the statistics over seeds;
 # every process run, tests/same_results_test's shipped scan among them, runs the same fits), and
 # the 24 scans of tests/uncertainty_coverage_test (42 s here, 2026-12-03; uncertainty/'s own tests
-# run the same estimators, and every process run the same budget).
-export GTEST_FILTER="${GTEST_FILTER:--*N1e7*:*AllSampleAccuracy.*:SolveDwell.CutsTheResidualRmsTenfold*:SolveDwell.AMeasuredGaussian*:SpiralPath.CarriesADwell*:WheelModelStatistics.*:HistoryCommand.ReportsTheKnownWear*:WheelProfileModel.*:SameResults.SimulatedN1e6*:Batch.AnInterruptedBatch*:UncertaintyCoverage.*}"
+# run the same estimators, and every process run the same budget), and the 2 x 12 scans of
+# tests/characteristics_coverage_test (164 s here under the sanitizers, a sixth of the suite, 2026-12-05;
+# characteristics/'s own tests run the same operators, and every process run evaluates them).
+export GTEST_FILTER="${GTEST_FILTER:--*N1e7*:*AllSampleAccuracy.*:SolveDwell.CutsTheResidualRmsTenfold*:SolveDwell.AMeasuredGaussian*:SpiralPath.CarriesADwell*:WheelModelStatistics.*:HistoryCommand.ReportsTheKnownWear*:WheelProfileModel.*:SameResults.SimulatedN1e6*:Batch.AnInterruptedBatch*:UncertaintyCoverage.*:CharacteristicsCoverage.*}"
 ctest --preset asan --parallel "$(nproc)" "$@"

@@ -17,6 +17,7 @@
 #include <thread>
 #include <vector>
 
+#include "core/testing/json_file.h"
 #include "core/testing/testing.h"
 
 namespace arcwheel {
@@ -30,7 +31,7 @@ using testing::RunArcwheel;
 using testing::TempDir;
 using testing::WriteText;
 
-json ReadJson(const fs::path& path) { return json::parse(ReadText(path)); }
+using testing::ReadJson;
 
 // The truth's mean arc radius and arc-centre axial position: the means over the per-phase
 // generating circles that `simulate` wrote.

@@ -7,7 +7,7 @@
 //
 // CI runs ARCWHEEL_COVERAGE_SCANS = 12 scans a wheel (default) and checks coverage loosely; from
 // 200 scans it checks 93-97 %. The long test of record:
-//   ARCWHEEL_COVERAGE_SCANS=1000 build/tests/tests_characteristics_coverage_test
+//   ARCWHEEL_COVERAGE_SCANS=1000 build/tests/tests_tests --gtest_filter='CharacteristicsCoverage.*'
 // prints the figures docs/characteristics.md quotes.
 
 #include <fmt/core.h>
@@ -61,7 +61,7 @@ workflows::ProcessPipelineResult Scan(const acquisition::WheelModel& wheel, doub
   return workflows::RunProcessPipeline(std::move(simulated.scan), "", "", options, quiet);
 }
 
-int Scans() {
+int CoverageScans() {
   const char* text = std::getenv("ARCWHEEL_COVERAGE_SCANS");
   return text ? std::max(1, std::atoi(text)) : 12;
 }
@@ -77,7 +77,7 @@ void CheckCoverage(const std::string& name, const acquisition::WheelModel& wheel
   const std::map<std::string, double> truth = {{"max_arc_error", form.arc_profile.measured_um},
                                                {"max_runout", form.runout.measured_um},
                                                {"max_roundness", form.roundness.measured_um}};
-  const int scans = Scans();
+  const int scans = CoverageScans();
   std::map<std::string, int> covered;
   std::map<std::string, double> error_sum, error_squares, u_sum;
   for (int i = 0; i < scans; ++i) {

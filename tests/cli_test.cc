@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "acquisition/simulate.h"
+#include "core/testing/json_file.h"
 #include "core/testing/testing.h"
 
 namespace arcwheel {
@@ -22,10 +23,7 @@ using testing::RunArcwheel;
 using testing::TempDir;
 using testing::WriteText;
 
-nlohmann::json ReadJson(const std::filesystem::path& path) {
-  std::ifstream in(path);
-  return nlohmann::json::parse(in);
-}
+using testing::ReadJson;
 
 TEST(Cli, SimulateThenProcessWritesTheContractKeys) {
   TempDir dir;

@@ -14,6 +14,7 @@
 
 #include "acquisition/scan_reader.h"
 #include "core/error.h"
+#include "core/testing/json_file.h"
 #include "core/testing/testing.h"
 
 namespace arcwheel {
@@ -24,10 +25,7 @@ using nlohmann::json;
 using testing::RunArcwheel;
 using testing::TempDir;
 
-json ReadJson(const std::filesystem::path& path) {
-  std::ifstream in(path);
-  return json::parse(in);
-}
+using testing::ReadJson;
 
 // One simulated scan with an encoder column (and dropouts, so that NaN samples travel through every
 // writer) and its foreign copies, made once for the whole suite.

@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "core/hdf5.h"
+#include "core/testing/json_file.h"
 #include "core/testing/testing.h"
 #include "grinding/prediction.h"
 #include "polishing/error_map_io.h"
@@ -33,7 +34,7 @@ using testing::TempDir;
 using testing::TrialPolishJob;
 using testing::WriteText;
 
-json ReadJson(const fs::path& path) { return json::parse(ReadText(path)); }
+using testing::ReadJson;
 
 // The shipped trial part (method.md A.9) and its nominal wheel.
 const fs::path kTrialPart = testing::SourceDir() / "grinding/examples/trial_part.json";

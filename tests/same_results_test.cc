@@ -29,6 +29,7 @@
 #include <set>
 #include <string>
 
+#include "core/testing/json_file.h"
 #include "core/testing/testing.h"
 
 namespace arcwheel {
@@ -40,10 +41,7 @@ using testing::TempDir;
 
 constexpr double kRelative = 1e-9;
 
-nlohmann::json ReadJson(const std::filesystem::path& path) {
-  std::ifstream in(path);
-  return nlohmann::json::parse(in);
-}
+using testing::ReadJson;
 
 bool EndsWith(const std::string& text, const std::string& suffix) {
   return text.size() >= suffix.size() &&

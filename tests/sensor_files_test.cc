@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "acquisition/simulate.h"
+#include "core/testing/json_file.h"
 #include "core/testing/testing.h"
 
 namespace arcwheel {
@@ -25,10 +26,7 @@ using testing::RunArcwheel;
 using testing::TempDir;
 using testing::WriteText;
 
-nlohmann::json ReadJson(const std::filesystem::path& path) {
-  std::ifstream in(path);
-  return nlohmann::json::parse(in);
-}
+using testing::ReadJson;
 
 // A contract CSV of a simulated wheel whose `# key: value` lines lack `drop` (one or more keys).
 std::filesystem::path CsvWithout(const TempDir& dir, const std::string& name, const std::string& drop) {
@@ -419,7 +417,7 @@ TEST(ScanSettings, RegenerateReadsASensorsFileWithThem) {
 
 // --- Refusals: the file, the line and the column (or the key) named; nothing written -------------
 
-struct Refusal {
+struct SensorFileRefusal {
   std::string name;
   std::string file;
   std::string text;
@@ -429,10 +427,10 @@ struct Refusal {
   std::string message;  // with {file} standing for the scan's path, {settings} for the settings'
 };
 
-class SensorRefusal : public ::testing::TestWithParam<Refusal> {};
+class SensorRefusal : public ::testing::TestWithParam<SensorFileRefusal> {};
 
 TEST_P(SensorRefusal, NamesTheProblemExitsAndWritesNothing) {
-  const Refusal& r = GetParam();
+  const SensorFileRefusal& r = GetParam();
   TempDir dir;
   const auto scan = dir / r.file;
   WriteText(scan, r.text);
@@ -464,7 +462,7 @@ const char* kSettings = R"({"spindle_rpm": 500, "feed_mm_per_min": 400})";
 INSTANTIATE_TEST_SUITE_P(
     Cli, SensorRefusal,
     ::testing::Values(
-        Refusal{
+        SensorFileRefusal{
             "AHeaderNoSniffClaims", "logger.txt", "Zeit;Weg\n0;1,5\n", kSettings, "", 3,
             "'{file}': its header is no format arcwheel knows; tried csv ('# key: value' lines or a z_mm "
             "column); sensortool (a 'sensorTOOL' line or a column row starting 'Acquisition time' or 'Epoch "
@@ -475,61 +473,66 @@ INSTANTIATE_TEST_SUITE_P(
             "or fixed-width values such as +01.2345 or -FFFFFFF). Force a reader with --format NAME (hdf5, "
             "csv, "
             "sensortool, gocator, keyence-lj, keyence-lk, columns or profile-hdf5)"},
-        Refusal{"AMissingColumn", "logger.txt", "Messung 7\nZeit;Weg\n0;1,5\n", kSettings,
-                "--columns z=Abstand", 3,
-                "acquisition.columns: '{file}': no line names the columns 'Abstand' (--columns)"},
-        Refusal{"AMissingColumnOverASensorsOwn", "export.csv",
-                std::string(kSensorToolHead) + "0,0000;1;1,5\r\n", kSettings,
-                "--format sensortool --columns z=Distance2", 3,
-                "'{file}' line 4: no column 'Distance2' (--columns z=...); the column row names 'Acquisition "
-                "time', "
-                "'Epoch time (ms)', 'Distance1 (mm)'"},
-        Refusal{
+        SensorFileRefusal{"AMissingColumn", "logger.txt", "Messung 7\nZeit;Weg\n0;1,5\n", kSettings,
+                          "--columns z=Abstand", 3,
+                          "acquisition.columns: '{file}': no line names the columns 'Abstand' (--columns)"},
+        SensorFileRefusal{
+            "AMissingColumnOverASensorsOwn", "export.csv", std::string(kSensorToolHead) + "0,0000;1;1,5\r\n",
+            kSettings, "--format sensortool --columns z=Distance2", 3,
+            "'{file}' line 4: no column 'Distance2' (--columns z=...); the column row names 'Acquisition "
+            "time', "
+            "'Epoch time (ms)', 'Distance1 (mm)'"},
+        SensorFileRefusal{
             "AUnitThatDoesNotParse", "export.csv",
             "sensorTOOL;1.9.0\r\nAcquisition time;Distance1 (furlong)\r\n0,0000;1,5\r\n", kSettings, "", 3,
             "'{file}' line 2: column 'Distance1 (furlong)': unit 'furlong' is not one of z (mm, um or nm)"},
-        Refusal{"AUnitOfTheOptionThatDoesNotParse", "logger.txt", "Zeit;Weg\n0;1,5\n", kSettings,
-                "--columns z=Weg:inch", 2, "--columns = 'z=Weg:inch' violates a unit of z: mm, um or nm"},
-        Refusal{
+        SensorFileRefusal{"AUnitOfTheOptionThatDoesNotParse", "logger.txt", "Zeit;Weg\n0;1,5\n", kSettings,
+                          "--columns z=Weg:inch", 2,
+                          "--columns = 'z=Weg:inch' violates a unit of z: mm, um or nm"},
+        SensorFileRefusal{
             "AnUnknownMarkerInSensorTool", "export.csv",
             std::string(kSensorToolHead) + "0,0000;1;1,5\r\n0,0001;1;n/a\r\n", kSettings, "", 3,
             "'{file}' line 6: column 'Distance1 (mm)': 'n/a' is neither a number nor an invalid marker this "
             "format knows (an empty cell or nan)"},
-        Refusal{"AnUnknownMarkerFromKeyence", "lk.txt", "+01.2345\r\n-FFFFFFF\r\n+0?.2345\r\n", kSettings, "",
-                3,
-                "'{file}' line 3: column 'OUT1': '+0?.2345' is neither a number nor an invalid marker this "
-                "format "
-                "knows (an empty cell, nan, +FFFFFFF, -FFFFFFF, XXXXXXXX or -------)"},
-        Refusal{"ATimeThatGoesBackwards", "export.csv",
-                std::string(kSensorToolHead) + "0,0000;1;1,5\r\n0,0002;1;1,5\r\n0,0001;1;1,5\r\n", kSettings,
-                "", 3, "'{file}' line 7: column 'Acquisition time': the time goes backwards"},
-        Refusal{
+        SensorFileRefusal{
+            "AnUnknownMarkerFromKeyence", "lk.txt", "+01.2345\r\n-FFFFFFF\r\n+0?.2345\r\n", kSettings, "", 3,
+            "'{file}' line 3: column 'OUT1': '+0?.2345' is neither a number nor an invalid marker this "
+            "format "
+            "knows (an empty cell, nan, +FFFFFFF, -FFFFFFF, XXXXXXXX or -------)"},
+        SensorFileRefusal{"ATimeThatGoesBackwards", "export.csv",
+                          std::string(kSensorToolHead) + "0,0000;1;1,5\r\n0,0002;1;1,5\r\n0,0001;1;1,5\r\n",
+                          kSettings, "", 3,
+                          "'{file}' line 7: column 'Acquisition time': the time goes backwards"},
+        SensorFileRefusal{
             "SettingsThatLeaveTheSamplePeriodUnknown", "lk.txt", "+01.2345\r\n+01.2346\r\n", kSettings, "", 3,
             "'{file}': lacks sample_period_s (and has no t column): give \"sample_period_s\" in the file's "
             "metadata or in --scan-settings SETTINGS.json"},
-        Refusal{"SettingsThatLeaveTheSpindleSpeedUnknown", "lk.txt", "+01.2345\r\n+01.2346\r\n",
-                R"({"sample_period_s": 1e-4, "feed_mm_per_min": 400})", "", 3,
-                "lacks spindle_rpm (and has no angle column): give \"spindle_rpm\""},
-        Refusal{"ASamplePeriodThatContradictsTheMeasuringRate", "export.csv",
-                std::string(kSensorToolHead) + "0,0000;1;1,5\r\n",
-                R"({"spindle_rpm": 500, "feed_mm_per_min": 400, "sample_period_s": 0.0002})", "", 2,
-                "sample_period_s contradicts the scan: '{settings}' gives sample_period_s = 0.0002, '{file}' "
-                "gives "
-                "sample_period_s = 0.0001"},
-        Refusal{"ASensorThatContradictsTheFile", "export.csv",
-                std::string(kSensorToolHead) + "0,0000;1;1,5\r\n",
-                R"({"spindle_rpm": 500, "feed_mm_per_min": 400, "sensor": "ILD1750"})", "", 2,
-                "sensor contradicts the scan: '{settings}' gives sensor = 'ILD1750', '{file}' gives sensor = "
-                "'ILD2300'"},
-        Refusal{"AnAngleInCountsWithoutCountsPerTurn", "logger.txt", "Zeit;Weg;Winkel\n0;1,5;10\n", kSettings,
-                "--columns z=Weg,angle=Winkel:counts", 3,
-                "'{file}' line 1: column 'Winkel' holds encoder counts: give \"encoder_counts_per_rev\" in "
-                "--scan-settings"},
-        Refusal{"AnUnknownFormatName", "export.csv", "never read\n", kSettings, "--format gocator-xyz", 2,
-                "--format = gocator-xyz violates hdf5, csv, sensortool, gocator, keyence-lj, keyence-lk, "
-                "columns or "
-                "profile-hdf5"}),
-    [](const ::testing::TestParamInfo<Refusal>& param_info) { return param_info.param.name; });
+        SensorFileRefusal{"SettingsThatLeaveTheSpindleSpeedUnknown", "lk.txt", "+01.2345\r\n+01.2346\r\n",
+                          R"({"sample_period_s": 1e-4, "feed_mm_per_min": 400})", "", 3,
+                          "lacks spindle_rpm (and has no angle column): give \"spindle_rpm\""},
+        SensorFileRefusal{
+            "ASamplePeriodThatContradictsTheMeasuringRate", "export.csv",
+            std::string(kSensorToolHead) + "0,0000;1;1,5\r\n",
+            R"({"spindle_rpm": 500, "feed_mm_per_min": 400, "sample_period_s": 0.0002})", "", 2,
+            "sample_period_s contradicts the scan: '{settings}' gives sample_period_s = 0.0002, '{file}' "
+            "gives "
+            "sample_period_s = 0.0001"},
+        SensorFileRefusal{
+            "ASensorThatContradictsTheFile", "export.csv", std::string(kSensorToolHead) + "0,0000;1;1,5\r\n",
+            R"({"spindle_rpm": 500, "feed_mm_per_min": 400, "sensor": "ILD1750"})", "", 2,
+            "sensor contradicts the scan: '{settings}' gives sensor = 'ILD1750', '{file}' gives sensor = "
+            "'ILD2300'"},
+        SensorFileRefusal{
+            "AnAngleInCountsWithoutCountsPerTurn", "logger.txt", "Zeit;Weg;Winkel\n0;1,5;10\n", kSettings,
+            "--columns z=Weg,angle=Winkel:counts", 3,
+            "'{file}' line 1: column 'Winkel' holds encoder counts: give \"encoder_counts_per_rev\" in "
+            "--scan-settings"},
+        SensorFileRefusal{
+            "AnUnknownFormatName", "export.csv", "never read\n", kSettings, "--format gocator-xyz", 2,
+            "--format = gocator-xyz violates hdf5, csv, sensortool, gocator, keyence-lj, keyence-lk, "
+            "columns or "
+            "profile-hdf5"}),
+    [](const ::testing::TestParamInfo<SensorFileRefusal>& param_info) { return param_info.param.name; });
 
 // A line-profile scan as a user runs it: simulated as a Gocator export, processed with its settings
 // file; the same file with two frames swapped is refused naming the file, the line and the column,

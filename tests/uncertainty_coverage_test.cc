@@ -9,7 +9,7 @@
 // model's own sections over the band (TrueMaxArcErrorUm), computed here without the pipeline. CI runs
 // ARCWHEEL_COVERAGE_SCANS = 24 scans (default) and checks coverage loosely; from 200 scans it checks
 // 93-97 %, and the long test of record,
-//   ARCWHEEL_COVERAGE_SCANS=1000 build/tests/tests_uncertainty_coverage_test
+//   ARCWHEEL_COVERAGE_SCANS=1000 build/tests/tests_tests --gtest_filter='UncertaintyCoverage.*'
 // prints the figures docs/uncertainty.md quotes (at 200, six figures all inside is a coin toss).
 
 #include <fmt/core.h>

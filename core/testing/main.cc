@@ -36,8 +36,8 @@ bool FilterSelects(std::string_view filter, const std::string& name) {
 
 bool DefinedIn(const testing::TestInfo& test, std::string_view source) {
   const std::string_view file = test.file();
-  return file == source ||
-         (file.size() > source.size() && file.ends_with(source) && file[file.size() - source.size() - 1] == '/');
+  return file == source || (file.size() > source.size() && file.ends_with(source) &&
+                            file[file.size() - source.size() - 1] == '/');
 }
 
 std::string FullName(const testing::TestInfo& test) {
@@ -64,7 +64,8 @@ std::string RestrictToSource(const std::string& source) {
     const std::string name = FullName(*test);
     for (const testing::TestInfo* other : tests) {
       if (!DefinedIn(*other, source) && FullName(*other) == name) {
-        return name + " is defined in both " + source + " and " + other->file() + ": give one a name of its own";
+        return name + " is defined in both " + source + " and " + other->file() +
+               ": give one a name of its own";
       }
     }
     if (!FilterSelects(filter, name)) continue;

@@ -14,9 +14,9 @@ include(GNUInstallDirs)
 #   file-local name must be unique in the folder's tests). Registered with CTest as <folder>/<n>,
 #   running the tests that file defines (core/testing/main.cc), or with SHARDS as <folder>/<n>/<i>
 #   for i < k, each running every k-th of them (GoogleTest's sharding), so that CTest runs a long
-#   file on both cores. COST (about the
-#   seconds it takes under the sanitizers) makes CTest start the long tests first on a clean
-#   checkout, which has no timings of earlier runs: started last, they ran one after the other.
+#   file on both cores. COST (about the seconds it takes under the sanitizers) makes CTest start the
+#   long tests first on a clean checkout, which has no timings of earlier runs: started last, they
+#   ran one after the other.
 # arcwheel_add_benchmark(NAME n SRCS ... DEPS ...): a Google Benchmark binary.
 # arcwheel_embed_text(OUT var SYMBOL s FILE f): writes a source file defining
 #   `extern const char s[]` = the text of f (a data file the binary needs at run time, such as a

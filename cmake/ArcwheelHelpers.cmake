@@ -5,6 +5,10 @@ include(GNUInstallDirs)
 #   file: a clean build in 70 % of the time); a file-local name must therefore be unique in its
 #   library. COLD marks a library with no numeric kernel (formatting, storage, orchestration):
 #   compiled at -O1 in optimised builds, as the tests are (see ARCWHEEL_TEST_OPTIMIZATION).
+#   COLD_SRCS are such sources of a library that has kernels too (its file formats, job files,
+#   logging): one unity batch of their own at -O1, the SRCS in batches of 8 at the build type's
+#   flags. A batch costs a parse of the heavy headers, so a library's cold sources are worth
+#   separating only when they fill most of a batch.
 # arcwheel_install_library(NAME n HEADERS ...): installs arcwheel_<n> as arcwheel::<n> of the
 #   arcwheel CMake package (cmake/ArcwheelPackage.cmake), and its public headers, the ones listed,
 #   under include/arcwheel/<n>/, where `#include "<n>/x.h"` finds them as in the source tree.
@@ -47,8 +51,8 @@ if(ARCWHEEL_SANITIZE)
 endif()
 
 function(arcwheel_add_library)
-  cmake_parse_arguments(ARG "COLD" "NAME" "SRCS;DEPS" ${ARGN})
-  add_library(arcwheel_${ARG_NAME} STATIC ${ARG_SRCS})
+  cmake_parse_arguments(ARG "COLD" "NAME" "SRCS;COLD_SRCS;DEPS" ${ARGN})
+  add_library(arcwheel_${ARG_NAME} STATIC ${ARG_SRCS} ${ARG_COLD_SRCS})
   add_library(arcwheel::${ARG_NAME} ALIAS arcwheel_${ARG_NAME})
   target_include_directories(arcwheel_${ARG_NAME} PUBLIC $<BUILD_INTERFACE:${PROJECT_SOURCE_DIR}>
                              $<BUILD_INTERFACE:${PROJECT_BINARY_DIR}/generated>
@@ -61,6 +65,22 @@ function(arcwheel_add_library)
   target_compile_options(arcwheel_${ARG_NAME} PRIVATE $<$<CXX_COMPILER_ID:GNU>:-Wno-subobject-linkage>)
   if(ARG_COLD)
     target_compile_options(arcwheel_${ARG_NAME} PRIVATE ${ARCWHEEL_COLD_OPTIMIZATION})
+  endif()
+  if(ARG_COLD_SRCS)
+    # Named unity groups instead of numbered batches: hot_<i> of 8 SRCS each, and cold, whose
+    # generated source (CMake names it unity_<group>_cxx.cxx) carries the -O1; set on the sources
+    # themselves, the option would take them out of the unity build.
+    set_target_properties(arcwheel_${ARG_NAME} PROPERTIES UNITY_BUILD_MODE GROUP)
+    set(_index 0)
+    foreach(_source IN LISTS ARG_SRCS)
+      math(EXPR _group "${_index} / 8")
+      set_source_files_properties(${_source} PROPERTIES UNITY_GROUP hot_${_group})
+      math(EXPR _index "${_index} + 1")
+    endforeach()
+    set_source_files_properties(${ARG_COLD_SRCS} PROPERTIES UNITY_GROUP cold)
+    set_source_files_properties(
+      ${CMAKE_CURRENT_BINARY_DIR}/CMakeFiles/arcwheel_${ARG_NAME}.dir/Unity/unity_cold_cxx.cxx
+      PROPERTIES COMPILE_OPTIONS "${ARCWHEEL_COLD_OPTIMIZATION}")
   endif()
 endfunction()
 

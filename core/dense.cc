@@ -26,6 +26,10 @@ Eigen::VectorXd LdltSolve(const Eigen::MatrixXd& a, const Eigen::VectorXd& b) { 
 
 Eigen::MatrixXd LdltSolve(const Eigen::MatrixXd& a, const Eigen::MatrixXd& b) { return a.ldlt().solve(b); }
 
+Eigen::Vector3d LdltSolve(const Eigen::Matrix3d& a, const Eigen::Vector3d& b) { return a.ldlt().solve(b); }
+
+Eigen::Matrix3Xd LdltSolve(const Eigen::Matrix3d& a, const Eigen::Matrix3Xd& b) { return a.ldlt().solve(b); }
+
 Eigen::VectorXd SemidefiniteSolve(const Eigen::MatrixXd& a, const Eigen::VectorXd& b) {
   const Eigen::LLT<Eigen::MatrixXd> llt(a);
   if (llt.info() == Eigen::Success) return llt.solve(b);

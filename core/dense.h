@@ -22,6 +22,11 @@ namespace arcwheel::dense {
 [[nodiscard]] Eigen::VectorXd LdltSolve(const Eigen::MatrixXd& a, const Eigen::VectorXd& b);
 [[nodiscard]] Eigen::MatrixXd LdltSolve(const Eigen::MatrixXd& a, const Eigen::MatrixXd& b);
 
+// The same for a 3 x 3 a: the normal equations of the circle fits, the association's Gauss-Newton
+// step and the prediction's plane, solved by one instantiation.
+[[nodiscard]] Eigen::Vector3d LdltSolve(const Eigen::Matrix3d& a, const Eigen::Vector3d& b);
+[[nodiscard]] Eigen::Matrix3Xd LdltSolve(const Eigen::Matrix3d& a, const Eigen::Matrix3Xd& b);
+
 // x of a x = b for a symmetric positive semi-definite a: LLT when a is positive definite, LDLT when
 // the Cholesky factorisation fails.
 [[nodiscard]] Eigen::VectorXd SemidefiniteSolve(const Eigen::MatrixXd& a, const Eigen::VectorXd& b);

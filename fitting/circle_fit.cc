@@ -203,7 +203,8 @@ void SetSolution(const ScaledPoints& s, const double p[3], CircleFit& fit) {
   // dp = -(J^T J)^-1 J^T diag(w_i dy_i / d_i) dy, where w_i dy_i / d_i is -J(i, 1) (to the bit).
   const Eigen::Matrix3d normal = jacobian.transpose() * jacobian;
   const Eigen::VectorXd along_y = -jacobian.col(1);
-  fit.sensitivity_to_y = -normal.ldlt().solve(jacobian.transpose() * along_y.asDiagonal());
+  fit.sensitivity_to_y =
+      -dense::LdltSolve(normal, Eigen::Matrix3Xd(jacobian.transpose() * along_y.asDiagonal()));
   fit.center_mm = {s.cx + p[0] * s.scale, s.cy + p[1] * s.scale};
   fit.radius_mm = p[2] * s.scale;
   fit.rms_residual_mm = std::sqrt(rss / static_cast<double>(n));

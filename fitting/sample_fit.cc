@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "core/check.h"
+#include "core/dense.h"
 #include "core/error.h"
 #include "core/interrupt.h"
 #include "core/nan.h"
@@ -439,7 +440,7 @@ Circle KasaCircle(const NodeSums& s, double band_center_mm, int min_points) {
   Circle c;
   if (s.count < std::max(4, min_points)) return c;
   const Eigen::Vector3d rhs(-s.kasa_w[0], -s.kasa_w[1], -s.kasa_w[2]);
-  const Eigen::Vector3d p = Normal(s).ldlt().solve(rhs);
+  const Eigen::Vector3d p = dense::LdltSolve(Normal(s), rhs);
   const double a = -p(0) / 2.0, b = -p(1) / 2.0;
   const double r2 = a * a + b * b - p(2);
   if (!p.allFinite() || !(r2 > 0.0)) return c;
@@ -727,7 +728,7 @@ WheelFit FitToSamples(std::span<const T> rho, const processing::HelixGeometry& g
         continue;
       }
       const Eigen::Vector3d jte(sums[j].jte[0], sums[j].jte[1], sums[j].jte[2]);
-      const Eigen::Vector3d step = -Normal(sums[j]).ldlt().solve(jte);
+      const Eigen::Vector3d step = -dense::LdltSolve(Normal(sums[j]), jte);
       if (!step.allFinite()) {
         circles[j].valid = false;
         continue;

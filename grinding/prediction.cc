@@ -9,6 +9,7 @@
 #include <numbers>
 
 #include "core/check.h"
+#include "core/dense.h"
 #include "core/error.h"
 #include "core/parallel.h"
 #include "grinding/toolpath.h"
@@ -165,7 +166,7 @@ std::vector<double> WithoutPlane(const FormPrediction& p) {
     normal += basis * basis.transpose();
     rhs += basis * p.error_um[k];
   }
-  const Eigen::Vector3d plane = normal.ldlt().solve(rhs);
+  const Eigen::Vector3d plane = dense::LdltSolve(normal, rhs);
   std::vector<double> residual(p.error_um.size());
   for (size_t k = 0; k < p.error_um.size(); ++k) {
     residual[k] = p.error_um[k] - plane.dot(Eigen::Vector3d(1.0, p.x_mm[k % nx], p.y_mm[k / nx]));

@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include <boost/random/mersenne_twister.hpp>
 #include <cmath>
 #include <numbers>
 #include <random>
@@ -252,6 +253,21 @@ TEST(FitNoiseFreeRows, RemovesTheNoiseAndMarksTheRowsLeftOut) {
     }
   }
   EXPECT_LT(std::sqrt(squares / counted), 0.05 * sigma);
+}
+
+// The bootstraps draw from Boost's twister (its state refill is branch-free) where they drew from
+// the standard library's: seeded by the same std::seed_seq, it must be the same stream, or every
+// type A uncertainty would move.
+TEST(BootstrapStream, BoostsTwisterIsTheStandardsStreamForASeedSequence) {
+  for (const std::uint64_t seed : {std::uint64_t{20261203}, std::uint64_t{0}, ~std::uint64_t{0}}) {
+    for (const std::uint64_t replicate : {std::uint64_t{0}, std::uint64_t{1}, std::uint64_t{99}}) {
+      std::seed_seq standard_seeds{seed, seed >> 32, replicate};
+      std::seed_seq boost_seeds{seed, seed >> 32, replicate};
+      std::mt19937_64 standard(standard_seeds);
+      boost::random::mt19937_64 boost(boost_seeds);
+      for (int i = 0; i < 100000; ++i) ASSERT_EQ(boost(), standard()) << "seed " << seed << ", draw " << i;
+    }
+  }
 }
 
 }  // namespace

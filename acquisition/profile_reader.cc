@@ -32,14 +32,8 @@ constexpr double kKeyenceLjUnitsPerMm = 1e5;
 
 std::string StageOf(ScanFormat format) { return "acquisition." + std::string(InfoOf(format).name); }
 
-std::string_view Trim(std::string_view s) {
-  while (!s.empty() && (s.front() == ' ' || s.front() == '\t' || s.front() == '\r')) s.remove_prefix(1);
-  while (!s.empty() && (s.back() == ' ' || s.back() == '\t' || s.back() == '\r')) s.remove_suffix(1);
-  return s;
-}
-
 bool ParseDouble(std::string_view cell, double& value) {
-  cell = Trim(cell);
+  cell = TrimBlanks(cell);
   if (!cell.empty() && cell.front() == '+') cell.remove_prefix(1);
   const auto [end, error] = std::from_chars(cell.data(), cell.data() + cell.size(), value);
   return !cell.empty() && error == std::errc() && end == cell.data() + cell.size() && std::isfinite(value);
@@ -59,7 +53,8 @@ void ForEachCell(std::string_view line, char separator, F&& f) {
 
 std::vector<std::string_view> Cells(std::string_view line, char separator) {
   std::vector<std::string_view> cells;
-  ForEachCell(line, separator, [&](std::size_t, std::string_view cell) { cells.push_back(Trim(cell)); });
+  ForEachCell(line, separator,
+              [&](std::size_t, std::string_view cell) { cells.push_back(TrimBlanks(cell)); });
   // A trailing separator ends no further column.
   if (cells.size() > 1 && cells.back().empty()) cells.pop_back();
   return cells;
@@ -77,7 +72,7 @@ class ProfileTextParser {
     std::string_view line;
     bool saw_profile = false;
     while (lines_.Next(line)) {
-      const std::string_view section = Trim(line);
+      const std::string_view section = TrimBlanks(line);
       if (section == "Info") {
         ReadGocatorInfo();
       } else if (section == "Profile") {
@@ -99,7 +94,7 @@ class ProfileTextParser {
     std::string_view line;
     std::size_t frame = 0;
     while (lines_.Next(line)) {
-      if (Trim(line).empty()) continue;
+      if (TrimBlanks(line).empty()) continue;
       if (scan_.x_mm.empty()) {
         ReadXRow(Cells(line, '\t'), 0, kKeyenceLjUnitsPerMm);
         continue;
@@ -123,7 +118,7 @@ class ProfileTextParser {
   void SkipSection() {
     std::string_view line;
     while (lines_.Next(line)) {
-      if (Trim(line) == "End") return;
+      if (TrimBlanks(line) == "End") return;
     }
   }
 
@@ -171,8 +166,8 @@ class ProfileTextParser {
     const std::size_t first_frame = scan_.frames();
     std::string_view line;
     while (lines_.Next(line)) {
-      if (Trim(line) == "End") break;
-      if (Trim(line).empty()) continue;
+      if (TrimBlanks(line) == "End") break;
+      if (TrimBlanks(line).empty()) continue;
       const std::vector<std::string_view> stamps =
           Cells(line.substr(0, NthSeparator(line, ',', kStamps.size())), ',');
       if (stamps.size() < kStamps.size())
@@ -249,7 +244,7 @@ class ProfileTextParser {
     ForEachCell(line, separator, [&](std::size_t index, std::string_view cell) {
       if (index < first_cell) return;
       const std::size_t column = index - first_cell;
-      cell = Trim(cell);
+      cell = TrimBlanks(cell);
       if (column >= points) {
         if (!cell.empty()) {
           Refuse(

@@ -28,6 +28,7 @@
 #include "core/error.h"
 #include "core/nan.h"
 #include "core/text_encoding.h"
+#include "core/text_lines.h"
 
 namespace arcwheel::acquisition {
 namespace {
@@ -47,17 +48,11 @@ std::string Lower(std::string_view text) {
   return lower;
 }
 
-std::string_view Trim(std::string_view s) {
-  while (!s.empty() && (s.front() == ' ' || s.front() == '\t' || s.front() == '\r')) s.remove_prefix(1);
-  while (!s.empty() && (s.back() == ' ' || s.back() == '\t' || s.back() == '\r')) s.remove_suffix(1);
-  return s;
-}
-
 // A header cell as the tools quote it: "Distance1 (mm)".
 std::string_view Unquote(std::string_view s) {
-  s = Trim(s);
+  s = TrimBlanks(s);
   if (s.size() >= 2 && s.front() == '"' && s.back() == '"') s = s.substr(1, s.size() - 2);
-  return Trim(s);
+  return TrimBlanks(s);
 }
 
 std::vector<std::string_view> SplitCells(std::string_view line, char separator) {
@@ -71,7 +66,7 @@ std::vector<std::string_view> SplitCells(std::string_view line, char separator) 
     start = next + 1;
   }
   // A trailing separator ends no further column.
-  if (cells.size() > 1 && Trim(cells.back()).empty()) cells.pop_back();
+  if (cells.size() > 1 && TrimBlanks(cells.back()).empty()) cells.pop_back();
   return cells;
 }
 
@@ -87,7 +82,7 @@ std::string UnitInHeader(std::string_view header) {
   if (open == std::string_view::npos) return "";
   const std::size_t close = header.find_first_of(")]", open);
   if (close == std::string_view::npos) return "";
-  return std::string(Trim(header.substr(open + 1, close - open - 1)));
+  return std::string(TrimBlanks(header.substr(open + 1, close - open - 1)));
 }
 
 // The divisor from `unit` to the contract's unit of `quantity` (mm, s, deg): dividing by an exact
@@ -157,12 +152,12 @@ std::vector<ColumnRequest> ParseColumnsOption(std::string_view text, std::vector
   std::size_t start = 0;
   while (start <= text.size()) {
     const std::size_t comma = text.find(',', start);
-    const std::string_view item =
-        Trim(text.substr(start, comma == std::string_view::npos ? std::string_view::npos : comma - start));
+    const std::string_view item = TrimBlanks(
+        text.substr(start, comma == std::string_view::npos ? std::string_view::npos : comma - start));
     start = comma == std::string_view::npos ? text.size() + 1 : comma + 1;
     const std::size_t equals = item.find('=');
     const std::optional<Quantity> quantity =
-        equals == std::string_view::npos ? std::nullopt : QuantityNamed(Trim(item.substr(0, equals)));
+        equals == std::string_view::npos ? std::nullopt : QuantityNamed(TrimBlanks(item.substr(0, equals)));
     if (!quantity) {
       problems->push_back(
           fmt::format("--columns = '{}' violates QUANTITY=NAME[:UNIT] with QUANTITY z, t, angle or y", item));
@@ -171,7 +166,7 @@ std::vector<ColumnRequest> ParseColumnsOption(std::string_view text, std::vector
     std::string_view rest = item.substr(equals + 1);
     std::string unit;
     if (const std::size_t colon = rest.rfind(':'); colon != std::string_view::npos) {
-      unit = std::string(Trim(rest.substr(colon + 1)));
+      unit = std::string(TrimBlanks(rest.substr(colon + 1)));
       rest = rest.substr(0, colon);
       if (!ScaleOf(*quantity, unit) && !(*quantity == Quantity::kAngle && Lower(unit) == "counts")) {
         problems->push_back(fmt::format("--columns = '{}' violates a unit of {}: {}", item,
@@ -264,16 +259,16 @@ class SensorParser {
   }
 
   void NoteUnused(std::string_view key) {
-    if (Trim(key).empty()) return;
-    unused_keys_ += (unused_keys_.empty() ? "'" : ", '") + Utf8(Trim(key)) + "'";
+    if (TrimBlanks(key).empty()) return;
+    unused_keys_ += (unused_keys_.empty() ? "'" : ", '") + Utf8(TrimBlanks(key)) + "'";
   }
 
   // A header line's number and unit, as in "Measuring rate;20 kHz", "Measuring rate;20;kHz" or
   // "Sampling cycle,50us"; returns the period in seconds.
   std::optional<double> PeriodOf(const std::vector<std::string_view>& cells) const {
     std::string text;
-    for (std::size_t i = 1; i < cells.size(); ++i) text += std::string(Trim(cells[i])) + " ";
-    std::string_view rest = Trim(text);
+    for (std::size_t i = 1; i < cells.size(); ++i) text += std::string(TrimBlanks(cells[i])) + " ";
+    std::string_view rest = TrimBlanks(text);
     std::size_t digits = 0;
     while (digits < rest.size() && (std::isdigit(static_cast<unsigned char>(rest[digits])) ||
                                     rest[digits] == '.' || rest[digits] == ',')) {
@@ -287,7 +282,7 @@ class SensorParser {
       return std::nullopt;
     }
     // Divided by exact powers of ten, so that "100 us" is the double nearest 1e-4 s, as "0.0001" is.
-    const std::string unit = Lower(Trim(rest.substr(digits)));
+    const std::string unit = Lower(TrimBlanks(rest.substr(digits)));
     if (unit == "hz") return 1.0 / value;
     if (unit == "khz") return 1.0 / (value * 1e3);
     if (unit == "mhz") return 1.0 / (value * 1e6);
@@ -302,10 +297,10 @@ class SensorParser {
     if (!period) {
       std::string written;
       for (std::size_t i = 1; i < cells.size(); ++i)
-        written += std::string(i > 1 ? " " : "") + std::string(Trim(cells[i]));
+        written += std::string(i > 1 ? " " : "") + std::string(TrimBlanks(cells[i]));
       Refuse(line_number_,
              fmt::format("'{}' is not a rate or period arcwheel reads ('{}'; e.g. 20 kHz, 50 us)",
-                         Utf8(Trim(cells[0])), Utf8(written)));
+                         Utf8(TrimBlanks(cells[0])), Utf8(written)));
     }
     MetadataSetter setter(metadata);
     (void)setter.Claim("sample_period_s");
@@ -378,7 +373,7 @@ class SensorParser {
     while (true) {
       if (!NextLine(line))
         RefuseFile("no column row (expected e.g. 'Acquisition time;Epoch time (ms);Distance1 (mm)')");
-      const std::string_view trimmed = Trim(line);
+      const std::string_view trimmed = TrimBlanks(line);
       if (trimmed.empty()) continue;
       const std::string lower = Lower(trimmed);
       const char separator = SeparatorOf(trimmed);
@@ -423,11 +418,11 @@ class SensorParser {
       const std::size_t before = position_;
       const std::size_t line_before = line_number_;
       if (!NextLine(line)) RefuseFile("no values");
-      const std::string_view trimmed = Trim(line);
+      const std::string_view trimmed = TrimBlanks(line);
       if (trimmed.empty()) continue;
       const char separator = SeparatorOf(trimmed);
       const std::vector<std::string_view> cells = SplitCells(trimmed, separator);
-      if (IsKeyenceLkValue(Trim(cells[0]))) {
+      if (IsKeyenceLkValue(TrimBlanks(cells[0]))) {
         // A raw stream: this line is the first value.
         position_ = before;
         line_number_ = line_before;
@@ -471,7 +466,7 @@ class SensorParser {
     if (!problems.empty()) throw Error(ErrorCode::kInvalidOption, stage_, JoinProblems(problems));
     std::string_view line;
     while (NextLine(line)) {
-      const std::string_view trimmed = Trim(line);
+      const std::string_view trimmed = TrimBlanks(line);
       if (trimmed.empty()) continue;
       std::vector<std::string> cells;
       for (const std::string_view cell : SplitCells(trimmed, SeparatorOf(trimmed)))
@@ -603,7 +598,7 @@ class SensorParser {
     std::size_t time_ties = 0;
     std::string_view line;
     while (NextLine(line)) {
-      if (Trim(line).empty()) continue;
+      if (TrimBlanks(line).empty()) continue;
       std::size_t start = 0;
       std::size_t index = 0;
       while (index <= last_index) {
@@ -616,7 +611,7 @@ class SensorParser {
         const int k = role[index];
         if (k >= 0) {
           const ColumnSpec& spec = columns_[static_cast<std::size_t>(k)];
-          const std::string_view cell = Trim(line.substr(start, stop - start));
+          const std::string_view cell = TrimBlanks(line.substr(start, stop - start));
           double value = 0.0;
           bool parsed = spec.clock_time ? ParseClock(cell, value) : ParseNumber(cell, value);
           if (!parsed && spec.quantity == Quantity::kT && !spec.clock_time && ParseClock(cell, value)) {

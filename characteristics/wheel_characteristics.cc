@@ -275,14 +275,19 @@ Prepared Prepare(const Measure& measure, std::size_t filter_group, const std::ve
   p.unfiltered.cutoff_upr = std::nullopt;
   FormCharacteristic& out = p.out;
   out.op = measure.op;
-  TurnFilter filter(measure.op.cutoff_upr);
-  const auto evaluate_filtered = [&](std::vector<double> values, const Node& node) {
-    filter.Apply(values);
+  // The nodes' values on both cores, a filter each (a thousand minimum zones at 1e8 samples).
+  std::vector<TurnFilter> filters;
+  for (int worker = 0; worker < 2; ++worker) filters.emplace_back(measure.op.cutoff_upr);
+  const auto evaluate_filtered = [&](std::vector<double> values, const Node& node, int worker) {
+    filters[static_cast<std::size_t>(worker)].Apply(values);
     return measure.evaluate(p.unfiltered, values, node);
   };
   out.per_node_um.assign(nodes.size(), kNaN);
+  RunOnWorkers(2, [&](int worker) {
+    for (std::size_t j = static_cast<std::size_t>(worker); j < nodes.size(); j += 2)
+      if (!nodes[j].values.empty()) out.per_node_um[j] = evaluate_filtered(nodes[j].values, nodes[j], worker);
+  });
   for (std::size_t j = 0; j < nodes.size(); ++j) {
-    if (!nodes[j].values.empty()) out.per_node_um[j] = evaluate_filtered(nodes[j].values, nodes[j]);
     if (std::isfinite(out.per_node_um[j]) &&
         (out.worst_index < 0 ||
          out.per_node_um[j] > out.per_node_um[static_cast<std::size_t>(out.worst_index)]))
@@ -311,10 +316,13 @@ Prepared Prepare(const Measure& measure, std::size_t filter_group, const std::ve
   // f(estimate) is the bias, their spread u. The estimate must hold little noise itself: noise
   // left in it raises f(estimate) and the replicates' maximum less than the measured one (a
   // section's own points as the estimate made the arc profile's bias 0.78 um short).
-  for (const std::size_t j : p.candidates) {
-    const double base = evaluate_filtered(nodes[j].truth_estimate, nodes[j]);
-    if (std::isfinite(base) && !(base <= p.base_max)) p.base_max = base;
-  }
+  std::vector<double> base(p.candidates.size(), kNaN);
+  RunOnWorkers(2, [&](int worker) {
+    for (std::size_t c = static_cast<std::size_t>(worker); c < base.size(); c += 2)
+      base[c] = evaluate_filtered(nodes[p.candidates[c]].truth_estimate, nodes[p.candidates[c]], worker);
+  });
+  for (const double value : base)
+    if (std::isfinite(value) && !(value <= p.base_max)) p.base_max = value;
   return p;
 }
 
@@ -458,10 +466,6 @@ std::vector<Node> TurnNodes(const WheelForm& form, const FormOperator& roundness
     node.coordinate = phase_deg;
     node.unit = &unit;
     if (!AllFinite(node.values)) node.values.clear();
-    if (!node.values.empty()) {
-      node.truth_estimate = TurnEstimate(form, node.values, nodes.size());
-      node.extra = EstimateCentre(roundness, node.truth_estimate, phase_deg);
-    }
     nodes.push_back(std::move(node));
     at.push_back(y);
   }
@@ -469,6 +473,15 @@ std::vector<Node> TurnNodes(const WheelForm& form, const FormOperator& roundness
     throw Error(ErrorCode::kBadInput, kWheelCharacteristicsStage,
                 fmt::format("no axial node of the map lies in the band [{:g}, {:g}] mm", form.band_low_mm,
                             form.band_high_mm));
+  // Each turn's noise-free estimate and its reference centre, on both cores.
+  RunOnWorkers(2, [&](int worker) {
+    for (std::size_t k = static_cast<std::size_t>(worker); k < nodes.size(); k += 2) {
+      Node& node = nodes[k];
+      if (node.values.empty()) continue;
+      node.truth_estimate = TurnEstimate(form, node.values, k);
+      node.extra = EstimateCentre(roundness, node.truth_estimate, phase_deg);
+    }
+  });
   return nodes;
 }
 

@@ -245,10 +245,20 @@ characteristics::CharacteristicsOptions CharacteristicOperators(const ProcessPip
   return out;
 }
 
+SmoothedTurnMap SmoothTurnMap(const ProcessPipelineOptions& options, const processing::WheelMap& map,
+                              const fitting::WheelFit& fit) {
+  SmoothedTurnMap out;
+  out.value_sigma_mm = ValueSigmasMm(map);
+  out.turn_smooth_um = SmoothedTurns(map, out.value_sigma_mm, fit.band_low_mm, fit.band_high_mm,
+                                     CharacteristicOperators(options, static_cast<int>(map.n_phase())),
+                                     options.uncertainty.max_degree);
+  return out;
+}
+
 CharacteristicsResult EvaluateCharacteristics(const ProcessPipelineOptions& options,
                                               const processing::WheelMap& map, const fitting::WheelFit& fit,
                                               const uncertainty::WheelUncertainty& wheel,
-                                              double wheel_radius_mm) {
+                                              double wheel_radius_mm, const SmoothedTurnMap& smoothed) {
   std::vector<double> center_axial, center_radial, radius;
   std::vector<char> usable;
   std::vector<std::string> warnings;
@@ -277,11 +287,8 @@ CharacteristicsResult EvaluateCharacteristics(const ProcessPipelineOptions& opti
   form.section_sigma_scale = wheel.section_sigma_scale;
   const characteristics::CharacteristicsOptions operators =
       CharacteristicOperators(options, static_cast<int>(map.n_phase()), &warnings);
-  const std::vector<double> value_sigma = ValueSigmasMm(map);
-  form.rho_sigma_mm = value_sigma;
-  const std::vector<double> turns = SmoothedTurns(map, value_sigma, fit.band_low_mm, fit.band_high_mm,
-                                                  operators, options.uncertainty.max_degree);
-  form.turn_smooth_um = turns;
+  form.rho_sigma_mm = smoothed.value_sigma_mm;
+  form.turn_smooth_um = smoothed.turn_smooth_um;
 
   CharacteristicsResult result;
   result.warnings = std::move(warnings);

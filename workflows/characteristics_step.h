@@ -67,11 +67,22 @@ struct CharacteristicsResult {
 [[nodiscard]] characteristics::CharacteristicsOptions CharacteristicOperators(
     const ProcessPipelineOptions& options, int points_per_turn, std::vector<std::string>* warnings = nullptr);
 
+// The map as the characteristics' bootstrap takes it: each value's 1-sigma (mm) and the band's
+// turns smoothed along the nodes (um; empty where they cannot be). It needs the map and the fits
+// only, so `process` makes it while the uncertainty stage runs.
+struct SmoothedTurnMap {
+  std::vector<double> value_sigma_mm;
+  std::vector<double> turn_smooth_um;
+};
+[[nodiscard]] SmoothedTurnMap SmoothTurnMap(const ProcessPipelineOptions& options,
+                                            const processing::WheelMap& map, const fitting::WheelFit& fit);
+
 [[nodiscard]] CharacteristicsResult EvaluateCharacteristics(const ProcessPipelineOptions& options,
                                                             const processing::WheelMap& map,
                                                             const fitting::WheelFit& fit,
                                                             const uncertainty::WheelUncertainty& uncertainty,
-                                                            double wheel_radius_mm);
+                                                            double wheel_radius_mm,
+                                                            const SmoothedTurnMap& smoothed);
 
 // summary.json's "characteristics" object.
 [[nodiscard]] nlohmann::json CharacteristicsToJson(const CharacteristicsResult& result);

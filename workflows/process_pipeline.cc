@@ -182,21 +182,37 @@ void DecideTolerances(const reports::Tolerances& tolerances, uncertainty::WheelU
                                 tolerances.rule.value_or(uncertainty::DecisionRule::kIso14253));
 }
 
-// Waits for the input's hash, writes the outputs and keeps the clock, for both kinds of scan.
 // The characteristics under their named operators, from the map, the fits and the budget's
 // type B inputs; their warnings join the processing's.
 void EvaluateCharacteristicsStep(const ProcessPipelineOptions& options,
-                                 const acquisition::ScanMetadata& metadata, ProcessPipelineResult& result,
-                                 StageClock& clock) {
+                                 const acquisition::ScanMetadata& metadata, const SmoothedTurnMap& smoothed,
+                                 ProcessPipelineResult& result, StageClock& clock) {
   clock.Start("characteristics");
   result.characteristics = EvaluateCharacteristics(
       options, result.processed.map, result.fit, *result.uncertainty,
       options.processing.wheel_radius_mm > 0.0 ? options.processing.wheel_radius_mm
-                                               : metadata.wheel_diameter_mm.value_or(400.0) / 2.0);
+                                               : metadata.wheel_diameter_mm.value_or(400.0) / 2.0,
+      smoothed);
   for (const std::string& warning : result.characteristics->warnings)
     result.processed.warnings.push_back(warning);
 }
 
+// The uncertainty, its decisions and the characteristics, after the fits. The characteristics'
+// smoothed turns need only the map and the fits: a thread of their own makes them while the
+// uncertainty's bootstrap runs, whose two workers leave a core idle part of the time.
+void EvaluateUncertaintyAndCharacteristics(const ProcessPipelineOptions& options,
+                                           const acquisition::ScanMetadata& metadata,
+                                           const acquisition::ProfilePlacement* placement,
+                                           ProcessPipelineResult& result, StageClock& clock) {
+  clock.Start("uncertainty");
+  std::future<SmoothedTurnMap> smoothed = std::async(
+      std::launch::async, [&] { return SmoothTurnMap(options, result.processed.map, result.fit); });
+  result.uncertainty = EvaluateUncertainty(options, metadata, result.processed, result.fit, placement);
+  if (options.tolerances) DecideTolerances(*options.tolerances, *result.uncertainty);
+  EvaluateCharacteristicsStep(options, metadata, smoothed.get(), result, clock);
+}
+
+// Waits for the input's hash, writes the outputs and keeps the clock, for both kinds of scan.
 void FinishRun(std::future<std::string> sha256, const std::filesystem::path& outdir,
                ProcessPipelineResult& result, StageClock& clock) {
   clock.Start("waiting for the SHA-256");
@@ -240,12 +256,8 @@ ProcessPipelineResult RunOnScan(acquisition::Scan scan, const std::string& scan_
   clock.Start("releasing the samples");
   const acquisition::ScanMetadata metadata = scan.metadata;
   scan = {};  // the samples are no longer needed: the uncertainty's bootstrap works on the map
-  if (!options.no_uncertainty) {
-    clock.Start("uncertainty");
-    result.uncertainty = EvaluateUncertainty(options, metadata, result.processed, result.fit);
-    if (options.tolerances) DecideTolerances(*options.tolerances, *result.uncertainty);
-    EvaluateCharacteristicsStep(options, metadata, result, clock);
-  }
+  if (!options.no_uncertainty)
+    EvaluateUncertaintyAndCharacteristics(options, metadata, nullptr, result, clock);
   progress.Update("writing", 0.9);
   FinishRun(std::move(sha256), outdir, result, clock);
   return result;
@@ -284,13 +296,8 @@ ProcessPipelineResult RunOnProfileScan(acquisition::ProfileScan scan, const std:
   result.fit = fitting::FitProfileWheel(processed.map, options.fit);
   const acquisition::ProfilePlacement placement = scan.placement;
   scan = {};
-  if (!options.no_uncertainty) {
-    clock.Start("uncertainty");
-    result.uncertainty =
-        EvaluateUncertainty(options, result.record.metadata, processed, result.fit, &placement);
-    if (options.tolerances) DecideTolerances(*options.tolerances, *result.uncertainty);
-    EvaluateCharacteristicsStep(options, result.record.metadata, result, clock);
-  }
+  if (!options.no_uncertainty)
+    EvaluateUncertaintyAndCharacteristics(options, result.record.metadata, &placement, result, clock);
   progress.Update("writing", 0.9);
   FinishRun(std::move(sha256), outdir, result, clock);
   return result;

@@ -9,6 +9,7 @@
 #include "core/interrupt.h"
 #include "core/parallel.h"
 #include "processing/uniform_cubic_bspline.h"
+#include "processing/valid_span.h"
 
 namespace arcwheel::processing {
 namespace {
@@ -19,15 +20,6 @@ namespace {
 // neighbours. At 1e-4 it damps a lobe of order 100 (a 3.6 deg wave) by 0.06 % where the samples
 // are dense; at 1e-7 the edge coefficients of a dropout swung by tens of micrometres.
 constexpr double kPenaltyRelative = 1e-4;
-
-template <typename T>
-std::pair<std::size_t, std::size_t> ValidSpan(std::span<const T> z) {
-  std::size_t first = 0;
-  while (first < z.size() && !std::isfinite(z[first])) ++first;
-  std::size_t last = z.size();
-  while (last > first && !std::isfinite(z[last - 1])) --last;
-  return {first, last};
-}
 
 std::size_t CountCells(double u_last, double u0, double h) {
   return static_cast<std::size_t>(std::floor((u_last - u0) / h)) + 1;

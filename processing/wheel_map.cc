@@ -14,6 +14,7 @@
 #include "core/nan.h"
 #include "core/parallel.h"
 #include "processing/cubic_interpolation.h"
+#include "processing/valid_span.h"
 
 namespace arcwheel::processing {
 namespace {
@@ -390,16 +391,6 @@ std::pair<double, double> CommonAxialSpan(const HelixGeometry& geometry, std::sp
     y_high = std::min(y_high, std::max(y_first, y_last));
   }
   return {y_low, y_high};
-}
-
-// The first and one past the last finite reading.
-template <typename T>
-std::pair<std::size_t, std::size_t> ValidSpan(std::span<const T> rho) {
-  std::size_t first = 0;
-  while (first < rho.size() && !std::isfinite(static_cast<double>(rho[first]))) ++first;
-  std::size_t last = rho.size();
-  while (last > first && !std::isfinite(static_cast<double>(rho[last - 1]))) --last;
-  return {first, last};
 }
 
 // A map's settings before its nodes: the options checked, the noise, the knot step, the pitch.

@@ -7,6 +7,7 @@
 #include <boost/random/mersenne_twister.hpp>
 #include <boost/random/normal_distribution.hpp>
 #include <cmath>
+#include <functional>
 #include <iterator>
 #include <numbers>
 #include <numeric>
@@ -60,6 +61,14 @@ UnitCircle UnitCircleOf(std::span<const double> phase_deg) {
 
 bool AllFinite(std::span<const double> values) {
   return std::all_of(values.begin(), values.end(), [](double v) { return std::isfinite(v); });
+}
+
+// work(i, worker) for i = 0 .. n - 1 on both cores, worker w taking i = w, w + 2, ...: the
+// per-node evaluations are independent, so their results do not depend on the sharing.
+void ForEachOnBothCores(std::size_t n, const std::function<void(std::size_t, int)>& work) {
+  RunOnWorkers(2, [&](int worker) {
+    for (std::size_t i = static_cast<std::size_t>(worker); i < n; i += 2) work(i, worker);
+  });
 }
 
 // RONt (um) of one turn of (filtered) radii about the spindle axis, as EvaluateRoundness takes it.
@@ -283,9 +292,8 @@ Prepared Prepare(const Measure& measure, std::size_t filter_group, const std::ve
     return measure.evaluate(p.unfiltered, values, node);
   };
   out.per_node_um.assign(nodes.size(), kNaN);
-  RunOnWorkers(2, [&](int worker) {
-    for (std::size_t j = static_cast<std::size_t>(worker); j < nodes.size(); j += 2)
-      if (!nodes[j].values.empty()) out.per_node_um[j] = evaluate_filtered(nodes[j].values, nodes[j], worker);
+  ForEachOnBothCores(nodes.size(), [&](std::size_t j, int worker) {
+    if (!nodes[j].values.empty()) out.per_node_um[j] = evaluate_filtered(nodes[j].values, nodes[j], worker);
   });
   for (std::size_t j = 0; j < nodes.size(); ++j) {
     if (std::isfinite(out.per_node_um[j]) &&
@@ -317,9 +325,9 @@ Prepared Prepare(const Measure& measure, std::size_t filter_group, const std::ve
   // left in it raises f(estimate) and the replicates' maximum less than the measured one (a
   // section's own points as the estimate made the arc profile's bias 0.78 um short).
   std::vector<double> base(p.candidates.size(), kNaN);
-  RunOnWorkers(2, [&](int worker) {
-    for (std::size_t c = static_cast<std::size_t>(worker); c < base.size(); c += 2)
-      base[c] = evaluate_filtered(nodes[p.candidates[c]].truth_estimate, nodes[p.candidates[c]], worker);
+  ForEachOnBothCores(base.size(), [&](std::size_t c, int worker) {
+    const Node& node = nodes[p.candidates[c]];
+    base[c] = evaluate_filtered(node.truth_estimate, node, worker);
   });
   for (const double value : base)
     if (std::isfinite(value) && !(value <= p.base_max)) p.base_max = value;
@@ -474,13 +482,11 @@ std::vector<Node> TurnNodes(const WheelForm& form, const FormOperator& roundness
                 fmt::format("no axial node of the map lies in the band [{:g}, {:g}] mm", form.band_low_mm,
                             form.band_high_mm));
   // Each turn's noise-free estimate and its reference centre, on both cores.
-  RunOnWorkers(2, [&](int worker) {
-    for (std::size_t k = static_cast<std::size_t>(worker); k < nodes.size(); k += 2) {
-      Node& node = nodes[k];
-      if (node.values.empty()) continue;
-      node.truth_estimate = TurnEstimate(form, node.values, k);
-      node.extra = EstimateCentre(roundness, node.truth_estimate, phase_deg);
-    }
+  ForEachOnBothCores(nodes.size(), [&](std::size_t k, int) {
+    Node& node = nodes[k];
+    if (node.values.empty()) return;
+    node.truth_estimate = TurnEstimate(form, node.values, k);
+    node.extra = EstimateCentre(roundness, node.truth_estimate, phase_deg);
   });
   return nodes;
 }

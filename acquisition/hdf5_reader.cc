@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <limits>
+#include <optional>
 #include <span>
 #include <string>
 #include <type_traits>
@@ -103,13 +104,15 @@ constexpr std::pair<const char*, std::vector<double> Scan::*> kColumns[] = {
     {"/scan/t", &Scan::t_s}, {"/scan/angle", &Scan::angle_deg}, {"/scan/y", &Scan::y_mm}};
 
 // Where the columns' values go: the scan's own vectors, or arrays shared with a parent process.
-template <typename Allocator>
+// float32 readings kept as they are stored are not read when `leave_in_file(name)` says that the
+// parent maps them from the file (it returns false where they cannot be: then they are read).
+template <typename Allocator, typename LeaveInFile>
 void ReadColumns(const hdf5::File& file, const ScanMetadata& metadata, const ReadOptions& options,
-                 Allocator&& allocate) {
+                 Allocator&& allocate, LeaveInFile&& leave_in_file) {
   const ZLayout layout = ReadZLayout(file);
   const std::string z = "/scan/z";
   if (layout.is_float32 && options.keep_float32) {
-    file.ReadInto(z, allocate(z, file.NumericCount(z, sizeof(float)), float{}));
+    if (!leave_in_file(z)) file.ReadInto(z, allocate(z, file.NumericCount(z, sizeof(float)), float{}));
   } else {
     const std::span<double> values = allocate(z, file.NumericCount(z, sizeof(double)), double{});
     file.ReadInto(z, values);
@@ -171,17 +174,24 @@ Scan ReadHdf5Scan(const std::filesystem::path& path, const ReadOptions& options)
       [&](hdf5::SharedArrays& shared) {
         const hdf5::File file = hdf5::File::OpenReadOnly(path);
         const Scan header = ReadHeader(file);
-        ReadColumns(file, header.metadata, options,
-                    [&](const std::string& name, std::size_t count, auto type) {
-                      return shared.Allocate<decltype(type)>(name, count);
-                    });
+        ReadColumns(
+            file, header.metadata, options,
+            [&](const std::string& name, std::size_t count, auto type) {
+              return shared.Allocate<decltype(type)>(name, count);
+            },
+            [&](const std::string& name) {
+              const std::optional<hdf5::FileExtent> extent = file.ContiguousFloat32Extent(name);
+              if (extent) shared.LeaveInFile<float>(name, *extent);
+              return extent.has_value();
+            });
       },
       0.0, options.while_reading);
   const hdf5::File file = hdf5::File::OpenReadOnly(path);
   if (!handed) return ReadHdf5Scan(file, options);
   Scan scan = ReadHeader(file);
-  // The float32 readings stay in the pages the child wrote (the largest column, and the one a
-  // large scan has); the double columns are copied out into vectors.
+  // The float32 readings (the largest column, and the one a large scan has) stay in the pages the
+  // child wrote, or in the file's own pages where the file stores them as they are kept; the
+  // double columns are copied out into vectors.
   if (auto z = arrays.Map<float>("/scan/z")) scan.z_float_mm = FloatColumn(z->values, std::move(z->mapping));
   const auto take = [&](const std::string& name) {
     if (std::optional<std::vector<double>> values = arrays.Take<double>(name))
@@ -194,16 +204,19 @@ Scan ReadHdf5Scan(const std::filesystem::path& path, const ReadOptions& options)
 
 Scan ReadHdf5Scan(const hdf5::File& file, const ReadOptions& options) {
   Scan scan = ReadHeader(file);
-  ReadColumns(file, scan.metadata, options, [&](const std::string& name, std::size_t count, auto type) {
-    if constexpr (std::is_same_v<decltype(type), float>) {
-      scan.z_float_mm = std::vector<float>(count);
-      return std::span<float>(scan.z_float_mm);
-    } else {
-      std::vector<double>& column = DoubleColumnOf(scan, name);
-      column.resize(count);
-      return std::span<double>(column);
-    }
-  });
+  ReadColumns(
+      file, scan.metadata, options,
+      [&](const std::string& name, std::size_t count, auto type) {
+        if constexpr (std::is_same_v<decltype(type), float>) {
+          scan.z_float_mm = std::vector<float>(count);
+          return std::span<float>(scan.z_float_mm);
+        } else {
+          std::vector<double>& column = DoubleColumnOf(scan, name);
+          column.resize(count);
+          return std::span<double>(column);
+        }
+      },
+      [](const std::string&) { return false; });
   return Finish(std::move(scan), file, options);
 }
 

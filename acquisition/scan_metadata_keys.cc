@@ -106,18 +106,26 @@ namespace {
 
 // Replaces with NaN every reading that `is_sentinel` matches, that is not finite, or that lies
 // outside [low, high] (compared in double, as for readings held in double). Written without
-// branches so that the compiler vectorizes it: this pass touches every sample of the scan.
+// branches inside a block so that the compiler vectorizes it: this pass touches every sample of
+// the scan. A block is written only when it holds an invalid reading that is not NaN already:
+// readings mapped from the file (hdf5::SharedArrays) are copied page by page as they are written,
+// and a scan's invalid readings are mostly the NaN its sensor wrote off the rim.
 template <typename T, typename IsSentinel>
 void MarkInvalid(std::span<T> readings, double low, double high, IsSentinel is_sentinel) {
   constexpr T kNaN = std::numeric_limits<T>::quiet_NaN();
   constexpr double kMax = std::numeric_limits<double>::max();
-  for (T& z : readings) {
+  const auto valid = [&](T z) {
     const double value = z;
-    const bool marked = is_sentinel(z);
     // |value| <= max is false for NaN and +-Inf (a float sensor's over-range reading).
-    const bool finite = std::abs(value) <= kMax;
-    const bool valid = !marked & finite & (value >= low) & (value <= high);
-    z = valid ? z : kNaN;
+    return !is_sentinel(z) & (std::abs(value) <= kMax) & (value >= low) & (value <= high);
+  };
+  constexpr std::size_t kBlock = 1024;
+  for (std::size_t start = 0; start < readings.size(); start += kBlock) {
+    const std::span<T> block = readings.subspan(start, std::min(kBlock, readings.size() - start));
+    unsigned to_mark = 0;
+    for (const T z : block) to_mark |= static_cast<unsigned>(!valid(z) & (z == z));
+    if (to_mark == 0) continue;
+    for (T& z : block) z = valid(z) ? z : kNaN;
   }
 }
 

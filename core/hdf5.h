@@ -45,9 +45,18 @@ class Handle {
 void ReadFirstInChildProcess(const std::filesystem::path& path, const std::function<void()>& read,
                              double timeout_s = 0.0);
 
+// Where a dataset's values lie in its file, as bytes from the file's start (user block included).
+struct FileExtent {
+  std::uint64_t offset = 0;
+  std::uint64_t count = 0;  // values
+};
+
 // Arrays that a child process fills in place and its parent then takes, through an anonymous
 // memory file (Linux memfd): a large dataset is read once, in the child, and never held twice in
-// full (the parent gives the shared pages back as it copies them out).
+// full (the parent gives the shared pages back as it copies them out). A dataset stored as the
+// parent wants it (contiguous float32, File::ContiguousFloat32Extent) is not read at all: the
+// child checks the file and says where the values lie, and the parent maps those pages of the
+// file.
 class SharedArrays {
  public:
   SharedArrays();  // Error{kIo} when the memory file cannot be made
@@ -60,9 +69,16 @@ class SharedArrays {
   [[nodiscard]] std::span<T> Allocate(const std::string& name, std::size_t count) {
     return {static_cast<T*>(Allocate(name, count, sizeof(T))), count};
   }
+  // In the child: the values of T under `name` are those at `extent` of the file being read.
+  template <typename T>
+  void LeaveInFile(const std::string& name, const FileExtent& extent) {
+    LeaveInFile(name, extent, sizeof(T));
+  }
   // In the parent, after ReadInChildProcess returned true: the array the child stored under
-  // `name` as values of T, mapped into this process (the child's own pages, not a copy) and kept
-  // mapped while `mapping` lives; nothing when it stored none such.
+  // `name` as values of T, mapped into this process (the child's own pages, or the file's pages
+  // in the page cache, copied only where this process writes; not a copy) and kept mapped while
+  // `mapping` lives; nothing when it stored none such. Error{kBadInput} when the file was
+  // replaced or changed size since the child read it.
   template <typename T>
   struct Mapped {
     std::span<T> values;
@@ -82,6 +98,12 @@ class SharedArrays {
     const Entry* entry = Find(name, sizeof(T));
     if (entry == nullptr) return std::nullopt;
     std::vector<T> values;
+    if (entry->in_file != 0) {
+      const std::shared_ptr<void> mapping = Map(*entry);
+      const T* first = static_cast<const T*>(mapping.get());
+      values.assign(first, first + entry->count);
+      return values;
+    }
     values.reserve(entry->count);
     MoveOut(*entry, [&](const void* data, std::size_t count) {
       const T* first = static_cast<const T*>(data);
@@ -98,16 +120,28 @@ class SharedArrays {
   struct Entry {
     char name[32] = {};
     std::uint32_t value_bytes = 0;
+    std::uint32_t in_file = 0;  // 1: `offset` is in the file read, not in the memory file
     std::uint64_t offset = 0;
     std::uint64_t count = 0;
+  };
+  // The file as the child found it, so that the parent maps the same file's pages.
+  struct FileIdentity {
+    std::uint64_t device = 0, inode = 0, bytes = 0;
+    std::int64_t modified_ns = 0;
+    bool operator==(const FileIdentity&) const = default;
   };
   struct Directory {
     std::uint32_t magic = 0;
     std::uint32_t complete = 0;
     std::uint32_t arrays = 0;
     Entry entries[kMaxArrays];
+    FileIdentity file;
   };
+  [[nodiscard]] static std::optional<FileIdentity> IdentityOf(int fd);  // nothing when fd < 0
+  Entry& AddEntry(const std::string& name, std::size_t count, std::size_t value_bytes);
   void* Allocate(const std::string& name, std::size_t count, std::size_t value_bytes);
+  void LeaveInFile(const std::string& name, const FileExtent& extent, std::size_t value_bytes);
+  [[nodiscard]] std::shared_ptr<void> MapFile(const Entry& entry) const;
   void MarkComplete();
   [[nodiscard]] bool ReadDirectory();
   [[nodiscard]] const Entry* Find(const std::string& name, std::size_t value_bytes) const;
@@ -115,7 +149,8 @@ class SharedArrays {
   [[nodiscard]] std::shared_ptr<void> Map(const Entry& entry) const;
 
   int fd_ = -1;
-  std::size_t end_ = 4096;  // the directory's page comes first
+  std::filesystem::path path_;  // of the file read (set by ReadInChildProcess)
+  std::size_t end_ = 4096;      // the directory's page comes first
   Directory directory_;
   std::vector<std::pair<void*, std::size_t>> mappings_;  // the child's
 };
@@ -156,6 +191,11 @@ class File {
   // more values (of `value_bytes` each in memory) than the file could hold, so that a damaged
   // header is refused before anything is allocated for it.
   [[nodiscard]] std::size_t NumericCount(const std::string& dataset, std::size_t value_bytes) const;
+  // Where the values of `dataset` lie in the file when they can be used as they are stored: one
+  // dimension, contiguous (so unfiltered), little-endian IEEE float32 on this little-endian
+  // machine, aligned for float, inside the file, and what libhdf5 reads at both ends; nothing
+  // otherwise (chunked, compressed, external, not yet written, other types, a file in memory).
+  [[nodiscard]] std::optional<FileExtent> ContiguousFloat32Extent(const std::string& dataset) const;
   // Reads a numeric dataset into `values`, which must hold NumericCount values (converted by HDF5).
   void ReadInto(const std::string& dataset, std::span<double> values) const;
   void ReadInto(const std::string& dataset, std::span<float> values) const;

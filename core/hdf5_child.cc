@@ -3,6 +3,7 @@
 #include <poll.h>
 #include <signal.h>
 #include <sys/mman.h>
+#include <sys/stat.h>
 #include <sys/types.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -179,7 +180,8 @@ SharedArrays::~SharedArrays() {
   close(fd_);
 }
 
-void* SharedArrays::Allocate(const std::string& name, std::size_t count, std::size_t value_bytes) {
+SharedArrays::Entry& SharedArrays::AddEntry(const std::string& name, std::size_t count,
+                                            std::size_t value_bytes) {
   if (directory_.arrays == kMaxArrays || name.size() >= sizeof(Entry::name)) {
     throw Error(ErrorCode::kInternal, kHdf5ChildStage,
                 "too many shared arrays, or the name '" + name + "' is too long");
@@ -188,6 +190,11 @@ void* SharedArrays::Allocate(const std::string& name, std::size_t count, std::si
   std::memcpy(entry.name, name.c_str(), name.size() + 1);
   entry.value_bytes = static_cast<std::uint32_t>(value_bytes);
   entry.count = count;
+  return entry;
+}
+
+void* SharedArrays::Allocate(const std::string& name, std::size_t count, std::size_t value_bytes) {
+  Entry& entry = AddEntry(name, count, value_bytes);
   entry.offset = end_;
   const std::size_t bytes = count * value_bytes;
   if (bytes == 0) return nullptr;
@@ -200,6 +207,27 @@ void* SharedArrays::Allocate(const std::string& name, std::size_t count, std::si
   if (address == MAP_FAILED) ThrowSystemError("cannot map the shared memory");
   mappings_.emplace_back(address, bytes);
   return address;
+}
+
+std::optional<SharedArrays::FileIdentity> SharedArrays::IdentityOf(int fd) {
+  struct stat status {};
+  if (fd < 0 || fstat(fd, &status) != 0) return std::nullopt;
+  return FileIdentity{
+      .device = status.st_dev,
+      .inode = status.st_ino,
+      .bytes = static_cast<std::uint64_t>(status.st_size),
+      .modified_ns = std::int64_t{status.st_mtim.tv_sec} * 1'000'000'000 + status.st_mtim.tv_nsec};
+}
+
+void SharedArrays::LeaveInFile(const std::string& name, const FileExtent& extent, std::size_t value_bytes) {
+  const int fd = open(path_.c_str(), O_RDONLY | O_CLOEXEC);
+  const std::optional<FileIdentity> identity = IdentityOf(fd);
+  if (fd >= 0) close(fd);
+  if (!identity) ThrowSystemError(fmt::format("cannot stat '{}'", path_.string()));
+  Entry& entry = AddEntry(name, extent.count, value_bytes);
+  entry.in_file = 1;
+  entry.offset = extent.offset;
+  directory_.file = *identity;
 }
 
 void SharedArrays::MarkComplete() {
@@ -243,7 +271,39 @@ void SharedArrays::MoveOut(const Entry& entry, const std::function<void(const vo
   }
 }
 
+std::shared_ptr<void> SharedArrays::MapFile(const Entry& entry) const {
+  const std::size_t bytes = entry.count * entry.value_bytes;
+  const int fd = open(path_.c_str(), O_RDONLY | O_CLOEXEC);
+  if (fd < 0) ThrowSystemError(fmt::format("cannot open '{}'", path_.string()));
+  const std::optional<FileIdentity> identity = IdentityOf(fd);
+  const bool same = identity == directory_.file && entry.offset + bytes <= identity->bytes;
+  if (!same) {
+    close(fd);
+    throw Error(ErrorCode::kBadInput, kHdf5ChildStage,
+                fmt::format("'{}' was replaced or changed while it was read: read it again", path_.string()));
+  }
+  if (bytes == 0) {
+    close(fd);
+    return nullptr;
+  }
+  // Private and populated read-only, then made writable: the page cache's own pages, one pass of
+  // the kernel over them (mapping them writable at once would copy every page), and a page is
+  // copied only where a reading is marked invalid. (Truncating the file while it is mapped would
+  // end this process with SIGBUS: a scan is not rewritten in place while it is processed.)
+  const std::uint64_t start = entry.offset / kPage * kPage;
+  const std::size_t length = bytes + static_cast<std::size_t>(entry.offset - start);
+  void* address = mmap(nullptr, length, PROT_READ, MAP_PRIVATE | MAP_POPULATE, fd, static_cast<off_t>(start));
+  close(fd);
+  if (address == MAP_FAILED || mprotect(address, length, PROT_READ | PROT_WRITE) != 0) {
+    if (address != MAP_FAILED) munmap(address, length);
+    ThrowSystemError(fmt::format("cannot map '{}'", path_.string()));
+  }
+  const std::shared_ptr<void> mapping(address, [length](void* mapped) { munmap(mapped, length); });
+  return {mapping, static_cast<char*>(address) + (entry.offset - start)};
+}
+
 std::shared_ptr<void> SharedArrays::Map(const Entry& entry) const {
+  if (entry.in_file != 0) return MapFile(entry);
   const std::size_t bytes = entry.count * entry.value_bytes;
   if (bytes == 0) return nullptr;
   // Populated at once: one pass of the kernel over the pages instead of a fault per 4 KiB later.
@@ -262,6 +322,7 @@ void ReadFirstInChildProcess(const std::filesystem::path& path, const std::funct
 bool ReadInChildProcess(const std::filesystem::path& path, SharedArrays& arrays,
                         const std::function<void(SharedArrays&)>& read, double timeout_s,
                         const std::function<void()>& meanwhile) {
+  arrays.path_ = path;
   const bool ran = RunInChildProcess(
       path,
       [&] {

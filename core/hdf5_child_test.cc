@@ -9,6 +9,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <optional>
 #include <span>
 #include <string>
@@ -128,6 +129,64 @@ TEST(ReadInChildProcess, MapsTheChildsArrayIntoTheParentWritableAndAlive) {
   EXPECT_EQ(floats->values.back(), static_cast<float>(kFloats - 1) * 0.25f);
   floats->values[7] = -1.0f;
   EXPECT_EQ(floats->values[7], -1.0f);
+}
+
+// A file of `count` floats i / 2 after a 100-byte header (not on a page boundary).
+std::filesystem::path WriteFloatsAfterAHeader(const std::filesystem::path& path, std::size_t count) {
+  std::ofstream out(path, std::ios::binary);
+  const std::string header(100, 'h');
+  out.write(header.data(), static_cast<std::streamsize>(header.size()));
+  for (std::size_t i = 0; i < count; ++i) {
+    const float value = static_cast<float>(i) * 0.5f;
+    out.write(reinterpret_cast<const char*>(&value), sizeof value);
+  }
+  return path;
+}
+
+std::string FileBytes(const std::filesystem::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+TEST(ReadInChildProcess, MapsValuesLeftInTheFileWritableWithoutWritingTheFile) {
+  constexpr std::size_t kFloats = 50'000;
+  const std::filesystem::path path = WriteFloatsAfterAHeader("left_in_file.bin", kFloats);
+  const std::string before = FileBytes(path);
+  SharedArrays arrays;
+  ASSERT_TRUE(ReadInChildProcess(path, arrays, [](SharedArrays& shared) {
+    shared.LeaveInFile<float>("z", {.offset = 100, .count = kFloats});
+  }));
+  std::optional<SharedArrays::Mapped<float>> floats = arrays.Map<float>("z");
+  ASSERT_TRUE(floats.has_value());
+  ASSERT_EQ(floats->values.size(), kFloats);
+  for (std::size_t i = 0; i < kFloats; ++i) ASSERT_EQ(floats->values[i], static_cast<float>(i) * 0.5f) << i;
+  floats->values[3] = -1.0f;
+  EXPECT_EQ(floats->values[3], -1.0f);
+  EXPECT_EQ(FileBytes(path), before) << "a write into the mapping reached the file";
+  const std::optional<std::vector<float>> taken = arrays.Take<float>("z");
+  ASSERT_TRUE(taken.has_value());
+  EXPECT_EQ(taken->at(3), 1.5f);
+  EXPECT_EQ(taken->back(), static_cast<float>(kFloats - 1) * 0.5f);
+  std::filesystem::remove(path);
+}
+
+TEST(ReadInChildProcess, RefusesAFileThatChangedAfterTheChildReadIt) {
+  const std::filesystem::path path = WriteFloatsAfterAHeader("changed_after_read.bin", 1000);
+  SharedArrays arrays;
+  ASSERT_TRUE(ReadInChildProcess(path, arrays, [](SharedArrays& shared) {
+    shared.LeaveInFile<float>("z", {.offset = 100, .count = 1000});
+  }));
+  std::ofstream(path, std::ios::app) << "appended";
+  try {
+    (void)arrays.Map<float>("z");
+    ADD_FAILURE() << "a file that changed was mapped";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.code(), ErrorCode::kBadInput);
+    EXPECT_NE(std::string(e.what()).find("changed_after_read.bin' was replaced or changed"),
+              std::string::npos)
+        << e.what();
+  }
+  std::filesystem::remove(path);
 }
 
 TEST(ReadInChildProcess, LeavesARefusedReadToTheCaller) {

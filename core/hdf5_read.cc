@@ -1,9 +1,13 @@
 // arcwheel::hdf5's reads of numeric datasets: their sizes checked before anything is allocated,
 // and a failed read explained where a filter plugin is missing.
+#include <fcntl.h>
 #include <hdf5.h>
+#include <unistd.h>
 
 #include <algorithm>
+#include <bit>
 #include <cstddef>
+#include <cstring>
 #include <span>
 #include <string>
 #include <vector>
@@ -120,6 +124,53 @@ void File::ReadInto(const std::string& dataset, std::span<double> values) const 
 
 void File::ReadInto(const std::string& dataset, std::span<float> values) const {
   ReadIntoSpan(handle_.id(), OpenDataset(dataset), H5T_NATIVE_FLOAT, values, Where(dataset));
+}
+
+namespace {
+
+// `count` values from `first` on, as libhdf5 reads them and as the file holds them at `offset`.
+bool SameValuesInFile(const Handle& data, const std::filesystem::path& path, std::uint64_t offset,
+                      hsize_t first, hsize_t count) {
+  std::vector<float> read(count), stored(count);
+  const Handle file_space(H5Dget_space(data.id()), H5Sclose);
+  const Handle memory_space(H5Screate_simple(1, &count, nullptr), H5Sclose);
+  if (H5Sselect_hyperslab(file_space.id(), H5S_SELECT_SET, &first, nullptr, &count, nullptr) < 0 ||
+      H5Dread(data.id(), H5T_NATIVE_FLOAT, memory_space.id(), file_space.id(), H5P_DEFAULT, read.data()) < 0)
+    return false;
+  const int fd = open(path.c_str(), O_RDONLY | O_CLOEXEC);
+  if (fd < 0) return false;
+  const auto bytes = static_cast<ssize_t>(count * sizeof(float));
+  const bool got = pread(fd, stored.data(), static_cast<std::size_t>(bytes),
+                         static_cast<off_t>(offset + first * sizeof(float))) == bytes;
+  close(fd);
+  return got && std::memcmp(read.data(), stored.data(), static_cast<std::size_t>(bytes)) == 0;
+}
+
+}  // namespace
+
+std::optional<FileExtent> File::ContiguousFloat32Extent(const std::string& dataset) const {
+  if (image_ || std::endian::native != std::endian::little) return std::nullopt;
+  const Handle data = OpenDataset(dataset);
+  const Handle type(H5Dget_type(data.id()), H5Tclose);
+  const Handle creation(H5Dget_create_plist(data.id()), H5Pclose);
+  const Handle space(H5Dget_space(data.id()), H5Sclose);
+  if (H5Tequal(type.id(), H5T_IEEE_F32LE) <= 0 || !creation.valid() ||
+      H5Pget_layout(creation.id()) != H5D_CONTIGUOUS || H5Pget_external_count(creation.id()) != 0 ||
+      H5Sget_simple_extent_ndims(space.id()) != 1)
+    return std::nullopt;
+  const std::size_t count = hdf5::NumericCount(handle_.id(), data, sizeof(float), Where(dataset));
+  // libhdf5 1.10 gives the address from the file's start, user block included.
+  const haddr_t offset = H5Dget_offset(data.id());
+  std::error_code error;
+  const std::uintmax_t file_bytes = std::filesystem::file_size(path_, error);
+  if (count == 0 || offset == HADDR_UNDEF || offset % alignof(float) != 0 || error ||
+      H5Dget_storage_size(data.id()) != count * sizeof(float) || offset + count * sizeof(float) > file_bytes)
+    return std::nullopt;
+  const hsize_t probe = std::min<hsize_t>(count, 1024);
+  if (!SameValuesInFile(data, path_, offset, 0, probe) ||
+      !SameValuesInFile(data, path_, offset, count - probe, probe))
+    return std::nullopt;
+  return FileExtent{.offset = offset, .count = count};
 }
 
 std::vector<double> File::ReadDoubles(const std::string& dataset) const {

@@ -14,6 +14,7 @@
 
 #include "acquisition/scan_reader.h"
 #include "core/error.h"
+#include "core/sha256.h"
 #include "core/testing/json_file.h"
 #include "core/testing/testing.h"
 
@@ -109,6 +110,38 @@ TEST_F(ForeignFiles, Float32ReadingsKeptAsFloatAreTheSamplesOfAPlainRead) {
     ExpectSameColumn(kept.t_s, plain.t_s, "t");
   }
   EXPECT_GE(kept_as_float, 3) << "h5py's float32 variants (plain, big-endian, compressed) stay float32";
+}
+
+// Whether `path` is mapped into this process (/proc/self/maps names the file of each mapping).
+bool MappedHere(const std::filesystem::path& path) {
+  std::ifstream maps("/proc/self/maps");
+  const std::string canonical = std::filesystem::canonical(path).string();
+  for (std::string line; std::getline(maps, line);) {
+    if (line.size() >= canonical.size() && line.ends_with(canonical)) return true;
+  }
+  return false;
+}
+
+// h5py's contiguous float32 readings are not copied: the reader maps the file's own pages, past a
+// user block, and marks the sensor's invalid readings (its sentinel, readings beyond its range) in
+// this process's copies of the pages it writes, never in the file.
+TEST_F(ForeignFiles, ContiguousFloat32IsMappedFromTheFileWhichStaysAsItWas) {
+  const Scan plain = acquisition::ReadScan(Base());
+  for (const std::string name : {"user_block.h5", "float32_sentinel.h5", "fixed_utf8.h5"}) {
+    SCOPED_TRACE(name);
+    const std::string before = Sha256OfFile(Good(name));
+    {
+      acquisition::ReadOptions keep;
+      keep.keep_float32 = true;
+      Scan kept = acquisition::ReadScan(Good(name), keep);
+      ASSERT_TRUE(kept.holds_float());
+      EXPECT_TRUE(MappedHere(Good(name))) << "the readings were copied, not mapped";
+      kept.WidenToDouble();
+      ExpectSameColumn(kept.z_mm, plain.z_mm, "z");
+    }
+    EXPECT_FALSE(MappedHere(Good(name))) << "the mapping outlived the scan";
+    EXPECT_EQ(Sha256OfFile(Good(name)), before) << "the reader wrote into the file";
+  }
 }
 
 TEST_F(ForeignFiles, EveryVariantReadsToTheSamplesNumbersAndTextOfThePlainFile) {

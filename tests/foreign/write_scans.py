@@ -140,6 +140,16 @@ def write_hdf5_variants(good, bad, columns, numbers, expected):
     good_file("libver_latest.h5", file_options={"libver": "latest"})
     good_file("lzf.h5", dataset_options={"compression": "lzf"})
     good_file("float64_z.h5", z=columns["z"].astype(np.float64))
+    good_file("user_block.h5", file_options={"userblock_size": 512})
+    # A sensor's own marks for its invalid readings, where the plain file has NaN: its sentinel
+    # (invalid_value) and readings beyond its range, in float32 as stored.
+    z = columns["z"].astype(np.float32)
+    invalid = np.flatnonzero(np.isnan(z))
+    z[invalid[0::2]] = np.float32(-999.0)
+    z[invalid[1::2]] = np.float32(numbers["range_max_mm"] + 2.0)
+    good_file("float32_sentinel.h5", z=z)
+    with h5py.File(os.path.join(good, "float32_sentinel.h5"), "a") as f:
+        f["scan"].attrs["invalid_value"] = -999.0
     good_file("mixed_case_keys.h5", number_writer=mixed_case_keys)
     with h5py.File(os.path.join(good, "mixed_case_keys.h5"), "a") as f:
         f["scan"].attrs["Comment"] = "dressed with a 46 um SiC stick"

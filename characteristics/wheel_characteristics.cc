@@ -104,15 +104,17 @@ double RoundnessBound(const FormOperator& op, std::span<const double> radius_mm,
     cx *= 2.0 / static_cast<double>(n);
     cy *= 2.0 / static_cast<double>(n);
   }
-  double low = std::numeric_limits<double>::infinity(), high = -low;
+  // The range of the squared distances: the square root is monotonic and correctly rounded, so
+  // the roots of their extremes are the extremes of the roots, to the bit.
+  double low2 = std::numeric_limits<double>::infinity(), high2 = -low2;
   for (std::size_t i = 0; i < n; ++i) {
     const double dx = radius_mm[i] * cos[i] - cx, dy = radius_mm[i] * sin[i] - cy;
-    const double d = std::sqrt(dx * dx + dy * dy);
-    low = std::min(low, d);
-    high = std::max(high, d);
+    const double d2 = dx * dx + dy * dy;
+    low2 = std::min(low2, d2);
+    high2 = std::max(high2, d2);
   }
   // A rounding's margin: the operator computes the same distances its own way.
-  return (high - low) * 1000.0 * (1.0 + 1e-9) + 1e-9;
+  return (std::sqrt(high2) - std::sqrt(low2)) * 1000.0 * (1.0 + 1e-9) + 1e-9;
 }
 
 // Total indicator reading (um) of one turn about the spindle axis.

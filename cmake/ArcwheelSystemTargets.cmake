@@ -3,7 +3,7 @@
 # built), so the installed package's link interfaces name them, and arcwheelConfig.cmake defines
 # them from the consumer's own find_package(HDF5) and find_library, as cmake/Dependencies.cmake
 # does in the build. Expects HDF5 (C), PkgConfig::FFTW3, FFTW3_THREADS_LIBRARY, Threads, orocos_kdl,
-# urdfdom, OPENCV_INCLUDE_DIR, OPENCV_CORE_LIBRARY, OPENCV_IMGPROC_LIBRARY, OROCOS_KDL_LIBRARY, KDL_PARSER_LIBRARY and KDL_PARSER_INCLUDE_DIR found.
+# urdfdom, OPENCV_INCLUDE_DIR, OPENCV_CORE_LIBRARY, OPENCV_IMGPROC_LIBRARY, and OROCOS_KDL_LIBRARY found.
 if(NOT TARGET arcwheel::hdf5)
   add_library(arcwheel::hdf5 INTERFACE IMPORTED)
   target_include_directories(arcwheel::hdf5 SYSTEM INTERFACE ${HDF5_C_INCLUDE_DIRS} ${HDF5_INCLUDE_DIRS})
@@ -23,7 +23,7 @@ endif()
 if(NOT TARGET arcwheel::kdl)
   # orocos KDL with the URDF parsers: only polishing/robot_kinematics.cc includes their headers.
   add_library(arcwheel::kdl INTERFACE IMPORTED)
-  target_include_directories(arcwheel::kdl SYSTEM INTERFACE ${KDL_PARSER_INCLUDE_DIR} ${urdfdom_INCLUDE_DIRS}
+  target_include_directories(arcwheel::kdl SYSTEM INTERFACE ${urdfdom_INCLUDE_DIRS}
                              ${orocos_kdl_INCLUDE_DIRS})
-  target_link_libraries(arcwheel::kdl INTERFACE ${KDL_PARSER_LIBRARY} ${urdfdom_LIBRARIES} ${OROCOS_KDL_LIBRARY})
+  target_link_libraries(arcwheel::kdl INTERFACE ${urdfdom_LIBRARIES} ${OROCOS_KDL_LIBRARY})
 endif()

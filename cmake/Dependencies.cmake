@@ -15,16 +15,14 @@ find_package(Boost 1.74 REQUIRED)
 find_path(OPENCV_INCLUDE_DIR opencv2/imgproc.hpp PATH_SUFFIXES opencv4 REQUIRED)
 find_library(OPENCV_CORE_LIBRARY opencv_core REQUIRED)
 find_library(OPENCV_IMGPROC_LIBRARY opencv_imgproc REQUIRED)
-# The robot's kinematics (polishing/robot_kinematics.cc): orocos KDL, the URDF parser urdfdom and
-# kdl_parser between them. kdl_parser's own CMake package (catkin-generated) looks for ROS's
-# ament tools, which Debian does not ship: its library and header are found directly.
+# The robot's kinematics (polishing/robot_kinematics.cc): orocos KDL and the URDF parser urdfdom.
+# (Debian's kdl_parser, which joins the two, links some fifty ROS libraries that every start of the
+# program would load: robot_kinematics.cc makes the chain from urdfdom's links itself.)
 find_package(orocos_kdl REQUIRED)
 # Its package names the library by a bare name (orocos-kdl): found as a path, as an installed
 # package's link interface needs.
 find_library(OROCOS_KDL_LIBRARY orocos-kdl REQUIRED)
 find_package(urdfdom REQUIRED)
-find_library(KDL_PARSER_LIBRARY kdl_parser REQUIRED)
-find_path(KDL_PARSER_INCLUDE_DIR kdl_parser/kdl_parser.hpp REQUIRED)
 if(ARCWHEEL_BUILD_PYTHON)
   # Debian's interpreter, which has numpy, h5py and matplotlib (scripts/packages.txt); a python3
   # earlier on the PATH (pyenv) may lack them.

@@ -10,9 +10,8 @@
 #include <kdl/chainfksolverpos_recursive.hpp>
 #include <kdl/frames.hpp>
 #include <kdl/jntarray.hpp>
-#include <kdl/tree.hpp>
-#include <kdl_parser/kdl_parser.hpp>
 #include <numbers>
+#include <vector>
 
 #include "core/error.h"
 
@@ -42,6 +41,49 @@ const Eigen::Matrix3d& LinkToTool0() {
   throw Error(ErrorCode::kBadInput, kRobotKinematicsStage, fmt::format("URDF '{}' {}", source, what));
 }
 
+KDL::Frame FrameOf(const urdf::Pose& pose) {
+  double x = 0.0, y = 0.0, z = 0.0, w = 1.0;
+  pose.rotation.getQuaternion(x, y, z, w);
+  return {KDL::Rotation::Quaternion(x, y, z, w),
+          KDL::Vector(pose.position.x, pose.position.y, pose.position.z)};
+}
+
+// A URDF joint as KDL's segment joint, as kdl_parser makes it: the joint sits at the origin of its
+// frame in the parent link, its axis turned into the parent link's axes. Joints that neither turn
+// nor slide are fixed.
+KDL::Joint JointOf(const urdf::Joint& joint) {
+  const KDL::Frame parent_from_joint = FrameOf(joint.parent_to_joint_origin_transform);
+  const KDL::Vector axis = parent_from_joint.M * KDL::Vector(joint.axis.x, joint.axis.y, joint.axis.z);
+  switch (joint.type) {
+    case urdf::Joint::REVOLUTE:
+    case urdf::Joint::CONTINUOUS:
+      return {joint.name, parent_from_joint.p, axis, KDL::Joint::RotAxis};
+    case urdf::Joint::PRISMATIC:
+      return {joint.name, parent_from_joint.p, axis, KDL::Joint::TransAxis};
+    default:
+      return KDL::Joint(joint.name, KDL::Joint::None);
+  }
+}
+
+// The chain of links from `base` to `tip`: each link from the tip back to the base is a segment
+// whose joint is the link's parent joint. (kdl_parser builds the whole tree first; it also brings
+// some fifty ROS libraries into every start of the program.) False when `tip` does not descend
+// from `base`.
+bool ChainBetween(const urdf::ModelInterface& model, const std::string& base, const std::string& tip,
+                  KDL::Chain& chain) {
+  std::vector<KDL::Segment> segments;
+  urdf::LinkConstSharedPtr link = model.getLink(tip);
+  while (link && link->name != base) {
+    const urdf::JointSharedPtr& joint = link->parent_joint;
+    if (!joint) return false;
+    segments.emplace_back(link->name, JointOf(*joint), FrameOf(joint->parent_to_joint_origin_transform));
+    link = model.getLink(joint->parent_link_name);
+  }
+  if (!link) return false;
+  for (auto segment = segments.rbegin(); segment != segments.rend(); ++segment) chain.addSegment(*segment);
+  return true;
+}
+
 }  // namespace
 
 int JointQuadrant(double angle_rad) { return static_cast<int>(std::floor(angle_rad / (kPi / 2.0))); }
@@ -61,9 +103,7 @@ RobotKinematics::RobotKinematics(const RobotModel& model, const std::string& urd
   console_bridge::setLogLevel(console_bridge::CONSOLE_BRIDGE_LOG_NONE);
   const urdf::ModelInterfaceSharedPtr parsed = urdf::parseURDF(urdf);
   if (!parsed) Refuse(source, "does not parse (not well-formed XML, or not a valid URDF robot)");
-  KDL::Tree tree;
-  if (!kdl_parser::treeFromUrdfModel(*parsed, tree)) Refuse(source, "cannot be read as a KDL tree");
-  if (!tree.getChain("base_link", "tool0", chain_->chain))
+  if (!ChainBetween(*parsed, "base_link", "tool0", chain_->chain))
     Refuse(source, "has no chain of links from 'base_link' to 'tool0'");
   if (chain_->chain.getNrOfJoints() != kRobotJoints) {
     Refuse(source, fmt::format("has {} moving joints from base_link to tool0, a six-axis arm has {}",

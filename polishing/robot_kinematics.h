@@ -1,9 +1,8 @@
 #pragma once
 // Forward and inverse kinematics of a robot model (robot_model.h). The forward kinematics is
-// orocos KDL's over the chain base_link -> tool0 of the model's URDF (read with urdfdom and
-// kdl_parser); the inverse is the closed form of an ortho-parallel arm with a spherical wrist
-// (Brandstoetter et al. 2014), whose geometry is checked against the URDF when the kinematics is
-// made. KDL's headers stay in robot_kinematics.cc.
+// orocos KDL's over the chain base_link -> tool0 of the model's URDF (read with urdfdom); the inverse is the
+// closed form of an ortho-parallel arm with a spherical wrist (Brandstoetter et al. 2014), whose geometry is
+// checked against the URDF when the kinematics is made. KDL's headers stay in robot_kinematics.cc.
 //
 // Frames and units: poses are base_from_flange (the flange's tool0 frame in the robot's base
 // frame), translation in mm; joint angles in rad, with the controller's signs and zeros.

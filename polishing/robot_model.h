@@ -3,7 +3,7 @@
 // of a robot in the cell.
 //
 // A model is a URDF (polishing/robots/, embedded in the library) that orocos KDL reads through
-// urdfdom and kdl_parser (robot_kinematics.h), plus the closed-form geometry of its arm, which
+// urdfdom (robot_kinematics.h), plus the closed-form geometry of its arm, which
 // the inverse kinematics uses and which is checked against the URDF's forward kinematics. The
 // joint limits and speeds are the URDF's: for the shipped models they are those of the
 // manufacturer's product specification, cited in the URDF and in docs/polishing.md.

@@ -117,7 +117,9 @@ void MarkInvalid(std::span<T> readings, double low, double high, IsSentinel is_s
   const auto valid = [&](T z) {
     const double value = z;
     // |value| <= max is false for NaN and +-Inf (a float sensor's over-range reading).
-    return !is_sentinel(z) & (std::abs(value) <= kMax) & (value >= low) & (value <= high);
+    const bool finite = std::abs(value) <= kMax;
+    const bool sentinel = is_sentinel(z);
+    return !sentinel & finite & (value >= low) & (value <= high);
   };
   constexpr std::size_t kBlock = 1024;
   for (std::size_t start = 0; start < readings.size(); start += kBlock) {

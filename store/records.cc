@@ -149,15 +149,27 @@ const std::vector<Characteristic>& PolishCharacteristics() {
   return list;
 }
 
+// What every run's record takes alike from its summary.json: how it was run, the version that
+// wrote it, its folder and the options it ran with (the summary's `options_key` object, as JSON).
+StoredRun RunFromSummary(std::string_view command, const json& summary, const fs::path& outdir,
+                         const std::string& via, std::string_view options_key) {
+  StoredRun run;
+  run.command = command;
+  run.via = via;
+  run.arcwheel_version = String(summary, {schema::summary::kArcwheelVersion});
+  run.output_folder = Absolute(outdir);
+  const json* options = Find(summary, {options_key});
+  run.options = options != nullptr ? options->dump() : "{}";
+  return run;
+}
+
 }  // namespace
 
 StoredRun ProcessRun(const fs::path& outdir, const std::string& via) {
   namespace k = schema::summary;
   const fs::path path = outdir / k::kFileName;
   const json summary = ReadJsonFile(path, "store");
-  StoredRun run;
-  run.command = s::runs::kProcess;
-  run.via = via;
+  StoredRun run = RunFromSummary(s::runs::kProcess, summary, outdir, via, k::kProcessing);
   run.wheel_id = String(summary, {k::kScan, k::scan::kWheelId});
   run.scan_timestamp = String(summary, {k::kScan, k::scan::kTimestamp});
   if (!run.scan_timestamp.empty()) {
@@ -168,10 +180,6 @@ StoredRun ProcessRun(const fs::path& outdir, const std::string& via) {
       run.scan_time_s.reset();  // kept as text; `history` names it when asked
     }
   }
-  run.arcwheel_version = String(summary, {k::kArcwheelVersion});
-  run.output_folder = Absolute(outdir);
-  const json* processing = Find(summary, {k::kProcessing});
-  run.options = processing != nullptr ? processing->dump() : "{}";
   const std::string scan_path = String(summary, {k::kInput, k::input::kPath});
   run.inputs.push_back({std::string(s::inputs::kScan), scan_path.empty() ? "" : Absolute(scan_path),
                         String(summary, {k::kInput, k::input::kSha256})});
@@ -183,13 +191,7 @@ StoredRun ToolpathRun(const fs::path& outdir, const fs::path& job,
                       const std::optional<fs::path>& wheel_summary, const std::string& via) {
   namespace k = schema::toolpath::summary;
   const json summary = ReadJsonFile(outdir / schema::toolpath::kSummaryFileName, "store");
-  StoredRun run;
-  run.command = s::runs::kToolpath;
-  run.via = via;
-  run.arcwheel_version = String(summary, {k::kArcwheelVersion});
-  run.output_folder = Absolute(outdir);
-  const json* used = Find(summary, {k::kJob});
-  run.options = used != nullptr ? used->dump() : "{}";
+  StoredRun run = RunFromSummary(s::runs::kToolpath, summary, outdir, via, k::kJob);
   run.inputs.push_back(Input(s::inputs::kJob, job));
   if (wheel_summary) {
     run.inputs.push_back(Input(s::inputs::kWheel, *wheel_summary));
@@ -204,13 +206,7 @@ StoredRun PolishRun(const fs::path& outdir, const fs::path& job, const std::opti
                     const std::string& via) {
   namespace k = schema::polish::summary;
   const json summary = ReadJsonFile(outdir / schema::polish::kSummaryFileName, "store");
-  StoredRun run;
-  run.command = s::runs::kPolish;
-  run.via = via;
-  run.arcwheel_version = String(summary, {k::kArcwheelVersion});
-  run.output_folder = Absolute(outdir);
-  const json* used = Find(summary, {k::kJob});
-  run.options = used != nullptr ? used->dump() : "{}";
+  StoredRun run = RunFromSummary(s::runs::kPolish, summary, outdir, via, k::kJob);
   run.inputs.push_back(Input(s::inputs::kJob, job));
   fs::path map = error_map.value_or(String(summary, {k::kJob, k::job::kErrorMap, k::job::error_map::kFile}));
   if (!map.empty() && map.is_relative() && !fs::exists(map)) map = job.parent_path() / map;

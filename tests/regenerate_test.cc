@@ -5,6 +5,7 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <nlohmann/json.hpp>
@@ -18,6 +19,7 @@
 #include "grinding/prediction.h"
 #include "polishing/error_map_io.h"
 #include "polishing/job.h"
+#include "store/store.h"
 #include "surfaces/surface.h"
 #include "tests/trial_jobs.h"
 
@@ -89,7 +91,7 @@ class Regenerate : public ::testing::Test {
     ASSERT_EQ(sim.exit_status, 0) << sim.output;
     WriteText(dir / "part.json", SmallTrialPart().dump(2));
     WriteText(dir / "polish.json", TrialPolishJob().dump(2));
-    run_ = RunArcwheel(Command(dir / "first"));
+    run_ = RunArcwheel(Command(dir / "first", "polish.json", "--db " + (dir / "runs.sqlite").string()));
   }
   static void TearDownTestSuite() { dir_.reset(); }
 
@@ -129,6 +131,32 @@ TEST_F(Regenerate, WritesEachStepsFilesAndOneReport) {
     EXPECT_THAT(html, HasSubstr(step));
   EXPECT_GT(fs::file_size(out / "regenerate_report.pdf"), 1000u);
   EXPECT_THAT(testing::PdfText(out / "regenerate_report.pdf"), HasSubstr("Polishing plan"));
+}
+
+// Each step is recorded in the store as its own summary tells it: the command, run by
+// `regenerate`, the step's folder, the version that wrote it and the options it ran with.
+TEST_F(Regenerate, RecordsEachStepInTheStoreAsItsSummaryTellsIt) {
+  ASSERT_EQ(run_.exit_status, 0) << run_.output;
+  const fs::path out = *dir_ / "first";
+  store::Store db = store::Store::Open((*dir_ / "runs.sqlite").string());
+  const std::vector<store::StoredRun> runs = db.Runs();
+  ASSERT_EQ(runs.size(), 3u);
+  struct Step {
+    std::string command, folder, summary, options_key;
+  };
+  for (const Step& step : {Step{"process", "wheel", "summary.json", "processing"},
+                           Step{"toolpath", "toolpath", "toolpath_summary.json", "job"},
+                           Step{"polish", "polish", "polish_summary.json", "job"}}) {
+    SCOPED_TRACE(step.command);
+    const auto run = std::find_if(runs.begin(), runs.end(),
+                                  [&](const store::StoredRun& r) { return r.command == step.command; });
+    ASSERT_NE(run, runs.end());
+    const nlohmann::json summary = nlohmann::json::parse(ReadText(out / step.folder / step.summary));
+    EXPECT_EQ(run->via, "regenerate");
+    EXPECT_EQ(fs::weakly_canonical(run->output_folder), fs::weakly_canonical(out / step.folder));
+    EXPECT_EQ(run->arcwheel_version, summary.at("arcwheel_version").get<std::string>());
+    EXPECT_EQ(nlohmann::json::parse(run->options), summary.at(step.options_key));
+  }
 }
 
 // The toolpath's own geometry: eq. 5 gives Yw = Y + Ra ny (n the upward unit normal), so every

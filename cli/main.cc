@@ -14,6 +14,7 @@
 
 #include "cli/commands.h"
 #include "core/error.h"
+#include "core/free_memory.h"
 #include "core/interrupt.h"
 #include "core/version.h"
 
@@ -111,6 +112,7 @@ std::vector<std::string> ArgumentsForCli11(int argc, char** argv) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  arcwheel::KeepFreedBlocksForReuse();
   CLI::App app{"arcwheel: metrology and toolpaths for arc-profile diamond wheels", "arcwheel"};
   app.footer(kExitCodes);
   app.require_subcommand(1);

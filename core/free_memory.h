@@ -1,10 +1,14 @@
 #pragma once
-// Gives the heap's free pages back to the system once a stage has dropped large arrays.
+// The heap's policy for a stage's working arrays.
 //
-// glibc keeps a freed block inside its arena, resident, when the block was smaller than its mmap
-// threshold, which rises to the size of every mapped block freed (up to 32 MiB): after the first
-// few stages of a long scan, arrays of several MiB come from the arenas, and what one stage frees
-// stays in the process's peak memory while later stages allocate arrays of other sizes beside it.
+// A stage's arrays (megabytes each) are freed and allocated again by the next stage. By default
+// glibc gives such blocks back to the kernel and maps them anew, and every page of a block mapped
+// anew faults on its first touch, which costs tens of microseconds a page on some virtual
+// machines (a 1e8-sample `process` took some 45 000 faults). The program keeps blocks up to
+// malloc's largest mapping threshold (32 MiB) in the heap for reuse instead; larger ones (a long
+// scan's columns) are still mapped and unmapped whole. Where a stage has dropped large arrays and
+// the next allocates arrays of other sizes, `ReturnFreedMemory` gives the heap's free pages back,
+// so that they do not stay in the process's peak memory beside the new ones.
 
 #include <cstdlib>  // defines __GLIBC__ on glibc
 #if defined(__GLIBC__)
@@ -12,6 +16,15 @@
 #endif
 
 namespace arcwheel {
+
+// Called once, first thing in main(): a library's users keep their own heap policy.
+inline void KeepFreedBlocksForReuse() {
+#if defined(__GLIBC__)
+  constexpr int kLargestHeapBlock = 32 << 20;  // glibc's own maximum for this threshold
+  mallopt(M_MMAP_THRESHOLD, kLargestHeapBlock);
+  mallopt(M_TRIM_THRESHOLD, 1 << 30);
+#endif
+}
 
 inline void ReturnFreedMemory() {
 #if defined(__GLIBC__)

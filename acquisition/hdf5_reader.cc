@@ -7,8 +7,10 @@
 #include <string>
 #include <type_traits>
 #include <utility>
+#include <variant>
 #include <vector>
 
+#include "acquisition/read_in_child.h"
 #include "acquisition/scan_format.h"
 #include "acquisition/scan_metadata_keys.h"
 #include "acquisition/scan_reader.h"
@@ -165,28 +167,24 @@ Scan Finish(Scan scan, const hdf5::File& file, const ReadOptions& options) {
 
 }  // namespace
 
-Scan ReadHdf5Scan(const std::filesystem::path& path, const ReadOptions& options) {
-  // The data are read once, in the child process that guards against libhdf5 crashing on a
-  // damaged file; here only the header is read again (what the child has already read safely).
-  hdf5::SharedArrays arrays;
-  const bool handed = hdf5::ReadInChildProcess(
-      path, arrays,
-      [&](hdf5::SharedArrays& shared) {
-        const hdf5::File file = hdf5::File::OpenReadOnly(path);
-        const Scan header = ReadHeader(file);
-        ReadColumns(
-            file, header.metadata, options,
-            [&](const std::string& name, std::size_t count, auto type) {
-              return shared.Allocate<decltype(type)>(name, count);
-            },
-            [&](const std::string& name) {
-              const std::optional<hdf5::FileExtent> extent = file.ContiguousFloat32Extent(name);
-              if (extent) shared.LeaveInFile<float>(name, *extent);
-              return extent.has_value();
-            });
+namespace internal {
+
+void ReadHelixInChild(const hdf5::File& file, const ReadOptions& options, hdf5::SharedArrays& shared) {
+  const Scan header = ReadHeader(file);
+  ReadColumns(
+      file, header.metadata, options,
+      [&](const std::string& name, std::size_t count, auto type) {
+        return shared.Allocate<decltype(type)>(name, count);
       },
-      0.0, options.while_reading);
-  const hdf5::File file = hdf5::File::OpenReadOnly(path);
+      [&](const std::string& name) {
+        const std::optional<hdf5::FileExtent> extent = file.ContiguousFloat32Extent(name);
+        if (extent) shared.LeaveInFile<float>(name, *extent);
+        return extent.has_value();
+      });
+}
+
+Scan HelixFromChild(const hdf5::File& file, hdf5::SharedArrays& arrays, bool handed,
+                    const ReadOptions& options) {
   if (!handed) return ReadHdf5Scan(file, options);
   Scan scan = ReadHeader(file);
   // The float32 readings (the largest column, and the one a large scan has) stay in the pages the
@@ -200,6 +198,21 @@ Scan ReadHdf5Scan(const std::filesystem::path& path, const ReadOptions& options)
   take("/scan/z");
   for (const auto& [name, member] : kColumns) take(name);
   return Finish(std::move(scan), file, options);
+}
+
+}  // namespace internal
+
+Scan ReadHdf5Scan(const std::filesystem::path& path, const ReadOptions& options) {
+  // The data are read once, in the child process that guards against libhdf5 crashing on a
+  // damaged file; here only the header is read again (what the child has already read safely).
+  hdf5::SharedArrays arrays;
+  const bool handed = hdf5::ReadInChildProcess(
+      path, arrays,
+      [&](hdf5::SharedArrays& shared) {
+        internal::ReadHelixInChild(hdf5::File::OpenReadOnly(path), options, shared);
+      },
+      0.0, options.while_reading);
+  return internal::HelixFromChild(hdf5::File::OpenReadOnly(path), arrays, handed, options);
 }
 
 Scan ReadHdf5Scan(const hdf5::File& file, const ReadOptions& options) {
@@ -218,6 +231,32 @@ Scan ReadHdf5Scan(const hdf5::File& file, const ReadOptions& options) {
       },
       [](const std::string&) { return false; });
   return Finish(std::move(scan), file, options);
+}
+
+std::variant<Scan, ProfileScan> ReadAnyScan(const std::filesystem::path& path, const ReadOptions& options) {
+  const ScanFormat format =
+      ScanFormatOfContent(path, options.format, !options.columns.empty(), "acquisition");
+  if (format != ScanFormat::kHdf5 || !options.format.empty()) {
+    if (!IsProfileFormat(format)) return ReadScan(path, options);
+    if (options.while_reading) options.while_reading();
+    return ReadProfileScan(path, format, options.settings);
+  }
+  // One child reads the file as the kind its groups tell (a /profile group: a line-profile scan).
+  hdf5::SharedArrays arrays;
+  const bool handed = hdf5::ReadInChildProcess(
+      path, arrays,
+      [&](hdf5::SharedArrays& shared) {
+        const hdf5::File file = hdf5::File::OpenReadOnly(path);
+        if (file.HasObject("/profile")) {
+          internal::ReadProfileInChild(path, shared);
+        } else {
+          internal::ReadHelixInChild(file, options, shared);
+        }
+      },
+      0.0, options.while_reading);
+  const hdf5::File file = hdf5::File::OpenReadOnly(path);
+  if (file.HasObject("/profile")) return internal::ProfileFromChild(path, arrays, handed, options.settings);
+  return internal::HelixFromChild(file, arrays, handed, options);
 }
 
 Scan ReadScan(const std::filesystem::path& path, const ReadOptions& options) {

@@ -13,6 +13,7 @@
 #include <sstream>
 
 #include "acquisition/profile_scan.h"
+#include "acquisition/read_in_child.h"
 #include "acquisition/scan_metadata_keys.h"
 #include "acquisition/scan_settings.h"
 #include "core/check.h"
@@ -382,17 +383,6 @@ bool IsProfileFormat(ScanFormat format) {
          format == ScanFormat::kKeyenceLj;
 }
 
-std::optional<ScanFormat> ProfileFormatOf(const std::filesystem::path& path, std::string_view forced,
-                                          bool has_column_map) {
-  const ScanFormat format = ScanFormatOfContent(path, forced, has_column_map, "acquisition");
-  if (IsProfileFormat(format)) return format;
-  if (format != ScanFormat::kHdf5 || !forced.empty()) return std::nullopt;
-  // Read first in a child process, as every HDF5 file a user gives (core/hdf5.h).
-  hdf5::ReadFirstInChildProcess(path, [&] { (void)hdf5::File::OpenReadOnly(path).HasObject("/profile"); });
-  if (hdf5::File::OpenReadOnly(path).HasObject("/profile")) return ScanFormat::kProfileHdf5;
-  return std::nullopt;
-}
-
 double ProfileScan::PhaseDeg(std::size_t frame) const {
   const double start = metadata.start_phase_deg;
   if (!encoder.empty() && placement.encoder_counts_per_rev > 0.0) {
@@ -423,10 +413,20 @@ ProfileScan ReadProfileScan(const std::filesystem::path& path, ScanFormat format
   // The readings are read once, in the child process that guards against libhdf5 crashing on a
   // damaged file (core/hdf5.h); here only the header and the small columns are read again.
   hdf5::SharedArrays arrays;
-  const bool handed = hdf5::ReadInChildProcess(path, arrays, [&](hdf5::SharedArrays& shared) {
-    (void)ReadProfileHdf5(path,
-                          [&](std::size_t count) { return shared.Allocate<double>("/profile/z", count); });
-  });
+  const bool handed = hdf5::ReadInChildProcess(
+      path, arrays, [&](hdf5::SharedArrays& shared) { internal::ReadProfileInChild(path, shared); });
+  return internal::ProfileFromChild(path, arrays, handed, settings);
+}
+
+namespace internal {
+
+void ReadProfileInChild(const std::filesystem::path& path, hdf5::SharedArrays& shared) {
+  (void)ReadProfileHdf5(path,
+                        [&](std::size_t count) { return shared.Allocate<double>("/profile/z", count); });
+}
+
+ProfileScan ProfileFromChild(const std::filesystem::path& path, hdf5::SharedArrays& arrays, bool handed,
+                             const ScanSettingsFile* settings) {
   ProfileScan scan = ReadProfileHdf5(path, nullptr);
   if (std::optional<std::vector<double>> z = handed ? arrays.Take<double>("/profile/z") : std::nullopt) {
     scan.z_mm = std::move(*z);
@@ -439,10 +439,12 @@ ProfileScan ReadProfileScan(const std::filesystem::path& path, ScanFormat format
     }
   }
   ApplyProfileSettings(settings, scan);
-  if (!scan.encoder.empty()) UnwrapEncoder(scan, StageOf(format));
+  if (!scan.encoder.empty()) UnwrapEncoder(scan, StageOf(ScanFormat::kProfileHdf5));
   ValidateProfileScan(scan);
   return scan;
 }
+
+}  // namespace internal
 
 void ValidateProfileScan(const ProfileScan& scan) {
   const std::string stage =

@@ -57,12 +57,6 @@ inline constexpr std::size_t kMinValidPointsPerFrame = 8;
 
 [[nodiscard]] bool IsProfileFormat(ScanFormat format);
 
-// The format of a line-profile file, or empty for a point-sensor scan: by `forced` (--format),
-// else by the extension and a sniff (scan_format.h), and for an HDF5 file by a /profile group. A
-// column map (`--columns`, has_column_map) always reads a point scan.
-[[nodiscard]] std::optional<ScanFormat> ProfileFormatOf(const std::filesystem::path& path,
-                                                        std::string_view forced, bool has_column_map = false);
-
 // Reads a line-profile scan in `format` (kProfileHdf5, kGocator or kKeyenceLj), merges `settings`
 // (may be null: the keys of scan_settings.h plus the placement's) and validates it. Throws
 // Error{kBadInput} naming the file, the frame and the column for: frames out of order, an encoder

@@ -7,7 +7,9 @@
 #include <filesystem>
 #include <fstream>
 #include <string>
+#include <variant>
 
+#include "acquisition/scan_reader.h"
 #include "acquisition/scan_settings.h"
 #include "core/error.h"
 #include "core/hdf5.h"
@@ -180,17 +182,7 @@ ProfileScan SmallSimulatedScan() {
   return SimulateProfileScan(PaperTestWheel(), settings);
 }
 
-class ProfileLayouts : public ::testing::TestWithParam<ScanFormat> {};
-
-TEST_P(ProfileLayouts, ReadBackTheSimulatedReadingsExactly) {
-  const ProfileScan simulated = SmallSimulatedScan();
-  const std::filesystem::path path = std::filesystem::path(::testing::TempDir()) /
-                                     (std::string("profile_") + std::string(InfoOf(GetParam()).name) +
-                                      (GetParam() == ScanFormat::kProfileHdf5 ? ".h5" : ".csv"));
-  WriteProfileScan(simulated, GetParam(), path);
-  const ScanSettingsFile settings = Settings(ProfileScanSettingsJson(simulated));
-  ASSERT_EQ(ProfileFormatOf(path, ""), GetParam());
-  const ProfileScan read = ReadProfileScan(path, GetParam(), &settings);
+void ExpectReadBackExactly(const ProfileScan& read, const ProfileScan& simulated) {
   ASSERT_EQ(read.frames(), simulated.frames());
   EXPECT_EQ(read.x_mm, simulated.x_mm);
   for (std::size_t i = 0; i < read.z_mm.size(); ++i) {
@@ -203,6 +195,47 @@ TEST_P(ProfileLayouts, ReadBackTheSimulatedReadingsExactly) {
   for (std::size_t f = 0; f < read.frames(); ++f)
     EXPECT_NEAR(read.PhaseDeg(f), simulated.PhaseDeg(f), 1e-9) << f;
   EXPECT_DOUBLE_EQ(read.placement.encoder_counts_per_rev, 64.0);
+}
+
+class ProfileLayouts : public ::testing::TestWithParam<ScanFormat> {};
+
+TEST_P(ProfileLayouts, ReadBackTheSimulatedReadingsExactly) {
+  const ProfileScan simulated = SmallSimulatedScan();
+  const std::filesystem::path path = std::filesystem::path(::testing::TempDir()) /
+                                     (std::string("profile_") + std::string(InfoOf(GetParam()).name) +
+                                      (GetParam() == ScanFormat::kProfileHdf5 ? ".h5" : ".csv"));
+  WriteProfileScan(simulated, GetParam(), path);
+  const ScanSettingsFile settings = Settings(ProfileScanSettingsJson(simulated));
+  // Read by its named layout, and by what `process` finds in the file (ReadAnyScan).
+  ReadOptions options;
+  options.settings = &settings;
+  std::variant<Scan, ProfileScan> found = ReadAnyScan(path, options);
+  ASSERT_TRUE(std::holds_alternative<ProfileScan>(found));
+  for (const ProfileScan& read :
+       {ReadProfileScan(path, GetParam(), &settings), std::get<ProfileScan>(found)}) {
+    ExpectReadBackExactly(read, simulated);
+  }
+  std::filesystem::remove(path);
+}
+
+TEST(ReadAnyScan, ReadsAHelicalScanAsOne) {
+  const std::filesystem::path path = std::filesystem::path(::testing::TempDir()) / "any_helix.h5";
+  ScanSettings settings;
+  settings.sample_period_s = 1e-3;
+  settings.feed_mm_per_min = 600.0;
+  const Scan simulated = SimulateScan(PaperTestWheel(), settings).scan;
+  WriteScan(simulated, /*float32=*/false, path);
+  std::variant<Scan, ProfileScan> found = ReadAnyScan(path);
+  ASSERT_TRUE(std::holds_alternative<Scan>(found));
+  const std::vector<double>& z_mm = std::get<Scan>(found).z_mm;
+  ASSERT_EQ(z_mm.size(), simulated.z_mm.size());
+  for (std::size_t i = 0; i < z_mm.size(); ++i) {
+    if (std::isnan(simulated.z_mm[i])) {
+      EXPECT_TRUE(std::isnan(z_mm[i])) << i;
+    } else {
+      EXPECT_EQ(z_mm[i], simulated.z_mm[i]) << i;
+    }
+  }
   std::filesystem::remove(path);
 }
 

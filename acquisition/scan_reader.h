@@ -12,8 +12,10 @@
 #include <functional>
 #include <string>
 #include <string_view>
+#include <variant>
 #include <vector>
 
+#include "acquisition/profile_scan.h"
 #include "acquisition/scan.h"
 #include "acquisition/scan_format.h"
 #include "core/hdf5.h"
@@ -44,6 +46,14 @@ struct ReadOptions {
 // By the format that options.format names, or that the file's extension and a sniff of its header
 // select (scan_format.h, ScanFormatOfContent): ReadHdf5Scan, ReadCsvScan or ReadSensorScan.
 [[nodiscard]] Scan ReadScan(const std::filesystem::path& path, const ReadOptions& options = {});
+
+// A scan of either kind, as `process` reads it: a line-profile scan (profile_scan.h) when
+// options.format names a profile layout, or the extension and a sniff select one, or an HDF5 file
+// (not forced to "hdf5") has a /profile group; else a point-sensor scan, as ReadScan reads it. An
+// HDF5 file is opened in one child process for both, the kind and the data (ReadHdf5Scan).
+// options.settings and options.while_reading serve both kinds.
+[[nodiscard]] std::variant<Scan, ProfileScan> ReadAnyScan(const std::filesystem::path& path,
+                                                          const ReadOptions& options = {});
 
 // formats.md 2.1: group /scan, dataset /scan/z, optional /scan/t, /scan/angle, /scan/y. The data
 // are read once, in a child process that guards against libhdf5 crashing on a damaged file

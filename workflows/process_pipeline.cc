@@ -341,34 +341,29 @@ ProcessPipelineResult RunProcessPipeline(const std::string& scan_path, const std
                                          ProcessPipelineOptions options, Progress& progress) {
   ResolveProcessPipelineOptions(options);
   progress.Update("reading", 0.0);
-  // ReadScan forks (an HDF5 file is read first in a child process, core/hdf5_child.cc), and no
+  // ReadAnyScan forks (an HDF5 file is read first in a child process, core/hdf5_child.cc), and no
   // thread may be alive at fork(): the input's SHA-256 starts after it, on the second core while
   // the child reads (this process only waits for it then).
   StageClock clock;
   clock.Start("reading");
-  if (const auto profile =
-          acquisition::ProfileFormatOf(scan_path, options.scan_format, !options.columns.empty())) {
-    acquisition::ProfileScan scan = acquisition::ReadProfileScan(
-        scan_path, *profile, options.scan_settings ? &*options.scan_settings : nullptr);
-    std::future<std::string> hash =
-        std::async(std::launch::async, [scan_path] { return Sha256OfFile(scan_path); });
-    return RunOnProfileScan(std::move(scan), scan_path, std::move(hash), outdir, options, progress,
-                            std::move(clock));
-  }
   std::future<std::string> sha256;
   const auto start_hash = [&] {
     sha256 = std::async(std::launch::async, [scan_path] { return Sha256OfFile(scan_path); });
   };
-  acquisition::Scan scan =
-      acquisition::ReadScan(scan_path, {.keep_float32 = true,
-                                        .while_reading = start_hash,
-                                        .settings = options.scan_settings ? &*options.scan_settings : nullptr,
-                                        .format = options.scan_format,
-                                        .columns = options.columns});
-  clock.Stop();
+  std::variant<acquisition::Scan, acquisition::ProfileScan> scan = acquisition::ReadAnyScan(
+      scan_path, {.keep_float32 = true,
+                  .while_reading = start_hash,
+                  .settings = options.scan_settings ? &*options.scan_settings : nullptr,
+                  .format = options.scan_format,
+                  .columns = options.columns});
   if (!sha256.valid()) start_hash();  // a reader that had nothing to overlap
-  return RunOnScan(std::move(scan), scan_path, std::move(sha256), outdir, options, progress,
-                   std::move(clock));
+  if (auto* profile = std::get_if<acquisition::ProfileScan>(&scan)) {
+    return RunOnProfileScan(std::move(*profile), scan_path, std::move(sha256), outdir, options, progress,
+                            std::move(clock));
+  }
+  clock.Stop();
+  return RunOnScan(std::get<acquisition::Scan>(std::move(scan)), scan_path, std::move(sha256), outdir,
+                   options, progress, std::move(clock));
 }
 
 ProcessPipelineResult RunProcessPipeline(acquisition::Scan scan, std::string input_sha256,

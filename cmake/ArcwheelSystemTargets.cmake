@@ -1,9 +1,9 @@
-# arcwheel::hdf5, arcwheel::fftw3_threads, arcwheel::opencv and arcwheel::kdl: targets for system libraries whose packages give
+# arcwheel::hdf5, arcwheel::fftw3_threads and arcwheel::kdl: targets for system libraries whose packages give
 # CMake variables or a bare library rather than a target. They are imported targets (nothing is
 # built), so the installed package's link interfaces name them, and arcwheelConfig.cmake defines
 # them from the consumer's own find_package(HDF5) and find_library, as cmake/Dependencies.cmake
 # does in the build. Expects HDF5 (C), PkgConfig::FFTW3, FFTW3_THREADS_LIBRARY, Threads, orocos_kdl,
-# urdfdom, OPENCV_INCLUDE_DIR, OPENCV_CORE_LIBRARY, OPENCV_IMGPROC_LIBRARY, and OROCOS_KDL_LIBRARY found.
+# urdfdom and OROCOS_KDL_LIBRARY found.
 if(NOT TARGET arcwheel::hdf5)
   add_library(arcwheel::hdf5 INTERFACE IMPORTED)
   target_include_directories(arcwheel::hdf5 SYSTEM INTERFACE ${HDF5_C_INCLUDE_DIRS} ${HDF5_INCLUDE_DIRS})
@@ -13,12 +13,6 @@ endif()
 if(NOT TARGET arcwheel::fftw3_threads)
   add_library(arcwheel::fftw3_threads INTERFACE IMPORTED)
   target_link_libraries(arcwheel::fftw3_threads INTERFACE ${FFTW3_THREADS_LIBRARY} PkgConfig::FFTW3 Threads::Threads)
-endif()
-if(NOT TARGET arcwheel::opencv)
-  # OpenCV's core and imgproc: only polishing/error_map_scattered.cc includes their headers.
-  add_library(arcwheel::opencv INTERFACE IMPORTED)
-  target_include_directories(arcwheel::opencv SYSTEM INTERFACE ${OPENCV_INCLUDE_DIR})
-  target_link_libraries(arcwheel::opencv INTERFACE ${OPENCV_IMGPROC_LIBRARY} ${OPENCV_CORE_LIBRARY})
 endif()
 if(NOT TARGET arcwheel::kdl)
   # orocos KDL with the URDF parsers: only polishing/robot_kinematics.cc includes their headers.

@@ -9,12 +9,9 @@ find_package(OpenSSL REQUIRED COMPONENTS Crypto)
 find_package(Threads REQUIRED)
 # Boost.Math (header-only): the chi-square distribution of the wheel model's Wald test (fitting/wheel_model_knots.cc).
 find_package(Boost 1.74 REQUIRED)
-# OpenCV: only the Delaunay triangulation (cv::Subdiv2D) for scattered error maps (polishing/).
-# Debian's libopencv-core-dev and libopencv-imgproc-dev carry no CMake package (libopencv-dev,
-# which does, pulls in every module and GDAL): the two libraries and their headers are found directly.
-find_path(OPENCV_INCLUDE_DIR opencv2/imgproc.hpp PATH_SUFFIXES opencv4 REQUIRED)
-find_library(OPENCV_CORE_LIBRARY opencv_core REQUIRED)
-find_library(OPENCV_IMGPROC_LIBRARY opencv_imgproc REQUIRED)
+# qhull: the Delaunay triangulation of scattered error maps (polishing/error_map_scattered.cc),
+# its reentrant C library (Qhull::qhull_r), as scipy.spatial.Delaunay uses it.
+find_package(Qhull REQUIRED)
 # The robot's kinematics (polishing/robot_kinematics.cc): orocos KDL and the URDF parser urdfdom.
 # (Debian's kdl_parser, which joins the two, links some fifty ROS libraries that every start of the
 # program would load: robot_kinematics.cc makes the chain from urdfdom's links itself.)

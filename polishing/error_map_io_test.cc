@@ -837,6 +837,11 @@ TEST(ReadScatteredCsv, RefusesTooFewCollinearOrCoincidentPointsNamingTheFile) {
   EXPECT_TRUE(Contains(m, "pts.csv'") && Contains(m, "line 3") && Contains(m, "line 6") &&
               Contains(m, "one place"))
       << m;
+  // Two points 1e-11 of the map's size apart, inside the hull (qhull keeps both).
+  m = error("x_mm,y_mm,error_um\n0,0,1\n10,0,2\n0,10,3\n10,10,4\n5,5,1\n5,5.0000000001,2\n");
+  EXPECT_TRUE(Contains(m, "pts.csv'") && Contains(m, "line 6") && Contains(m, "line 7") &&
+              Contains(m, "one place"))
+      << m;
   m = error("x_mm,y_mm,error_um\n0,0,1\n1,0,nan\n0,1,3\n");
   EXPECT_TRUE(Contains(m, "pts.csv' line 3")) << m;
 }

@@ -1,15 +1,16 @@
-// Scattered error-map points onto a regular grid: a Delaunay triangulation (cv::Subdiv2D) and
-// linear interpolation within each triangle.
+// Scattered error-map points onto a regular grid: a Delaunay triangulation (qhull, as
+// scipy.spatial.Delaunay makes it) and linear interpolation within each triangle.
 #include <fmt/core.h>
+#include <libqhull_r/qhull_ra.h>
 
 #include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstddef>
-#include <opencv2/imgproc.hpp>
+#include <cstdio>
+#include <limits>
 #include <span>
 #include <string>
-#include <tuple>
 #include <vector>
 
 #include "core/error.h"
@@ -21,7 +22,7 @@ namespace {
 
 using namespace internal;
 
-// Scattered points: triangulation by cv::Subdiv2D, interpolation in double precision.
+// Scattered points: triangulation by qhull, interpolation in double precision.
 
 struct Triangle {
   std::array<int, 3> v;
@@ -64,62 +65,125 @@ void CheckSpread(std::span<const ScatteredPoint> points, const std::string& name
   }
 }
 
-Triangulation Triangulate(std::span<const ScatteredPoint> points, const std::string& name) {
-  CheckSpread(points, name);
+// qhull's messages, kept in memory for an error's text.
+class MessageBuffer {
+ public:
+  MessageBuffer() : file_(open_memstream(&text_, &size_)) {}
+  ~MessageBuffer() {
+    if (file_ != nullptr) std::fclose(file_);
+    std::free(text_);
+  }
+  MessageBuffer(const MessageBuffer&) = delete;
+  MessageBuffer& operator=(const MessageBuffer&) = delete;
+
+  [[nodiscard]] FILE* file() const { return file_; }
+  [[nodiscard]] std::string Text() {
+    if (file_ != nullptr) std::fflush(file_);
+    std::string text = text_ != nullptr ? std::string(text_, size_) : std::string();
+    const std::size_t end = text.find_last_not_of(" \n");
+    return end == std::string::npos ? text : text.substr(0, end + 1);
+  }
+
+ private:
+  char* text_ = nullptr;
+  std::size_t size_ = 0;
+  FILE* file_;
+};
+
+// One qhull computation, freed however it ends.
+class Qhull {
+ public:
+  Qhull() { qh_zero(&qh_, nullptr); }
+  ~Qhull() {
+    int current_long = 0, total_long = 0;
+    qh_freeqhull(&qh_, !qh_ALL);
+    qh_memfreeshort(&qh_, &current_long, &total_long);
+  }
+  Qhull(const Qhull&) = delete;
+  Qhull& operator=(const Qhull&) = delete;
+
+  qhT* get() { return &qh_; }
+
+ private:
+  qhT qh_;
+};
+
+// The point nearest to points[k] other than itself (the message for points at one place).
+std::size_t NearestOther(std::span<const ScatteredPoint> points, std::size_t k) {
+  std::size_t nearest = k == 0 ? 1 : 0;
+  double best = std::numeric_limits<double>::infinity();
+  for (std::size_t j = 0; j < points.size(); ++j) {
+    if (j == k) continue;
+    const double d = std::hypot(points[j].x_mm - points[k].x_mm, points[j].y_mm - points[k].y_mm);
+    if (d < best) best = d, nearest = j;
+  }
+  return nearest;
+}
+
+[[noreturn]] void FailAtOnePlace(std::span<const ScatteredPoint> points, std::size_t a, std::size_t b,
+                                 const std::string& name) {
+  Fail(name, fmt::format("{} ({}, {}) mm and {} ({}, {}) mm lie at one place (closer than 1e-7 of the map's "
+                         "size)",
+                         PointName(points, std::min(a, b)), points[std::min(a, b)].x_mm,
+                         points[std::min(a, b)].y_mm, PointName(points, std::max(a, b)),
+                         points[std::max(a, b)].x_mm, points[std::max(a, b)].y_mm));
+}
+
+// Two points closer than 1e-7 of the map's size make a triangle of no use (and qhull drops an exact
+// repeat): refused, naming both. The nearest neighbour of a point is one of its Delaunay
+// neighbours, so the triangles' edges and the points qhull left out are all that need a look.
+void CheckNoTwoAtOnePlace(std::span<const ScatteredPoint> points, const Triangulation& t,
+                          const std::string& name) {
   double x_min = points[0].x_mm, x_max = x_min, y_min = points[0].y_mm, y_max = y_min;
   for (const ScatteredPoint& p : points) {
     x_min = std::min(x_min, p.x_mm), x_max = std::max(x_max, p.x_mm);
     y_min = std::min(y_min, p.y_mm), y_max = std::max(y_max, p.y_mm);
   }
-  // Subdiv2D works in float inside an integer rectangle: centre the points on 0 and scale them to
-  // +-1e6 in a rectangle 100 times larger, so that its outer triangle lies far from the hull.
-  const double cx = 0.5 * (x_min + x_max), cy = 0.5 * (y_min + y_max);
-  const double half = 0.5 * std::max(x_max - x_min, y_max - y_min);
-  const double s = 1e6 / half;
-  constexpr int kRect = 100'000'000;
+  const double apart_mm = 1e-7 * std::max(x_max - x_min, y_max - y_min);
+  std::vector<char> is_vertex(points.size(), 0);
+  for (const Triangle& tri : t.triangles) {
+    for (std::size_t c = 0; c < 3; ++c) {
+      const auto a = static_cast<std::size_t>(tri.v[c]), b = static_cast<std::size_t>(tri.v[(c + 1) % 3]);
+      is_vertex[a] = 1;
+      if (std::hypot(points[a].x_mm - points[b].x_mm, points[a].y_mm - points[b].y_mm) < apart_mm)
+        FailAtOnePlace(points, a, b, name);
+    }
+  }
+  for (std::size_t k = 0; k < points.size(); ++k)
+    if (is_vertex[k] == 0) FailAtOnePlace(points, k, NearestOther(points, k), name);
+}
+
+Triangulation Triangulate(std::span<const ScatteredPoint> points, const std::string& name) {
+  CheckSpread(points, name);
+  std::vector<coordT> coordinates;
+  coordinates.reserve(2 * points.size());
+  for (const ScatteredPoint& p : points) coordinates.insert(coordinates.end(), {p.x_mm, p.y_mm});
+  // scipy.spatial.Delaunay's options in two dimensions: Delaunay (d) of the points scaled to the
+  // unit box (Qbb), near-coincident points kept aside (Qc), a point at infinity for cocircular
+  // input (Qz), wide facets allowed (Q12), the output triangulated (Qt).
+  char options[] = "qhull d Qbb Qc Qz Q12 Qt";
+  MessageBuffer messages;
+  Qhull qhull;
+  qhT* qh = qhull.get();
+  const int code = qh_new_qhull(qh, 2, static_cast<int>(points.size()), coordinates.data(), False, options,
+                                nullptr, messages.file());
+  if (code != 0) Fail(name, fmt::format("the Delaunay triangulation failed: {}", messages.Text()));
   Triangulation t;
-  try {
-    cv::Subdiv2D subdivision(cv::Rect(-kRect, -kRect, 2 * kRect, 2 * kRect));
-    std::vector<int> point_of_vertex;
-    for (std::size_t k = 0; k < points.size(); ++k) {
-      const cv::Point2f q(static_cast<float>((points[k].x_mm - cx) * s),
-                          static_cast<float>((points[k].y_mm - cy) * s));
-      const int vertex = subdivision.insert(q);
-      if (vertex >= static_cast<int>(point_of_vertex.size()))
-        point_of_vertex.resize(static_cast<std::size_t>(vertex) + 1, -1);
-      if (point_of_vertex[static_cast<std::size_t>(vertex)] >= 0) {
-        const auto other = static_cast<std::size_t>(point_of_vertex[static_cast<std::size_t>(vertex)]);
-        Fail(name,
-             fmt::format("{} ({}, {}) mm and {} ({}, {}) mm lie at one place (closer than 1e-7 of the map's "
-                         "size)",
-                         PointName(points, other), points[other].x_mm, points[other].y_mm,
-                         PointName(points, k), points[k].x_mm, points[k].y_mm));
-      }
-      point_of_vertex[static_cast<std::size_t>(vertex)] = static_cast<int>(k);
+  facetT* facet = nullptr;
+  FORALLfacets {
+    if (facet->upperdelaunay) continue;
+    Triangle tri{};
+    std::size_t corner = 0;
+    vertexT* vertex = nullptr;
+    vertexT** vertexp = nullptr;
+    FOREACHvertex_(facet->vertices) {
+      if (corner < 3) tri.v[corner] = qh_pointid(qh, vertex->point);
+      ++corner;
     }
-    std::vector<int> leading;
-    subdivision.getLeadingEdgeList(leading);
-    for (const int edge : leading) {
-      Triangle tri{};
-      int e = edge;
-      bool real = true;
-      for (int corner = 0; corner < 3; ++corner) {
-        const int vertex = subdivision.edgeOrg(e);
-        // Vertices 0-3 are Subdiv2D's own (a dummy and the outer triangle): not ours.
-        if (vertex < 4 || vertex >= static_cast<int>(point_of_vertex.size()) ||
-            point_of_vertex[static_cast<std::size_t>(vertex)] < 0) {
-          real = false;
-          break;
-        }
-        tri.v[static_cast<std::size_t>(corner)] = point_of_vertex[static_cast<std::size_t>(vertex)];
-        e = subdivision.getEdge(e, cv::Subdiv2D::NEXT_AROUND_LEFT);
-      }
-      if (real && e == edge) t.triangles.push_back(tri);
-    }
-  } catch (const cv::Exception& e) {
-    Fail(name, fmt::format("the Delaunay triangulation failed: {}", e.what()));
+    if (corner == 3) t.triangles.push_back(tri);
   }
   if (t.triangles.empty()) Fail(name, "the Delaunay triangulation holds no triangle");
+  CheckNoTwoAtOnePlace(points, t, name);
   return t;
 }
 

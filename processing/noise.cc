@@ -49,6 +49,18 @@ double MiddleOf(std::size_t n, const ValueAt& value_at, std::size_t& count) {
   return *middle;
 }
 
+// 1.4826 * MAD / sqrt(6) of the finite differences(m), m in [0, n); 0 for fewer than 10.
+template <typename Differences>
+double SigmaOfDifferences(std::size_t n, const Differences& differences) {
+  std::size_t count = 0;
+  const double center = MiddleOf(n, differences, count);
+  if (count < 10) return 0.0;
+  // 1.4826 * MAD estimates sigma for Gaussian data.
+  const double mad = MiddleOf(
+      n, [&](std::size_t m) { return std::abs(differences(m) - center); }, count);
+  return 1.4826 * mad / std::sqrt(6.0);
+}
+
 template <typename T>
 double NoiseSigmaMm(std::span<const T> z) {
   if (z.size() < 3) return 0.0;
@@ -59,13 +71,12 @@ double NoiseSigmaMm(std::span<const T> z) {
     const std::size_t i = 1 + m * stride;
     return double{z[i - 1]} - 2.0 * double{z[i]} + double{z[i + 1]};
   };
-  std::size_t count = 0;
-  const double center = MiddleOf(n, difference, count);
-  if (count < 10) return 0.0;
-  // 1.4826 * MAD estimates sigma for Gaussian data.
-  const double mad = MiddleOf(
-      n, [&](std::size_t m) { return std::abs(difference(m) - center); }, count);
-  return 1.4826 * mad / std::sqrt(6.0);
+  if (stride == 1) return SigmaOfDifferences(n, difference);
+  // A longer scan's differences lie a cache line or more apart over all its pages: gathered once,
+  // not read there in each of the four passes (which took 0.1 s more at 1e8 samples).
+  std::vector<double> gathered(n);
+  for (std::size_t m = 0; m < n; ++m) gathered[m] = difference(m);
+  return SigmaOfDifferences(n, [&](std::size_t m) { return gathered[m]; });
 }
 
 }  // namespace

@@ -6,8 +6,11 @@
 #include <boost/random/normal_distribution.hpp>
 #include <cmath>
 #include <limits>
+#include <map>
+#include <mutex>
 #include <numbers>
 #include <random>
+#include <tuple>
 
 #include "core/dense.h"
 #include "core/error.h"
@@ -63,9 +66,16 @@ Eigen::VectorXd EvenPositions(SmoothBasis basis, int columns) {
 
 // The basis at `columns` equally spaced columns, orthonormalised in order (thin Q of a Householder
 // QR), so that the fit of each order is the first Functions(order) coefficients of one projection.
-Eigen::MatrixXd OrthonormalBasis(SmoothBasis basis, int max_order, int columns) {
-  const Eigen::MatrixXd design = Design(basis, max_order, EvenPositions(basis, columns), columns);
-  return dense::HouseholderThinQ(design);
+// Made once a process for each (basis, order, columns): a scan asks for the same few, the Fourier
+// basis of a turn five times, and each QR cost some 5 ms of a 1e6-sample scan's processing.
+const Eigen::MatrixXd& OrthonormalBasis(SmoothBasis basis, int max_order, int columns) {
+  static std::mutex mutex;
+  static std::map<std::tuple<SmoothBasis, int, int>, Eigen::MatrixXd> made;  // its nodes never move
+  const std::lock_guard<std::mutex> lock(mutex);
+  const auto [found, inserted] = made.try_emplace({basis, max_order, columns});
+  if (inserted)
+    found->second = dense::HouseholderThinQ(Design(basis, max_order, EvenPositions(basis, columns), columns));
+  return found->second;
 }
 
 // Points over [-1, 1] at which a positioned row's PV is taken: the fitted function over the

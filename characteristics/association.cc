@@ -270,11 +270,22 @@ SimplexOutcome Simplex(const LinearProgramme& lp, std::vector<int>& basis, Vecto
 
 // Point indices in order of their angle about the centre of the programme.
 std::vector<int> ByAngle(const LinearProgramme& lp) {
-  std::vector<double> angle(static_cast<std::size_t>(lp.n()));
-  for (int i = 0; i < lp.n(); ++i) {
-    angle[static_cast<std::size_t>(i)] = std::atan2(lp.direction(i).y(), lp.direction(i).x());
+  const auto n = static_cast<std::size_t>(lp.n());
+  std::vector<double> angle(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    angle[i] = std::atan2(lp.direction(static_cast<int>(i)).y(), lp.direction(static_cast<int>(i)).x());
   }
-  std::vector<int> order(static_cast<std::size_t>(lp.n()));
+  std::vector<int> order(n);
+  // Points given around the circle (a turn's, a section's) are in order from the smallest angle
+  // on: with no two angles equal, that rotation is the one order the sort would find.
+  const std::size_t first =
+      static_cast<std::size_t>(std::min_element(angle.begin(), angle.end()) - angle.begin());
+  bool rising = true;
+  for (std::size_t k = 1; k < n && rising; ++k) rising = angle[(first + k - 1) % n] < angle[(first + k) % n];
+  if (rising) {
+    for (std::size_t k = 0; k < n; ++k) order[k] = static_cast<int>((first + k) % n);
+    return order;
+  }
   std::iota(order.begin(), order.end(), 0);
   std::sort(order.begin(), order.end(), [&](int a, int b) {
     return angle[static_cast<std::size_t>(a)] < angle[static_cast<std::size_t>(b)];
@@ -540,11 +551,11 @@ std::vector<std::string> AssociationOptions::Problems() const {
   return problems;
 }
 
-std::string CircleDataProblem(std::span<const double> x_mm, std::span<const double> y_mm) {
-  ARCWHEEL_CHECK(x_mm.size() == y_mm.size()) << x_mm.size() << " x, " << y_mm.size() << " y";
-  const std::size_t n = x_mm.size();
-  if (n < 3) return fmt::format("a circle needs at least 3 points, got {}", n);
-  const Points points = CentredPoints(x_mm, y_mm);
+namespace {
+
+// CircleDataProblem of points already centred (n >= 3).
+std::string DataProblem(const Points& points) {
+  const auto n = static_cast<std::size_t>(points.size());
   if (!(points.scale_mm > 0)) return fmt::format("all {} points coincide", n);
   // The principal direction of the points; collinear when no point leaves its line.
   Eigen::Matrix2d scatter = Eigen::Matrix2d::Zero();
@@ -563,16 +574,27 @@ std::string CircleDataProblem(std::span<const double> x_mm, std::span<const doub
   return "";
 }
 
+}  // namespace
+
+std::string CircleDataProblem(std::span<const double> x_mm, std::span<const double> y_mm) {
+  ARCWHEEL_CHECK(x_mm.size() == y_mm.size()) << x_mm.size() << " x, " << y_mm.size() << " y";
+  const std::size_t n = x_mm.size();
+  if (n < 3) return fmt::format("a circle needs at least 3 points, got {}", n);
+  return DataProblem(CentredPoints(x_mm, y_mm));
+}
+
 AssociatedCircle AssociateCircle(std::span<const double> x_mm, std::span<const double> y_mm,
                                  const AssociationOptions& options) {
   ThrowIfProblems(ErrorCode::kInvalidOption, kAssociationStage, options.Problems());
   AssociatedCircle result;
   result.association = options.association;
   result.n = static_cast<int>(x_mm.size());
-  if (const std::string problem = CircleDataProblem(x_mm, y_mm); !problem.empty()) {
+  ARCWHEEL_CHECK(x_mm.size() == y_mm.size()) << x_mm.size() << " x, " << y_mm.size() << " y";
+  if (x_mm.size() < 3) return Failed(result, AssociationStatus::kDegenerate, CircleDataProblem(x_mm, y_mm));
+  const Points points = CentredPoints(x_mm, y_mm);
+  if (const std::string problem = DataProblem(points); !problem.empty()) {
     return Failed(result, AssociationStatus::kDegenerate, problem);
   }
-  const Points points = CentredPoints(x_mm, y_mm);
   const std::optional<Circle> algebraic = AlgebraicCircle(points);
   if (!algebraic) return Failed(result, AssociationStatus::kDegenerate, "the points determine no circle");
   const Circle least_squares = GeometricCircle(points, *algebraic);

@@ -9,6 +9,7 @@
 
 #include "acquisition/scan_settings.h"
 #include "core/error.h"
+#include "core/parallel.h"
 #include "core/text_encoding.h"
 
 namespace arcwheel::acquisition {
@@ -104,6 +105,9 @@ void MetadataSetter::SetText(const std::string& name, std::string_view value) {
 
 namespace {
 
+// Below this many readings the pass is too short to share.
+constexpr std::size_t kParallelFrom = std::size_t{1} << 22;
+
 // Replaces with NaN every reading that `is_sentinel` matches, that is not finite, or that lies
 // outside [low, high] (compared in double, as for readings held in double). Written without
 // branches inside a block so that the compiler vectorizes it: this pass touches every sample of
@@ -122,13 +126,23 @@ void MarkInvalid(std::span<T> readings, double low, double high, IsSentinel is_s
     return !sentinel & finite & (value >= low) & (value <= high);
   };
   constexpr std::size_t kBlock = 1024;
-  for (std::size_t start = 0; start < readings.size(); start += kBlock) {
-    const std::span<T> block = readings.subspan(start, std::min(kBlock, readings.size() - start));
-    unsigned to_mark = 0;
-    for (const T z : block) to_mark |= static_cast<unsigned>(!valid(z) & (z == z));
-    if (to_mark == 0) continue;
-    for (T& z : block) z = valid(z) ? z : kNaN;
-  }
+  const auto mark = [&](std::size_t first_block, std::size_t end_block) {
+    for (std::size_t b = first_block; b < end_block; ++b) {
+      const std::size_t start = b * kBlock;
+      const std::span<T> block = readings.subspan(start, std::min(kBlock, readings.size() - start));
+      unsigned to_mark = 0;
+      for (const T z : block) to_mark |= static_cast<unsigned>(!valid(z) & (z == z));
+      if (to_mark == 0) continue;
+      for (T& z : block) z = valid(z) ? z : kNaN;
+    }
+  };
+  // A large scan's first pass over its pages (the file's, mapped) is the reading's largest part:
+  // the two halves on both cores.
+  const std::size_t blocks = (readings.size() + kBlock - 1) / kBlock;
+  if (readings.size() < kParallelFrom) return mark(0, blocks);
+  RunOnWorkers(2, [&](int worker) {
+    mark(blocks * static_cast<std::size_t>(worker) / 2, blocks * static_cast<std::size_t>(worker + 1) / 2);
+  });
 }
 
 }  // namespace

@@ -653,43 +653,62 @@ std::vector<std::string> CharacteristicsOptions::Problems() const {
   return problems;
 }
 
-WheelCharacteristics EvaluateWheelCharacteristics(const WheelForm& form,
-                                                  const CharacteristicsOptions& options) {
+namespace {
+
+// The options, the turns' operators at the map's phases and the sizes, checked before either part.
+void Check(const WheelForm& form, const CharacteristicsOptions& options) {
   std::vector<std::string> problems = options.Problems();
-  const std::size_t n_phase = form.arc_radius_mm.size();
-  const int per_turn = static_cast<int>(n_phase);
+  const int per_turn = static_cast<int>(form.arc_radius_mm.size());
   if (const std::string p = RoundnessOperatorProblem(options.roundness, per_turn); !p.empty())
     problems.push_back("roundness: " + p);
   if (const std::string p = RunoutOperatorProblem(options.runout, per_turn); !p.empty())
     problems.push_back("circular run-out: " + p);
   ThrowIfProblems(ErrorCode::kInvalidOption, kWheelCharacteristicsStage, problems);
-  CheckSizes(form, n_phase, form.y_mm.size());
+  CheckSizes(form, form.arc_radius_mm.size(), form.y_mm.size());
+}
 
+}  // namespace
+
+WheelCharacteristics EvaluateTurnCharacteristics(const WheelForm& form,
+                                                 const CharacteristicsOptions& options) {
+  Check(form, options);
+  const std::size_t n_phase = form.arc_radius_mm.size();
   const std::vector<double> phase_deg = PhaseGridDeg(n_phase);
   std::vector<double> node_y;
   const UnitCircle unit = UnitCircleOf(phase_deg);
   const std::vector<Node> turns = TurnNodes(form, options.roundness, n_phase, phase_deg, unit, node_y);
-  const std::uint64_t seed = MixedSeed(options.seed, form.rho_mm);
-  const double map_sigma_um = form.map_sigma_mm * 1000.0;
-
-  WheelCharacteristics out;
-  // The sections' arc profile on a thread of its own beside the turns: each bootstrap's two
-  // workers leave a core idle part of the time, and SectionNodes is serial.
-  std::future<FormCharacteristic> arc_profile = std::async(std::launch::async, [&] {
-    const std::vector<Node> sections = SectionNodes(form, n_phase, options.arc_profile);
-    const Measure arc_measure[] = {{options.arc_profile, ArcProfile, ArcProfileBound}};
-    return std::move(
-        LargestWithBootstrap(arc_measure, sections, phase_deg, options, map_sigma_um, seed + 2)[0]);
-  });
   // Roundness and run-out are taken on the same turns: one replicate's noise serves both.
   const Measure turn_measures[] = {{options.roundness, Roundness, RoundnessBound},
                                    {options.runout, Runout, nullptr}};
   std::vector<FormCharacteristic> of_turns =
-      LargestWithBootstrap(turn_measures, turns, node_y, options, map_sigma_um, seed);
+      LargestWithBootstrap(turn_measures, turns, node_y, options, form.map_sigma_mm * 1000.0,
+                           MixedSeed(options.seed, form.rho_mm));
+  WheelCharacteristics out;
   out.roundness = std::move(of_turns[0]);
   out.runout = std::move(of_turns[1]);
-  out.arc_profile = arc_profile.get();
   out.worst_roundness_section = WorstRoundnessSection(out.roundness, turns, node_y);
+  return out;
+}
+
+FormCharacteristic EvaluateArcProfile(const WheelForm& form, const CharacteristicsOptions& options) {
+  Check(form, options);
+  const std::size_t n_phase = form.arc_radius_mm.size();
+  const std::vector<Node> sections = SectionNodes(form, n_phase, options.arc_profile);
+  const Measure arc_measure[] = {{options.arc_profile, ArcProfile, ArcProfileBound}};
+  return std::move(LargestWithBootstrap(arc_measure, sections, PhaseGridDeg(n_phase), options,
+                                        form.map_sigma_mm * 1000.0,
+                                        MixedSeed(options.seed, form.rho_mm) + 2)[0]);
+}
+
+WheelCharacteristics EvaluateWheelCharacteristics(const WheelForm& form,
+                                                  const CharacteristicsOptions& options) {
+  Check(form, options);
+  // The sections' arc profile on a thread of its own beside the turns: each bootstrap's two
+  // workers leave a core idle part of the time, and SectionNodes is serial.
+  std::future<FormCharacteristic> arc_profile =
+      std::async(std::launch::async, [&] { return EvaluateArcProfile(form, options); });
+  WheelCharacteristics out = EvaluateTurnCharacteristics(form, options);
+  out.arc_profile = arc_profile.get();
   return out;
 }
 

@@ -144,4 +144,14 @@ struct WheelCharacteristics {
 [[nodiscard]] WheelCharacteristics EvaluateWheelCharacteristics(const WheelForm& form,
                                                                 const CharacteristicsOptions& options);
 
+// EvaluateWheelCharacteristics in its two parts, for a caller that has the turns' inputs before
+// the sections' (`process`: the sections' smoothed fit comes from the uncertainty stage, and the
+// turns are evaluated while it runs). The turns' roundness, run-out and worst roundness section
+// (arc_profile left empty) read neither section_smooth_um nor section_sigma_scale; the sections'
+// arc profile needs them. The same numbers as together, and the same refusals.
+[[nodiscard]] WheelCharacteristics EvaluateTurnCharacteristics(const WheelForm& form,
+                                                               const CharacteristicsOptions& options);
+[[nodiscard]] FormCharacteristic EvaluateArcProfile(const WheelForm& form,
+                                                    const CharacteristicsOptions& options);
+
 }  // namespace arcwheel::characteristics

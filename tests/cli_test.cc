@@ -103,7 +103,7 @@ TEST(Cli, ProcessTimingsListEveryStageAndSumThem) {
                                              "per-phase fits",
                                              "wheel model",
                                              "releasing the samples",
-                                             "uncertainty",
+                                             "uncertainty and turns",
                                              "characteristics",
                                              "waiting for the SHA-256",
                                              "writing"};

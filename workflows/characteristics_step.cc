@@ -255,44 +255,76 @@ SmoothedTurnMap SmoothTurnMap(const ProcessPipelineOptions& options, const proce
   return out;
 }
 
+namespace {
+
+// The characteristics' view of the map and the fits: characteristics::WheelForm holds spans, and the
+// per-phase arrays they point into live here (so it is neither copied nor moved).
+class FormOfTheWheel {
+ public:
+  FormOfTheWheel(const processing::WheelMap& map, const fitting::WheelFit& fit, double wheel_radius_mm,
+                 const SmoothedTurnMap& smoothed) {
+    for (const fitting::PhaseFit& phase : fit.phases) {
+      center_axial_.push_back(phase.center_axial_mm);
+      center_radial_.push_back(phase.center_radial_mm);
+      radius_.push_back(phase.arc_radius_mm);
+      usable_.push_back(phase.usable ? 1 : 0);
+    }
+    form.rho_mm = map.rho_mm;
+    form.y_mm = map.y_mm;
+    form.map_sigma_mm = map.map_sigma_mm;
+    form.radius_offset_mm = wheel_radius_mm;
+    form.band_low_mm = fit.band_low_mm;
+    form.band_high_mm = fit.band_high_mm;
+    form.center_axial_mm = center_axial_;
+    form.center_radial_mm = center_radial_;
+    form.arc_radius_mm = radius_;
+    form.usable = usable_;
+    form.section_bins = fit.section_bins;
+    form.section_residual_um = fit.section_residual_um;
+    form.section_y_mm = fit.section_y_mm;
+    form.section_sigma_um = fit.section_sigma_um;
+    form.rho_sigma_mm = smoothed.value_sigma_mm;
+    form.turn_smooth_um = smoothed.turn_smooth_um;
+  }
+  FormOfTheWheel(const FormOfTheWheel&) = delete;
+  FormOfTheWheel& operator=(const FormOfTheWheel&) = delete;
+
+  characteristics::WheelForm form;
+
+ private:
+  std::vector<double> center_axial_, center_radial_, radius_;
+  std::vector<char> usable_;
+};
+
+}  // namespace
+
+TurnCharacteristics EvaluateTurnCharacteristics(const ProcessPipelineOptions& options,
+                                                const processing::WheelMap& map, const fitting::WheelFit& fit,
+                                                double wheel_radius_mm) {
+  TurnCharacteristics out;
+  out.smoothed = SmoothTurnMap(options, map, fit);
+  const FormOfTheWheel wheel(map, fit, wheel_radius_mm, out.smoothed);
+  out.form = characteristics::EvaluateTurnCharacteristics(
+      wheel.form, CharacteristicOperators(options, static_cast<int>(map.n_phase())));
+  return out;
+}
+
 CharacteristicsResult EvaluateCharacteristics(const ProcessPipelineOptions& options,
                                               const processing::WheelMap& map, const fitting::WheelFit& fit,
                                               const uncertainty::WheelUncertainty& wheel,
-                                              double wheel_radius_mm, const SmoothedTurnMap& smoothed) {
-  std::vector<double> center_axial, center_radial, radius;
-  std::vector<char> usable;
+                                              double wheel_radius_mm, TurnCharacteristics turns) {
   std::vector<std::string> warnings;
-  for (const fitting::PhaseFit& phase : fit.phases) {
-    center_axial.push_back(phase.center_axial_mm);
-    center_radial.push_back(phase.center_radial_mm);
-    radius.push_back(phase.arc_radius_mm);
-    usable.push_back(phase.usable ? 1 : 0);
-  }
-  characteristics::WheelForm form;
-  form.rho_mm = map.rho_mm;
-  form.y_mm = map.y_mm;
-  form.map_sigma_mm = map.map_sigma_mm;
-  form.radius_offset_mm = wheel_radius_mm;
-  form.band_low_mm = fit.band_low_mm;
-  form.band_high_mm = fit.band_high_mm;
-  form.center_axial_mm = center_axial;
-  form.center_radial_mm = center_radial;
-  form.arc_radius_mm = radius;
-  form.usable = usable;
-  form.section_bins = fit.section_bins;
-  form.section_residual_um = fit.section_residual_um;
-  form.section_y_mm = fit.section_y_mm;
-  form.section_sigma_um = fit.section_sigma_um;
-  form.section_smooth_um = wheel.smoothed_section_um;
-  form.section_sigma_scale = wheel.section_sigma_scale;
   const characteristics::CharacteristicsOptions operators =
       CharacteristicOperators(options, static_cast<int>(map.n_phase()), &warnings);
-  form.rho_sigma_mm = smoothed.value_sigma_mm;
-  form.turn_smooth_um = smoothed.turn_smooth_um;
+  FormOfTheWheel form_of_the_wheel(map, fit, wheel_radius_mm, turns.smoothed);
+  characteristics::WheelForm& form = form_of_the_wheel.form;
+  form.section_smooth_um = wheel.smoothed_section_um;
+  form.section_sigma_scale = wheel.section_sigma_scale;
 
   CharacteristicsResult result;
   result.warnings = std::move(warnings);
-  result.form = characteristics::EvaluateWheelCharacteristics(form, operators);
+  result.form = std::move(turns.form);
+  result.form.arc_profile = characteristics::EvaluateArcProfile(form, operators);
   if (options.tolerances)
     result.rule = options.tolerances->rule.value_or(uncertainty::DecisionRule::kIso14253);
   const auto& f = result.form;

@@ -77,12 +77,23 @@ struct SmoothedTurnMap {
 [[nodiscard]] SmoothedTurnMap SmoothTurnMap(const ProcessPipelineOptions& options,
                                             const processing::WheelMap& map, const fitting::WheelFit& fit);
 
-[[nodiscard]] CharacteristicsResult EvaluateCharacteristics(const ProcessPipelineOptions& options,
-                                                            const processing::WheelMap& map,
-                                                            const fitting::WheelFit& fit,
-                                                            const uncertainty::WheelUncertainty& uncertainty,
-                                                            double wheel_radius_mm,
-                                                            const SmoothedTurnMap& smoothed);
+// The turns' characteristics (roundness, run-out, the worst roundness section) and the smoothed
+// map they are taken on: they need the map and the fits only, so `process` evaluates them while the
+// uncertainty stage runs.
+struct TurnCharacteristics {
+  SmoothedTurnMap smoothed;
+  characteristics::WheelCharacteristics form;  // arc_profile empty
+};
+[[nodiscard]] TurnCharacteristics EvaluateTurnCharacteristics(const ProcessPipelineOptions& options,
+                                                              const processing::WheelMap& map,
+                                                              const fitting::WheelFit& fit,
+                                                              double wheel_radius_mm);
+
+// Every characteristic: the turns' (above), the sections' arc profile, which needs the uncertainty
+// stage's smoothed fit of the sections, and the least-squares figures with the uncertainty's U.
+[[nodiscard]] CharacteristicsResult EvaluateCharacteristics(
+    const ProcessPipelineOptions& options, const processing::WheelMap& map, const fitting::WheelFit& fit,
+    const uncertainty::WheelUncertainty& uncertainty, double wheel_radius_mm, TurnCharacteristics turns);
 
 // summary.json's "characteristics" object.
 [[nodiscard]] nlohmann::json CharacteristicsToJson(const CharacteristicsResult& result);

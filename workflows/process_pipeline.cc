@@ -182,34 +182,33 @@ void DecideTolerances(const reports::Tolerances& tolerances, uncertainty::WheelU
                                 tolerances.rule.value_or(uncertainty::DecisionRule::kIso14253));
 }
 
-// The characteristics under their named operators, from the map, the fits and the budget's
-// type B inputs; their warnings join the processing's.
-void EvaluateCharacteristicsStep(const ProcessPipelineOptions& options,
-                                 const acquisition::ScanMetadata& metadata, const SmoothedTurnMap& smoothed,
-                                 ProcessPipelineResult& result, StageClock& clock) {
-  clock.Start("characteristics");
-  result.characteristics = EvaluateCharacteristics(
-      options, result.processed.map, result.fit, *result.uncertainty,
-      options.processing.wheel_radius_mm > 0.0 ? options.processing.wheel_radius_mm
-                                               : metadata.wheel_diameter_mm.value_or(400.0) / 2.0,
-      smoothed);
-  for (const std::string& warning : result.characteristics->warnings)
-    result.processed.warnings.push_back(warning);
+// The wheel's radius the characteristics take their turns about.
+double WheelRadiusMm(const ProcessPipelineOptions& options, const acquisition::ScanMetadata& metadata) {
+  return options.processing.wheel_radius_mm > 0.0 ? options.processing.wheel_radius_mm
+                                                  : metadata.wheel_diameter_mm.value_or(400.0) / 2.0;
 }
 
-// The uncertainty, its decisions and the characteristics, after the fits. The characteristics'
-// smoothed turns need only the map and the fits: a thread of their own makes them while the
-// uncertainty's bootstrap runs, whose two workers leave a core idle part of the time.
+// The uncertainty, its decisions and the characteristics, after the fits. The turns'
+// characteristics need only the map and the fits: a thread of their own evaluates them while the
+// uncertainty's bootstraps run, whose workers leave a core idle part of the time; the sections'
+// arc profile follows the uncertainty, whose smoothed fit of the sections it starts from. Their
+// warnings join the processing's.
 void EvaluateUncertaintyAndCharacteristics(const ProcessPipelineOptions& options,
                                            const acquisition::ScanMetadata& metadata,
                                            const acquisition::ProfilePlacement* placement,
                                            ProcessPipelineResult& result, StageClock& clock) {
-  clock.Start("uncertainty");
-  std::future<SmoothedTurnMap> smoothed = std::async(
-      std::launch::async, [&] { return SmoothTurnMap(options, result.processed.map, result.fit); });
+  clock.Start("uncertainty and turns");
+  const double wheel_radius_mm = WheelRadiusMm(options, metadata);
+  std::future<TurnCharacteristics> turns = std::async(std::launch::async, [&] {
+    return EvaluateTurnCharacteristics(options, result.processed.map, result.fit, wheel_radius_mm);
+  });
   result.uncertainty = EvaluateUncertainty(options, metadata, result.processed, result.fit, placement);
   if (options.tolerances) DecideTolerances(*options.tolerances, *result.uncertainty);
-  EvaluateCharacteristicsStep(options, metadata, smoothed.get(), result, clock);
+  clock.Start("characteristics");
+  result.characteristics = EvaluateCharacteristics(options, result.processed.map, result.fit,
+                                                   *result.uncertainty, wheel_radius_mm, turns.get());
+  for (const std::string& warning : result.characteristics->warnings)
+    result.processed.warnings.push_back(warning);
 }
 
 // Waits for the input's hash, writes the outputs and keeps the clock, for both kinds of scan.

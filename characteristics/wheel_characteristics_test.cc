@@ -77,6 +77,23 @@ TEST(WheelCharacteristics, RoundnessIsTwiceTheFilteredHarmonicAtTheWorstNode) {
   EXPECT_NEAR(result.roundness.u_um, 0.0, 1e-9);
 }
 
+// `process` evaluates the turns while the uncertainty runs and the arc profile after it: each part
+// draws its own replicates, so the parts give the numbers of the whole to the bit. (The arc
+// profile's own numbers go through `process` in tests/same_results_test.)
+TEST(WheelCharacteristics, TheTurnsApartAreTheWhole) {
+  const TestWheel wheel(0.002, 20, 0.0015, 0.0003, 7);
+  const WheelCharacteristics whole = EvaluateWheelCharacteristics(wheel.Form(), {});
+  const WheelCharacteristics turns = EvaluateTurnCharacteristics(wheel.Form(), {});
+  for (const auto& [part, of_whole] :
+       {std::pair{&turns.roundness, &whole.roundness}, std::pair{&turns.runout, &whole.runout}}) {
+    EXPECT_GT(of_whole->u_um, 0.0);
+    EXPECT_EQ(part->value_um, of_whole->value_um);
+    EXPECT_EQ(part->u_um, of_whole->u_um);
+    EXPECT_EQ(part->worst_index, of_whole->worst_index);
+  }
+  EXPECT_EQ(turns.worst_roundness_section.ront_um, whole.worst_roundness_section.ront_um);
+}
+
 TEST(WheelCharacteristics, RunoutIsTheFilteredTurnsTotalIndicatorReading) {
   const double e = 0.010, a = 0.002;
   const TestWheel wheel(e, 30, a, 0.0);

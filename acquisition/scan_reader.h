@@ -28,7 +28,8 @@ struct ReadOptions {
   // float32 readings stay float32 (Scan::z_float_mm): half the memory, the same results.
   bool keep_float32 = false;
   // Work for this process while the file is read: called once, while a child process reads an
-  // HDF5 file (after its fork, so it may start threads), else just before the read.
+  // HDF5 file (after its fork, so it may start threads), else just before the read (after it for a
+  // line-profile scan named by options.format, whose reader forks itself).
   std::function<void()> while_reading;
   // formats.md 2.4: the settings from outside the file (`--scan-settings`), merged into the file's
   // own before the scan is checked (ApplyScanSettings); null: none. Not owned.

@@ -770,6 +770,26 @@ TEST(InterpolateScattered, ReproducesAPlaneExactlyAndLeavesNodesOutsideTheHullWi
   EXPECT_NEAR(std::remainder(map.grid.y0_mm, 0.5), 0.0, 1e-12);
 }
 
+// A square lattice (every four neighbours on one circle: the Delaunay triangulation is not unique)
+// far from the origin: every point stays a vertex, and a plane comes back on every node.
+TEST(InterpolateScattered, ReproducesAPlaneOnACocircularLatticeFarFromTheOrigin) {
+  auto plane = [](double x, double y) { return 0.3 * (x - 1e4) - 0.7 * (y + 5e3) + 2.0; };
+  std::vector<ScatteredPoint> points;
+  for (int j = 0; j <= 20; ++j)
+    for (int i = 0; i <= 30; ++i) {
+      const double x = 1e4 + 1.5 * i, y = -5e3 + 1.5 * j;
+      points.push_back({x, y, plane(x, y)});
+    }
+  const ErrorMap map = InterpolateScattered(points, 0.5, "lattice.csv");
+  EXPECT_EQ(map.grid.nx, 91);
+  EXPECT_EQ(map.grid.ny, 61);
+  for (int j = 0; j < map.grid.ny; ++j)
+    for (int i = 0; i < map.grid.nx; ++i) {
+      ASSERT_TRUE(std::isfinite(map.At(i, j))) << i << ", " << j;
+      EXPECT_NEAR(map.At(i, j), plane(map.grid.X(i), map.grid.Y(j)), 1e-9);
+    }
+}
+
 TEST(InterpolateScattered, StaysWithinTheLinearInterpolationBoundOfAQuadratic) {
   // Points on a jittered square lattice of pitch h (each moved by at most 0.3 h per axis). For
   // f = x^2 + y^2 the linear interpolant over a triangle exceeds f by R^2 - |p - c|^2, R and c the

@@ -8,6 +8,7 @@
 #include <cmath>
 #include <cstddef>
 #include <cstdio>
+#include <cstdlib>
 #include <limits>
 #include <span>
 #include <string>
@@ -174,13 +175,16 @@ Triangulation Triangulate(std::span<const ScatteredPoint> points, const std::str
     if (facet->upperdelaunay) continue;
     Triangle tri{};
     std::size_t corner = 0;
+    bool ours = true;  // each corner one of the points (not Qz's point at infinity)
     vertexT* vertex = nullptr;
     vertexT** vertexp = nullptr;
     FOREACHvertex_(facet->vertices) {
-      if (corner < 3) tri.v[corner] = qh_pointid(qh, vertex->point);
+      const int id = qh_pointid(qh, vertex->point);
+      ours = ours && id >= 0 && id < static_cast<int>(points.size());
+      if (corner < 3) tri.v[corner] = id;
       ++corner;
     }
-    if (corner == 3) t.triangles.push_back(tri);
+    if (corner == 3 && ours) t.triangles.push_back(tri);
   }
   if (t.triangles.empty()) Fail(name, "the Delaunay triangulation holds no triangle");
   CheckNoTwoAtOnePlace(points, t, name);

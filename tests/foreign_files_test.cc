@@ -11,7 +11,9 @@
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <string>
+#include <variant>
 
+#include "acquisition/profile_scan.h"
 #include "acquisition/scan_reader.h"
 #include "core/error.h"
 #include "core/sha256.h"
@@ -270,6 +272,57 @@ TEST_F(ForeignFiles, AFilterThisHdf5CannotDecodeIsNamed) {
       << run.output;
   EXPECT_NE(run.output.find("hdf5-plugin-lzf"), std::string::npos) << run.output;
   EXPECT_FALSE(std::filesystem::exists(out / "x"));
+}
+
+// A line-profile scan as h5py writes it (gzip-chunked /profile/z, variable-length UTF-8 text):
+// `process` tells it by its /profile group in the one child that reads it, and the values come back
+// exactly as the script made them (z = (p - f) / 8 mm, exact in binary; frame 3 point 5 NaN).
+TEST(ForeignProfileFiles, AnH5pyProfileScanIsToldByItsGroupAndReadExactly) {
+  TempDir dir;
+  const std::filesystem::path path = dir / "profile_h5py.h5";
+  constexpr int kFrames = 40, kPoints = 24;
+  const std::string script =
+      "import h5py, numpy as np\n"
+      "f, p = np.meshgrid(np.arange(" +
+      std::to_string(kFrames) + "), np.arange(" + std::to_string(kPoints) +
+      "), indexing='ij')\n"
+      "z = (p - f) / 8.0\n"
+      "z[3, 5] = np.nan\n"
+      "with h5py.File('" +
+      path.string() +
+      "', 'w') as h:\n"
+      "    g = h.create_group('profile')\n"
+      "    g.create_dataset('z', data=z, compression='gzip', chunks=True)\n"
+      "    g.create_dataset('x_mm', data=np.arange(" +
+      std::to_string(kPoints) +
+      ") * 0.5 - 6.0)\n"
+      "    g.create_dataset('t', data=np.arange(" +
+      std::to_string(kFrames) +
+      ") * 0.001)\n"
+      "    g.attrs['spindle_rpm'] = 500.0\n"
+      "    g.attrs['wheel_id'] = 'R\u00e4d 7'\n";
+  { std::ofstream(dir / "write.py") << script; }
+  const std::string command = "/usr/bin/python3 " + (dir / "write.py").string() + " 2>&1";
+  ASSERT_EQ(std::system(command.c_str()), 0) << script;
+
+  std::variant<Scan, acquisition::ProfileScan> found = acquisition::ReadAnyScan(path);
+  ASSERT_TRUE(std::holds_alternative<acquisition::ProfileScan>(found));
+  const acquisition::ProfileScan& scan = std::get<acquisition::ProfileScan>(found);
+  ASSERT_EQ(scan.frames(), static_cast<std::size_t>(kFrames));
+  ASSERT_EQ(scan.points(), static_cast<std::size_t>(kPoints));
+  for (int p = 0; p < kPoints; ++p) EXPECT_EQ(scan.x_mm[static_cast<std::size_t>(p)], p * 0.5 - 6.0) << p;
+  for (int f = 0; f < kFrames; ++f) {
+    for (int p = 0; p < kPoints; ++p) {
+      const double z = scan.z_mm[static_cast<std::size_t>(f * kPoints + p)];
+      if (f == 3 && p == 5) {
+        EXPECT_TRUE(std::isnan(z));
+      } else {
+        EXPECT_EQ(z, (p - f) / 8.0) << f << ", " << p;
+      }
+    }
+  }
+  EXPECT_EQ(scan.metadata.spindle_rpm, 500.0);
+  EXPECT_EQ(scan.metadata.wheel_id, "R\u00e4d 7");
 }
 
 }  // namespace

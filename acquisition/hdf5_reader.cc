@@ -250,14 +250,14 @@ std::variant<Scan, ProfileScan> ReadAnyScan(const std::filesystem::path& path, c
       [&](hdf5::SharedArrays& shared) {
         const hdf5::File file = hdf5::File::OpenReadOnly(path);
         if (file.HasObject("/profile")) {
-          internal::ReadProfileInChild(path, shared);
+          internal::ReadProfileInChild(file, shared);
         } else {
           internal::ReadHelixInChild(file, options, shared);
         }
       },
       0.0, options.while_reading);
   const hdf5::File file = hdf5::File::OpenReadOnly(path);
-  if (file.HasObject("/profile")) return internal::ProfileFromChild(path, arrays, handed, options.settings);
+  if (file.HasObject("/profile")) return internal::ProfileFromChild(file, arrays, handed, options.settings);
   return internal::HelixFromChild(file, arrays, handed, options);
 }
 

@@ -283,12 +283,11 @@ class ProfileTextParser {
 // every row the same), optional /profile/t and /profile/encoder [frames]; attributes on /profile.
 // `z_into` gives the room for /profile/z's values (the child's shared pages), or is null to leave
 // them to the caller (the parent, which takes what the child read).
-ProfileScan ReadProfileHdf5(const std::filesystem::path& path,
+ProfileScan ReadProfileHdf5(const hdf5::File& file,
                             const std::function<std::span<double>(std::size_t)>& z_into) {
   const std::string stage = StageOf(ScanFormat::kProfileHdf5);
-  const hdf5::File file = hdf5::File::OpenReadOnly(path);
   ProfileScan scan;
-  scan.path = path.string();
+  scan.path = file.path().string();
   scan.read.format = "profile-hdf5";
   const auto refuse = [&](const std::string& problem) {
     throw Error(ErrorCode::kBadInput, stage, fmt::format("'{}': {}", scan.path, problem));
@@ -413,25 +412,26 @@ ProfileScan ReadProfileScan(const std::filesystem::path& path, ScanFormat format
   // The readings are read once, in the child process that guards against libhdf5 crashing on a
   // damaged file (core/hdf5.h); here only the header and the small columns are read again.
   hdf5::SharedArrays arrays;
-  const bool handed = hdf5::ReadInChildProcess(
-      path, arrays, [&](hdf5::SharedArrays& shared) { internal::ReadProfileInChild(path, shared); });
-  return internal::ProfileFromChild(path, arrays, handed, settings);
+  const bool handed = hdf5::ReadInChildProcess(path, arrays, [&](hdf5::SharedArrays& shared) {
+    internal::ReadProfileInChild(hdf5::File::OpenReadOnly(path), shared);
+  });
+  return internal::ProfileFromChild(hdf5::File::OpenReadOnly(path), arrays, handed, settings);
 }
 
 namespace internal {
 
-void ReadProfileInChild(const std::filesystem::path& path, hdf5::SharedArrays& shared) {
-  (void)ReadProfileHdf5(path,
+void ReadProfileInChild(const hdf5::File& file, hdf5::SharedArrays& shared) {
+  (void)ReadProfileHdf5(file,
                         [&](std::size_t count) { return shared.Allocate<double>("/profile/z", count); });
 }
 
-ProfileScan ProfileFromChild(const std::filesystem::path& path, hdf5::SharedArrays& arrays, bool handed,
+ProfileScan ProfileFromChild(const hdf5::File& file, hdf5::SharedArrays& arrays, bool handed,
                              const ScanSettingsFile* settings) {
-  ProfileScan scan = ReadProfileHdf5(path, nullptr);
+  ProfileScan scan = ReadProfileHdf5(file, nullptr);
   if (std::optional<std::vector<double>> z = handed ? arrays.Take<double>("/profile/z") : std::nullopt) {
     scan.z_mm = std::move(*z);
   } else {
-    scan.z_mm = hdf5::File::OpenReadOnly(path).ReadDoubles("/profile/z");
+    scan.z_mm = file.ReadDoubles("/profile/z");
   }
   if (scan.metadata.invalid_value) {
     for (double& z_mm : scan.z_mm) {

@@ -5,8 +5,6 @@
 // is ReadInChildProcess's answer: false, the parent reads the whole file itself. One child serves
 // both kinds, so that `process` opens a file it has not yet seen in one child, not two.
 
-#include <filesystem>
-
 #include "acquisition/profile_scan.h"
 #include "acquisition/scan_reader.h"
 #include "core/hdf5.h"
@@ -19,8 +17,8 @@ void ReadHelixInChild(const hdf5::File& file, const ReadOptions& options, hdf5::
                                   const ReadOptions& options);
 
 // The contract's line-profile layout: /profile.
-void ReadProfileInChild(const std::filesystem::path& path, hdf5::SharedArrays& shared);
-[[nodiscard]] ProfileScan ProfileFromChild(const std::filesystem::path& path, hdf5::SharedArrays& arrays,
-                                           bool handed, const ScanSettingsFile* settings);
+void ReadProfileInChild(const hdf5::File& file, hdf5::SharedArrays& shared);
+[[nodiscard]] ProfileScan ProfileFromChild(const hdf5::File& file, hdf5::SharedArrays& arrays, bool handed,
+                                           const ScanSettingsFile* settings);
 
 }  // namespace arcwheel::acquisition::internal

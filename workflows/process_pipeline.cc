@@ -268,14 +268,14 @@ ProcessPipelineResult RunOnScan(acquisition::Scan scan, const std::string& scan_
                                       result.processed.map, options.fit);
   });
   const acquisition::ScanMetadata metadata = scan.metadata;
+  const bool turns_beside_the_model = scan.size() <= kMaxReadingsForTurnsBesideTheModel;
   std::future<TurnCharacteristics> turns;
-  if (scan.size() <= kMaxReadingsForTurnsBesideTheModel)
-    turns = StartTurnCharacteristics(options, metadata, result);
+  if (turns_beside_the_model) turns = StartTurnCharacteristics(options, metadata, result);
   clock.Start("wheel model");
   result.model = FitModelUnlessOff(options, scan, result.processed, result.fit);
   clock.Start("releasing the samples");
   scan = {};  // the samples are no longer needed: the uncertainty's bootstrap works on the map
-  if (!turns.valid()) turns = StartTurnCharacteristics(options, metadata, result);
+  if (!turns_beside_the_model) turns = StartTurnCharacteristics(options, metadata, result);
   if (!options.no_uncertainty)
     EvaluateUncertaintyAndCharacteristics(options, metadata, nullptr, std::move(turns), result, clock);
   progress.Update("writing", 0.9);

@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # The whole test suite built with AddressSanitizer and UndefinedBehaviorSanitizer (preset asan:
-# clang; the fuzz targets are in the same build, but no library carries the fuzzer's coverage
+# clang; UBSan's arithmetic checks, its pointer checks left to ASan, see cmake/ArcwheelHelpers.cmake;
+# the fuzz targets are in the same build, but no library carries the fuzzer's coverage
 # instrumentation, which would slow every test several times over).
 set -euo pipefail
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)

@@ -6,6 +6,8 @@
 #include <fstream>
 #include <limits>
 #include <nlohmann/json.hpp>
+#include <utility>
+#include <vector>
 
 #include "acquisition/scan_format.h"
 #include "acquisition/scan_reader.h"
@@ -150,6 +152,49 @@ TEST(Hdf5Reader, MarksKeptFloat32ReadingsWhereverTheyLie) {
     }
   }
   EXPECT_EQ(scan.CountValid(), n - invalid.size());
+}
+
+// The range's limits are doubles and the kept readings floats: a reading is in range when its
+// value is, compared exactly (0.1f lies above 0.1, -0.3f below -0.3), and limits beyond float's
+// range take every finite reading in.
+TEST(Hdf5Reader, ComparesKeptFloat32ReadingsWithTheRangeExactly) {
+  const auto next_toward_zero = [](float z) { return std::nextafter(z, 0.0f); };
+  const std::vector<float> near_limits = {0.1f,
+                                          next_toward_zero(0.1f),
+                                          -0.3f,
+                                          next_toward_zero(-0.3f),
+                                          0.0f,
+                                          -std::numeric_limits<float>::max(),
+                                          std::numeric_limits<float>::max()};
+  for (const auto& [low, high] : {std::pair{-0.3, 0.1}, std::pair{-1e300, 1e300}}) {
+    TempDir dir;
+    std::vector<float> z(4000, 0.05f);
+    for (std::size_t k = 0; k < near_limits.size(); ++k) z[100 + k] = near_limits[k];
+    {
+      auto file = hdf5::File::Create(dir / "scan.h5");
+      file.CreateGroup("/scan");
+      file.WriteFloats("/scan/z", z, {z.size()});
+      file.WriteAttribute("/scan", "spindle_rpm", 500.0);
+      file.WriteAttribute("/scan", "feed_mm_per_min", 100.0);
+      file.WriteAttribute("/scan", "sample_period_s", 0.001);
+      file.WriteAttribute("/scan", "range_min_mm", low);
+      file.WriteAttribute("/scan", "range_max_mm", high);
+    }
+    ReadOptions options;
+    options.keep_float32 = true;
+    const Scan scan = ReadHdf5Scan(dir / "scan.h5", options);
+    ASSERT_TRUE(scan.holds_float());
+    for (std::size_t k = 0; k < near_limits.size(); ++k) {
+      const double value = near_limits[k];
+      const bool in_range = value >= low && value <= high;
+      if (in_range) {
+        EXPECT_EQ(scan.z_float_mm[100 + k], near_limits[k]) << value << " in [" << low << ", " << high << "]";
+      } else {
+        EXPECT_TRUE(std::isnan(scan.z_float_mm[100 + k]))
+            << value << " outside [" << low << ", " << high << "]";
+      }
+    }
+  }
 }
 
 TEST(Hdf5Reader, KeepsFloat32ReadingsInTheChildsPagesAndCopiesThemAsValues) {

@@ -108,22 +108,41 @@ namespace {
 // Below this many readings the pass is too short to share.
 constexpr std::size_t kParallelFrom = std::size_t{1} << 22;
 
+// The least T at or above `bound` and the greatest T at or below it: for every T value z,
+// double(z) >= bound exactly when z >= AtLeast<T>(bound), and double(z) <= bound exactly when
+// z <= AtMost<T>(bound) (NaN stays NaN, and compares false either way). A float sensor's readings
+// are thus compared with a range given in double without widening each of them.
+template <typename T>
+T AtLeast(double bound) {
+  const T rounded = static_cast<T>(bound);
+  return static_cast<double>(rounded) < bound ? std::nextafter(rounded, std::numeric_limits<T>::infinity())
+                                              : rounded;
+}
+template <typename T>
+T AtMost(double bound) {
+  const T rounded = static_cast<T>(bound);
+  return static_cast<double>(rounded) > bound ? std::nextafter(rounded, -std::numeric_limits<T>::infinity())
+                                              : rounded;
+}
+
 // Replaces with NaN every reading that `is_sentinel` matches, that is not finite, or that lies
-// outside [low, high] (compared in double, as for readings held in double). Written without
-// branches inside a block so that the compiler vectorizes it: this pass touches every sample of
-// the scan. A block is written only when it holds an invalid reading that is not NaN already:
-// readings mapped from the file (hdf5::SharedArrays) are copied page by page as they are written,
-// and a scan's invalid readings are mostly the NaN its sensor wrote off the rim.
+// outside [low, high] (the readings' values against the range's, compared exactly, in the
+// readings' own type: AtLeast, AtMost). Written without branches inside a block so that the
+// compiler vectorizes it: this pass touches every sample of the scan. A block is written only when
+// it holds an invalid reading that is not NaN already: readings mapped from the file
+// (hdf5::SharedArrays) are copied page by page as they are written, and a scan's invalid readings
+// are mostly the NaN its sensor wrote off the rim.
 template <typename T, typename IsSentinel>
 void MarkInvalid(std::span<T> readings, double low, double high, IsSentinel is_sentinel) {
   constexpr T kNaN = std::numeric_limits<T>::quiet_NaN();
-  constexpr double kMax = std::numeric_limits<double>::max();
+  constexpr T kMax = std::numeric_limits<T>::max();
+  const T least = AtLeast<T>(low);
+  const T greatest = AtMost<T>(high);
   const auto valid = [&](T z) {
-    const double value = z;
-    // |value| <= max is false for NaN and +-Inf (a float sensor's over-range reading).
-    const bool finite = std::abs(value) <= kMax;
+    // |z| <= max is false for NaN and +-Inf (a float sensor's over-range reading).
+    const bool finite = std::abs(z) <= kMax;
     const bool sentinel = is_sentinel(z);
-    return !sentinel & finite & (value >= low) & (value <= high);
+    return !sentinel & finite & (z >= least) & (z <= greatest);
   };
   constexpr std::size_t kBlock = 1024;
   const auto mark = [&](std::size_t first_block, std::size_t end_block) {

@@ -286,18 +286,25 @@ std::shared_ptr<void> SharedArrays::MapFile(const Entry& entry) const {
     close(fd);
     return nullptr;
   }
-  // Private and populated read-only, then made writable: the page cache's own pages, one pass of
-  // the kernel over them (mapping them writable at once would copy every page), and a page is
-  // copied only where a reading is marked invalid. (Truncating the file while it is mapped would
-  // end this process with SIGBUS: a scan is not rewritten in place while it is processed.)
+  // Private, writable, and populated for reading: the page cache's own pages, mapped in one pass
+  // of the kernel, and a page copied only where a reading is marked invalid. Populating a writable
+  // private mapping with MAP_POPULATE would copy every page; MADV_POPULATE_READ (Linux 5.14) maps
+  // them for reading only. An older kernel gets them populated read-only and then made writable,
+  // a second pass over the page tables. (Truncating the file while it is mapped would end this
+  // process with SIGBUS: a scan is not rewritten in place while it is processed.)
   const std::uint64_t start = entry.offset / kPage * kPage;
   const std::size_t length = bytes + static_cast<std::size_t>(entry.offset - start);
-  void* address = mmap(nullptr, length, PROT_READ, MAP_PRIVATE | MAP_POPULATE, fd, static_cast<off_t>(start));
-  close(fd);
-  if (address == MAP_FAILED || mprotect(address, length, PROT_READ | PROT_WRITE) != 0) {
-    if (address != MAP_FAILED) munmap(address, length);
-    ThrowSystemError(fmt::format("cannot map '{}'", path_.string()));
+  void* address = mmap(nullptr, length, PROT_READ | PROT_WRITE, MAP_PRIVATE, fd, static_cast<off_t>(start));
+  if (address != MAP_FAILED && madvise(address, length, MADV_POPULATE_READ) != 0) {
+    munmap(address, length);
+    address = mmap(nullptr, length, PROT_READ, MAP_PRIVATE | MAP_POPULATE, fd, static_cast<off_t>(start));
+    if (address != MAP_FAILED && mprotect(address, length, PROT_READ | PROT_WRITE) != 0) {
+      munmap(address, length);
+      address = MAP_FAILED;
+    }
   }
+  close(fd);
+  if (address == MAP_FAILED) ThrowSystemError(fmt::format("cannot map '{}'", path_.string()));
   const std::shared_ptr<void> mapping(address, [length](void* mapped) { munmap(mapped, length); });
   return {mapping, static_cast<char*>(address) + (entry.offset - start)};
 }

@@ -211,7 +211,7 @@ Scan ReadHdf5Scan(const std::filesystem::path& path, const ReadOptions& options)
       [&](hdf5::SharedArrays& shared) {
         internal::ReadHelixInChild(hdf5::File::OpenReadOnly(path), options, shared);
       },
-      0.0, options.while_reading);
+      0.0);
   return internal::HelixFromChild(hdf5::File::OpenReadOnly(path), arrays, handed, options);
 }
 
@@ -255,7 +255,7 @@ std::variant<Scan, ProfileScan> ReadAnyScan(const std::filesystem::path& path, c
           internal::ReadHelixInChild(file, options, shared);
         }
       },
-      0.0, options.while_reading);
+      0.0);
   const hdf5::File file = hdf5::File::OpenReadOnly(path);
   if (file.HasObject("/profile")) return internal::ProfileFromChild(file, arrays, handed, options.settings);
   return internal::HelixFromChild(file, arrays, handed, options);

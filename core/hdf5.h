@@ -114,8 +114,7 @@ class SharedArrays {
 
  private:
   friend bool ReadInChildProcess(const std::filesystem::path&, SharedArrays&,
-                                 const std::function<void(SharedArrays&)>&, double,
-                                 const std::function<void()>&);
+                                 const std::function<void(SharedArrays&)>&, double);
   static constexpr std::uint32_t kMaxArrays = 8;
   struct Entry {
     char name[32] = {};
@@ -160,11 +159,8 @@ class SharedArrays {
 // file and its arrays are there to take (the caller then reads only the file's header itself);
 // false when no child could be started, or the reader refused the file in the child: the caller
 // then reads the whole file itself, and a refusal comes again with the reader's own message.
-// `meanwhile`, when given, is called once in this process while the child reads (after the fork,
-// so it may start threads), or before returning when no child was started.
 bool ReadInChildProcess(const std::filesystem::path& path, SharedArrays& arrays,
-                        const std::function<void(SharedArrays&)>& read, double timeout_s = 0.0,
-                        const std::function<void()>& meanwhile = {});
+                        const std::function<void(SharedArrays&)>& read, double timeout_s = 0.0);
 
 class File {
  public:

@@ -75,17 +75,10 @@ std::optional<int> WaitFor(pid_t child, double timeout_s, int exit_pipe) {
 
 // Runs `read` in a child process: false when no child could be started (or this is one already),
 // true when the child finished (whether its read succeeded or refused the file); throws when it
-// crashed or did not finish in time. `meanwhile` (may be empty) runs here while the child reads,
-// or before returning false.
-bool RunInChildProcess(const std::filesystem::path& path, const std::function<void()>& read, double timeout_s,
-                       const std::function<void()>& meanwhile) {
-  const auto run_meanwhile = [&] {
-    if (meanwhile) meanwhile();
-  };
-  if (g_in_child) {
-    run_meanwhile();
-    return false;
-  }
+// crashed or did not finish in time.
+bool RunInChildProcess(const std::filesystem::path& path, const std::function<void()>& read,
+                       double timeout_s) {
+  if (g_in_child) return false;
   if (timeout_s <= 0.0) timeout_s = DefaultTimeoutS(path);
   std::fflush(nullptr);  // nothing buffered twice
   int exit_pipe[2] = {-1, -1};
@@ -95,7 +88,6 @@ bool RunInChildProcess(const std::filesystem::path& path, const std::function<vo
     for (const int end : exit_pipe) {
       if (end >= 0) close(end);
     }
-    run_meanwhile();
     return false;
   }
   if (child == 0) {
@@ -109,15 +101,6 @@ bool RunInChildProcess(const std::filesystem::path& path, const std::function<vo
     _exit(0);
   }
   if (exit_pipe[1] >= 0) close(exit_pipe[1]);
-  try {
-    run_meanwhile();
-  } catch (...) {
-    kill(child, SIGKILL);
-    while (waitpid(child, nullptr, 0) < 0 && errno == EINTR) {
-    }
-    if (exit_pipe[0] >= 0) close(exit_pipe[0]);
-    throw;
-  }
   const std::optional<int> status = WaitFor(child, timeout_s, exit_pipe[0]);
   if (exit_pipe[0] >= 0) close(exit_pipe[0]);
   ThrowIfInterrupted();
@@ -323,12 +306,11 @@ std::shared_ptr<void> SharedArrays::Map(const Entry& entry) const {
 
 void ReadFirstInChildProcess(const std::filesystem::path& path, const std::function<void()>& read,
                              double timeout_s) {
-  (void)RunInChildProcess(path, read, timeout_s, {});
+  (void)RunInChildProcess(path, read, timeout_s);
 }
 
 bool ReadInChildProcess(const std::filesystem::path& path, SharedArrays& arrays,
-                        const std::function<void(SharedArrays&)>& read, double timeout_s,
-                        const std::function<void()>& meanwhile) {
+                        const std::function<void(SharedArrays&)>& read, double timeout_s) {
   arrays.path_ = path;
   const bool ran = RunInChildProcess(
       path,
@@ -336,7 +318,7 @@ bool ReadInChildProcess(const std::filesystem::path& path, SharedArrays& arrays,
         read(arrays);
         arrays.MarkComplete();
       },
-      timeout_s, meanwhile);
+      timeout_s);
   return ran && arrays.ReadDirectory();
 }
 

@@ -222,32 +222,5 @@ TEST(ReadInChildProcess, ReadsDirectlyWhenCalledInsideTheChild) {
   EXPECT_EQ(outer.Take<double>("nested").value().at(0), 0.0);
 }
 
-// The caller's own work (the input's hash in `process`) runs once, in this process, while the child
-// reads: it sees the child still reading, and may start a thread, the fork being behind it.
-TEST(ReadInChildProcess, RunsTheCallersWorkOnceWhileTheChildReads) {
-  SharedArrays arrays;
-  const std::filesystem::path flag = ::testing::TempDir() + "child_has_finished";
-  std::filesystem::remove(flag);
-  int calls = 0;
-  bool child_still_reading = false;
-  const bool handed = ReadInChildProcess(
-      kPath, arrays,
-      [&](SharedArrays& shared) {
-        std::this_thread::sleep_for(std::chrono::milliseconds(300));
-        shared.Allocate<double>("value", 1)[0] = 2.5;
-        std::ofstream(flag) << "done";
-      },
-      0.0,
-      [&] {
-        ++calls;
-        std::thread([&] { child_still_reading = !std::filesystem::exists(flag); }).join();
-      });
-  ASSERT_TRUE(handed);
-  EXPECT_EQ(calls, 1);
-  EXPECT_TRUE(child_still_reading);
-  EXPECT_EQ(arrays.Take<double>("value").value().at(0), 2.5);
-  std::filesystem::remove(flag);
-}
-
 }  // namespace
 }  // namespace arcwheel::hdf5

@@ -364,8 +364,9 @@ ProcessPipelineResult RunProcessPipeline(const std::string& scan_path, const std
   ResolveProcessPipelineOptions(options);
   progress.Update("reading", 0.0);
   // ReadAnyScan forks (an HDF5 file is read first in a child process, core/hdf5_child.cc), and no
-  // thread may be alive at fork(): the input's SHA-256 starts after it, on the second core while
-  // the child reads (this process only waits for it then).
+  // thread may be alive at fork(): the input's SHA-256 starts after it, on the second core, beside
+  // a text file's parsing or, for an HDF5 file, beside the stages after the read (this process
+  // only waits for it before writing).
   StageClock clock;
   clock.Start("reading");
   std::future<std::string> sha256;
@@ -378,7 +379,7 @@ ProcessPipelineResult RunProcessPipeline(const std::string& scan_path, const std
                   .settings = options.scan_settings ? &*options.scan_settings : nullptr,
                   .format = options.scan_format,
                   .columns = options.columns});
-  if (!sha256.valid()) start_hash();  // a reader that had nothing to overlap
+  if (!sha256.valid()) start_hash();  // an HDF5 file's reader, which does not call it
   if (auto* profile = std::get_if<acquisition::ProfileScan>(&scan)) {
     return RunOnProfileScan(std::move(*profile), scan_path, std::move(sha256), outdir, options, progress,
                             std::move(clock));

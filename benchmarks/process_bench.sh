@@ -5,9 +5,11 @@
 #   1e6, 1e7: 22 mm of rim at 500 rpm with 10 us samples (the feed sets the sample count);
 #   1e8: a long, fine scan, 400 kHz for four minutes (2000 turns over 22 mm).
 # Usage: benchmarks/process_bench.sh [SAMPLES...]   (default: 1000000 10000000 100000000)
+# ARCWHEEL_BINARY=path runs another build's arcwheel (build/cli/arcwheel by default): an older
+# commit's, say, for a before-and-after the same hour.
 set -euo pipefail
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
-arcwheel="$root/build/cli/arcwheel"
+arcwheel="${ARCWHEEL_BINARY:-$root/build/cli/arcwheel}"
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 sizes=("$@")

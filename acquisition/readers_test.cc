@@ -3,7 +3,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
 #include <fstream>
+#include <initializer_list>
 #include <limits>
 #include <nlohmann/json.hpp>
 #include <utility>
@@ -24,6 +26,19 @@ using testing::ErrorOf;
 using ::testing::HasSubstr;
 using testing::TempDir;
 using testing::WriteText;
+
+// A float32 scan of the contract's layout at `path`: the settings every test here gives, and the
+// attributes in `more` (the invalid value, the range).
+void WriteFloatScan(const std::filesystem::path& path, const std::vector<float>& z,
+                    std::initializer_list<std::pair<const char*, double>> more = {}) {
+  auto file = hdf5::File::Create(path);
+  file.CreateGroup("/scan");
+  file.WriteFloats("/scan/z", z, {z.size()});
+  file.WriteAttribute("/scan", "spindle_rpm", 500.0);
+  file.WriteAttribute("/scan", "feed_mm_per_min", 100.0);
+  file.WriteAttribute("/scan", "sample_period_s", 0.001);
+  for (const auto& [name, value] : more) file.WriteAttribute("/scan", name, value);
+}
 
 const char* kSettings = "# spindle_rpm: 500\n# feed_mm_per_min: 100\n# sample_period_s: 0.001\n";
 
@@ -92,18 +107,9 @@ TEST(CsvReader, NamesTheLineOfAValueThatDoesNotParse) {
 
 TEST(Hdf5Reader, ComparesTheInvalidValueInTheFilesOwnType) {
   TempDir dir;
-  {
-    auto file = hdf5::File::Create(dir / "scan.h5");
-    file.CreateGroup("/scan");
-    std::vector<float> z(400, 0.5f);
-    z[3] = 0.1f;  // not exactly representable: only a float comparison finds it
-    file.WriteFloats("/scan/z", z, {400});
-    file.WriteAttribute("/scan", "spindle_rpm", 500.0);
-    file.WriteAttribute("/scan", "feed_mm_per_min", 100.0);
-    file.WriteAttribute("/scan", "sample_period_s", 0.001);
-    file.WriteAttribute("/scan", "invalid_value", 0.1);
-    file.WriteAttribute("/scan", "range_max_mm", 3.0);
-  }
+  std::vector<float> z(400, 0.5f);
+  z[3] = 0.1f;  // not exactly representable: only a float comparison finds it
+  WriteFloatScan(dir / "scan.h5", z, {{"invalid_value", 0.1}, {"range_max_mm", 3.0}});
   const Scan scan = ReadHdf5Scan(dir / "scan.h5");
   EXPECT_TRUE(std::isnan(scan.z_mm[3]));
   EXPECT_EQ(scan.CountValid(), 399u);
@@ -128,17 +134,7 @@ TEST(Hdf5Reader, MarksKeptFloat32ReadingsWhereverTheyLie) {
   }
   z[n - 1] = -5.0f;  // below range_min_mm, the last reading of the short block
   invalid.push_back(n - 1);
-  {
-    auto file = hdf5::File::Create(dir / "scan.h5");
-    file.CreateGroup("/scan");
-    file.WriteFloats("/scan/z", z, {n});
-    file.WriteAttribute("/scan", "spindle_rpm", 500.0);
-    file.WriteAttribute("/scan", "feed_mm_per_min", 100.0);
-    file.WriteAttribute("/scan", "sample_period_s", 0.001);
-    file.WriteAttribute("/scan", "invalid_value", 0.1);
-    file.WriteAttribute("/scan", "range_min_mm", -3.0);
-    file.WriteAttribute("/scan", "range_max_mm", 3.0);
-  }
+  WriteFloatScan(dir / "scan.h5", z, {{"invalid_value", 0.1}, {"range_min_mm", -3.0}, {"range_max_mm", 3.0}});
   ReadOptions options;
   options.keep_float32 = true;
   const Scan scan = ReadHdf5Scan(dir / "scan.h5", options);
@@ -170,16 +166,7 @@ TEST(Hdf5Reader, ComparesKeptFloat32ReadingsWithTheRangeExactly) {
     TempDir dir;
     std::vector<float> z(4000, 0.05f);
     for (std::size_t k = 0; k < near_limits.size(); ++k) z[100 + k] = near_limits[k];
-    {
-      auto file = hdf5::File::Create(dir / "scan.h5");
-      file.CreateGroup("/scan");
-      file.WriteFloats("/scan/z", z, {z.size()});
-      file.WriteAttribute("/scan", "spindle_rpm", 500.0);
-      file.WriteAttribute("/scan", "feed_mm_per_min", 100.0);
-      file.WriteAttribute("/scan", "sample_period_s", 0.001);
-      file.WriteAttribute("/scan", "range_min_mm", low);
-      file.WriteAttribute("/scan", "range_max_mm", high);
-    }
+    WriteFloatScan(dir / "scan.h5", z, {{"range_min_mm", low}, {"range_max_mm", high}});
     ReadOptions options;
     options.keep_float32 = true;
     const Scan scan = ReadHdf5Scan(dir / "scan.h5", options);
@@ -202,14 +189,7 @@ TEST(Hdf5Reader, KeepsFloat32ReadingsInTheChildsPagesAndCopiesThemAsValues) {
   std::vector<float> z(5000);
   for (std::size_t i = 0; i < z.size(); ++i) z[i] = 0.5f + static_cast<float>(i) / 1024.0f;
   z[10] = std::numeric_limits<float>::quiet_NaN();
-  {
-    auto file = hdf5::File::Create(dir / "scan.h5");
-    file.CreateGroup("/scan");
-    file.WriteFloats("/scan/z", z, {z.size()});
-    file.WriteAttribute("/scan", "spindle_rpm", 500.0);
-    file.WriteAttribute("/scan", "feed_mm_per_min", 100.0);
-    file.WriteAttribute("/scan", "sample_period_s", 0.001);
-  }
+  WriteFloatScan(dir / "scan.h5", z);
   ReadOptions options;
   options.keep_float32 = true;
   Scan scan = ReadHdf5Scan(dir / "scan.h5", options);

@@ -248,8 +248,8 @@ void FinishRun(std::future<std::string> sha256, const std::filesystem::path& out
   result.clock = std::move(clock);
 }
 
-// Everything after the scan is in memory. `sha256` delivers the input's hash (computed meanwhile
-// on another thread when the scan came from a file).
+// Everything after the scan is in memory. `sha256` delivers the input's hash (computed on another
+// thread, beside these stages, when the scan came from a file).
 ProcessPipelineResult RunOnScan(acquisition::Scan scan, const std::string& scan_path,
                                 std::future<std::string> sha256, const std::filesystem::path& outdir,
                                 const ProcessPipelineOptions& options, Progress& progress, StageClock clock) {

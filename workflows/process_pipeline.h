@@ -83,7 +83,8 @@ struct ProcessPipelineResult {
 };
 
 // Reads the scan at `scan_path` (acquisition::ReadScan, float32 readings kept as float32),
-// hashes the file on a second thread meanwhile, and runs the pipeline. The record states
+// hashes the file on a second thread (beside a text file's parsing; after an HDF5 file's read,
+// beside the later stages), and runs the pipeline. The record states
 // `scan_path` as given (converted to UTF-8). When `outdir` is not empty, writes
 // OUTDIR/summary.json and OUTDIR/wheel_map.h5 (fitting::WriteProcessOutputs: nothing partial on failure).
 // Throws Error: kInvalidOption for bad options (before the scan is read), kBadInput/kIo from the

@@ -238,10 +238,10 @@ std::variant<Scan, ProfileScan> ReadAnyScan(const std::filesystem::path& path, c
       ScanFormatOfContent(path, options.format, !options.columns.empty(), "acquisition");
   if (format != ScanFormat::kHdf5 || !options.format.empty()) {
     if (!IsProfileFormat(format)) return ReadScan(path, options);
-    // Called after the read: the HDF5 layout's reader forks, and no thread may be alive then.
-    ProfileScan scan = ReadProfileScan(path, format, options.settings);
-    if (options.while_reading) options.while_reading();
-    return scan;
+    // Beside a text export's parsing; not before the HDF5 layout's reader, which forks (no thread
+    // may be alive then): the caller starts its work after that read.
+    if (format != ScanFormat::kProfileHdf5 && options.while_reading) options.while_reading();
+    return ReadProfileScan(path, format, options.settings);
   }
   // One child reads the file as the kind its groups tell (a /profile group: a line-profile scan).
   hdf5::SharedArrays arrays;

@@ -27,12 +27,11 @@ struct ScanSettingsFile;  // acquisition/scan_settings.h
 struct ReadOptions {
   // float32 readings stay float32 (Scan::z_float_mm): half the memory, the same results.
   bool keep_float32 = false;
-  // Work for this process beside the parsing of a text file: called once, just before the read
-  // (after it for a line-profile scan named by options.format, whose reader forks itself). An HDF5
-  // file's reader does not call it: its reading child takes milliseconds, and the one pass over
-  // the readings that follows takes both cores, which a third thread would slow (at 1e8 samples
-  // the reading took 0.23 s with the input's SHA-256 beside it, 0.16 s without). The caller starts
-  // such work after the read.
+  // Work for this process beside the parsing of a text file: called once, just before the read.
+  // An HDF5 file's readers do not call it: they fork (no thread may be alive then), their child
+  // takes milliseconds, and the one pass over the readings that follows takes both cores, which a
+  // third thread would slow (at 1e8 samples the reading took 0.23 s with the input's SHA-256
+  // beside it, 0.16 s without). The caller starts such work after an HDF5 file's read.
   std::function<void()> while_reading;
   // formats.md 2.4: the settings from outside the file (`--scan-settings`), merged into the file's
   // own before the scan is checked (ApplyScanSettings); null: none. Not owned.

@@ -1,14 +1,16 @@
 include(GNUInstallDirs)
 
 # arcwheel_add_library(NAME n SRCS ... DEPS ...): target arcwheel_<n>, alias arcwheel::<n>.
-#   Its sources are compiled in unity batches of 8 (each heavy header parsed once a batch, not once a
-#   file: a clean build in 70 % of the time); a file-local name must therefore be unique in its
-#   library. COLD marks a library with no numeric kernel (formatting, storage, orchestration):
+#   Its sources are compiled as one unity batch (each heavy header parsed, and each template used
+#   instantiated and optimised, once a library, not once a file: a clean build in 70 % of the time,
+#   and batches of 8 took 5 % more than one batch); a file-local name must therefore be unique in
+#   its library. COLD marks a library with no numeric kernel (formatting, storage, orchestration):
 #   compiled at -O1 in optimised builds, as the tests are (see ARCWHEEL_TEST_OPTIMIZATION).
 #   COLD_SRCS are such sources of a library that has kernels too (its file formats, job files,
-#   logging): one unity batch of their own at -O1, the SRCS in batches of 8 at the build type's
-#   flags. A batch costs a parse of the heavy headers, so a library's cold sources are worth
-#   separating only when they fill most of a batch.
+#   logging): one unity batch of their own at -O1, the SRCS another at the build type's flags. A
+#   batch costs a parse of the heavy headers, so a library's cold sources are worth separating only
+#   when they are many. A library may group its sources further (fitting/CMakeLists.txt), so that
+#   an edit recompiles less than the whole library.
 # arcwheel_install_library(NAME n HEADERS ...): installs arcwheel_<n> as arcwheel::<n> of the
 #   arcwheel CMake package (cmake/ArcwheelPackage.cmake), and its public headers, the ones listed,
 #   under include/arcwheel/<n>/, where `#include "<n>/x.h"` finds them as in the source tree.
@@ -70,7 +72,7 @@ function(arcwheel_add_library)
                              $<INSTALL_INTERFACE:${CMAKE_INSTALL_INCLUDEDIR}/arcwheel>)
   target_link_libraries(arcwheel_${ARG_NAME} PUBLIC ${ARG_DEPS})
   target_compile_options(arcwheel_${ARG_NAME} PRIVATE ${ARCWHEEL_WARNINGS})
-  set_target_properties(arcwheel_${ARG_NAME} PROPERTIES UNITY_BUILD ON UNITY_BUILD_BATCH_SIZE 8)
+  set_target_properties(arcwheel_${ARG_NAME} PROPERTIES UNITY_BUILD ON UNITY_BUILD_BATCH_SIZE 0)
   # GCC takes a source included into a unity batch for a header, and a header's type that holds a
   # file-local one for a linkage hazard; in a source file it is none.
   target_compile_options(arcwheel_${ARG_NAME} PRIVATE $<$<CXX_COMPILER_ID:GNU>:-Wno-subobject-linkage>)
@@ -78,16 +80,11 @@ function(arcwheel_add_library)
     target_compile_options(arcwheel_${ARG_NAME} PRIVATE ${ARCWHEEL_COLD_OPTIMIZATION})
   endif()
   if(ARG_COLD_SRCS)
-    # Named unity groups instead of numbered batches: hot_<i> of 8 SRCS each, and cold, whose
-    # generated source (CMake names it unity_<group>_cxx.cxx) carries the -O1; set on the sources
-    # themselves, the option would take them out of the unity build.
+    # Two named unity groups, hot (the SRCS) and cold, whose generated source (CMake names it
+    # unity_<group>_cxx.cxx) carries the -O1; set on the sources themselves, the option would take
+    # them out of the unity build.
     set_target_properties(arcwheel_${ARG_NAME} PROPERTIES UNITY_BUILD_MODE GROUP)
-    set(_index 0)
-    foreach(_source IN LISTS ARG_SRCS)
-      math(EXPR _group "${_index} / 8")
-      set_source_files_properties(${_source} PROPERTIES UNITY_GROUP hot_${_group})
-      math(EXPR _index "${_index} + 1")
-    endforeach()
+    set_source_files_properties(${ARG_SRCS} PROPERTIES UNITY_GROUP hot)
     set_source_files_properties(${ARG_COLD_SRCS} PROPERTIES UNITY_GROUP cold)
     set_source_files_properties(
       ${CMAKE_CURRENT_BINARY_DIR}/CMakeFiles/arcwheel_${ARG_NAME}.dir/Unity/unity_cold_cxx.cxx

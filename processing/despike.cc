@@ -17,13 +17,13 @@ namespace arcwheel::processing {
 namespace {
 
 template <typename T>
-constexpr T kNaN = std::numeric_limits<T>::quiet_NaN();
+constexpr T kQuietNaN = std::numeric_limits<T>::quiet_NaN();
 
 // Median of `values`, which it reorders; NaN when empty. An even count takes the mean of the two
 // middle values.
 double MedianInPlace(std::span<double> values) {
   const std::size_t n = values.size();
-  if (n == 0) return kNaN<double>;
+  if (n == 0) return kQuietNaN<double>;
   const auto middle = values.begin() + static_cast<std::ptrdiff_t>(n / 2);
   std::nth_element(values.begin(), middle, values.end());
   if (n % 2 == 1) return *middle;
@@ -439,7 +439,7 @@ void DespikeByMedian(std::span<T> z, int w, double threshold_mm, DespikeResult& 
   for (int pass = 1; !newly.empty(); ++pass) {
     for (const std::size_t i : newly) {
       dropped.emplace_back(i, z[i]);
-      z[i] = kNaN<T>;
+      z[i] = kQuietNaN<T>;
     }
     if (pass == kMaxPasses) break;
     std::vector<std::size_t> next;

@@ -37,7 +37,7 @@ std::vector<ReportFigure> MapFigures(const RegenerateReportContent& content) {
   return figures;
 }
 
-const std::vector<std::string> kChangeHeader = {"Quantity", "Previous", "Now", "Change"};
+const std::vector<std::string> kRegenerationHeader = {"Quantity", "Previous", "Now", "Change"};
 
 std::string RenderHtml(const RegenerateReportContent& content, const std::vector<ReportFigure>& figures) {
   using namespace internal;
@@ -56,7 +56,7 @@ std::string RenderHtml(const RegenerateReportContent& content, const std::vector
   if (content.previous.empty()) {
     html += "<p>No previous regeneration given (--previous) or found beside this one.</p>\n";
   } else {
-    html += "<p>" + Escape(content.previous) + "</p>\n" + Table(kChangeHeader, content.changes);
+    html += "<p>" + Escape(content.previous) + "</p>\n" + Table(kRegenerationHeader, content.changes);
   }
   return html + HtmlPageEnd();
 }
@@ -81,7 +81,10 @@ void RenderPdf(const RegenerateReportContent& content, const std::vector<ReportF
   } else {
     pdf.Paragraph(content.previous);
     const std::vector<double> widths(4, 0.25 * kContentWidth_pt);
-    pdf.Row({{kChangeHeader[0], {}}, {kChangeHeader[1], {}}, {kChangeHeader[2], {}}, {kChangeHeader[3], {}}},
+    pdf.Row({{kRegenerationHeader[0], {}},
+             {kRegenerationHeader[1], {}},
+             {kRegenerationHeader[2], {}},
+             {kRegenerationHeader[3], {}}},
             widths, true);
     for (const std::vector<std::string>& row : content.changes)
       pdf.Row({{row[0], {}}, {row[1], {}}, {row[2], {}}, {row[3], {}}}, widths, false);

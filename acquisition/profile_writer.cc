@@ -11,6 +11,7 @@
 #include "core/atomic_file.h"
 #include "core/error.h"
 #include "core/hdf5.h"
+#include "core/json_text.h"
 
 namespace arcwheel::acquisition {
 namespace {
@@ -170,7 +171,7 @@ std::string ProfileScanSettingsJson(const ProfileScan& scan) {
   if (m.wheel_width_mm) settings["wheel_width_mm"] = *m.wheel_width_mm;
   if (!m.wheel_id.empty()) settings["wheel_id"] = m.wheel_id;
   if (!m.timestamp.empty()) settings["timestamp"] = m.timestamp;
-  return settings.dump(2) + "\n";
+  return JsonText(settings, 2) + "\n";
 }
 
 ProfileScan SimulateProfileScan(const WheelModel& wheel, const ProfileScanSettings& s) {

@@ -11,6 +11,7 @@
 
 #include "acquisition/scan_metadata_keys.h"
 #include "core/error.h"
+#include "core/json_text.h"
 
 namespace arcwheel::acquisition {
 namespace {
@@ -86,13 +87,7 @@ std::string ScanSettingsKeysText() {
 ScanSettingsFile ParseScanSettings(std::string_view text, const std::string& name) {
   ScanSettingsFile settings;
   settings.path = name;
-  nlohmann::json document;
-  try {
-    document = nlohmann::json::parse(text);
-  } catch (const nlohmann::json::exception& e) {
-    throw Error(ErrorCode::kInvalidOption, kScanSettingsStage,
-                fmt::format("'{}' is not JSON: {}", name, e.what()));
-  }
+  const nlohmann::json document = ParseJsonText(text, name, kScanSettingsStage, ErrorCode::kInvalidOption);
   if (!document.is_object()) {
     throw Error(
         ErrorCode::kInvalidOption, kScanSettingsStage,
@@ -102,13 +97,13 @@ ScanSettingsFile ParseScanSettings(std::string_view text, const std::string& nam
   for (const auto& [key, value] : document.items()) {
     if (IsNumericKey(key)) {
       if (!value.is_number() || !std::isfinite(value.get<double>())) {
-        problems.push_back(fmt::format("'{}' must be a number, got {}", key, value.dump()));
+        problems.push_back(fmt::format("'{}' must be a number, got {}", key, JsonText(value)));
         continue;
       }
       settings.numbers.emplace_back(key, value.get<double>());
     } else if (IsTextKey(key)) {
       if (!value.is_string()) {
-        problems.push_back(fmt::format("'{}' must be text, got {}", key, value.dump()));
+        problems.push_back(fmt::format("'{}' must be text, got {}", key, JsonText(value)));
         continue;
       }
       settings.texts.emplace_back(key, value.get<std::string>());

@@ -11,6 +11,7 @@
 #include "core/atomic_file.h"
 #include "core/error.h"
 #include "core/hdf5.h"
+#include "core/json_text.h"
 
 namespace arcwheel::acquisition {
 namespace {
@@ -183,7 +184,7 @@ std::string TruthJson(const WheelModel& wheel, const ScanSettings& s, const Simu
   truth["note"] =
       "Per-phase values are the generating circle of each section (without the profile error, grit "
       "and beam offset); the sensor frame's radial coordinate is rho = R - sensor_zero_radius_mm.";
-  return truth.dump(2) + "\n";
+  return JsonText(truth, 2) + "\n";
 }
 
 }  // namespace arcwheel::acquisition

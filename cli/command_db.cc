@@ -10,6 +10,7 @@
 #include "cli/commands.h"
 #include "core/atomic_file.h"
 #include "core/error.h"
+#include "core/json_text.h"
 #include "store/queries.h"
 #include "store/store.h"
 
@@ -66,7 +67,8 @@ void Export(const DbArguments& arguments) {
   filter.wheel_id = arguments.wheel;
   if (!arguments.since.empty()) filter.since_s = store::ParseSince_s(arguments.since, "--since");
   const std::vector<store::StoredRun> runs = results.Runs(filter);
-  const std::string text = arguments.csv ? store::ExportCsv(runs) : store::ExportJson(runs).dump(2) + "\n";
+  const std::string text =
+      arguments.csv ? store::ExportCsv(runs) : JsonText(store::ExportJson(runs), 2) + "\n";
   if (arguments.output.empty() || arguments.output == "-") {
     fmt::print("{}", text);
   } else {

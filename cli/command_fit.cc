@@ -10,6 +10,7 @@
 #include "cli/columns_csv.h"
 #include "cli/commands.h"
 #include "core/error.h"
+#include "core/json_text.h"
 #include "fitting/circle_fit.h"
 
 namespace arcwheel::cli {
@@ -97,7 +98,7 @@ void AddFitCommand(CLI::App& app) {
                                    ? LeastSquaresCircle(*path, points)
                                    : ChebyshevCircle(*path, points, chosen);
     // 17 significant digits: the numbers round-trip exactly.
-    fmt::print("{}\n", out.dump(-1, ' ', false, nlohmann::json::error_handler_t::strict));
+    fmt::print("{}\n", JsonText(out));
   });
 }
 

@@ -158,7 +158,7 @@ void AddFrameCommand(CLI::App& app) {
       out["pmac_axis_definitions"] = lines;
       for (const std::string& line : lines) summary += "  " + line + "\n";
     }
-    EmitText(out.dump(2) + "\n", args->output);
+    EmitText(JsonText(out, 2) + "\n", args->output);
     if (::isatty(STDERR_FILENO)) fmt::print(stderr, "{}", summary);
   });
 }

@@ -20,6 +20,7 @@
 #include "cli/output.h"
 #include "core/atomic_file.h"
 #include "core/error.h"
+#include "core/json_text.h"
 #include "core/number_format.h"
 #include "frames/force_centre.h"
 #include "frames/force_record_io.h"
@@ -81,7 +82,7 @@ void AddSolve(CLI::App& headcenter) {
       summary += fmt::format("  removal-centre offset ({:.4f}, {:.4f}) mm\n", Shown(solved.offset_mm->x()),
                              Shown(solved.offset_mm->y()));
     }
-    EmitText(solved.json.dump(2) + "\n", args->output);
+    EmitText(JsonText(solved.json, 2) + "\n", args->output);
     SummariseOnTerminal(summary);
   });
 }
@@ -106,7 +107,7 @@ void AddCalibrate(CLI::App& headcenter) {
     const workflows::HeadcenterCalibration result =
         workflows::CalibrateHeadcenter(args->presses, args->solve, args->fit);
     const frames::TransformFit& fit = result.fit;
-    EmitText(result.json.dump(2) + "\n", args->output);
+    EmitText(JsonText(result.json, 2) + "\n", args->output);
     SummariseOnTerminal(
         fmt::format("sensor -> machine: rotation {:.4f} deg, translation ({:.4f}, {:.4f}) mm, rms residual "
                     "{:.4f} mm over {} presses\n",
@@ -152,7 +153,7 @@ void AddMoves(CLI::App& headcenter) {
   moves->callback([args] {
     const workflows::HeadcenterMoves result =
         workflows::TabulateHeadcenterMoves(args->records, args->calibration, args->solve);
-    EmitText(result.json.dump(2) + "\n", args->output);
+    EmitText(JsonText(result.json, 2) + "\n", args->output);
     SummariseOnTerminal(TablesSummary(result.tables));
   });
 }

@@ -14,6 +14,7 @@
 #include "cli/columns_csv.h"
 #include "cli/commands.h"
 #include "core/error.h"
+#include "core/json_text.h"
 
 namespace arcwheel::cli {
 namespace {
@@ -148,9 +149,7 @@ void AddRoundnessCommand(CLI::App& app) {
     } catch (const Error& error) {
       throw Error(error.code(), kRoundnessStage, fmt::format("'{}': {}", *path, error.what()));
     }
-    fmt::print(
-        "{}\n",
-        ToJson(result, trace.radius_mm.size()).dump(-1, ' ', false, nlohmann::json::error_handler_t::strict));
+    fmt::print("{}\n", JsonText(ToJson(result, trace.radius_mm.size())));
   });
 }
 

@@ -116,7 +116,7 @@ void AddFit(CLI::App& transform) {
     const frames::TransformFit result = FitNamingFile(pairs, model, args->options, args->pairs);
     nlohmann::json out = frames::TransformFitToJson(result);
     out["input"] = args->pairs;
-    EmitText(out.dump(2) + "\n", args->output);
+    EmitText(JsonText(out, 2) + "\n", args->output);
     SummariseOnTerminal(FitSummary(result));
   });
 }

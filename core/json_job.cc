@@ -10,6 +10,7 @@
 #include <utility>
 
 #include "core/error.h"
+#include "core/json_text.h"
 
 namespace arcwheel {
 
@@ -45,7 +46,7 @@ void JsonSection::Expected(const std::string& key, const std::string& expected) 
   if (key.empty() && object_ != nullptr) {
     given = object_->dump();
   } else if (Has(key)) {
-    given = At(key).dump();
+    given = JsonText(At(key));
   }
   Fail(key, fmt::format("expected {}, got {}", expected, given));
 }

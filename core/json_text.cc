@@ -10,12 +10,13 @@
 
 namespace arcwheel {
 
-nlohmann::json ParseJsonText(std::string_view text, const std::string& name, std::string_view stage) {
+nlohmann::json ParseJsonText(std::string_view text, const std::string& name, std::string_view stage,
+                             ErrorCode code) {
   try {
     return nlohmann::json::parse(text);
   } catch (const nlohmann::json::exception& error) {
     // parse_error for syntax, out_of_range for a number that overflows a double.
-    throw Error(ErrorCode::kBadInput, stage, fmt::format("'{}' is not valid JSON: {}", name, error.what()));
+    throw Error(code, stage, fmt::format("'{}' is not valid JSON: {}", name, error.what()));
   }
 }
 
@@ -27,5 +28,7 @@ nlohmann::json ReadJsonFile(const std::filesystem::path& path, std::string_view 
   if (in.bad()) throw Error(ErrorCode::kIo, stage, fmt::format("cannot read '{}'", path.string()));
   return ParseJsonText(text.str(), path.string(), stage);
 }
+
+std::string JsonText(const nlohmann::json& value, int indent) { return value.dump(indent); }
 
 }  // namespace arcwheel

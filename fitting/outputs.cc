@@ -7,6 +7,7 @@
 #include "core/atomic_file.h"
 #include "core/error.h"
 #include "core/hdf5.h"
+#include "core/json_text.h"
 #include "core/version.h"
 #include "schema/summary.h"
 #include "schema/wheel_map.h"
@@ -270,7 +271,7 @@ std::string SummaryJson(const RunRecord& record, const processing::ProcessedScan
   if (later_stages != nullptr) {
     for (const auto& [name, object] : later_stages->items()) s[name] = object;
   }
-  return s.dump(2) + "\n";
+  return JsonText(s, 2) + "\n";
 }
 
 void WriteProcessOutputs(const std::filesystem::path& outdir, const RunRecord& record,

@@ -335,7 +335,7 @@ Job ParseJob(const std::string& text, const std::filesystem::path& source,
   });
   root.Finish();
   Validate(root, job);
-  job.resolved_json = root.resolved().dump();
+  job.resolved_json = JsonText(root.resolved());
   return job;
 }
 

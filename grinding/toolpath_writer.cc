@@ -15,6 +15,7 @@
 #include "core/atomic_file.h"
 #include "core/check.h"
 #include "core/error.h"
+#include "core/json_text.h"
 #include "core/version.h"
 #include "schema/toolpath_outputs.h"
 
@@ -171,7 +172,7 @@ nlohmann::json SummaryJson(const Job& job, const ToolpathRunReport& report,
   namespace key = schema::toolpath::summary;
   nlohmann::json j;
   j[key::kArcwheelVersion] = kVersion;
-  j[key::kJob] = nlohmann::json::parse(job.resolved_json);
+  j[key::kJob] = ParseJsonText(job.resolved_json, "the resolved job", kToolpathWriterStage);
   j[key::kJobPath] = job.source.string();
   j[key::kSurface] = job.surface->Describe();
   j[key::kWheel] = job.wheel.description;
@@ -303,7 +304,7 @@ ToolpathRunReport RunToolpathJob(const Job& job, const std::filesystem::path& ou
       outputs.Stage(output_folder / schema::toolpath::kSummaryFileName);
   {
     std::ofstream summary = OpenStaged(summary_path);
-    summary << SummaryJson(job, report, files).dump(2) << "\n";
+    summary << JsonText(SummaryJson(job, report, files), 2) << "\n";
     CloseChecked(summary, output_folder / schema::toolpath::kSummaryFileName);
   }
   outputs.Commit();

@@ -299,7 +299,7 @@ PolishJob ReadPolishJob(const std::filesystem::path& path,
   }
   s.ThrowIfProblems(problems);
   s.ThrowIfProblems(SizeProblems(job));
-  job.resolved_json = s.resolved().dump();
+  job.resolved_json = JsonText(s.resolved());
   return job;
 }
 
@@ -558,7 +558,7 @@ PolishRunReport RunPolishJob(const PolishJob& job, const std::filesystem::path& 
   json summary = {
       {key::kSchemaVersion, schema::VersionText(schema::polish::kVersion)},
       {key::kArcwheelVersion, kVersion},
-      {key::kJob, json::parse(job.resolved_json)},
+      {key::kJob, ParseJsonText(job.resolved_json, "the resolved job", kJobStage)},
       {key::kPoints, report.points},
       {key::kTotalTimeS, report.dwell.total_time_s},
       {key::kBefore, figures(report.dwell.before)},
@@ -619,7 +619,7 @@ PolishRunReport RunPolishJob(const PolishJob& job, const std::filesystem::path& 
     schema::grid_map::WriteGridMap(residual,
                                    outputs.Stage(output_folder / schema::polish::kResidualGridFileName));
   }
-  write(schema::polish::kSummaryFileName, summary.dump(2) + "\n");
+  write(schema::polish::kSummaryFileName, JsonText(summary, 2) + "\n");
   outputs.Commit();
   return report;
 }

@@ -8,6 +8,7 @@
 
 #include "core/atomic_file.h"
 #include "core/error.h"
+#include "core/json_text.h"
 #include "core/nan.h"
 #include "reports/html_page.h"
 #include "reports/pdf_flow.h"
@@ -327,7 +328,7 @@ WrittenComparison WriteComparison(const std::filesystem::path& before_dir,
   internal::RenderPdfPages(pdf_temporary, Title(comparison),
                            [&](internal::PdfFlow& pdf) { LayoutComparisonPdf(pdf, comparison); });
   WriteFileAtomically(html_temporary, RenderComparisonHtml(comparison));
-  WriteFileAtomically(json_temporary, ComparisonJson(comparison).dump(2) + "\n");
+  WriteFileAtomically(json_temporary, JsonText(ComparisonJson(comparison), 2) + "\n");
   outputs.Commit();
   return written;
 }

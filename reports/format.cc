@@ -5,6 +5,7 @@
 #include <cmath>
 #include <nlohmann/json.hpp>
 
+#include "core/json_text.h"
 #include "core/number_format.h"
 
 namespace arcwheel::reports {
@@ -62,7 +63,7 @@ std::string FormatHeight(double value_um, double scale_um) {
 
 std::string FormatJsonValue(const nlohmann::json& value) {
   if (value.is_string()) return value.get<std::string>();
-  if (value.is_number_integer()) return WithMinus(value.dump());
+  if (value.is_number_integer()) return WithMinus(JsonText(value));
   if (value.is_number()) return FormatSignificant(value.get<double>());
   if (value.is_boolean()) return value.get<bool>() ? "true" : "false";
   if (value.is_null()) return "null";
@@ -71,7 +72,7 @@ std::string FormatJsonValue(const nlohmann::json& value) {
     for (std::size_t i = 0; i < value.size(); ++i) text += (i == 0 ? "" : ", ") + FormatJsonValue(value[i]);
     return text + "]";
   }
-  return value.dump();
+  return JsonText(value);
 }
 
 }  // namespace arcwheel::reports

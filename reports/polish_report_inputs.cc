@@ -167,7 +167,7 @@ class JsonReader {
   [[nodiscard]] double Number(const std::string& key) const {
     const json& value = Require(key);
     if (!value.is_number() || !std::isfinite(value.get<double>()))
-      Fail(key, "is not a finite number (found " + value.dump() + ")");
+      Fail(key, "is not a finite number (found " + JsonText(value) + ")");
     return value.get<double>();
   }
   [[nodiscard]] double OptionalNumber(const std::string& key, double fallback) const {
@@ -176,24 +176,24 @@ class JsonReader {
   [[nodiscard]] std::int64_t Count(const std::string& key) const {
     const json& value = Require(key);
     if (!value.is_number_integer() || value.get<std::int64_t>() < 0) {
-      Fail(key, "is not a non-negative integer (found " + value.dump() + ")");
+      Fail(key, "is not a non-negative integer (found " + JsonText(value) + ")");
     }
     return value.get<std::int64_t>();
   }
   [[nodiscard]] std::string String(const std::string& key) const {
     const json& value = Require(key);
-    if (!value.is_string()) Fail(key, "is not a string (found " + value.dump() + ")");
+    if (!value.is_string()) Fail(key, "is not a string (found " + JsonText(value) + ")");
     return value.get<std::string>();
   }
   [[nodiscard]] bool Boolean(const std::string& key) const {
     const json& value = Require(key);
-    if (!value.is_boolean()) Fail(key, "is not true or false (found " + value.dump() + ")");
+    if (!value.is_boolean()) Fail(key, "is not true or false (found " + JsonText(value) + ")");
     return value.get<bool>();
   }
   // The number as the file writes it (nlohmann's shortest round-trip form, as the writer used).
   [[nodiscard]] std::string NumberText(const std::string& key) const {
     (void)Number(key);
-    return Require(key).dump();
+    return JsonText(Require(key));
   }
 
  private:

@@ -52,7 +52,7 @@ const json& RequireObject(const json& object, const JsonWhere& parent, std::stri
 // A number, or null for "could not be computed" (read as NaN).
 double NumberOrNull(const json& value, const JsonWhere& where) {
   if (value.is_null()) return kNaN;
-  if (!value.is_number()) BadSummary(where, "is not a number (found " + value.dump() + ")");
+  if (!value.is_number()) BadSummary(where, "is not a number (found " + JsonText(value) + ")");
   return value.get<double>();
 }
 
@@ -68,7 +68,7 @@ double OptionalNumber(const json& object, const JsonWhere& parent, std::string_v
 std::int64_t RequireCount(const json& object, const JsonWhere& parent, std::string_view name) {
   const json& value = RequireKey(object, parent, name);
   if (!value.is_number_integer() || value.get<std::int64_t>() < 0) {
-    BadSummary(parent.Child(name), "is not a non-negative integer (found " + value.dump() + ")");
+    BadSummary(parent.Child(name), "is not a non-negative integer (found " + JsonText(value) + ")");
   }
   return value.get<std::int64_t>();
 }
@@ -76,7 +76,7 @@ std::int64_t RequireCount(const json& object, const JsonWhere& parent, std::stri
 int RequireInt(const json& object, const JsonWhere& parent, std::string_view name) {
   const json& value = RequireKey(object, parent, name);
   if (!value.is_number_integer() || value.get<std::int64_t>() < 0 || value.get<std::int64_t>() > 1000000) {
-    BadSummary(parent.Child(name), "is not a non-negative integer (found " + value.dump() + ")");
+    BadSummary(parent.Child(name), "is not a non-negative integer (found " + JsonText(value) + ")");
   }
   return value.get<int>();
 }
@@ -84,13 +84,13 @@ int RequireInt(const json& object, const JsonWhere& parent, std::string_view nam
 bool RequireBool(const json& object, const JsonWhere& parent, std::string_view name) {
   const json& value = RequireKey(object, parent, name);
   if (!value.is_boolean())
-    BadSummary(parent.Child(name), "is not true or false (found " + value.dump() + ")");
+    BadSummary(parent.Child(name), "is not true or false (found " + JsonText(value) + ")");
   return value.get<bool>();
 }
 
 std::string RequireString(const json& object, const JsonWhere& parent, std::string_view name) {
   const json& value = RequireKey(object, parent, name);
-  if (!value.is_string()) BadSummary(parent.Child(name), "is not a string (found " + value.dump() + ")");
+  if (!value.is_string()) BadSummary(parent.Child(name), "is not a string (found " + JsonText(value) + ")");
   return value.get<std::string>();
 }
 

@@ -38,7 +38,7 @@ void CheckOrder(const Limit& limit, ErrorCode code, const std::string& where) {
 
 double FiniteNumber(const nlohmann::json& value, const std::string& where) {
   if (!value.is_number() || !std::isfinite(value.get<double>())) {
-    BadTolerance(ErrorCode::kBadInput, where, "is not a finite number (found " + value.dump() + ")");
+    BadTolerance(ErrorCode::kBadInput, where, "is not a finite number (found " + JsonText(value) + ")");
   }
   return value.get<double>();
 }
@@ -65,11 +65,11 @@ bool ParseOperatorKey(const std::string& key, const std::string& name, const nlo
                           : "is for a closed profile: an arc's filter is 'filter_cutoff_mm'");
     const double cutoff = FiniteNumber(value, where);
     if (!(cutoff > 0.0))
-      BadTolerance(ErrorCode::kBadInput, where, "is not above 0 (found " + value.dump() + ")");
+      BadTolerance(ErrorCode::kBadInput, where, "is not above 0 (found " + JsonText(value) + ")");
     (name == "filter_upr" ? op.filter_upr : op.filter_cutoff_mm) = cutoff;
   } else if (name == "filter") {
     if (value != "none")
-      BadTolerance(ErrorCode::kBadInput, where, "is not \"none\" (found " + value.dump() + ")");
+      BadTolerance(ErrorCode::kBadInput, where, "is not \"none\" (found " + JsonText(value) + ")");
     op.no_filter = true;
   } else {
     if (key == schema::summary::kMaxRunoutUm)
@@ -79,7 +79,7 @@ bool ParseOperatorKey(const std::string& key, const std::string& name, const nlo
         value.is_string() ? characteristics::ParseAssociation(value.get<std::string>()) : std::nullopt;
     if (!association)
       BadTolerance(ErrorCode::kBadInput, where,
-                   "is not " + characteristics::AssociationNames() + " (found " + value.dump() + ")");
+                   "is not " + characteristics::AssociationNames() + " (found " + JsonText(value) + ")");
     op.association = value.get<std::string>();
   }
   return true;
@@ -151,7 +151,7 @@ Tolerances ParseTolerances(const std::string& text, const std::string& name) {
           value.is_string() ? uncertainty::DecisionRuleFromName(value.get<std::string>()) : std::nullopt;
       if (!rule)
         BadTolerance(ErrorCode::kBadInput, where,
-                     "is not 'iso14253-1' or 'simple-acceptance' (found " + value.dump() + ")");
+                     "is not 'iso14253-1' or 'simple-acceptance' (found " + JsonText(value) + ")");
       tolerances.rule = rule;
       continue;
     }

@@ -6,6 +6,7 @@
 #include <limits>
 
 #include "core/error.h"
+#include "core/json_text.h"
 #include "core/nan.h"
 #include "schema/summary.h"
 
@@ -82,7 +83,7 @@ json Row(const StoredRun& run, const StoredNumber& number) {
 // RFC 4180: a cell with a comma, quote or line break is quoted, its quotes doubled.
 std::string CsvCell(const json& value) {
   if (value.is_null()) return "";
-  std::string text = value.is_string() ? value.get<std::string>() : value.dump();
+  std::string text = value.is_string() ? value.get<std::string>() : JsonText(value);
   if (text.find_first_of(",\"\r\n") == std::string::npos) return text;
   std::string quoted = "\"";
   for (char c : text) {

@@ -6,6 +6,7 @@
 #include <utility>
 
 #include "core/error.h"
+#include "core/json_text.h"
 
 namespace arcwheel::surfaces {
 namespace {
@@ -60,14 +61,15 @@ std::shared_ptr<const Surface> ReadHeightGrid(JsonSection& s) {
   g.grid.ny = static_cast<int>(rows.size());
   for (std::size_t j = 0; j < rows.size(); ++j) {
     const std::string key = fmt::format("heights_mm[{}]", j);
-    if (!rows[j].is_array()) s.Fail(key, fmt::format("expected an array of heights, got {}", rows[j].dump()));
+    if (!rows[j].is_array())
+      s.Fail(key, fmt::format("expected an array of heights, got {}", JsonText(rows[j])));
     if (j == 0) g.grid.nx = static_cast<int>(rows[j].size());
     if (static_cast<int>(rows[j].size()) != g.grid.nx) {
       s.Fail(key, fmt::format("expected {} heights (as row 0), got {}", g.grid.nx, rows[j].size()));
     }
     for (const nlohmann::json& h : rows[j]) {
       if (!h.is_number() || !std::isfinite(h.get<double>())) {
-        s.Fail(key, fmt::format("expected finite numbers only, got {}", h.dump()));
+        s.Fail(key, fmt::format("expected finite numbers only, got {}", JsonText(h)));
       }
       g.heights_mm.push_back(h.get<double>());
     }

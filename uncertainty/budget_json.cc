@@ -49,7 +49,7 @@ std::string Quoted(const nlohmann::json& value) {
     return text;
   }
   if (value.is_number()) return ShowSignificant(value.get<double>());
-  return value.dump();
+  return JsonText(value);
 }
 
 class Reader {

@@ -10,6 +10,7 @@
 #include "core/atomic_file.h"
 #include "core/error.h"
 #include "core/interrupt.h"
+#include "core/json_text.h"
 #include "workflows/batch_internal.h"
 #include "workflows/step_inputs.h"
 
@@ -74,7 +75,7 @@ Outcome Finish(const BatchOptions& args, const Scan& scan, int wait_status, doub
     bool complete = true;
     for (const std::string& file : ResultFiles()) complete = complete && fs::exists(folder / file);
     if (complete) {
-      WriteFileAtomically(folder / kStepInputsFileName, inputs.dump(2) + "\n");
+      WriteFileAtomically(folder / kStepInputsFileName, JsonText(inputs, 2) + "\n");
       outcome.status = Status::kDone;
       outcome.message.clear();
       return outcome;

@@ -80,7 +80,7 @@ json IndexRow(const BatchOptions& args, const Scan& scan, const Outcome& outcome
 std::string CsvCell(const json& value) {
   if (value.is_null()) return "";
   if (value.is_number_float()) return fmt::format("{}", value.get<double>());
-  if (!value.is_string()) return value.dump();
+  if (!value.is_string()) return JsonText(value);
   const std::string text = value.get<std::string>();
   if (text.find_first_of(",\"\r\n") == std::string::npos) return text;
   std::string quoted = "\"";
@@ -125,7 +125,7 @@ void WriteIndex(const BatchOptions& args, const std::vector<Scan>& scans,
     for (const std::string& name : names) cells.push_back(CsvCell(row.at(name)));
     append_line(cells);
   }
-  WriteFileAtomically(fs::path(args.outdir) / kIndexJson, index.dump(2) + "\n");
+  WriteFileAtomically(fs::path(args.outdir) / kIndexJson, JsonText(index, 2) + "\n");
   WriteFileAtomically(fs::path(args.outdir) / kIndexCsv, csv);
 }
 

@@ -58,7 +58,7 @@ void WriteOutcome(const BatchOptions& args, const Scan& scan, const Outcome& out
                        {"message", outcome.message},
                        {"seconds", std::round(outcome.seconds * 1e3) / 1e3},
                        {"inputs", inputs}};
-  WriteFileAtomically(OutcomePath(args, scan), record.dump(2) + "\n");
+  WriteFileAtomically(OutcomePath(args, scan), JsonText(record, 2) + "\n");
 }
 
 // The outcome a batch (perhaps an array task elsewhere) recorded for the scan, if any.

@@ -43,7 +43,7 @@ bool RunOrReuse(const fs::path& outdir, const ChainStepSpec& step, const json& i
   fmt::print("step {}/{} {}:\n", step.number, kStepCount, step.id);
   try {
     run(folder);
-    WriteFileAtomically(folder / kStepInputsFileName, inputs.dump(2) + "\n");
+    WriteFileAtomically(folder / kStepInputsFileName, JsonText(inputs, 2) + "\n");
   } catch (const Error& e) {
     std::error_code ignored;
     fs::remove_all(folder, ignored);

@@ -281,7 +281,7 @@ void WriteChainReport(const RegenerateOptions& args, const StepStatus& status, c
     record[record_key::kPrevious] = previous->string();
   }
   const reports::WrittenRegenerateReport written = reports::WriteRegenerateReport(content, outdir);
-  WriteFileAtomically(outdir / kRecordFileName, record.dump(2) + "\n");
+  WriteFileAtomically(outdir / kRecordFileName, JsonText(record, 2) + "\n");
   fmt::print("step 4/4 report: {}\n                 {}\n", written.html.string(), written.pdf.string());
 }
 

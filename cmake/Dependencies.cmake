@@ -7,7 +7,8 @@ find_package(CLI11 REQUIRED)
 find_package(fmt REQUIRED)
 find_package(OpenSSL REQUIRED COMPONENTS Crypto)
 find_package(Threads REQUIRED)
-# Boost.Math (header-only): the chi-square distribution of the wheel model's Wald test (fitting/wheel_model_knots.cc).
+# Boost (header-only): Boost.Math's distributions (the chi-square test in core/statistics.cc, the
+# coverage factor in uncertainty/budget.cc) and Boost.Random's portable normal deviates.
 find_package(Boost 1.74 REQUIRED)
 # qhull: the Delaunay triangulation of scattered error maps (polishing/error_map_scattered.cc),
 # its reentrant C library (Qhull::qhull_r), as scipy.spatial.Delaunay uses it.

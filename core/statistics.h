@@ -1,6 +1,7 @@
 #pragma once
-// The plain statistics of a few values that several stages report (per-phase fits, force records).
-// Not for the bulk of a scan: processing/noise.cc has a faster median for millions of values.
+// The plain statistics of a few values that several stages report (per-phase fits, force records),
+// and the chi-square test that two stages apply. Not for the bulk of a scan: processing/noise.cc
+// has a faster median for millions of values.
 
 #include <algorithm>
 #include <cstddef>
@@ -25,5 +26,9 @@ namespace arcwheel {
   std::nth_element(values.begin(), middle, values.end());
   return *middle;
 }
+
+// P(X >= chi2) for X chi-square distributed with `dof` degrees of freedom (Boost.Math, compiled
+// once here): the p-value of a chi-square test. dof > 0 and chi2 >= 0, finite.
+[[nodiscard]] double ChiSquaredUpperTail(double chi2, double dof);
 
 }  // namespace arcwheel

@@ -2,7 +2,6 @@
 // fine fit's normal equations linearised at coarser knots.
 #include <algorithm>
 #include <array>
-#include <boost/math/distributions/chi_squared.hpp>
 #include <cmath>
 #include <iterator>
 #include <limits>
@@ -10,6 +9,7 @@
 #include <vector>
 
 #include "core/dense.h"
+#include "core/statistics.h"
 #include "fitting/wheel_model_impl.h"
 
 namespace arcwheel::fitting::internal {
@@ -40,9 +40,7 @@ Variation WaldTestOfConstancy(const VectorXd& r, const MatrixXd& c) {
                              : (projection != 0.0 ? std::numeric_limits<double>::infinity() : 0.0);
   }
   v.dof = static_cast<int>(k - 1);
-  v.p_value = std::isfinite(v.chi2)
-                  ? boost::math::cdf(boost::math::complement(boost::math::chi_squared(v.dof), v.chi2))
-                  : 0.0;
+  v.p_value = std::isfinite(v.chi2) ? ChiSquaredUpperTail(v.chi2, v.dof) : 0.0;
   return v;
 }
 

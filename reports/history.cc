@@ -3,16 +3,17 @@
 #include <fmt/format.h>
 
 #include <algorithm>
-#include <boost/math/distributions/chi_squared.hpp>
 #include <cmath>
 #include <ctime>
 #include <limits>
-#include <regex>
+#include <optional>
 #include <sstream>
 
 #include "core/atomic_file.h"
 #include "core/error.h"
 #include "core/nan.h"
+#include "core/statistics.h"
+#include "core/text_pattern.h"
 #include "reports/html_page.h"
 #include "reports/pdf_flow.h"
 #include "schema/summary.h"
@@ -245,27 +246,27 @@ void LayoutHistoryPdf(internal::PdfFlow& pdf, const History& h) {
 }  // namespace
 
 double ParseTimestamp_s(const std::string& text, const std::string& where) {
-  static const std::regex kIso(
-      R"(^(\d{4})-(\d{2})-(\d{2})[T ](\d{2}):(\d{2})(?::(\d{2})(\.\d+)?)?(Z|[+-]\d{2}:?\d{2})?$)");
-  std::smatch m;
-  const std::string trimmed = Trim(text);
-  if (!std::regex_match(trimmed, m, kIso)) {
+  const auto m =
+      MatchWhole(Trim(text),
+                 R"(^(\d{4})-(\d{2})-(\d{2})[T ](\d{2}):(\d{2})(?::(\d{2})(\.\d+)?)?(Z|[+-]\d{2}:?\d{2})?$)");
+  if (!m) {
     throw Error(ErrorCode::kBadInput, kHistoryStage,
                 where + " '" + text + "' is not an ISO 8601 date and time (e.g. 2026-03-01T08:30:00Z)");
   }
+  const std::vector<std::optional<std::string>>& g = *m;
   std::tm t{};
-  t.tm_year = std::stoi(m[1]) - 1900;
-  t.tm_mon = std::stoi(m[2]) - 1;
-  t.tm_mday = std::stoi(m[3]);
-  t.tm_hour = std::stoi(m[4]);
-  t.tm_min = std::stoi(m[5]);
-  t.tm_sec = m[6].matched ? std::stoi(m[6]) : 0;
+  t.tm_year = std::stoi(*g[1]) - 1900;
+  t.tm_mon = std::stoi(*g[2]) - 1;
+  t.tm_mday = std::stoi(*g[3]);
+  t.tm_hour = std::stoi(*g[4]);
+  t.tm_min = std::stoi(*g[5]);
+  t.tm_sec = g[6] ? std::stoi(*g[6]) : 0;
   if (t.tm_mon > 11 || t.tm_mday < 1 || t.tm_mday > 31 || t.tm_hour > 23 || t.tm_min > 59 || t.tm_sec > 60)
     throw Error(ErrorCode::kBadInput, kHistoryStage, where + " '" + text + "' is not a valid date and time");
   double seconds = static_cast<double>(timegm(&t));
-  if (m[7].matched) seconds += std::stod(m[7]);
-  if (m[8].matched && m[8] != "Z") {
-    const std::string zone = m[8];
+  if (g[7]) seconds += std::stod(*g[7]);
+  if (g[8] && *g[8] != "Z") {
+    const std::string& zone = *g[8];
     const int hours = std::stoi(zone.substr(1, 2));
     const int minutes = std::stoi(zone.substr(zone.size() - 2));
     seconds -= (zone[0] == '-' ? -1.0 : 1.0) * (hours * 3600.0 + minutes * 60.0);
@@ -347,8 +348,7 @@ WearRate FitWearRate(const std::vector<double>& time_s, const std::vector<double
     w.chi2_per_dof = w.chi2_per_dof_scans_alone;
     // Chi-square test of the scans' sigmas alone; rejected at 5 %: a repeatability term s_R found
     // by bisection so that chi-square / dof = 1 (chi-square falls as s_R grows).
-    const double p_value =
-        boost::math::cdf(boost::math::complement(boost::math::chi_squared(dof), line.chi2));
+    const double p_value = ChiSquaredUpperTail(line.chi2, dof);
     if (p_value < 0.05) {
       double low = 0.0, high = 0.0;
       for (std::size_t i = 0; i < radius_mm.size(); ++i)

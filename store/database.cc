@@ -1,6 +1,6 @@
 #include "store/database.h"
 
-#include <regex>
+#include "core/text_pattern.h"
 
 namespace arcwheel::store::internal {
 
@@ -37,10 +37,8 @@ std::optional<std::int64_t> AsInteger(const Value& value) {
 }
 
 std::string WithoutPassword(const std::string& url) {
-  static const std::regex kPassword(R"(^([a-z]+://[^:/@]*):[^@]*@)");
-  std::string masked = std::regex_replace(url, kPassword, "$1:***@");
-  static const std::regex kPasswordParameter(R"(password=[^&\s]*)");
-  return std::regex_replace(masked, kPasswordParameter, "password=***");
+  const std::string masked = ReplaceMatches(url, R"(^([a-z]+://[^:/@]*):[^@]*@)", "$1:***@");
+  return ReplaceMatches(masked, R"(password=[^&\s]*)", "password=***");
 }
 
 }  // namespace arcwheel::store::internal

@@ -6,10 +6,10 @@
 #include <sqlite3.h>
 
 #include <chrono>
-#include <regex>
 #include <thread>
 
 #include "core/error.h"
+#include "core/text_pattern.h"
 #include "store/database.h"
 
 namespace arcwheel::store::internal {
@@ -21,10 +21,7 @@ constexpr const char* kSqliteDatabaseStage = "store";
 constexpr int kBusyTimeoutMs = 60000;
 
 // $1, $2, ... -> ?1, ?2, ...: one SQL text for both engines.
-std::string SqliteParameters(const std::string& sql) {
-  static const std::regex kParameter(R"(\$(\d+))");
-  return std::regex_replace(sql, kParameter, "?$1");
-}
+std::string SqliteParameters(const std::string& sql) { return ReplaceMatches(sql, R"(\$(\d+))", "?$1"); }
 
 class Statement {
  public:

@@ -164,6 +164,18 @@ TEST(Store, AStoreThatCannotBeOpenedIsNamed) {
   EXPECT_EQ(std::string(server.what()).find("secret"), std::string::npos) << server.what();
 }
 
+TEST(Store, APostgresUrlIsNamedWithoutItsPassword) {
+  using internal::WithoutPassword;
+  EXPECT_EQ(WithoutPassword("postgresql://shop:s3cret@db.example:5432/arcwheel"),
+            "postgresql://shop:***@db.example:5432/arcwheel");
+  EXPECT_EQ(WithoutPassword("postgresql://db.example/arcwheel?user=shop&password=s3cret&sslmode=require"),
+            "postgresql://db.example/arcwheel?user=shop&password=***&sslmode=require");
+  EXPECT_EQ(WithoutPassword("host=db.example password=s3cret dbname=arcwheel"),
+            "host=db.example password=*** dbname=arcwheel");
+  EXPECT_EQ(WithoutPassword("postgresql://shop@db.example/arcwheel"),
+            "postgresql://shop@db.example/arcwheel");
+}
+
 TEST(Store, SinceTakesADateOrADateTime) {
   EXPECT_EQ(ParseSince_s("2026-03-01", "--since"), 1772323200.0);
   EXPECT_EQ(ParseSince_s("2026-03-01T01:00:00Z", "--since"), 1772323200.0 + 3600.0);

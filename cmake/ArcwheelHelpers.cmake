@@ -3,9 +3,10 @@ include(GNUInstallDirs)
 # arcwheel_add_library(NAME n SRCS ... DEPS ...): target arcwheel_<n>, alias arcwheel::<n>.
 #   Its sources are compiled as one unity batch (each heavy header parsed, and each template used
 #   instantiated and optimised, once a library, not once a file: a clean build in 70 % of the time;
-#   the four libraries that had two or three batches of 8 took 82 CPU-s in them, 67 in one);
-#   a file-local name must therefore be unique in its library. COLD marks a library with no numeric kernel (formatting, storage, orchestration):
-#   compiled at -O1 in optimised builds, as the tests are (see ARCWHEEL_TEST_OPTIMIZATION).
+#   the four libraries that had two or three batches of 8 took 82 CPU-s in them, 67 in one); a
+#   file-local name must therefore be unique in its library. COLD marks a library with no numeric
+#   kernel (formatting, storage, orchestration): compiled at -O1 in optimised builds, as the tests
+#   are (see ARCWHEEL_TEST_OPTIMIZATION).
 #   COLD_SRCS are such sources of a library that has kernels too (its file formats, job files,
 #   logging): one unity batch of their own at -O1, the SRCS another at the build type's flags. A
 #   batch costs a parse of the heavy headers, so a library's cold sources are worth separating only

@@ -4,14 +4,22 @@
 
 namespace arcwheel {
 
-std::string ReplaceMatches(const std::string& text, const std::string& pattern, const std::string& format) {
-  return std::regex_replace(text, std::regex(pattern), format);
+struct TextPattern::Compiled {
+  std::regex regex;
+};
+
+TextPattern::TextPattern(const std::string& pattern) : compiled_(new Compiled{std::regex(pattern)}) {}
+
+TextPattern::~TextPattern() = default;
+
+std::string TextPattern::ReplaceIn(const std::string& text, const std::string& format) const {
+  return std::regex_replace(text, compiled_->regex, format);
 }
 
-std::optional<std::vector<std::optional<std::string>>> MatchWhole(const std::string& text,
-                                                                  const std::string& pattern) {
+std::optional<std::vector<std::optional<std::string>>> TextPattern::MatchWhole(
+    const std::string& text) const {
   std::smatch match;
-  if (!std::regex_match(text, match, std::regex(pattern))) return std::nullopt;
+  if (!std::regex_match(text, match, compiled_->regex)) return std::nullopt;
   std::vector<std::optional<std::string>> groups;
   for (const auto& group : match) groups.push_back(group.matched ? std::optional(group.str()) : std::nullopt);
   return groups;

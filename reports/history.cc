@@ -246,9 +246,9 @@ void LayoutHistoryPdf(internal::PdfFlow& pdf, const History& h) {
 }  // namespace
 
 double ParseTimestamp_s(const std::string& text, const std::string& where) {
-  const auto m =
-      MatchWhole(Trim(text),
-                 R"(^(\d{4})-(\d{2})-(\d{2})[T ](\d{2}):(\d{2})(?::(\d{2})(\.\d+)?)?(Z|[+-]\d{2}:?\d{2})?$)");
+  static const TextPattern kIso(
+      R"(^(\d{4})-(\d{2})-(\d{2})[T ](\d{2}):(\d{2})(?::(\d{2})(\.\d+)?)?(Z|[+-]\d{2}:?\d{2})?$)");
+  const auto m = kIso.MatchWhole(Trim(text));
   if (!m) {
     throw Error(ErrorCode::kBadInput, kHistoryStage,
                 where + " '" + text + "' is not an ISO 8601 date and time (e.g. 2026-03-01T08:30:00Z)");

@@ -37,8 +37,9 @@ std::optional<std::int64_t> AsInteger(const Value& value) {
 }
 
 std::string WithoutPassword(const std::string& url) {
-  const std::string masked = ReplaceMatches(url, R"(^([a-z]+://[^:/@]*):[^@]*@)", "$1:***@");
-  return ReplaceMatches(masked, R"(password=[^&\s]*)", "password=***");
+  static const TextPattern kPassword(R"(^([a-z]+://[^:/@]*):[^@]*@)");
+  static const TextPattern kPasswordParameter(R"(password=[^&\s]*)");
+  return kPasswordParameter.ReplaceIn(kPassword.ReplaceIn(url, "$1:***@"), "password=***");
 }
 
 }  // namespace arcwheel::store::internal

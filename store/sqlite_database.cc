@@ -21,7 +21,10 @@ constexpr const char* kSqliteDatabaseStage = "store";
 constexpr int kBusyTimeoutMs = 60000;
 
 // $1, $2, ... -> ?1, ?2, ...: one SQL text for both engines.
-std::string SqliteParameters(const std::string& sql) { return ReplaceMatches(sql, R"(\$(\d+))", "?$1"); }
+std::string SqliteParameters(const std::string& sql) {
+  static const TextPattern kParameter(R"(\$(\d+))");
+  return kParameter.ReplaceIn(sql, "?$1");
+}
 
 class Statement {
  public:

@@ -34,9 +34,9 @@ std::vector<double> CellCutsPerDeg(const Layout& fine) {
   return per_deg;
 }
 
-// The sums of a closed cell's samples about their mean position d and mean z.
+// The sums of powers of a closed cell's sample positions about their mean, d.
 struct CentralMoments {
-  double n = 0, d2 = 0, d3 = 0, d4 = 0, d5 = 0, zd = 0, zd2 = 0, z2 = 0;
+  double n = 0, d2 = 0, d3 = 0, d4 = 0, d5 = 0;
 };
 
 // The three-point Gauss rule of positions with these central moments: nodes x (sorted) and
@@ -73,58 +73,103 @@ void GaussRule(const CentralMoments& m, std::array<double, 3>& x, std::array<dou
   }
 }
 
+// The part of a cell's closing that depends on its samples' positions alone: their central moments,
+// the Gauss rule and its Vandermonde matrix. A cell without gaps (every sample of first..last
+// valid) has positions 0..n-1 about the same centre, so this is a function of its count, and the
+// cells of a turn mostly share their count: a part keeps the last one (the same operations on the
+// same positions, so the same bits).
+struct PositionRule {
+  double n = 0, center = 0;  // the cell it was made for; n = 0: none yet
+  CentralMoments moments;
+  std::array<double, 3> x{}, w{};
+  Eigen::PartialPivLU<Eigen::Matrix3d> vandermonde;
+};
+
+// The positions' moments, rule and matrix of a cell of n samples about `center`, for
+// `position_of(k)` the k-th valid sample's index - first.
+template <typename PositionOf>
+void MakePositionRule(double n, double center, const PositionOf& position_of, PositionRule& rule) {
+  rule.n = n;
+  rule.center = center;
+  rule.moments = CentralMoments{};
+  rule.moments.n = n;
+  const auto count = static_cast<std::size_t>(n);
+  for (std::size_t k = 0; k < count; ++k) {
+    const double d = position_of(k) - center;
+    const double d2 = d * d;
+    rule.moments.d2 += d2;
+    rule.moments.d3 += d2 * d;
+    rule.moments.d4 += d2 * d2;
+    rule.moments.d5 += d2 * d2 * d;
+  }
+  GaussRule(rule.moments, rule.x, rule.w);
+  Eigen::Matrix3d vandermonde;
+  for (int k = 0; k < 3; ++k) {
+    const double xk = rule.x[static_cast<std::size_t>(k)];
+    vandermonde.col(k) << 1.0, xk, xk * xk;
+  }
+  rule.vandermonde.compute(vandermonde);
+}
+
 // A cell of the valid samples first..last (all in the band; n of them, their positions summing
-// to sum_s and their z to sum_z_mm), from a second look at its samples (still in cache).
+// to sum_s and their z to sum_z_mm), from a second look at its samples (still in cache). `rule`:
+// the part's last position rule, reused when the cell has no gaps and the same count.
 template <typename Sample>
 HelixCell CloseCell(const Samples<Sample>& samples, std::uint64_t first, std::uint64_t last, double n,
-                    double sum_s, double sum_z_mm) {
+                    double sum_s, double sum_z_mm, PositionRule& rule) {
   HelixCell cell;
   cell.first = first;
   cell.count = static_cast<std::uint32_t>(n);
   const double center = sum_s / n;
   cell.z_mean_mm = sum_z_mm / n;
-  CentralMoments m;
-  m.n = n;
-  std::size_t seen = 0;
-  for (std::uint64_t i = first; i <= last; ++i) {
-    const auto rho = static_cast<double>(samples.rho_mm[i]);
-    if (!std::isfinite(rho)) continue;
-    const double d = static_cast<double>(i - first) - center, e = rho - cell.z_mean_mm;
-    if (seen < 3) {  // a cell of up to three samples keeps them as its points
+  const auto rho_at = [&](std::uint64_t i) { return static_cast<double>(samples.rho_mm[i]); };
+  if (n <= 3.0) {  // a cell of up to three samples keeps them as its points
+    std::size_t seen = 0;
+    for (std::uint64_t i = first; i <= last; ++i) {
+      if (!std::isfinite(rho_at(i))) continue;
       cell.node[seen] = static_cast<float>(i - first);
       cell.weight[seen] = 1.0f;
-      cell.value_mm[seen] = static_cast<float>(e);
+      cell.value_mm[seen] = static_cast<float>(rho_at(i) - cell.z_mean_mm);
+      ++seen;
     }
-    ++seen;
-    const double d2 = d * d;
-    m.d2 += d2;
-    m.d3 += d2 * d;
-    m.d4 += d2 * d2;
-    m.d5 += d2 * d2 * d;
-    m.zd += e * d;
-    m.zd2 += e * d2;
-    m.z2 += e * e;
+    return cell;
   }
-  if (seen <= 3) return cell;
-  std::array<double, 3> x{}, w{};
-  GaussRule(m, x, w);
+  const bool gapless = static_cast<double>(last - first + 1) == n;
+  if (!gapless) {
+    std::vector<double> positions;
+    positions.reserve(static_cast<std::size_t>(n));
+    for (std::uint64_t i = first; i <= last; ++i) {
+      if (std::isfinite(rho_at(i))) positions.push_back(static_cast<double>(i - first));
+    }
+    MakePositionRule(
+        n, center, [&](std::size_t k) { return positions[k]; }, rule);
+    rule.n = 0;  // made for this cell's gaps: not one to reuse
+  } else if (rule.n != n || rule.center != center) {
+    MakePositionRule(
+        n, center, [](std::size_t k) { return static_cast<double>(k); }, rule);
+  }
+  double zd = 0.0, zd2 = 0.0, z2 = 0.0;
+  for (std::uint64_t i = first; i <= last; ++i) {
+    const double rho = rho_at(i);
+    if (!gapless && !std::isfinite(rho)) continue;
+    const double d = static_cast<double>(i - first) - center, e = rho - cell.z_mean_mm;
+    const double d2 = d * d;
+    zd += e * d;
+    zd2 += e * d2;
+    z2 += e * e;
+  }
   // Pseudo-values v / w: sum v = 0 (about the mean), sum v x = sum (z - mean) d, sum v x^2 =
   // sum (z - mean) d^2.
-  Eigen::Matrix3d vandermonde;
-  for (int k = 0; k < 3; ++k) {
-    const double xk = x[static_cast<std::size_t>(k)];
-    vandermonde.col(k) << 1.0, xk, xk * xk;
-  }
-  const Eigen::Vector3d v = vandermonde.partialPivLu().solve(Eigen::Vector3d(0.0, m.zd, m.zd2));
+  const Eigen::Vector3d v = rule.vandermonde.solve(Eigen::Vector3d(0.0, zd, zd2));
   double carried = 0.0;
   for (std::size_t k = 0; k < 3; ++k) {
     const double vk = v[static_cast<Eigen::Index>(k)];
-    cell.node[k] = static_cast<float>(center + x[k]);
-    cell.weight[k] = static_cast<float>(w[k]);
-    cell.value_mm[k] = static_cast<float>(vk / w[k]);
-    carried += vk * vk / w[k];
+    cell.node[k] = static_cast<float>(center + rule.x[k]);
+    cell.weight[k] = static_cast<float>(rule.w[k]);
+    cell.value_mm[k] = static_cast<float>(vk / rule.w[k]);
+    carried += vk * vk / rule.w[k];
   }
-  cell.rss_offset_mm2 = static_cast<float>(m.z2 - carried);
+  cell.rss_offset_mm2 = static_cast<float>(z2 - carried);
   return cell;
 }
 
@@ -191,6 +236,7 @@ void BinPart(const Samples<Sample>& samples, const std::vector<double>& cuts_per
                  static_cast<double>(end - begin))));
   }
   double low = std::numeric_limits<double>::infinity(), high = -low;
+  PositionRule rule;
   for (std::size_t from = begin; from < end;) {
     const std::size_t to = std::min(CellEnd(geometry, cuts_per_deg, from), end);
     double n = 0.0, sum_s = 0.0, sum_z = 0.0;
@@ -205,7 +251,7 @@ void BinPart(const Samples<Sample>& samples, const std::vector<double>& cuts_per
       sum_z += rho;
     }
     if (n > 0.0) {
-      cells.push_back(CloseCell(samples, first, last, n, sum_s, sum_z));
+      cells.push_back(CloseCell(samples, first, last, n, sum_s, sum_z, rule));
       for (const std::size_t i : {first, last}) {
         low = std::min(low, geometry.AxialAt(i));
         high = std::max(high, geometry.AxialAt(i));

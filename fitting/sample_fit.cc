@@ -323,16 +323,17 @@ double RunWeight(const Run& run, const PassSetup& pass) {
   return w;
 }
 
-// One pass of the fit over the runs (Kasa or Gauss-Newton, as `pass` says). A run weighs
-// RunWeight; its centroid's variance is sigma^2 / samples.
-void AccumulateRuns(const RunParts& parts, const PassSetup& pass, const processing::WheelMap& map,
-                    std::vector<NodeSums>& sums, CellSums* cells) {
+// One pass of the fit over the runs of the nodes first..end - 1 (Kasa or Gauss-Newton, as `pass`
+// says). A run weighs RunWeight; its centroid's variance is sigma^2 / samples.
+void AccumulateRunsOfNodes(const RunParts& parts, const PassSetup& pass, const processing::WheelMap& map,
+                           std::size_t first, std::size_t end, std::vector<NodeSums>& sums, CellSums* cells) {
   const std::size_t n_y = map.n_y();
   const double map_y0 = map.y_mm.front();
   const double map_inv_step = n_y > 1 ? 1.0 / (map.y_mm[1] - map.y_mm[0]) : 0.0;
   // The parts one after the other (not std::views::join: clang 14 with libstdc++ 12 refuses it).
   for (const std::vector<Run>& part : parts) {
     for (const Run& run : part) {
+      if (run.node < first || run.node >= end) continue;
       const double y = run.y_mm;
       const double v =
           pass.slope != nullptr ? run.rho_mm - run.offset_deg * pass.slope->At(run.node, y) : run.rho_mm;
@@ -425,6 +426,18 @@ void AccumulateRuns(const RunParts& parts, const PassSetup& pass, const processi
       }
     }
   }
+}
+
+// One pass over all runs, each worker taking half of the nodes: everything a run adds to is its
+// node's, so each sum takes the same runs in the same order as in one pass.
+void AccumulateRuns(const RunParts& parts, const PassSetup& pass, const processing::WheelMap& map,
+                    std::vector<NodeSums>& sums, CellSums* cells) {
+  const std::size_t n_phase = sums.size();
+  RunOnWorkers(kWorkers, [&](int worker) {
+    const auto w = static_cast<std::size_t>(worker);
+    AccumulateRunsOfNodes(parts, pass, map, n_phase * w / kWorkers, n_phase * (w + 1) / kWorkers, sums,
+                          cells);
+  });
 }
 
 Eigen::Matrix3d Symmetric(const std::array<double, 6>& u) {

@@ -30,6 +30,24 @@ double ChooseKnotStep(const MapOptions& options, const HelixGeometry& geometry, 
   return step;
 }
 
+// The valid samples, counted a block at a time until ChooseKnotStep keeps its first step (one
+// phase step): a larger count cannot change that, so a long scan is not read to its end for it.
+template <typename T>
+std::size_t ValidSamplesToChooseTheKnotStep(std::span<const T> rho, const HelixGeometry& geometry,
+                                            const MapOptions& options) {
+  if (options.knot_step_deg > 0) return 0;  // given, not chosen
+  constexpr std::size_t kCountedAtOnce = std::size_t{1} << 20;
+  const double phase_step = 360.0 / options.phases;
+  std::size_t valid = 0;
+  for (std::size_t from = 0; from < rho.size(); from += kCountedAtOnce) {
+    const std::span<const T> block = rho.subspan(from, std::min(kCountedAtOnce, rho.size() - from));
+    valid += static_cast<std::size_t>(
+        std::count_if(block.begin(), block.end(), [](T v) { return std::isfinite(static_cast<double>(v)); }));
+    if (ChooseKnotStep(options, geometry, valid) == phase_step) break;
+  }
+  return valid;
+}
+
 // The spline at one phase node on every turn it covers, in the order of the helix (ascending u);
 // sigmas are set by SetSectionSigmas.
 Section SampleSection(const HelixSpline& spline, const HelixGeometry& geometry, double phase_deg,
@@ -398,11 +416,10 @@ template <typename T>
 WheelMap StartMap(std::span<const T> rho, const HelixGeometry& geometry, double noise_sigma_mm,
                   const MapOptions& options) {
   ThrowIfProblems(ErrorCode::kInvalidOption, "processing.map", options.Problems());
-  const auto valid = static_cast<std::size_t>(
-      std::count_if(rho.begin(), rho.end(), [](T v) { return std::isfinite(static_cast<double>(v)); }));
   WheelMap map;
   map.noise_sigma_mm = noise_sigma_mm;
-  map.knot_step_deg = ChooseKnotStep(options, geometry, valid);
+  map.knot_step_deg =
+      ChooseKnotStep(options, geometry, ValidSamplesToChooseTheKnotStep(rho, geometry, options));
   map.pitch_mm = geometry.PitchMm();
   return map;
 }

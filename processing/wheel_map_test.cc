@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <numeric>
 #include <random>
 #include <span>
@@ -11,6 +12,7 @@
 
 #include "acquisition/simulate.h"
 #include "core/error.h"
+#include "core/nan.h"
 #include "processing/helix_geometry.h"
 
 namespace arcwheel::processing {
@@ -241,6 +243,35 @@ TEST(BuildWheelMap, CountsCoverageAsThePlainPerSampleRuleOnCellBoundaries) {
       ExpectPlainCoverage(c, 0.01, random);
     }
   }
+}
+
+// The knot step is the first multiple of the phase step that spans 2.5 valid samples on average
+// (for the helix spline): counted over the whole scan, wherever its valid samples lie. A long scan
+// (3.5 million samples, over three blocks of the count) valid only at every 1900th sample needs
+// 15 phase steps; valid only in its first 1.2 million, one.
+TEST(PlanWheelMap, ChoosesTheKnotStepFromAllTheValidSamples) {
+  acquisition::ScanSettings settings = SmallScan();
+  settings.sample_period_s = 1e-5;  // 0.03 deg a sample
+  settings.feed_mm_per_min = 12.0 / 35.0 * 60.0;
+  settings.float32 = false;
+  acquisition::Scan scan = acquisition::SimulateScan(acquisition::LobedTestWheel(), settings).scan;
+  ASSERT_GT(scan.size(), 3'400'000u);
+  const HelixGeometry geometry(scan, settings.spindle_rpm_nominal);
+  const double span_deg = PhaseOfSample(settings, scan.size() - 1) - PhaseOfSample(settings, 0);
+  const auto expected_step = [&](std::size_t valid) {
+    return 10.0 * std::ceil(2.5 * span_deg / static_cast<double>(valid) / 10.0);
+  };
+  const std::vector<double> readings = scan.z_mm;
+  for (const auto& [valid_at, expected_valid] :
+       {std::pair<std::function<bool(std::size_t)>, std::size_t>{[](std::size_t i) { return i % 1900 == 0; },
+                                                                 (scan.size() + 1899) / 1900},
+        {[](std::size_t i) { return i < 1'200'000; }, 1'200'000}}) {
+    for (std::size_t i = 0; i < scan.size(); ++i) scan.z_mm[i] = valid_at(i) ? readings[i] : kNaN;
+    const WheelMap map = PlanWheelMap(std::span<const double>(scan.z_mm), geometry, 1e-3, {}, {.phases = 36});
+    EXPECT_DOUBLE_EQ(map.knot_step_deg, expected_step(expected_valid)) << expected_valid << " valid samples";
+  }
+  EXPECT_DOUBLE_EQ(expected_step((scan.size() + 1899) / 1900), 150.0);
+  EXPECT_DOUBLE_EQ(expected_step(1'200'000), 10.0);
 }
 
 TEST(BuildWheelMap, RefusesOptionsOutOfRange) {

@@ -212,6 +212,19 @@ TEST(StuckReadings, DropsTheSameRunsAsOnePassWhereverTheMiddleFalls) {
   gaps[43] = 0.0;
   gaps[46] = std::numeric_limits<double>::infinity();
   scans.push_back(gaps);
+  // Long stretches of distinct readings (checked 64 at a time) with runs, invalid readings and
+  // -0 beside +0 at and across the ends of those stretches.
+  std::vector<double> long_scan(1000);
+  for (std::size_t i = 0; i < long_scan.size(); ++i) long_scan[i] = 0.001 * static_cast<double>(i);
+  for (std::size_t i = 62; i < 66; ++i) long_scan[i] = 7.0;
+  for (std::size_t i = 127; i < 129; ++i) long_scan[i] = 8.0;
+  long_scan[200] = kNaN;
+  long_scan[255] = std::numeric_limits<double>::infinity();
+  long_scan[319] = -0.0;
+  long_scan[320] = 0.0;
+  for (std::size_t i = 400; i < 470; ++i) long_scan[i] = 9.0;
+  long_scan[999] = long_scan[998];
+  scans.push_back(long_scan);
   for (const std::size_t min_run : {0u, 2u, 3u, 16u}) {
     for (const std::vector<double>& scan : scans) {
       std::vector<double> expected_z = scan, z = scan;
@@ -224,6 +237,16 @@ TEST(StuckReadings, DropsTheSameRunsAsOnePassWhereverTheMiddleFalls) {
       EXPECT_EQ(got.min_run, min_run);
       for (std::size_t i = 0; i < z.size(); ++i) {
         EXPECT_EQ(std::isnan(z[i]), std::isnan(expected_z[i])) << "sample " << i << " of " << z.size();
+      }
+      // The same readings as float32 (distinct as doubles, distinct as floats).
+      std::vector<float> z_float(scan.begin(), scan.end());
+      const StuckReadingsResult got_float = DropStuckReadings(z_float, min_run);
+      EXPECT_EQ(got_float.dropped, expected.dropped) << scan.size() << ", " << min_run;
+      EXPECT_EQ(got_float.runs, expected.runs) << scan.size() << ", " << min_run;
+      EXPECT_EQ(got_float.valid, expected.valid) << scan.size() << ", " << min_run;
+      for (std::size_t i = 0; i < z_float.size(); ++i) {
+        EXPECT_EQ(std::isnan(z_float[i]), std::isnan(expected_z[i]))
+            << "float sample " << i << " of " << z.size();
       }
     }
   }

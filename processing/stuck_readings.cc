@@ -10,26 +10,56 @@ namespace arcwheel::processing {
 
 namespace {
 
-// The runs of z_mm[begin, end), which starts a run.
+// Readings checked at once for the common case, each valid and unlike the next.
+constexpr std::size_t kAtOnce = 64;
+
+// True when every one of z[0, kAtOnce) is valid and differs from the reading after it: each is
+// then a run of one. Branch-free, so that GCC vectorises it.
+template <typename T>
+bool AllRunsOfOne(const T* z) {
+  int stuck_or_invalid = 0;
+  for (std::size_t k = 0; k < kAtOnce; ++k) {
+    const bool valid = std::abs(z[k]) <= std::numeric_limits<T>::max();  // false for NaN and inf
+    stuck_or_invalid |= static_cast<int>(!(valid & (z[k] != z[k + 1])));
+  }
+  return stuck_or_invalid == 0;
+}
+
+// The run that starts at `begin` (< end), added to `result` (and dropped when stuck); where the
+// next one starts.
+template <typename T>
+std::size_t TakeRun(std::span<T> z_mm, std::size_t begin, std::size_t end, std::size_t min_run,
+                    StuckReadingsResult& result) {
+  std::size_t next = begin + 1;
+  const bool valid = std::isfinite(z_mm[begin]);
+  if (valid) {
+    while (next < end && z_mm[next] == z_mm[begin]) ++next;
+  }
+  const std::size_t length = next - begin;
+  if (valid) result.valid += length;
+  if (valid && min_run >= 2 && length >= min_run) {
+    std::fill(z_mm.begin() + static_cast<std::ptrdiff_t>(begin),
+              z_mm.begin() + static_cast<std::ptrdiff_t>(next), std::numeric_limits<T>::quiet_NaN());
+    result.dropped += length;
+    ++result.runs;
+    result.longest_run = std::max(result.longest_run, length);
+  }
+  return next;
+}
+
+// The runs of z_mm[begin, end), which starts a run: kAtOnce readings at a time where each is a
+// run of one, else run by run to the end of those readings.
 template <typename T>
 StuckReadingsResult DropStuckIn(std::span<T> z_mm, std::size_t begin, std::size_t end, std::size_t min_run) {
   StuckReadingsResult result;
   while (begin < end) {
-    std::size_t next = begin + 1;
-    const bool valid = std::isfinite(z_mm[begin]);
-    if (valid) {
-      while (next < end && z_mm[next] == z_mm[begin]) ++next;
+    if (end - begin > kAtOnce && AllRunsOfOne(z_mm.data() + begin)) {
+      result.valid += kAtOnce;
+      begin += kAtOnce;
+      continue;
     }
-    const std::size_t length = next - begin;
-    if (valid) result.valid += length;
-    if (valid && min_run >= 2 && length >= min_run) {
-      std::fill(z_mm.begin() + static_cast<std::ptrdiff_t>(begin),
-                z_mm.begin() + static_cast<std::ptrdiff_t>(next), std::numeric_limits<T>::quiet_NaN());
-      result.dropped += length;
-      ++result.runs;
-      result.longest_run = std::max(result.longest_run, length);
-    }
-    begin = next;
+    const std::size_t checked_to = std::min(end, begin + kAtOnce);
+    while (begin < checked_to) begin = TakeRun(z_mm, begin, end, min_run, result);
   }
   return result;
 }

@@ -9,6 +9,7 @@
 
 #include "acquisition/scan_settings.h"
 #include "core/error.h"
+#include "core/nan.h"
 #include "core/parallel.h"
 #include "core/text_encoding.h"
 
@@ -135,12 +136,10 @@ T AtMost(double bound) {
 template <typename T, typename IsSentinel>
 void MarkInvalid(std::span<T> readings, double low, double high, IsSentinel is_sentinel) {
   constexpr T kNaN = std::numeric_limits<T>::quiet_NaN();
-  constexpr T kMax = std::numeric_limits<T>::max();
   const T least = AtLeast<T>(low);
   const T greatest = AtMost<T>(high);
   const auto valid = [&](T z) {
-    // |z| <= max is false for NaN and +-Inf (a float sensor's over-range reading).
-    const bool finite = std::abs(z) <= kMax;
+    const bool finite = FiniteWithoutBranch(z);  // false for a float sensor's over-range +-Inf too
     const bool sentinel = is_sentinel(z);
     return !sentinel & finite & (z >= least) & (z <= greatest);
   };

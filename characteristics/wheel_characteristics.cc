@@ -65,8 +65,7 @@ UnitCircle UnitCircleOf(std::span<const double> phase_deg) {
 // replicate.
 bool AllFinite(std::span<const double> values) {
   int non_finite = 0;
-  for (const double v : values)
-    non_finite |= static_cast<int>(!(std::abs(v) <= std::numeric_limits<double>::max()));
+  for (const double v : values) non_finite |= static_cast<int>(!FiniteWithoutBranch(v));
   return non_finite == 0;
 }
 

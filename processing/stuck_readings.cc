@@ -4,6 +4,7 @@
 #include <cmath>
 #include <limits>
 
+#include "core/nan.h"
 #include "core/parallel.h"
 
 namespace arcwheel::processing {
@@ -19,8 +20,7 @@ template <typename T>
 bool AllRunsOfOne(const T* z) {
   int stuck_or_invalid = 0;
   for (std::size_t k = 0; k < kAtOnce; ++k) {
-    const bool valid = std::abs(z[k]) <= std::numeric_limits<T>::max();  // false for NaN and inf
-    stuck_or_invalid |= static_cast<int>(!(valid & (z[k] != z[k + 1])));
+    stuck_or_invalid |= static_cast<int>(!(FiniteWithoutBranch(z[k]) & (z[k] != z[k + 1])));
   }
   return stuck_or_invalid == 0;
 }
